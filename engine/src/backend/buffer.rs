@@ -1,0 +1,180 @@
+//! Buffers, with staging upload and readback for device-local ones.
+use super::Context;
+use crate::error::{Error, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+pub struct BufferDesc<'a> {
+    pub name: &'a str,
+    pub size: u64,
+    pub usage: vk::BufferUsageFlags,
+    /// `GpuOnly` for device-local data, `CpuToGpu` for per-frame uploads, `GpuToCpu` for
+    /// readback.
+    pub location: MemoryLocation,
+}
+
+pub struct Buffer {
+    ctx: Arc<Context>,
+    pub(crate) raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    size: u64,
+    name: String,
+}
+
+impl Buffer {
+    pub fn new(ctx: &Arc<Context>, desc: &BufferDesc) -> Result<Buffer> {
+        if desc.size == 0 {
+            return Err(Error::InvalidArgument(format!("buffer {} has size 0", desc.name)));
+        }
+        let info = vk::BufferCreateInfo::default()
+            .size(desc.size)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid device and create info.
+        let raw = unsafe { ctx.device.create_buffer(&info, None) }
+            .map_err(Error::vk("vkCreateBuffer"))?;
+        // SAFETY: raw was just created on this device.
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
+            name: desc.name,
+            requirements,
+            location: desc.location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: the buffer is unbound and unused.
+                unsafe { ctx.device.destroy_buffer(raw, None) };
+                return Err(allocation_error(desc.name, e));
+            }
+        };
+        // SAFETY: the allocation satisfies the buffer's requirements and is not bound elsewhere.
+        let bound = unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) };
+        let buffer = Buffer {
+            ctx: ctx.clone(),
+            raw,
+            allocation: Some(allocation),
+            size: desc.size,
+            name: desc.name.to_owned(),
+        };
+        bound.map_err(Error::vk("vkBindBufferMemory"))?;
+        ctx.set_name(raw, desc.name);
+        Ok(buffer)
+    }
+
+    /// A device-local buffer filled with `data` through a staging buffer.
+    pub fn with_data(ctx: &Arc<Context>, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> Result<Buffer> {
+        let buffer = Buffer::new(ctx, &BufferDesc {
+            name,
+            size: data.len() as u64,
+            usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        buffer.upload(data)?;
+        Ok(buffer)
+    }
+
+    pub fn size(&self) -> u64 {
+        self.size
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn raw(&self) -> vk::Buffer {
+        self.raw
+    }
+
+    fn mapped(&self) -> Option<&[u8]> {
+        self.allocation.as_ref()?.mapped_slice().map(|s| &s[..self.size as usize])
+    }
+
+    /// Writes into a host-visible buffer at `offset`.
+    pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
+        let end = offset.checked_add(data.len() as u64).filter(|&e| e <= self.size).ok_or_else(|| {
+            Error::InvalidArgument(format!(
+                "write of {} bytes at {offset} past the end of buffer {} ({} bytes)",
+                data.len(),
+                self.name,
+                self.size
+            ))
+        })?;
+        let name = &self.name;
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| Error::InvalidArgument(format!("buffer {name} is not host-visible")))?;
+        slice[offset as usize..end as usize].copy_from_slice(data);
+        Ok(())
+    }
+
+    /// Copies `data` into this buffer: directly when mapped, else through a staging buffer.
+    pub fn upload(&self, data: &[u8]) -> Result<()> {
+        if data.len() as u64 > self.size {
+            return Err(Error::InvalidArgument(format!(
+                "upload of {} bytes into buffer {} of {} bytes",
+                data.len(),
+                self.name,
+                self.size
+            )));
+        }
+        let mut staging = Buffer::new(&self.ctx, &BufferDesc {
+            name: &format!("{}.staging", self.name),
+            size: data.len().max(1) as u64,
+            usage: vk::BufferUsageFlags::TRANSFER_SRC,
+            location: MemoryLocation::CpuToGpu,
+        })?;
+        staging.write(0, data)?;
+        let region = vk::BufferCopy::default().size(data.len() as u64);
+        self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
+            // SAFETY: both buffers are alive until the one-shot submission has completed.
+            unsafe { self.ctx.device.cmd_copy_buffer(cmd, staging.raw, self.raw, &[region]) }
+        })
+    }
+
+    /// Reads the whole buffer back to the host (waits for the GPU).
+    pub fn read(&self) -> Result<Vec<u8>> {
+        if let Some(mapped) = self.mapped() {
+            return Ok(mapped.to_vec());
+        }
+        let staging = Buffer::new(&self.ctx, &BufferDesc {
+            name: &format!("{}.readback", self.name),
+            size: self.size,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        let region = vk::BufferCopy::default().size(self.size);
+        self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| {
+            // SAFETY: both buffers are alive until the submission has completed.
+            unsafe { self.ctx.device.cmd_copy_buffer(cmd, self.raw, staging.raw, &[region]) }
+        })?;
+        staging
+            .mapped()
+            .map(<[u8]>::to_vec)
+            .ok_or_else(|| Error::InvalidArgument(format!("{} readback memory is not mapped", self.name)))
+    }
+}
+
+pub(crate) fn allocation_error(name: &str, e: gpu_allocator::AllocationError) -> Error {
+    match e {
+        gpu_allocator::AllocationError::OutOfMemory => Error::OutOfDeviceMemory { call: "gpu-allocator allocate" },
+        e => Error::Allocation { name: name.to_owned(), message: e.to_string() },
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: Kage waits for every submission that uses a buffer before dropping it
+        // (frames wait on their fence; one-shots wait inline).
+        unsafe { self.ctx.device.destroy_buffer(self.raw, None) };
+        if let Some(allocation) = self.allocation.take() {
+            let _ = self.ctx.allocator().free(allocation);
+        }
+    }
+}

@@ -1,0 +1,115 @@
+//! Command buffers and submission. Kage records a frame into one primary command buffer and
+//! waits for its fence; `one_shot` is the same for set-up work (uploads, layout changes).
+use super::Context;
+use crate::error::{Error, Result};
+use ash::vk;
+
+/// How long a submission may run before Kage calls it hung. Long compute jobs (reference
+/// rendering, precomputation) are split into submissions well below this on lavapipe.
+const FENCE_TIMEOUT_NS: u64 = 600_000_000_000;
+
+/// A command buffer with its fence, reused frame after frame.
+pub struct CommandRecorder {
+    pub(crate) cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+impl Context {
+    pub(crate) fn create_recorder(&self, name: &str) -> Result<CommandRecorder> {
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(*self.command_pool.lock().unwrap_or_else(|e| e.into_inner()))
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // SAFETY: the pool is locked for the allocation (pools are externally synchronized).
+        let cmd = {
+            let _pool = self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
+            unsafe { self.device.allocate_command_buffers(&info) }
+                .map_err(Error::vk("vkAllocateCommandBuffers"))?[0]
+        };
+        // SAFETY: valid device, default create info.
+        let fence = match unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) } {
+            Ok(f) => f,
+            Err(e) => {
+                self.free_command_buffer(cmd);
+                return Err(Error::vk("vkCreateFence")(e));
+            }
+        };
+        self.set_name(cmd, name);
+        self.set_name(fence, &format!("{name}.fence"));
+        Ok(CommandRecorder { cmd, fence })
+    }
+
+    fn free_command_buffer(&self, cmd: vk::CommandBuffer) {
+        let pool = self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
+        // SAFETY: the buffer came from this pool and is not pending (callers wait first).
+        unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
+    }
+
+    pub(crate) fn destroy_recorder(&self, recorder: CommandRecorder) {
+        self.free_command_buffer(recorder.cmd);
+        // SAFETY: the fence is not in use once the last submission was waited for.
+        unsafe { self.device.destroy_fence(recorder.fence, None) };
+    }
+
+    pub(crate) fn begin(&self, recorder: &CommandRecorder) -> Result<()> {
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: the buffer is not pending: every submit is waited for before the next begin.
+        unsafe { self.device.begin_command_buffer(recorder.cmd, &begin) }
+            .map_err(Error::vk("vkBeginCommandBuffer"))
+    }
+
+    /// Ends, submits and waits for the recorder's command buffer.
+    pub(crate) fn submit_and_wait(&self, recorder: &CommandRecorder) -> Result<()> {
+        // SAFETY: recording was begun by `begin`.
+        unsafe { self.device.end_command_buffer(recorder.cmd) }
+            .map_err(Error::vk("vkEndCommandBuffer"))?;
+        let cmds = [recorder.cmd];
+        let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+        {
+            let queue = self.queue();
+            // SAFETY: the queue is locked; the fence is unsignalled (reset after each wait).
+            unsafe { self.device.queue_submit(*queue, &[submit], recorder.fence) }
+                .map_err(Error::vk("vkQueueSubmit"))?;
+        }
+        // SAFETY: the fence was just submitted.
+        unsafe { self.device.wait_for_fences(&[recorder.fence], true, FENCE_TIMEOUT_NS) }
+            .map_err(Error::vk("vkWaitForFences"))?;
+        // SAFETY: the fence is signalled and no longer in use.
+        unsafe { self.device.reset_fences(&[recorder.fence]) }.map_err(Error::vk("vkResetFences"))
+    }
+
+    /// Records `record` into a fresh command buffer, submits it and waits.
+    pub fn one_shot(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let recorder = self.create_recorder(name)?;
+        let result = self.begin(&recorder).and_then(|()| {
+            record(recorder.cmd);
+            self.submit_and_wait(&recorder)
+        });
+        if result.is_ok() {
+            self.destroy_recorder(recorder);
+        } else if self.wait_idle().is_ok() {
+            self.destroy_recorder(recorder);
+        }
+        result
+    }
+
+    /// A full memory barrier: everything before finishes and is visible to everything after.
+    pub fn full_barrier(&self, cmd: vk::CommandBuffer) {
+        let barrier = vk::MemoryBarrier::default()
+            .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+            .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
+        // SAFETY: recording command buffer of this device.
+        unsafe {
+            self.device.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::DependencyFlags::empty(),
+                &[barrier],
+                &[],
+                &[],
+            )
+        };
+    }
+}

@@ -1,0 +1,395 @@
+//! Instance, device, queue and allocator: the one object every other piece borrows.
+use super::validation::{self, ValidationLog};
+use crate::error::{Error, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{c_char, CStr, CString};
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to create a [`Context`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextDesc {
+    /// Turn on `VK_LAYER_KHRONOS_validation` and collect its messages (see
+    /// [`Context::take_validation_messages`]). Missing layer is an error, not a silent downgrade.
+    pub validation: bool,
+    /// Pick the first device whose name contains this (case-insensitive). `None` reads the
+    /// `KAGE_DEVICE` environment variable; unset, a discrete GPU is preferred.
+    pub device: Option<String>,
+}
+
+/// What `kage info` reports about the device.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub device_type: String,
+    pub driver: String,
+    pub api_version: String,
+    /// Nanoseconds per timestamp tick; `None` when the queue cannot write timestamps.
+    pub timestamp_period_ns: Option<f64>,
+    /// Every optional feature or extension Kage looks at, and whether it is there.
+    pub features: Vec<(&'static str, bool)>,
+}
+
+pub struct Context {
+    _entry: ash::Entry,
+    pub(crate) instance: ash::Instance,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    validation: Option<Box<ValidationLog>>,
+    pub(crate) debug: Option<ash::ext::debug_utils::Device>,
+    pub(crate) physical: vk::PhysicalDevice,
+    pub(crate) device: ash::Device,
+    pub(crate) dynamic_rendering: ash::khr::dynamic_rendering::Device,
+    pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
+    queue: Mutex<vk::Queue>,
+    pub(crate) command_pool: Mutex<vk::CommandPool>,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    info: DeviceInfo,
+}
+
+fn has_extension(list: &[vk::ExtensionProperties], name: &CStr) -> bool {
+    list.iter().any(|e| e.extension_name_as_c_str() == Ok(name))
+}
+
+fn version_string(v: u32) -> String {
+    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+}
+
+impl Context {
+    pub fn new(desc: &ContextDesc) -> Result<Arc<Context>> {
+        // SAFETY: loading the system Vulkan loader; its initialisation has no preconditions.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
+
+        // SAFETY: plain enumeration calls on a loaded entry.
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
+        if desc.validation
+            && !layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+        {
+            return Err(Error::Unsupported(
+                "the validation layer VK_LAYER_KHRONOS_validation (Debian: vulkan-validationlayers)"
+                    .into(),
+            ));
+        }
+        // SAFETY: as above.
+        let mut instance_exts = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
+        if desc.validation {
+            // SAFETY: as above; the layer name is a valid C string.
+            let from_layer = unsafe {
+                entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER))
+            }
+            .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
+            instance_exts.extend(from_layer);
+        }
+        let debug_utils = has_extension(&instance_exts, ash::ext::debug_utils::NAME);
+
+        let app_name = c"kage";
+        let app = vk::ApplicationInfo::default()
+            .application_name(app_name)
+            .engine_name(app_name)
+            .api_version(vk::API_VERSION_1_3);
+        let layer_ptrs: Vec<*const c_char> =
+            if desc.validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
+        let ext_ptrs: Vec<*const c_char> =
+            if debug_utils { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+        let instance_info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layer_ptrs)
+            .enabled_extension_names(&ext_ptrs);
+        // SAFETY: the create info points at locals that outlive the call.
+        let instance = unsafe { entry.create_instance(&instance_info, None) }
+            .map_err(Error::vk("vkCreateInstance"))?;
+
+        // Declared before the guard so that it outlives the messenger the guard destroys.
+        let validation = desc.validation.then(|| Box::new(ValidationLog::default()));
+        // From here on a failure must undo what was created: the guard does it on drop.
+        let mut guard = Guard { instance: instance.clone(), messenger: None, device: None };
+        let (debug_instance, messenger) = match (&validation, debug_utils) {
+            (Some(log), true) => {
+                let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
+                let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                    .message_severity(validation::SEVERITIES)
+                    .message_type(
+                        vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                            | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                            | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                    )
+                    .pfn_user_callback(Some(validation::callback))
+                    .user_data(&**log as *const ValidationLog as *mut _);
+                // SAFETY: the log is boxed, so its address is stable until the context drops,
+                // and the context destroys the messenger first.
+                let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
+                    .map_err(Error::vk("vkCreateDebugUtilsMessengerEXT"))?;
+                guard.messenger = Some((loader.clone(), messenger));
+                (Some(loader), messenger)
+            }
+            (Some(_), false) => {
+                return Err(Error::Unsupported(
+                    "VK_EXT_debug_utils, needed to collect validation messages".into(),
+                ))
+            }
+            (None, _) => (None, vk::DebugUtilsMessengerEXT::null()),
+        };
+
+        let wanted = desc.device.clone().or_else(|| std::env::var("KAGE_DEVICE").ok());
+        let (physical, queue_family) = pick_device(&instance, wanted.as_deref())?;
+
+        // SAFETY: valid physical device from this instance.
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        // SAFETY: as above.
+        let device_exts = unsafe { instance.enumerate_device_extension_properties(physical) }
+            .map_err(Error::vk("vkEnumerateDeviceExtensionProperties"))?;
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        // SAFETY: as above.
+        let features = unsafe { instance.get_physical_device_features(physical) };
+        let timestamps = props.limits.timestamp_compute_and_graphics == vk::TRUE
+            && families[queue_family as usize].timestamp_valid_bits > 0;
+        // SAFETY: as above.
+        let rgba32f = unsafe {
+            instance.get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
+        };
+        let rgba32f_linear = rgba32f
+            .optimal_tiling_features
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
+
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        // SAFETY: Vulkan 1.2 device (checked by pick_device); the chain is well formed.
+        unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
+        let driver_text = format!(
+            "{} ({})",
+            driver.driver_name_as_c_str().unwrap_or(c"?").to_string_lossy(),
+            driver.driver_info_as_c_str().unwrap_or(c"?").to_string_lossy()
+        );
+
+        let info = DeviceInfo {
+            name: props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned(),
+            device_type: format!("{:?}", props.device_type),
+            driver: driver_text,
+            api_version: version_string(props.api_version),
+            timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
+            features: vec![
+                ("VK_KHR_dynamic_rendering (required)", has_extension(&device_exts, ash::khr::dynamic_rendering::NAME)),
+                ("VK_KHR_push_descriptor (required)", has_extension(&device_exts, ash::khr::push_descriptor::NAME)),
+                ("RGBA32F linear filtering (required)", rgba32f_linear),
+                ("timestamps on the graphics/compute queue (pass timings)", timestamps),
+                ("VK_EXT_debug_utils (object names, labels)", debug_utils),
+                ("VK_LAYER_KHRONOS_validation (installed)", layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))),
+                ("shaderFloat64", features.shader_float64 == vk::TRUE),
+                ("ray query (not used: Kage casts rays through its own BVH)", has_extension(&device_exts, ash::khr::ray_query::NAME)),
+            ],
+        };
+        for (name, present) in &info.features {
+            if name.ends_with("(required)") && !present {
+                return Err(Error::Unsupported(format!("{name} on {}", info.name)));
+            }
+        }
+
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let device_ext_ptrs =
+            [ash::khr::dynamic_rendering::NAME.as_ptr(), ash::khr::push_descriptor::NAME.as_ptr()];
+        let mut dynamic_rendering_features =
+            vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
+        let enabled = vk::PhysicalDeviceFeatures::default();
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_extension_names(&device_ext_ptrs)
+            .enabled_features(&enabled)
+            .push_next(&mut dynamic_rendering_features);
+        // SAFETY: the create info points at locals that outlive the call.
+        let device = unsafe { instance.create_device(physical, &device_info, None) }
+            .map_err(Error::vk("vkCreateDevice"))?;
+        guard.device = Some(device.clone());
+        // SAFETY: queue 0 of a family requested above.
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| Error::Allocation { name: "allocator".into(), message: e.to_string() })?;
+
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: valid device and create info.
+        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }
+            .map_err(Error::vk("vkCreateCommandPool"))?;
+
+        std::mem::forget(guard);
+        let ctx = Context {
+            debug: debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
+            dynamic_rendering: ash::khr::dynamic_rendering::Device::new(&instance, &device),
+            push_descriptor: ash::khr::push_descriptor::Device::new(&instance, &device),
+            _entry: entry,
+            instance,
+            debug_instance,
+            messenger,
+            validation,
+            physical,
+            device,
+            queue: Mutex::new(queue),
+            command_pool: Mutex::new(command_pool),
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            info,
+        };
+        ctx.set_name(command_pool, "kage.command_pool");
+        ctx.set_name(queue, "kage.queue");
+        Ok(Arc::new(ctx))
+    }
+
+    pub fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+
+    pub fn device(&self) -> &ash::Device {
+        &self.device
+    }
+
+    /// Whether validation is on for this context.
+    pub fn validating(&self) -> bool {
+        self.validation.is_some()
+    }
+
+    /// Every validation message of warning or error severity since the last call.
+    pub fn take_validation_messages(&self) -> Vec<String> {
+        self.validation.as_ref().map(|log| log.take()).unwrap_or_default()
+    }
+
+    pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        self.allocator.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub(crate) fn queue(&self) -> MutexGuard<'_, vk::Queue> {
+        self.queue.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Gives a Vulkan object a debug name (no-op without VK_EXT_debug_utils).
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Some(debug) = &self.debug else { return };
+        let Ok(name) = CString::new(name.replace('\0', " ")) else { return };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+        // SAFETY: the handle belongs to this device; naming has no other effect.
+        // A failure to name is not worth failing the caller for.
+        let _ = unsafe { debug.set_debug_utils_object_name(&info) };
+    }
+
+    /// Waits until the device is idle (used before destroying shared resources).
+    pub fn wait_idle(&self) -> Result<()> {
+        let _queue = self.queue();
+        // SAFETY: the queue lock is held, so no submission races with the wait.
+        unsafe { self.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        // SAFETY: every resource holds an Arc<Context>, so none is alive here; waiting first
+        // makes sure no submitted work still uses the pool.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(*self.command_pool.get_mut().unwrap_or_else(|e| e.into_inner()), None);
+        }
+        // The allocator frees its memory blocks through the device: drop it before the device.
+        // SAFETY: dropped exactly once, here.
+        unsafe { ManuallyDrop::drop(&mut self.allocator) };
+        // SAFETY: all children of the device and instance are gone.
+        unsafe {
+            self.device.destroy_device(None);
+            if let Some(loader) = &self.debug_instance {
+                loader.destroy_debug_utils_messenger(self.messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// Undoes a partly built context when `Context::new` fails half way.
+struct Guard {
+    instance: ash::Instance,
+    messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    device: Option<ash::Device>,
+}
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        // SAFETY: only reached on an error path; nothing else owns these objects, and the
+        // allocator (which frees through the device) was dropped before us or never made.
+        unsafe {
+            if let Some(device) = &self.device {
+                device.destroy_device(None);
+            }
+            if let Some((loader, messenger)) = &self.messenger {
+                loader.destroy_debug_utils_messenger(*messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// Chooses a Vulkan 1.2+ device with a graphics+compute queue: by name when asked, otherwise
+/// discrete GPU first, then integrated, virtual, CPU.
+fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::PhysicalDevice, u32)> {
+    // SAFETY: plain enumeration on a valid instance.
+    let devices = unsafe { instance.enumerate_physical_devices() }
+        .map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
+    let mut candidates = Vec::new();
+    let mut names = Vec::new();
+    for physical in devices {
+        // SAFETY: physical device from this instance.
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let name = props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
+        names.push(name.clone());
+        if props.api_version < vk::API_VERSION_1_2 {
+            continue;
+        }
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let Some(family) = families.iter().position(|f| {
+            f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        }) else {
+            continue;
+        };
+        let rank = match props.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 3,
+            _ => 4,
+        };
+        candidates.push((rank, name, physical, family as u32));
+    }
+    if let Some(wanted) = wanted {
+        let needle = wanted.to_lowercase();
+        return candidates
+            .into_iter()
+            .find(|c| c.1.to_lowercase().contains(&needle))
+            .map(|c| (c.2, c.3))
+            .ok_or_else(|| {
+                Error::NoDevice(format!(
+                    "no Vulkan 1.2 device named like {wanted:?}; devices: {}",
+                    if names.is_empty() { "none".into() } else { names.join(", ") }
+                ))
+            });
+    }
+    candidates.sort_by_key(|c| c.0);
+    candidates.into_iter().next().map(|c| (c.2, c.3)).ok_or_else(|| {
+        Error::NoDevice(if names.is_empty() {
+            "the loader found no device (Debian: install mesa-vulkan-drivers for lavapipe)".into()
+        } else {
+            format!("none of {} has Vulkan 1.2 and a graphics+compute queue", names.join(", "))
+        })
+    })
+}

@@ -1,0 +1,111 @@
+//! Descriptors: every pipeline has one set, written with push descriptors at record time, so
+//! there are no pools or set lifetimes to manage. Binding `i` is the i-th entry of the list.
+use super::{Buffer, Context, Image, Sampler};
+use ash::vk;
+
+/// What a shader binding is; the pipeline's set layout is built from a list of these.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    UniformBuffer,
+    StorageBuffer,
+    SampledImage,
+    StorageImage,
+}
+
+impl BindingKind {
+    fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+        }
+    }
+}
+
+/// A resource bound at record time, in binding order.
+pub enum Binding<'a> {
+    Uniform(&'a Buffer),
+    Storage(&'a Buffer),
+    Sampled(&'a Image, &'a Sampler),
+    StorageImage(&'a Image),
+}
+
+impl Binding<'_> {
+    fn kind(&self) -> BindingKind {
+        match self {
+            Binding::Uniform(_) => BindingKind::UniformBuffer,
+            Binding::Storage(_) => BindingKind::StorageBuffer,
+            Binding::Sampled(..) => BindingKind::SampledImage,
+            Binding::StorageImage(_) => BindingKind::StorageImage,
+        }
+    }
+}
+
+pub(crate) fn set_layout_bindings(kinds: &[BindingKind]) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(i, kind)| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(i as u32)
+                .descriptor_type(kind.descriptor_type())
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::ALL)
+        })
+        .collect()
+}
+
+/// Binds `bindings` to set 0 of `layout`. Panics are impossible here; a binding list that does
+/// not match the layout is a programming error that validation reports.
+pub fn push_descriptors(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    bind_point: vk::PipelineBindPoint,
+    layout: vk::PipelineLayout,
+    expected: &[BindingKind],
+    bindings: &[Binding],
+) {
+    debug_assert_eq!(expected, bindings.iter().map(Binding::kind).collect::<Vec<_>>().as_slice());
+    let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
+        .iter()
+        .map(|b| match b {
+            Binding::Uniform(buf) | Binding::Storage(buf) => {
+                [vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }]
+            }
+            _ => [vk::DescriptorBufferInfo::default()],
+        })
+        .collect();
+    let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = bindings
+        .iter()
+        .map(|b| match b {
+            Binding::Sampled(image, sampler) => [vk::DescriptorImageInfo {
+                sampler: sampler.raw,
+                image_view: image.view,
+                image_layout: vk::ImageLayout::GENERAL,
+            }],
+            Binding::StorageImage(image) => [vk::DescriptorImageInfo {
+                sampler: vk::Sampler::null(),
+                image_view: image.view,
+                image_layout: vk::ImageLayout::GENERAL,
+            }],
+            _ => [vk::DescriptorImageInfo::default()],
+        })
+        .collect();
+    let writes: Vec<vk::WriteDescriptorSet> = bindings
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let write = vk::WriteDescriptorSet::default()
+                .dst_binding(i as u32)
+                .descriptor_type(b.kind().descriptor_type());
+            match b {
+                Binding::Uniform(_) | Binding::Storage(_) => write.buffer_info(&buffer_infos[i]),
+                _ => write.image_info(&image_infos[i]),
+            }
+        })
+        .collect();
+    // SAFETY: recording command buffer; the writes point at locals alive for the call, and the
+    // set layout was created with the push-descriptor flag.
+    unsafe { ctx.push_descriptor.cmd_push_descriptor_set(cmd, bind_point, layout, 0, &writes) };
+}

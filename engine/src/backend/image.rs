@@ -1,0 +1,285 @@
+//! Images and samplers. Layout policy: every image is moved to `GENERAL` when it is created and
+//! stays there between commands (see `pass` for why), so passes never track layouts. Copies
+//! alone step into the transfer layout drivers prefer and back, inside `record_copy_to` and
+//! `upload`.
+use super::buffer::allocation_error;
+use super::{Buffer, BufferDesc, Context};
+use crate::error::{Error, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+pub struct ImageDesc<'a> {
+    pub name: &'a str,
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+    pub format: vk::Format,
+    pub usage: vk::ImageUsageFlags,
+}
+
+pub struct Image {
+    ctx: Arc<Context>,
+    pub(crate) raw: vk::Image,
+    pub(crate) view: vk::ImageView,
+    allocation: Option<Allocation>,
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+    pub format: vk::Format,
+    name: String,
+}
+
+fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    match format {
+        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM => vk::ImageAspectFlags::DEPTH,
+        _ => vk::ImageAspectFlags::COLOR,
+    }
+}
+
+/// Bytes per texel of the formats Kage reads back or uploads.
+fn texel_bytes(format: vk::Format) -> Option<u64> {
+    match format {
+        vk::Format::R32G32B32A32_SFLOAT => Some(16),
+        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::R32_SFLOAT | vk::Format::R32_UINT | vk::Format::D32_SFLOAT => Some(4),
+        _ => None,
+    }
+}
+
+impl Image {
+    pub fn new(ctx: &Arc<Context>, desc: &ImageDesc) -> Result<Image> {
+        // SAFETY: plain property query.
+        let limits = unsafe { ctx.instance.get_physical_device_properties(ctx.physical) }.limits;
+        if desc.width == 0 || desc.height == 0 || desc.layers == 0
+            || desc.width > limits.max_image_dimension2_d
+            || desc.height > limits.max_image_dimension2_d
+            || desc.layers > limits.max_image_array_layers
+        {
+            return Err(Error::InvalidArgument(format!(
+                "image {} of {}x{}x{} is outside the device limits (1..={} per side, {} layers)",
+                desc.name, desc.width, desc.height, desc.layers,
+                limits.max_image_dimension2_d, limits.max_image_array_layers
+            )));
+        }
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
+            .mip_levels(1)
+            .array_layers(desc.layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid device and create info.
+        let raw = unsafe { ctx.device.create_image(&info, None) }.map_err(Error::vk("vkCreateImage"))?;
+        // SAFETY: raw was just created on this device.
+        let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
+        let allocation = match ctx.allocator().allocate(&AllocationCreateDesc {
+            name: desc.name,
+            requirements,
+            location: MemoryLocation::GpuOnly,
+            linear: false,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: unbound, unused image.
+                unsafe { ctx.device.destroy_image(raw, None) };
+                return Err(allocation_error(desc.name, e));
+            }
+        };
+        let mut image = Image {
+            ctx: ctx.clone(),
+            raw,
+            view: vk::ImageView::null(),
+            allocation: None,
+            width: desc.width,
+            height: desc.height,
+            layers: desc.layers,
+            format: desc.format,
+            name: desc.name.to_owned(),
+        };
+        // SAFETY: the allocation satisfies the image's requirements.
+        let bound = unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
+        image.allocation = Some(allocation);
+        bound.map_err(Error::vk("vkBindImageMemory"))?;
+        ctx.set_name(raw, desc.name);
+
+        let view_type = if desc.layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(view_type)
+            .format(desc.format)
+            .subresource_range(image.range());
+        // SAFETY: the image is bound to memory; the view covers its whole range.
+        image.view = unsafe { ctx.device.create_image_view(&view_info, None) }
+            .map_err(Error::vk("vkCreateImageView"))?;
+        ctx.set_name(image.view, &format!("{}.view", desc.name));
+
+        ctx.one_shot(&format!("{}.to_general", desc.name), |cmd| {
+            image.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL)
+        })?;
+        Ok(image)
+    }
+
+    /// Records a layout change of the whole image, ordered after all earlier commands.
+    fn transition(&self, cmd: vk::CommandBuffer, from: vk::ImageLayout, to: vk::ImageLayout) {
+        let barrier = vk::ImageMemoryBarrier::default()
+            .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+            .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+            .old_layout(from)
+            .new_layout(to)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(self.raw)
+            .subresource_range(self.range());
+        // SAFETY: recording command buffer; the image is alive until the submission completes.
+        unsafe {
+            self.ctx.device.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[barrier],
+            )
+        }
+    }
+
+    pub(crate) fn range(&self) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange {
+            aspect_mask: aspect_of(self.format),
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: self.layers,
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn view(&self) -> vk::ImageView {
+        self.view
+    }
+
+    /// Bytes of the whole image in a tightly packed buffer.
+    pub fn byte_size(&self) -> Result<u64> {
+        let texel = texel_bytes(self.format).ok_or_else(|| {
+            Error::InvalidArgument(format!("no host copies of {:?} ({})", self.format, self.name))
+        })?;
+        Ok(texel * self.width as u64 * self.height as u64 * self.layers as u64)
+    }
+
+    pub(crate) fn copy_region(&self) -> vk::BufferImageCopy {
+        vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: aspect_of(self.format),
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: self.layers,
+            })
+            .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 })
+    }
+
+    /// Records a copy of the whole image into `buffer` (tightly packed, layer after layer).
+    pub fn record_copy_to(&self, cmd: vk::CommandBuffer, buffer: &Buffer) {
+        let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        self.transition(cmd, vk::ImageLayout::GENERAL, src);
+        // SAFETY: recording command buffer; the image was just moved to `src`.
+        unsafe { self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, src, buffer.raw, &[self.copy_region()]) }
+        self.transition(cmd, src, vk::ImageLayout::GENERAL);
+    }
+
+    /// Fills the image from tightly packed texels through a staging buffer.
+    pub fn upload(&self, data: &[u8]) -> Result<()> {
+        let expected = self.byte_size()?;
+        if data.len() as u64 != expected {
+            return Err(Error::InvalidArgument(format!(
+                "upload of {} bytes into image {} of {expected} bytes",
+                data.len(),
+                self.name
+            )));
+        }
+        let mut staging = Buffer::new(&self.ctx, &BufferDesc {
+            name: &format!("{}.staging", self.name),
+            size: expected,
+            usage: vk::BufferUsageFlags::TRANSFER_SRC,
+            location: MemoryLocation::CpuToGpu,
+        })?;
+        staging.write(0, data)?;
+        let region = self.copy_region();
+        self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
+            let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
+            self.transition(cmd, vk::ImageLayout::GENERAL, dst);
+            // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
+            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region]) }
+            self.transition(cmd, dst, vk::ImageLayout::GENERAL);
+        })
+    }
+
+    /// Reads the whole image back (waits for the GPU).
+    pub fn read(&self) -> Result<Vec<u8>> {
+        let staging = Buffer::new(&self.ctx, &BufferDesc {
+            name: &format!("{}.readback", self.name),
+            size: self.byte_size()?,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| self.record_copy_to(cmd, &staging))?;
+        staging.read()
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        // SAFETY: no submission using the image is pending (frames and one-shots wait).
+        unsafe {
+            if self.view != vk::ImageView::null() {
+                self.ctx.device.destroy_image_view(self.view, None);
+            }
+            self.ctx.device.destroy_image(self.raw, None);
+        }
+        if let Some(allocation) = self.allocation.take() {
+            let _ = self.ctx.allocator().free(allocation);
+        }
+    }
+}
+
+/// A sampler; Kage needs only a few kinds, chosen by the constructor's arguments.
+pub struct Sampler {
+    ctx: Arc<Context>,
+    pub(crate) raw: vk::Sampler,
+}
+
+impl Sampler {
+    /// Linear filtering; `u` repeats (longitude wraps around), `v` clamps (poles).
+    pub fn new(ctx: &Arc<Context>, name: &str, linear: bool, repeat_u: bool) -> Result<Sampler> {
+        let filter = if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
+        let u = if repeat_u { vk::SamplerAddressMode::REPEAT } else { vk::SamplerAddressMode::CLAMP_TO_EDGE };
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(filter)
+            .min_filter(filter)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(u)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(0.0);
+        // SAFETY: valid device and create info.
+        let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
+        ctx.set_name(raw, name);
+        Ok(Sampler { ctx: ctx.clone(), raw })
+    }
+}
+
+impl Drop for Sampler {
+    fn drop(&mut self) {
+        // SAFETY: no pending submission uses the sampler.
+        unsafe { self.ctx.device.destroy_sampler(self.raw, None) };
+    }
+}

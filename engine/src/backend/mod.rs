@@ -1,0 +1,25 @@
+//! The thin Vulkan layer: everything that talks to ash lives here, one concern per file.
+//!
+//! Resources hold an `Arc<Context>` and destroy themselves on drop, so a host cannot leak them
+//! or outlive the device. Every object gets a debug name when `VK_EXT_debug_utils` is present.
+mod buffer;
+mod commands;
+mod context;
+mod descriptor;
+mod image;
+mod pipeline;
+mod rendering;
+mod timestamps;
+mod validation;
+
+pub use buffer::{Buffer, BufferDesc};
+pub use commands::CommandRecorder;
+pub use context::{Context, ContextDesc, DeviceInfo};
+pub use descriptor::{push_descriptors, Binding, BindingKind};
+pub use image::{Image, ImageDesc, Sampler};
+pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline, VertexAttribute};
+pub use timestamps::TimestampPool;
+pub use validation::ValidationLog;
+
+pub use ash::vk;
+pub use gpu_allocator::MemoryLocation;

@@ -1,0 +1,251 @@
+//! Compute and graphics pipelines. Each owns its set layout (push descriptors, set 0) and
+//! pipeline layout, and records its own binds so passes stay short.
+use super::descriptor::{push_descriptors, set_layout_bindings};
+use super::{Binding, BindingKind, Context};
+use crate::error::{Error, Result};
+use ash::vk;
+use std::sync::Arc;
+
+struct Layout {
+    set: vk::DescriptorSetLayout,
+    pipeline: vk::PipelineLayout,
+    bindings: Vec<BindingKind>,
+    push_size: u32,
+}
+
+fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size: u32) -> Result<Layout> {
+    let set_bindings = set_layout_bindings(bindings);
+    let set_info = vk::DescriptorSetLayoutCreateInfo::default()
+        .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
+        .bindings(&set_bindings);
+    // SAFETY: valid device and create info.
+    let set = unsafe { ctx.device.create_descriptor_set_layout(&set_info, None) }
+        .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
+    ctx.set_name(set, &format!("{name}.set_layout"));
+    let ranges = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::ALL, offset: 0, size: push_size }];
+    let sets = [set];
+    let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(&sets);
+    if push_size > 0 {
+        info = info.push_constant_ranges(&ranges);
+    }
+    // SAFETY: valid device and create info.
+    let pipeline = match unsafe { ctx.device.create_pipeline_layout(&info, None) } {
+        Ok(p) => p,
+        Err(e) => {
+            // SAFETY: the set layout is unused.
+            unsafe { ctx.device.destroy_descriptor_set_layout(set, None) };
+            return Err(Error::vk("vkCreatePipelineLayout")(e));
+        }
+    };
+    ctx.set_name(pipeline, &format!("{name}.layout"));
+    Ok(Layout { set, pipeline, bindings: bindings.to_vec(), push_size })
+}
+
+fn destroy_layout(ctx: &Context, layout: &Layout) {
+    // SAFETY: no pending submission uses the layouts.
+    unsafe {
+        ctx.device.destroy_pipeline_layout(layout.pipeline, None);
+        ctx.device.destroy_descriptor_set_layout(layout.set, None);
+    }
+}
+
+/// A shader module that lives only while its pipeline is created.
+struct Module<'a> {
+    ctx: &'a Context,
+    raw: vk::ShaderModule,
+}
+
+impl<'a> Module<'a> {
+    fn new(ctx: &'a Context, name: &str, spirv: &[u8]) -> Result<Module<'a>> {
+        let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
+            .map_err(|e| Error::InvalidArgument(format!("SPIR-V of {name}: {e}")))?;
+        let info = vk::ShaderModuleCreateInfo::default().code(&words);
+        // SAFETY: the words are SPIR-V compiled by build.rs.
+        let raw = unsafe { ctx.device.create_shader_module(&info, None) }
+            .map_err(Error::vk("vkCreateShaderModule"))?;
+        ctx.set_name(raw, name);
+        Ok(Module { ctx, raw })
+    }
+}
+
+impl Drop for Module<'_> {
+    fn drop(&mut self) {
+        // SAFETY: modules may be destroyed once the pipelines using them are created.
+        unsafe { self.ctx.device.destroy_shader_module(self.raw, None) };
+    }
+}
+
+fn push_bytes(ctx: &Context, cmd: vk::CommandBuffer, layout: &Layout, bytes: &[u8]) {
+    debug_assert_eq!(bytes.len() as u32, layout.push_size, "push constant size mismatch");
+    if !bytes.is_empty() {
+        // SAFETY: recording command buffer; the range was declared in the layout.
+        unsafe { ctx.device.cmd_push_constants(cmd, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes) };
+    }
+}
+
+pub struct ComputePipeline {
+    ctx: Arc<Context>,
+    raw: vk::Pipeline,
+    layout: Layout,
+}
+
+impl ComputePipeline {
+    pub fn new(ctx: &Arc<Context>, name: &str, spirv: &[u8], bindings: &[BindingKind], push_size: u32) -> Result<ComputePipeline> {
+        let module = Module::new(ctx, &format!("{name}.comp"), spirv)?;
+        let layout = create_layout(ctx, name, bindings, push_size)?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module.raw)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline);
+        // SAFETY: valid device, module and layout.
+        let raw = match unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) } {
+            Ok(p) => p[0],
+            Err((_, e)) => {
+                destroy_layout(ctx, &layout);
+                return Err(Error::vk("vkCreateComputePipelines")(e));
+            }
+        };
+        ctx.set_name(raw, name);
+        Ok(ComputePipeline { ctx: ctx.clone(), raw, layout })
+    }
+
+    /// Binds the pipeline, its resources and push constants, then dispatches.
+    pub fn dispatch(&self, cmd: vk::CommandBuffer, bindings: &[Binding], push: &[u8], groups: [u32; 3]) {
+        // SAFETY: recording command buffer of this device.
+        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
+        push_descriptors(&self.ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.layout.pipeline, &self.layout.bindings, bindings);
+        push_bytes(&self.ctx, cmd, &self.layout, push);
+        // SAFETY: pipeline and descriptors bound above.
+        unsafe { self.ctx.device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+    }
+}
+
+impl Drop for ComputePipeline {
+    fn drop(&mut self) {
+        // SAFETY: no pending submission uses the pipeline.
+        unsafe { self.ctx.device.destroy_pipeline(self.raw, None) };
+        destroy_layout(&self.ctx, &self.layout);
+    }
+}
+
+/// One vertex attribute read from binding 0 (one interleaved vertex buffer).
+#[derive(Clone, Copy, Debug)]
+pub struct VertexAttribute {
+    pub location: u32,
+    pub format: vk::Format,
+    pub offset: u32,
+}
+
+pub struct GraphicsDesc<'a> {
+    pub name: &'a str,
+    pub vertex_spirv: &'a [u8],
+    pub fragment_spirv: &'a [u8],
+    pub bindings: &'a [BindingKind],
+    pub push_size: u32,
+    /// Stride of the vertex buffer; 0 means no vertex input (vertices made in the shader).
+    pub vertex_stride: u32,
+    pub attributes: &'a [VertexAttribute],
+    pub topology: vk::PrimitiveTopology,
+    pub color_formats: &'a [vk::Format],
+    pub depth_format: Option<vk::Format>,
+    pub depth_test: bool,
+}
+
+pub struct GraphicsPipeline {
+    ctx: Arc<Context>,
+    raw: vk::Pipeline,
+    layout: Layout,
+}
+
+impl GraphicsPipeline {
+    pub fn new(ctx: &Arc<Context>, desc: &GraphicsDesc) -> Result<GraphicsPipeline> {
+        let vs = Module::new(ctx, &format!("{}.vert", desc.name), desc.vertex_spirv)?;
+        let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv)?;
+        let layout = create_layout(ctx, desc.name, desc.bindings, desc.push_size)?;
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs.raw).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs.raw).name(c"main"),
+        ];
+        let vertex_bindings = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: desc.vertex_stride,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let attributes: Vec<vk::VertexInputAttributeDescription> = desc
+            .attributes
+            .iter()
+            .map(|a| vk::VertexInputAttributeDescription { location: a.location, binding: 0, format: a.format, offset: a.offset })
+            .collect();
+        let mut vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+        if desc.vertex_stride > 0 {
+            vertex_input = vertex_input.vertex_binding_descriptions(&vertex_bindings).vertex_attribute_descriptions(&attributes);
+        }
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        // Kage's surfaces are two-sided (open meshes such as the teapot show their inside), so
+        // nothing is culled; shaders flip normals on back faces.
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(vk::CullModeFlags::NONE)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth_test)
+            .depth_write_enable(desc.depth_test)
+            .depth_compare_op(vk::CompareOp::LESS);
+        let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> = desc
+            .color_formats
+            .iter()
+            .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
+            .collect();
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(desc.color_formats)
+            .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout.pipeline)
+            .push_next(&mut rendering);
+        // SAFETY: every pointer in the create info refers to locals alive for the call.
+        let raw = match unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) } {
+            Ok(p) => p[0],
+            Err((_, e)) => {
+                destroy_layout(ctx, &layout);
+                return Err(Error::vk("vkCreateGraphicsPipelines")(e));
+            }
+        };
+        ctx.set_name(raw, desc.name);
+        Ok(GraphicsPipeline { ctx: ctx.clone(), raw, layout })
+    }
+
+    /// Binds the pipeline and its resources (call inside a rendering scope).
+    pub fn bind(&self, cmd: vk::CommandBuffer, bindings: &[Binding]) {
+        // SAFETY: recording command buffer of this device.
+        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw) };
+        push_descriptors(&self.ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.layout.pipeline, &self.layout.bindings, bindings);
+    }
+
+    pub fn push(&self, cmd: vk::CommandBuffer, bytes: &[u8]) {
+        push_bytes(&self.ctx, cmd, &self.layout, bytes);
+    }
+}
+
+impl Drop for GraphicsPipeline {
+    fn drop(&mut self) {
+        // SAFETY: no pending submission uses the pipeline.
+        unsafe { self.ctx.device.destroy_pipeline(self.raw, None) };
+        destroy_layout(&self.ctx, &self.layout);
+    }
+}

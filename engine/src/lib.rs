@@ -1,0 +1,26 @@
+//! Kage (影): a real-time lighting engine on raw Vulkan.
+//!
+//! Layers, bottom to top (each a folder):
+//! - [`backend`]: a thin layer over ash: device, memory, buffers, images, pipelines,
+//!   descriptors, timestamps, validation.
+//! - [`pass`]: named passes with inputs, outputs and a record function, each wrapped in a debug
+//!   label and a GPU timestamp pair.
+//! - [`techniques`]: lighting techniques built from passes.
+//! - [`scene`]: what a scene holds (groups, environment light, local lights, camera) and its file
+//!   format.
+//!
+//! Conventions: right-handed, +Y up; equirectangular maps map direction (x, y, z) to
+//! u = atan2(x, -z) / 2π wrapped into [0, 1), v = acos(y) / π, row 0 at the top (+Y).
+#![warn(unsafe_op_in_unsafe_fn)]
+
+pub mod backend;
+pub mod error;
+pub mod imageio;
+pub mod layouts;
+pub mod pass;
+pub mod renderer;
+pub mod scene;
+pub mod sh;
+pub mod techniques;
+
+pub use error::{Error, Result};

@@ -1,0 +1,156 @@
+//! The pass layer: a frame is a list of named passes, each with the resources it reads and
+//! writes and a function that records it. Every pass is wrapped in a debug label and a pair of
+//! GPU timestamps; after the frame's fence the timings are read back per pass.
+//!
+//! # Synchronization policy
+//! Kept conservative on purpose, until a measurement says a pass boundary is worth refining:
+//! - Every image lives in `GENERAL` layout from creation on (see `backend::Image`), so no pass
+//!   tracks or changes layouts.
+//! - Between two consecutive passes the executor records one full memory barrier
+//!   (all commands → all commands, memory writes → memory reads and writes). Within a pass,
+//!   the pass itself is responsible for any hazard between its own commands.
+//! - A frame is one command buffer, submitted and waited for on its fence before `run`
+//!   returns, so the host may read or rewrite any resource afterwards.
+//!
+//! The declared inputs and outputs are checked before recording: a pass may only read what an
+//! earlier pass of the frame wrote or what the frame imports (persistent resources), which
+//! catches passes recorded in the wrong order.
+mod timings;
+
+pub use timings::{TimingRow, TimingTable};
+
+use crate::backend::{Context, TimestampPool};
+use crate::error::{Error, Result};
+use ash::vk;
+use std::ffi::CString;
+use std::sync::Arc;
+
+/// One pass of a frame.
+pub struct Pass<'a> {
+    pub name: &'static str,
+    pub inputs: &'a [&'static str],
+    pub outputs: &'a [&'static str],
+    record: Box<dyn FnOnce(vk::CommandBuffer) + 'a>,
+}
+
+impl<'a> Pass<'a> {
+    pub fn new(
+        name: &'static str,
+        inputs: &'a [&'static str],
+        outputs: &'a [&'static str],
+        record: impl FnOnce(vk::CommandBuffer) + 'a,
+    ) -> Pass<'a> {
+        Pass { name, inputs, outputs, record: Box::new(record) }
+    }
+}
+
+/// The GPU time of one pass in one frame; `None` where the device has no timestamps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTiming {
+    pub name: &'static str,
+    pub gpu_ms: Option<f64>,
+}
+
+/// Records, submits and times frames; owns the command buffer and timestamp pool it reuses.
+pub struct FrameExecutor {
+    ctx: Arc<Context>,
+    name: String,
+    recorder: Option<crate::backend::CommandRecorder>,
+    timestamps: Option<TimestampPool>,
+}
+
+impl FrameExecutor {
+    pub fn new(ctx: &Arc<Context>, name: &str) -> Result<FrameExecutor> {
+        let recorder = ctx.create_recorder(&format!("{name}.commands"))?;
+        Ok(FrameExecutor { ctx: ctx.clone(), name: name.to_owned(), recorder: Some(recorder), timestamps: None })
+    }
+
+    /// Runs `passes` in order as one submission and returns each pass's GPU time.
+    pub fn run(&mut self, imports: &[&'static str], passes: Vec<Pass<'_>>) -> Result<Vec<PassTiming>> {
+        check_data_flow(imports, &passes)?;
+        let count = 2 * passes.len() as u32;
+        let period_ns = self.ctx.info().timestamp_period_ns;
+        if period_ns.is_some() && self.timestamps.as_ref().is_none_or(|t| t.capacity() < count) {
+            self.timestamps = Some(TimestampPool::new(&self.ctx, &format!("{}.timestamps", self.name), count.max(16))?);
+        }
+        let recorder = self.recorder.as_ref().ok_or(Error::InvalidArgument("frame executor was poisoned by an earlier failure".into()))?;
+        let cmd = recorder.cmd;
+        let timestamps = self.timestamps.as_ref().filter(|_| period_ns.is_some());
+        self.ctx.begin(recorder)?;
+        if let Some(t) = timestamps {
+            t.reset(cmd, count);
+        }
+        let names: Vec<&'static str> = passes.iter().map(|p| p.name).collect();
+        for (i, pass) in passes.into_iter().enumerate() {
+            if i > 0 {
+                self.ctx.full_barrier(cmd);
+            }
+            self.begin_label(cmd, pass.name);
+            if let Some(t) = timestamps {
+                t.write(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, 2 * i as u32);
+            }
+            (pass.record)(cmd);
+            if let Some(t) = timestamps {
+                t.write(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * i as u32 + 1);
+            }
+            self.end_label(cmd);
+        }
+        if let Err(e) = self.ctx.submit_and_wait(recorder) {
+            // The command buffer may still be pending after a timeout or device loss: never
+            // reuse it.
+            self.recorder = None;
+            return Err(e);
+        }
+        let ticks = match timestamps {
+            Some(t) => Some(t.read(count)?),
+            None => None,
+        };
+        Ok(names
+            .into_iter()
+            .enumerate()
+            .map(|(i, name)| PassTiming {
+                name,
+                gpu_ms: ticks.as_ref().zip(period_ns).map(|(t, period)| {
+                    t[2 * i + 1].saturating_sub(t[2 * i]) as f64 * period * 1e-6
+                }),
+            })
+            .collect())
+    }
+
+    fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        let Some(debug) = &self.ctx.debug else { return };
+        let Ok(name) = CString::new(name) else { return };
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
+        // SAFETY: recording command buffer; the label string outlives the call.
+        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+
+    fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(debug) = &self.ctx.debug {
+            // SAFETY: matches the begin_label just before.
+            unsafe { debug.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+}
+
+impl Drop for FrameExecutor {
+    fn drop(&mut self) {
+        if let Some(recorder) = self.recorder.take() {
+            self.ctx.destroy_recorder(recorder);
+        }
+    }
+}
+
+fn check_data_flow(imports: &[&'static str], passes: &[Pass<'_>]) -> Result<()> {
+    let mut available: Vec<&str> = imports.to_vec();
+    for pass in passes {
+        if let Some(missing) = pass.inputs.iter().find(|i| !available.contains(i)) {
+            return Err(Error::InvalidArgument(format!(
+                "pass {} reads {missing}, which no earlier pass writes and the frame does not import",
+                pass.name
+            )));
+        }
+        available.extend_from_slice(pass.outputs);
+    }
+    Ok(())
+}

@@ -1,0 +1,91 @@
+//! Per-pass GPU timings gathered over many frames: median, minimum and maximum per pass.
+use super::PassTiming;
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TimingRow {
+    pub name: String,
+    pub median_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+    /// Frames in which the pass ran (a pass such as the SH projection runs only when its input
+    /// changes).
+    pub frames: usize,
+}
+
+#[derive(Default, Debug)]
+pub struct TimingTable {
+    passes: Vec<(String, Vec<f64>)>,
+    frames: Vec<f64>,
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+impl TimingTable {
+    /// Adds one frame's timings; passes without a GPU time (no timestamps) are left out.
+    pub fn add_frame(&mut self, frame: &[PassTiming]) {
+        let mut total = 0.0;
+        for timing in frame {
+            let Some(ms) = timing.gpu_ms else { continue };
+            total += ms;
+            match self.passes.iter_mut().find(|(name, _)| name == timing.name) {
+                Some((_, samples)) => samples.push(ms),
+                None => self.passes.push((timing.name.to_owned(), vec![ms])),
+            }
+        }
+        if frame.iter().any(|t| t.gpu_ms.is_some()) {
+            self.frames.push(total);
+        }
+    }
+
+    /// One row per pass, in the order the passes first ran.
+    pub fn rows(&self) -> Vec<TimingRow> {
+        self.passes
+            .iter()
+            .map(|(name, samples)| TimingRow {
+                name: name.clone(),
+                median_ms: median(samples),
+                min_ms: samples.iter().copied().fold(f64::INFINITY, f64::min),
+                max_ms: samples.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                frames: samples.len(),
+            })
+            .collect()
+    }
+
+    /// Median over frames of the summed GPU time of all passes of a frame.
+    pub fn frame_median_ms(&self) -> f64 {
+        median(&self.frames)
+    }
+
+    pub fn frame_count(&self) -> usize {
+        self.frames.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_min_max_per_pass() {
+        let mut table = TimingTable::default();
+        for ms in [3.0, 1.0, 2.0, 10.0] {
+            table.add_frame(&[PassTiming { name: "a", gpu_ms: Some(ms) }, PassTiming { name: "b", gpu_ms: Some(1.0) }]);
+        }
+        let rows = table.rows();
+        assert_eq!(rows[0].name, "a");
+        assert_eq!((rows[0].median_ms, rows[0].min_ms, rows[0].max_ms), (2.5, 1.0, 10.0));
+        assert_eq!(rows[1].frames, 4);
+        assert_eq!(table.frame_median_ms(), 3.5);
+    }
+}

@@ -1,0 +1,203 @@
+//! The renderer: a scene on the GPU, its render targets, and the frame loop that runs a
+//! technique's passes and reads the picture back.
+use crate::backend::{vk, Buffer, BufferDesc, Context, Image, ImageDesc, MemoryLocation};
+use crate::error::{Error, Result};
+use crate::imageio::RgbaF32Image;
+use crate::layouts::{bytes_of, FrameUniforms};
+use crate::pass::{FrameExecutor, Pass, PassTiming};
+use crate::scene::Scene;
+use crate::techniques::env_sh::EnvSh;
+use crate::techniques::environment::GpuEnvironment;
+use crate::techniques::unshadowed::Unshadowed;
+use glam::Mat4;
+use std::sync::Arc;
+
+/// Linear radiance, 32-bit float per channel: the picture is compared against the ray-traced
+/// reference pixel by pixel, so no precision is given away before the output file.
+pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// The largest image side Kage renders (lavapipe and current GPUs allow 16384; 8192 keeps the
+/// colour target and its readback within 2 GiB).
+pub const MAX_SIZE: u32 = 8192;
+
+pub struct GpuMesh {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+    pub albedo: [f32; 3],
+    pub group: usize,
+}
+
+/// Geometry on the GPU: one vertex and index buffer per mesh, one transform per group.
+pub struct GpuScene {
+    pub meshes: Vec<GpuMesh>,
+    pub transforms: Vec<Mat4>,
+}
+
+impl GpuScene {
+    pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
+        let mut meshes = Vec::new();
+        for (g, group) in scene.groups.iter().enumerate() {
+            for mesh in &group.meshes {
+                let vertices: Vec<u8> = mesh
+                    .positions
+                    .iter()
+                    .zip(&mesh.normals)
+                    .flat_map(|(p, n)| [p[0], p[1], p[2], n[0], n[1], n[2]])
+                    .flat_map(f32::to_ne_bytes)
+                    .collect();
+                let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
+                let name = format!("{}.{}", group.name, mesh.name);
+                meshes.push(GpuMesh {
+                    vertices: Buffer::with_data(ctx, &format!("{name}.vertices"), vk::BufferUsageFlags::VERTEX_BUFFER, &vertices)?,
+                    indices: Buffer::with_data(ctx, &format!("{name}.indices"), vk::BufferUsageFlags::INDEX_BUFFER, &indices)?,
+                    index_count: mesh.indices.len() as u32,
+                    albedo: mesh.albedo,
+                    group: g,
+                });
+            }
+        }
+        Ok(GpuScene { meshes, transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect() })
+    }
+}
+
+pub struct Targets {
+    pub color: Image,
+    pub depth: Image,
+    readback: Buffer,
+}
+
+impl Targets {
+    fn new(ctx: &Arc<Context>, width: u32, height: u32) -> Result<Targets> {
+        if !(1..=MAX_SIZE).contains(&width) || !(1..=MAX_SIZE).contains(&height) {
+            return Err(Error::InvalidArgument(format!(
+                "image size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
+            )));
+        }
+        let color = Image::new(ctx, &ImageDesc {
+            name: "color",
+            width,
+            height,
+            layers: 1,
+            format: COLOR_FORMAT,
+            usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+        })?;
+        let depth = Image::new(ctx, &ImageDesc {
+            name: "depth",
+            width,
+            height,
+            layers: 1,
+            format: DEPTH_FORMAT,
+            usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        })?;
+        let readback = Buffer::new(ctx, &BufferDesc {
+            name: "color.readback",
+            size: color.byte_size()?,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        Ok(Targets { color, depth, readback })
+    }
+}
+
+/// What to render and how large.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { width: 512, height: 512 }
+    }
+}
+
+pub struct Renderer {
+    scene: GpuScene,
+    camera: crate::scene::Camera,
+    env: GpuEnvironment,
+    env_sh: EnvSh,
+    env_dirty: bool,
+    technique: Unshadowed,
+    frame_uniforms: Buffer,
+    targets: Targets,
+    executor: FrameExecutor,
+}
+
+impl Renderer {
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, options: &RenderOptions) -> Result<Renderer> {
+        let targets = Targets::new(ctx, options.width, options.height)?;
+        Ok(Renderer {
+            scene: GpuScene::new(ctx, scene)?,
+            camera: scene.camera.clone(),
+            env: GpuEnvironment::new(ctx, &scene.environment)?,
+            env_sh: EnvSh::new(ctx, &scene.environment)?,
+            env_dirty: true,
+            technique: Unshadowed::new(ctx)?,
+            frame_uniforms: Buffer::new(ctx, &BufferDesc {
+                name: "frame_uniforms",
+                size: size_of::<FrameUniforms>() as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })?,
+            targets,
+            executor: FrameExecutor::new(ctx, "frame")?,
+        })
+    }
+
+    /// Moves a group (a rigid transform: rotation, translation, uniform scale).
+    pub fn set_group_transform(&mut self, group: usize, transform: Mat4) -> Result<()> {
+        let count = self.scene.transforms.len();
+        if !transform.is_finite() {
+            return Err(Error::InvalidArgument(format!("transform of group {group} is not finite")));
+        }
+        let slot = self.scene.transforms.get_mut(group).ok_or_else(|| {
+            Error::InvalidArgument(format!("group {group} does not exist (the scene has {count})"))
+        })?;
+        *slot = transform;
+        Ok(())
+    }
+
+    /// Renders one frame and reads it back; returns each pass's GPU time.
+    pub fn render(&mut self) -> Result<Vec<PassTiming>> {
+        let (width, height) = (self.targets.color.width, self.targets.color.height);
+        let view_proj = self.camera.projection(width as f32 / height as f32) * self.camera.view();
+        let uniforms = FrameUniforms {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            camera_pos: self.camera.position.extend(1.0).to_array(),
+            env_params: [1.0, 0.0, 0.0, 0.0],
+        };
+        self.frame_uniforms.write(0, bytes_of(&uniforms))?;
+
+        let mut passes: Vec<Pass> = Vec::new();
+        if self.env_dirty {
+            passes.extend(self.env_sh.passes(&self.env));
+        }
+        passes.extend(self.technique.passes(&self.frame_uniforms, &self.env, &self.env_sh.coefficients, &self.scene, &self.targets));
+        let targets = &self.targets;
+        passes.push(Pass::new("readback", &["color"], &[], move |cmd| targets.color.record_copy_to(cmd, &targets.readback)));
+        let imports: &[&'static str] =
+            if self.env_dirty { &["frame_uniforms", "environment"] } else { &["frame_uniforms", "environment", "env_sh"] };
+        let timings = self.executor.run(imports, passes)?;
+        self.env_dirty = false;
+        Ok(timings)
+    }
+
+    /// The last rendered frame: linear radiance, row 0 at the top.
+    pub fn image(&self) -> Result<RgbaF32Image> {
+        let bytes = self.targets.readback.read()?;
+        let pixels = bytes
+            .chunks_exact(16)
+            .map(|t| std::array::from_fn(|k| f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])))
+            .collect();
+        Ok(RgbaF32Image { width: self.targets.color.width, height: self.targets.color.height, pixels })
+    }
+
+    /// The environment's SH coefficients as the renderer uses them.
+    pub fn env_sh(&self) -> Result<crate::sh::ShRgb9> {
+        self.env_sh.read()
+    }
+}

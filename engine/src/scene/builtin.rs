@@ -1,0 +1,56 @@
+//! Scenes compiled into the library, so that Kage renders something with no file on disk.
+//! Their assets live in `engine/assets/` (licences in `engine/assets/LICENSES.md`).
+use glam::Vec3;
+
+use super::{obj, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
+
+const TEAPOT_OBJ: &[u8] = include_bytes!("../../assets/teapot.obj");
+const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
+
+/// The teapot's bounds in its OBJ: +Y up, centred on the origin, 15.75 units tall.
+const TEAPOT_HEIGHT: f32 = 15.75;
+
+/// Names accepted by [`Scene::builtin`]; the first is the default.
+pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor"];
+
+pub fn builtin(name: &str) -> Result<Scene, SceneError> {
+    // Floor grid vertices per side: 31×31 is the paper's low-resolution receiver, 111×111 its
+    // high-resolution one.
+    let floor_vertices = match name {
+        "teapot" => 31,
+        "teapot-hires-floor" => 111,
+        _ => {
+            return Err(SceneError::invalid(format!(
+                "no built-in scene \"{name}\"; the built-in scenes are: {}",
+                BUILTIN.join(", ")
+            )))
+        }
+    };
+    // The embedded assets are known good, but a failure still reports rather than panics.
+    let context = |e: SceneError| e.within(&format!("built-in scene \"{name}\""));
+    let teapot = obj::parse_obj(TEAPOT_OBJ, "teapot", [0.75; 3]).map_err(context)?;
+    let floor = shapes::plane("floor", [6.0, 6.0], [floor_vertices; 2], [0.6; 3]).map_err(context)?;
+    let environment = EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?;
+
+    // One unit tall, standing on the floor.
+    let teapot_transform = Transform {
+        translation: Vec3::new(0.0, 0.5, 0.0),
+        scale: 1.0 / TEAPOT_HEIGHT,
+        ..Transform::default()
+    };
+    Ok(Scene {
+        name: name.to_string(),
+        groups: vec![
+            Group { name: "teapot".into(), meshes: vec![teapot], transform: teapot_transform },
+            Group { name: "floor".into(), meshes: vec![floor], transform: Transform::default() },
+        ],
+        environment,
+        lights: Vec::new(),
+        camera: Camera {
+            position: Vec3::new(0.0, 2.2, 4.2),
+            target: Vec3::new(0.0, 0.4, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 40.0,
+        },
+    })
+}

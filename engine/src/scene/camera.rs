@@ -1,0 +1,96 @@
+//! A pinhole camera and the matrices the renderer draws with.
+use glam::{Mat4, Vec3};
+
+use super::SceneError;
+
+/// Clip planes of every projection. The scenes Kage renders are a few units across; with a 32-bit
+/// float depth buffer this range keeps depth precision far below a pixel.
+pub const NEAR: f32 = 0.01;
+pub const FAR: f32 = 1000.0;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view, in (0, 180) degrees.
+    pub fov_y_deg: f32,
+}
+
+impl Camera {
+    /// World to view space (right-handed, looking down −Z).
+    pub fn view(&self) -> Mat4 {
+        Mat4::look_at_rh(self.position, self.target, self.up)
+    }
+
+    /// View to Vulkan clip space: depth 0 at [`NEAR`] to 1 at [`FAR`], and Y negated because
+    /// Vulkan's framebuffer Y points down; so +Y in the world is up in the image (row 0 = top).
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        let flip_y = Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0));
+        flip_y * Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, NEAR, FAR)
+    }
+
+    /// Checks that the view and projection matrices will be well defined.
+    pub fn validated(self) -> Result<Camera, SceneError> {
+        for (name, v) in [("position", self.position), ("target", self.target), ("up", self.up)] {
+            if !v.is_finite() {
+                return Err(SceneError::invalid(format!("camera {name} {v} is not finite")));
+            }
+        }
+        let forward = self.target - self.position;
+        if forward.length_squared() == 0.0 {
+            return Err(SceneError::invalid("camera position and target are the same point"));
+        }
+        if self.up.length_squared() == 0.0 {
+            return Err(SceneError::invalid("camera up vector has zero length"));
+        }
+        if forward.normalize().cross(self.up.normalize()).length_squared() < 1e-12 {
+            return Err(SceneError::invalid("camera up vector is parallel to the viewing direction"));
+        }
+        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
+            return Err(SceneError::invalid(format!(
+                "camera fov_y_deg must be in (0, 180) degrees, got {}",
+                self.fov_y_deg
+            )));
+        }
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera { position: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 }
+    }
+
+    #[test]
+    fn world_up_is_image_top_and_depth_is_zero_to_one() {
+        let c = camera();
+        let clip = c.projection(1.0) * c.view();
+        let above = clip.project_point3(Vec3::new(0.0, 1.0, 0.0));
+        // Vulkan NDC: y = -1 is the top row.
+        assert!(above.y < 0.0);
+        let near = clip.project_point3(Vec3::new(0.0, 0.0, 5.0 - NEAR));
+        let far = clip.project_point3(Vec3::new(0.0, 0.0, 5.0 - FAR));
+        assert!(near.z.abs() < 1e-5 && (far.z - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn bad_cameras_are_rejected() {
+        assert!(camera().validated().is_ok());
+        let bad = [
+            Camera { target: camera().position, ..camera() },
+            Camera { up: Vec3::ZERO, ..camera() },
+            Camera { up: Vec3::Z, ..camera() },
+            Camera { fov_y_deg: 0.0, ..camera() },
+            Camera { fov_y_deg: 180.0, ..camera() },
+            Camera { fov_y_deg: f32::NAN, ..camera() },
+            Camera { position: Vec3::new(f32::NAN, 0.0, 0.0), ..camera() },
+        ];
+        for c in bad {
+            assert!(c.validated().is_err(), "{c:?}");
+        }
+    }
+}

@@ -1,0 +1,55 @@
+//! The one error type for everything a scene reads: its message always says which file (when
+//! there is one) and what is wrong with it, so a user can fix the input without a debugger.
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct SceneError {
+    file: Option<PathBuf>,
+    problem: String,
+}
+
+impl SceneError {
+    /// A problem with the named file.
+    pub fn in_file(file: impl Into<PathBuf>, problem: impl Into<String>) -> SceneError {
+        SceneError { file: Some(file.into()), problem: problem.into() }
+    }
+
+    /// A problem with data that came from no file (a built-in scene, an API call).
+    pub fn invalid(problem: impl Into<String>) -> SceneError {
+        SceneError { file: None, problem: problem.into() }
+    }
+
+    /// Prefixes the place the problem is at, e.g. `group 0 ("floor")`. A file this error already
+    /// names moves into the message, so nested errors read
+    /// `scene.json: group 0 ("teapot"): mesh 0: teapot.obj: ...` once attributed.
+    pub(crate) fn within(self, place: &str) -> SceneError {
+        SceneError { file: None, problem: format!("{place}: {self}") }
+    }
+
+    /// Names `file` as the file at fault, keeping any file already named in the message.
+    pub(crate) fn attributed_to(self, file: &Path) -> SceneError {
+        let problem = match self.file {
+            Some(_) => self.to_string(),
+            None => self.problem,
+        };
+        SceneError { file: Some(file.to_path_buf()), problem }
+    }
+
+    pub fn file(&self) -> Option<&Path> {
+        self.file.as_deref()
+    }
+
+    pub fn problem(&self) -> &str {
+        &self.problem
+    }
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.file {
+            Some(file) => write!(f, "{}: {}", file.display(), self.problem),
+            None => f.write_str(&self.problem),
+        }
+    }
+}

@@ -1,0 +1,88 @@
+//! Writing a scene as a self-contained folder that [`Scene::load`] reads back identically:
+//! `scene.json`, one OBJ per mesh and the environment as 32-bit float EXR.
+use std::collections::HashSet;
+use std::path::Path;
+
+use super::file::{CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, PointDesc, SceneFile, SpotDesc};
+use super::{obj, Light, Scene, SceneError};
+
+pub const SCENE_FILE: &str = "scene.json";
+pub const ENVIRONMENT_FILE: &str = "environment.exr";
+
+pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
+    std::fs::create_dir_all(dir).map_err(|e| SceneError::in_file(dir, format!("cannot create folder: {e}")))?;
+    scene.environment.write_exr(&dir.join(ENVIRONMENT_FILE))?;
+
+    let mut used_files = HashSet::new();
+    let mut groups = Vec::with_capacity(scene.groups.len());
+    for group in &scene.groups {
+        let mut meshes = Vec::with_capacity(group.meshes.len());
+        for mesh in &group.meshes {
+            let file = unique_file_name(&mesh.name, &mut used_files);
+            obj::write_obj(mesh, &dir.join(&file))?;
+            meshes.push(MeshDesc {
+                name: Some(mesh.name.clone()),
+                obj: Some(file),
+                plane: None,
+                sphere: None,
+                albedo: mesh.albedo,
+            });
+        }
+        let t = &group.transform;
+        groups.push(GroupDesc {
+            name: group.name.clone(),
+            translation: t.translation.to_array(),
+            rotation_deg: None,
+            // A quaternion, not Euler angles, so the rotation reads back bit for bit.
+            rotation_quat: Some(t.rotation.to_array()),
+            scale: t.scale,
+            meshes,
+        });
+    }
+
+    let c = &scene.camera;
+    let file = SceneFile {
+        name: Some(scene.name.clone()),
+        camera: CameraDesc {
+            position: c.position.to_array(),
+            target: c.target.to_array(),
+            up: c.up.to_array(),
+            fov_y_deg: c.fov_y_deg,
+        },
+        environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
+        groups,
+        lights: scene.lights.iter().map(light).collect(),
+    };
+    let path = dir.join(SCENE_FILE);
+    let json = serde_json::to_string_pretty(&file)
+        .map_err(|e| SceneError::in_file(&path, format!("cannot encode scene: {e}")))?;
+    std::fs::write(&path, json + "\n").map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))
+}
+
+fn light(light: &Light) -> LightDesc {
+    match *light {
+        Light::Point { position, intensity } => LightDesc::Point(PointDesc { position: position.to_array(), intensity }),
+        Light::Spot { position, direction, fov_deg, intensity } => LightDesc::Spot(SpotDesc {
+            position: position.to_array(),
+            direction: direction.to_array(),
+            fov_deg,
+            intensity,
+        }),
+    }
+}
+
+/// A portable file name from a mesh name; meshes with the same name get numbered files.
+fn unique_file_name(mesh_name: &str, used: &mut HashSet<String>) -> String {
+    let stem: String = mesh_name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .collect();
+    let stem = if stem.is_empty() { "mesh".to_string() } else { stem };
+    let mut file = format!("{stem}.obj");
+    let mut n = 2;
+    while !used.insert(file.clone()) {
+        file = format!("{stem}-{n}.obj");
+        n += 1;
+    }
+    file
+}

@@ -1,0 +1,115 @@
+//! Turning a parsed scene file into a validated [`Scene`]. Errors name the scene file and where
+//! in it the problem is; errors in a referenced file name that file too.
+use std::path::{Path, PathBuf};
+
+use glam::{Quat, Vec3};
+
+use super::file::{EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, SceneFile};
+use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
+
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
+    let file: SceneFile =
+        serde_json::from_str(&text).map_err(|e| SceneError::in_file(path, format!("invalid scene JSON: {e}")))?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+    let name = file.name.clone().or(stem).unwrap_or_default();
+    build(file, name, folder).map_err(|e| e.attributed_to(path))
+}
+
+/// Assembles a scene from its description; `folder` anchors the relative paths in it.
+fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
+    let c = &file.camera;
+    let camera = Camera {
+        position: Vec3::from(c.position),
+        target: Vec3::from(c.target),
+        up: Vec3::from(c.up),
+        fov_y_deg: c.fov_y_deg,
+    }
+    .validated()?;
+    let environment = environment(&file.environment, folder)?;
+    if file.groups.is_empty() {
+        return Err(SceneError::invalid("it has no groups"));
+    }
+    let groups = file
+        .groups
+        .into_iter()
+        .enumerate()
+        .map(|(at, g)| {
+            let place = format!("group {at} (\"{}\")", g.name);
+            group(g, folder).map_err(|e| e.within(&place))
+        })
+        .collect::<Result<_, _>>()?;
+    let lights = file
+        .lights
+        .into_iter()
+        .enumerate()
+        .map(|(at, l)| light(l).map_err(|e| e.within(&format!("light {at}"))))
+        .collect::<Result<_, _>>()?;
+    Ok(Scene { name, groups, environment, lights, camera })
+}
+
+fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneError> {
+    let map = match (&desc.image, desc.constant) {
+        (Some(image), None) => EnvMap::load(&folder.join(image))?,
+        (None, Some(rgb)) => {
+            if rgb.iter().any(|c| !(c.is_finite() && *c >= 0.0)) {
+                return Err(SceneError::invalid(format!("environment constant {rgb:?} must be finite and >= 0")));
+            }
+            EnvMap::constant(rgb)
+        }
+        _ => return Err(SceneError::invalid("environment needs exactly one of \"image\" or \"constant\"")),
+    };
+    map.scaled(desc.intensity)
+}
+
+fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
+    let rotation = match (desc.rotation_deg, desc.rotation_quat) {
+        (None, None) => Quat::IDENTITY,
+        (Some(degrees), None) => Transform::rotation_from_euler_deg(degrees),
+        (None, Some(q)) => Quat::from_array(q),
+        (Some(_), Some(_)) => {
+            return Err(SceneError::invalid("give either \"rotation_deg\" or \"rotation_quat\", not both"))
+        }
+    };
+    let transform = Transform { translation: Vec3::from(desc.translation), rotation, scale: desc.scale }.validated()?;
+    if desc.meshes.is_empty() {
+        return Err(SceneError::invalid("it has no meshes"));
+    }
+    let meshes = desc
+        .meshes
+        .into_iter()
+        .enumerate()
+        .map(|(at, m)| mesh(m, folder).map_err(|e| e.within(&format!("mesh {at}"))))
+        .collect::<Result<_, _>>()?;
+    Ok(Group { name: desc.name, meshes, transform })
+}
+
+fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
+    let mut mesh = match (desc.obj, desc.plane, desc.sphere) {
+        (Some(obj), None, None) => {
+            let path: PathBuf = folder.join(obj);
+            obj::load_obj(&path, desc.albedo)?
+        }
+        (None, Some(p), None) => shapes::plane("plane", p.size, p.vertices, desc.albedo)?,
+        (None, None, Some(s)) => shapes::sphere("sphere", s.radius, s.segments, desc.albedo)?,
+        _ => return Err(SceneError::invalid("a mesh needs exactly one of \"obj\", \"plane\" or \"sphere\"")),
+    };
+    if let Some(name) = desc.name {
+        mesh.name = name;
+    }
+    Ok(mesh)
+}
+
+fn light(desc: LightDesc) -> Result<Light, SceneError> {
+    let light = match desc {
+        LightDesc::Point(p) => Light::Point { position: Vec3::from(p.position), intensity: p.intensity },
+        LightDesc::Spot(s) => Light::Spot {
+            position: Vec3::from(s.position),
+            direction: Vec3::from(s.direction),
+            fov_deg: s.fov_deg,
+            intensity: s.intensity,
+        },
+    };
+    light.validated()
+}

@@ -1,0 +1,101 @@
+//! What a scene holds and how it is read and written.
+//!
+//! A [`Scene`] is rigid [`Group`]s of triangle [`Mesh`]es (one diffuse albedo each), one
+//! environment light ([`EnvMap`]), optional local [`Light`]s and a [`Camera`]. Nothing more until
+//! a technique needs it.
+//!
+//! Conventions:
+//! - Right-handed, +Y up. Group transforms scale uniformly, then rotate, then translate; Euler
+//!   angles in scene files are degrees with R = Rz · Ry · Rx (X applied first).
+//! - Triangles wind counter-clockwise seen from the side their normals point to.
+//! - Equirectangular environment maps: direction (x, y, z) ↔ u = atan2(x, −z) / 2π wrapped into
+//!   [0, 1), v = acos(y) / π; row 0 is the top (+Y); pixel centres at ((i + ½) / width,
+//!   (j + ½) / height). See [`envmap`] for the details and [`direction_to_uv`] for the code.
+//! - The camera's projection targets Vulkan clip space (depth 0..1) with +Y world up in the image.
+//!
+//! Scenes come from JSON files ([`file`] documents the schema), from the built-in set
+//! ([`BUILTIN`]), or from code. Every loading error is a [`SceneError`] naming the file and the
+//! problem.
+use std::path::Path;
+
+mod builtin;
+mod camera;
+pub mod envmap;
+mod error;
+mod export;
+pub mod file;
+mod light;
+mod load;
+mod mesh;
+mod obj;
+pub mod shapes;
+mod transform;
+
+pub use builtin::BUILTIN;
+pub use camera::{Camera, FAR, NEAR};
+pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
+pub use error::SceneError;
+pub use export::{ENVIRONMENT_FILE, SCENE_FILE};
+pub use light::{Light, MAX_SPOT_FOV_DEG};
+pub use mesh::Mesh;
+pub use obj::{load_obj, parse_obj, write_obj};
+pub use transform::Transform;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    pub name: String,
+    pub groups: Vec<Group>,
+    pub environment: EnvMap,
+    pub lights: Vec<Light>,
+    pub camera: Camera,
+}
+
+/// Meshes that move together.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Group {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub transform: Transform,
+}
+
+impl Scene {
+    /// Reads a JSON scene file; relative paths inside it are relative to its folder.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        load::load(path)
+    }
+
+    /// One of the scenes in [`BUILTIN`]; an unknown name is an error that lists them.
+    pub fn builtin(name: &str) -> Result<Scene, SceneError> {
+        builtin::builtin(name)
+    }
+
+    /// What a `--scene` argument means: an existing path or a name ending in `.json` is a scene
+    /// file, anything else a built-in name.
+    pub fn from_arg(arg: &str) -> Result<Scene, SceneError> {
+        let path = Path::new(arg);
+        if path.exists() || arg.ends_with(".json") {
+            Scene::load(path)
+        } else {
+            Scene::builtin(arg)
+        }
+    }
+
+    /// Writes `dir/`[`SCENE_FILE`], one OBJ per mesh and the environment as 32-bit float EXR,
+    /// such that [`Scene::load`] of the written scene file gives back this scene exactly
+    /// (meshes made by [`Mesh::new`] keep their vertex order; see [`Mesh`]).
+    pub fn export(&self, dir: &Path) -> Result<(), SceneError> {
+        export::export(self, dir)
+    }
+
+    pub fn meshes(&self) -> impl Iterator<Item = (&Group, &Mesh)> {
+        self.groups.iter().flat_map(|g| g.meshes.iter().map(move |m| (g, m)))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes().map(|(_, m)| m.triangle_count()).sum()
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.meshes().map(|(_, m)| m.vertex_count()).sum()
+    }
+}

@@ -1,0 +1,33 @@
+//! The environment map on the GPU: an RGBA32F image (alpha unused) and a sampler that wraps in
+//! longitude and clamps at the poles.
+use crate::backend::{vk, Context, Image, ImageDesc, Sampler};
+use crate::error::Result;
+use crate::scene::EnvMap;
+use std::sync::Arc;
+
+pub struct GpuEnvironment {
+    pub image: Image,
+    pub sampler: Sampler,
+}
+
+impl GpuEnvironment {
+    pub fn new(ctx: &Arc<Context>, map: &EnvMap) -> Result<GpuEnvironment> {
+        let image = Image::new(ctx, &ImageDesc {
+            name: "environment",
+            width: map.width(),
+            height: map.height(),
+            layers: 1,
+            format: vk::Format::R32G32B32A32_SFLOAT,
+            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+        })?;
+        let texels: Vec<u8> = map
+            .pixels()
+            .iter()
+            .flat_map(|p| [p[0], p[1], p[2], 0.0])
+            .flat_map(f32::to_ne_bytes)
+            .collect();
+        image.upload(&texels)?;
+        let sampler = Sampler::new(ctx, "environment.sampler", true, true)?;
+        Ok(GpuEnvironment { image, sampler })
+    }
+}

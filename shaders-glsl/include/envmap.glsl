@@ -1,0 +1,17 @@
+// Equirectangular mapping, the one documented in README and engine/src/scene:
+// u = atan2(x, -z) / 2pi wrapped into [0, 1), v = acos(y) / pi, row 0 at the top (+Y).
+#ifndef KAGE_ENVMAP_GLSL
+#define KAGE_ENVMAP_GLSL
+
+vec2 env_dir_to_uv(vec3 d) {
+    float u = atan(d.x, -d.z) / (2.0 * 3.14159265358979323846);
+    return vec2(fract(u), acos(clamp(d.y, -1.0, 1.0)) / 3.14159265358979323846);
+}
+
+vec3 env_uv_to_dir(vec2 uv) {
+    float theta = 3.14159265358979323846 * uv.y;
+    float phi = 2.0 * 3.14159265358979323846 * uv.x;
+    return vec3(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
+}
+
+#endif

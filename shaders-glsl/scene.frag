@@ -1,0 +1,17 @@
+#version 460
+// Unshadowed environment lighting: L = albedo / pi * E(n), E from the map's 9 SH coefficients.
+#include "layouts.glsl"
+#include "sh.glsl"
+
+layout(set = 0, binding = 1, std430) readonly buffer Sh { ShCoeffs sh; };
+layout(push_constant) uniform Push { DrawPush draw; };
+layout(location = 0) in vec3 world_normal;
+layout(location = 0) out vec4 color;
+
+void main() {
+    // Surfaces are two-sided: the back of an open mesh (the inside of the teapot) is lit as
+    // seen, with its normal turned towards the viewer.
+    vec3 n = normalize(gl_FrontFacing ? world_normal : -world_normal);
+    vec3 irradiance = max(sh9_irradiance(sh.c, n), vec3(0.0));
+    color = vec4(draw.albedo.rgb / KAGE_PI * irradiance, 1.0);
+}

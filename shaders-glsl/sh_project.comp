@@ -1,0 +1,39 @@
+#version 460
+// Projects the environment map onto 9 SH coefficients per channel. Invocation `lane` of group
+// `g` adds texels g*N*T + t*N + lane (t < T, N invocations per group), so neighbouring
+// invocations read neighbouring texels; each group writes one partial, which sh_reduce.comp
+// adds up.
+#include "constants.glsl"
+#include "layouts.glsl"
+#include "sh.glsl"
+#include "envmap.glsl"
+#include "sh_reduce.glsl"
+
+layout(local_size_x = KAGE_SH_GROUP) in;
+layout(set = 0, binding = 0) uniform sampler2D env;
+layout(set = 0, binding = 1, std430) writeonly buffer Partials { ShCoeffs partials[]; };
+layout(push_constant) uniform Push { ShProjectPush p; };  // size.xy: map size, z: texels per invocation
+
+void main() {
+    uint w = p.size.x, h = p.size.y;
+    vec3 acc[9];
+    for (int i = 0; i < 9; ++i) acc[i] = vec3(0.0);
+    uint first = gl_WorkGroupID.x * KAGE_SH_GROUP * p.size.z + gl_LocalInvocationIndex;
+    for (uint t = 0; t < p.size.z; ++t) {
+        uint index = first + t * KAGE_SH_GROUP;
+        if (index >= w * h) break;
+        uvec2 texel = uvec2(index % w, index / w);
+        vec3 dir = env_uv_to_dir((vec2(texel) + 0.5) / vec2(w, h));
+        // Exact solid angle of an equirectangular texel: (2pi / w) (cos theta0 - cos theta1).
+        float solid_angle = (2.0 * KAGE_PI / float(w))
+            * (cos(KAGE_PI * float(texel.y) / float(h)) - cos(KAGE_PI * float(texel.y + 1) / float(h)));
+        vec3 weighted = texelFetch(env, ivec2(texel), 0).rgb * solid_angle;
+        float y[9];
+        sh9_basis(dir, y);
+        for (int i = 0; i < 9; ++i) acc[i] += weighted * y[i];
+    }
+    sh_workgroup_sum(acc);
+    if (gl_LocalInvocationIndex == 0) {
+        for (int i = 0; i < 9; ++i) partials[gl_WorkGroupID.x].c[i] = vec4(acc[i], 0.0);
+    }
+}

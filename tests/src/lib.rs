@@ -1,0 +1,59 @@
+//! Helpers shared by Kage's integration tests: a validated context that fails the test on any
+//! validation message, small scenes built in code, and scratch folders.
+use kage::backend::{Context, ContextDesc};
+use kage::scene::{Camera, EnvMap, Group, Mesh, Scene, Transform};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A context with validation on. Dropping it asserts that validation reported nothing, so a
+/// test cannot forget the check.
+pub struct Validated(pub Arc<Context>);
+
+impl Validated {
+    pub fn new() -> Validated {
+        let ctx = Context::new(&ContextDesc { validation: true, device: None })
+            .expect("a Vulkan device with validation layers (run scripts/deps.sh)");
+        Validated(ctx)
+    }
+}
+
+impl Default for Validated {
+    fn default() -> Self {
+        Validated::new()
+    }
+}
+
+impl std::ops::Deref for Validated {
+    type Target = Arc<Context>;
+    fn deref(&self) -> &Arc<Context> {
+        &self.0
+    }
+}
+
+impl Drop for Validated {
+    fn drop(&mut self) {
+        let messages = self.0.take_validation_messages();
+        if !std::thread::panicking() {
+            assert!(messages.is_empty(), "validation reported:\n{}", messages.join("\n"));
+        }
+    }
+}
+
+/// A scene of one group holding `mesh`, under `environment`, seen by `camera`.
+pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Scene {
+    Scene {
+        name: "test".into(),
+        groups: vec![Group { name: "object".into(), meshes: vec![mesh], transform: Transform::default() }],
+        environment,
+        lights: vec![],
+        camera,
+    }
+}
+
+/// A fresh, empty folder under the system temp folder, unique per test.
+pub fn scratch_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kage-tests-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp folder");
+    dir
+}

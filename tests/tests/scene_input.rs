@@ -1,0 +1,250 @@
+//! Scene input: every kind of bad file gives an error naming the file and the problem (never a
+//! panic), and an exported scene reads back identical. No GPU needed.
+use std::path::{Path, PathBuf};
+
+use kage::scene::{Scene, BUILTIN};
+
+/// A fresh, empty folder under the system temp dir, unique to this process and test.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kage-scene-input-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+const CAMERA: &str = r#""camera": {"position": [0, 2, 6], "target": [0, 0.5, 0], "fov_y_deg": 40}"#;
+const ENVIRONMENT: &str = r#""environment": {"constant": [1, 1, 1]}"#;
+const TRIANGLE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+/// A scene file with one group holding `meshes`, plus any extra top-level entries.
+fn scene_json(group_extra: &str, meshes: &str, top_extra: &str) -> String {
+    format!(
+        r#"{{{CAMERA}, {ENVIRONMENT}{top_extra},
+            "groups": [{{"name": "g"{group_extra}, "meshes": [{meshes}]}}]}}"#
+    )
+}
+
+fn write(dir: &Path, name: &str, contents: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, contents).unwrap();
+    path
+}
+
+fn write_exr(dir: &Path, name: &str, width: usize, height: usize, value: [f32; 3]) -> PathBuf {
+    let path = dir.join(name);
+    exr::prelude::write_rgb_file(&path, width, height, |x, y| {
+        if (x, y) == (1, 1) {
+            (value[0], value[1], value[2])
+        } else {
+            (1.0f32, 1.0f32, 1.0f32)
+        }
+    })
+    .unwrap();
+    path
+}
+
+/// Loads `scene` and checks that the error names `blamed` (a file name) and says `problem`.
+#[track_caller]
+fn assert_rejected(scene: &Path, blamed: &str, problem: &str) {
+    match Scene::load(scene) {
+        Ok(_) => panic!("{} loaded, but should fail with {problem:?}", scene.display()),
+        Err(e) => {
+            let message = e.to_string();
+            assert!(message.contains(blamed), "{message:?} does not name {blamed:?}");
+            assert!(message.contains(problem), "{message:?} does not say {problem:?}");
+        }
+    }
+}
+
+#[test]
+fn missing_files_are_named() {
+    let dir = temp_dir("missing");
+    assert_rejected(&dir.join("nowhere.json"), "nowhere.json", "cannot read");
+    let scene = write(&dir, "scene.json", &scene_json("", r#"{"obj": "absent.obj", "albedo": [0.5, 0.5, 0.5]}"#, ""));
+    assert_rejected(&scene, "absent.obj", "cannot read");
+    let scene = write(&dir, "env.json", &scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#, "")
+        .replace(r#"{"constant": [1, 1, 1]}"#, r#"{"image": "absent.exr"}"#));
+    assert_rejected(&scene, "absent.exr", "cannot read");
+}
+
+#[test]
+fn bad_obj_files_are_rejected() {
+    let dir = temp_dir("obj");
+    let cases = [
+        ("malformed.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n", "malformed"),
+        ("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "NaN"),
+        ("infinite.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", "infinite"),
+        ("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of"),
+        ("empty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no triangles"),
+    ];
+    for (file, contents, problem) in cases {
+        write(&dir, file, contents);
+        let mesh = format!(r#"{{"obj": "{file}", "albedo": [0.5, 0.5, 0.5]}}"#);
+        let scene = write(&dir, &format!("{file}.json"), &scene_json("", &mesh, ""));
+        assert_rejected(&scene, file, problem);
+        // The scene file that referred to the OBJ is named too.
+        assert_rejected(&scene, &format!("{file}.json"), problem);
+    }
+}
+
+#[test]
+fn bad_environment_images_are_rejected() {
+    let dir = temp_dir("env");
+    write_exr(&dir, "square.exr", 4, 4, [1.0; 3]);
+    write_exr(&dir, "nan.exr", 4, 2, [1.0, f32::NAN, 1.0]);
+    write_exr(&dir, "inf.exr", 4, 2, [f32::INFINITY, 1.0, 1.0]);
+    write(&dir, "env.png", "not an image");
+    write(&dir, "garbage.exr", "not an image");
+    let cases = [
+        ("square.exr", "2:1"),
+        ("nan.exr", "NaN"),
+        ("inf.exr", "infinite"),
+        ("env.png", "unsupported"),
+        ("garbage.exr", "OpenEXR"),
+    ];
+    for (file, problem) in cases {
+        let json = scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#, "")
+            .replace(r#"{"constant": [1, 1, 1]}"#, &format!(r#"{{"image": "{file}"}}"#));
+        let scene = write(&dir, &format!("{file}.json"), &json);
+        assert_rejected(&scene, file, problem);
+    }
+}
+
+#[test]
+fn negative_pixels_are_clamped_and_counted() {
+    let dir = temp_dir("negative");
+    let path = write_exr(&dir, "negative.exr", 4, 2, [-1.0, 0.5, -2.0]);
+    let map = kage::scene::EnvMap::load(&path).unwrap();
+    assert_eq!(map.pixels()[4 + 1], [0.0, 0.5, 0.0]);
+    assert_eq!(map.clamped_negative(), 2);
+}
+
+#[test]
+fn radiance_hdr_files_load_and_are_checked() {
+    let dir = temp_dir("hdr");
+    // Uncompressed RGBE (rows narrower than 8 pixels are never run-length encoded);
+    // (128, 128, 128, 129) encodes 1.0 in each channel.
+    let hdr = |width: usize, height: usize| {
+        let mut bytes = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n").into_bytes();
+        for _ in 0..width * height {
+            bytes.extend([128, 128, 128, 129]);
+        }
+        bytes
+    };
+    std::fs::write(dir.join("good.hdr"), hdr(4, 2)).unwrap();
+    std::fs::write(dir.join("square.hdr"), hdr(4, 4)).unwrap();
+    let map = kage::scene::EnvMap::load(&dir.join("good.hdr")).unwrap();
+    assert_eq!((map.width(), map.height()), (4, 2));
+    assert!(map.pixels().iter().all(|p| *p == [1.0; 3]), "{:?}", map.pixels()[0]);
+    let message = kage::scene::EnvMap::load(&dir.join("square.hdr")).unwrap_err().to_string();
+    assert!(message.contains("square.hdr") && message.contains("2:1"), "{message}");
+}
+
+#[test]
+fn bad_scene_values_are_rejected() {
+    let dir = temp_dir("values");
+    let sphere = r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
+    let cases = [
+        ("syntax", "{\"camera\": ".to_string(), "line"),
+        ("unknown-top", scene_json("", sphere, r#", "fog": 1"#), "unknown field `fog`"),
+        ("unknown-group", scene_json(r#", "colour": 1"#, sphere, ""), "unknown field `colour`"),
+        ("unknown-mesh", scene_json("", r#"{"sphere": {"radius": 1, "segments": 8, "rings": 3}, "albedo": [1, 1, 1]}"#, ""), "unknown field `rings`"),
+        ("zero-scale", scene_json(r#", "scale": 0"#, sphere, ""), "scale"),
+        ("negative-scale", scene_json(r#", "scale": -2"#, sphere, ""), "scale"),
+        ("infinite-translation", scene_json(r#", "translation": [0, 1e39, 0]"#, sphere, ""), "translation"),
+        ("infinite-rotation", scene_json(r#", "rotation_deg": [1e39, 0, 0]"#, sphere, ""), "rotation"),
+        ("albedo", scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 1.5, 0.5]}"#, ""), "albedo"),
+        ("two-shapes", scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "obj": "a.obj", "albedo": [1, 1, 1]}"#, ""), "exactly one"),
+        ("no-meshes", scene_json("", "", ""), "no meshes"),
+        ("plane", scene_json("", r#"{"plane": {"size": [1, 1], "vertices": [1, 5]}, "albedo": [1, 1, 1]}"#, ""), "plane vertices"),
+        ("spot-fov", scene_json("", sphere, r#", "lights": [{"spot": {"position": [0, 3, 0], "direction": [0, -1, 0], "fov_deg": 171, "intensity": [1, 1, 1]}}]"#), "fov_deg"),
+        ("spot-direction", scene_json("", sphere, r#", "lights": [{"spot": {"position": [0, 3, 0], "direction": [0, 0, 0], "fov_deg": 60, "intensity": [1, 1, 1]}}]"#), "direction"),
+        ("light-kind", scene_json("", sphere, r#", "lights": [{"area": {}}]"#), "unknown variant `area`"),
+        ("env-intensity", scene_json("", sphere, "").replace(r#""constant": [1, 1, 1]"#, r#""constant": [1, 1, 1], "intensity": -1"#), "intensity"),
+    ];
+    for (name, json, problem) in cases {
+        let file = format!("{name}.json");
+        assert_rejected(&write(&dir, &file, &json), &file, problem);
+    }
+}
+
+#[test]
+fn bad_cameras_are_rejected() {
+    let dir = temp_dir("camera");
+    let sphere = r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
+    let cases = [
+        ("same-point", r#""position": [1, 2, 3], "target": [1, 2, 3], "fov_y_deg": 40"#, "same point"),
+        ("zero-up", r#""position": [0, 2, 6], "target": [0, 0, 0], "up": [0, 0, 0], "fov_y_deg": 40"#, "up"),
+        ("fov-zero", r#""position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 0"#, "fov_y_deg"),
+        ("fov-180", r#""position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 180"#, "fov_y_deg"),
+        ("infinite", r#""position": [0, 1e39, 6], "target": [0, 0, 0], "fov_y_deg": 40"#, "not finite"),
+    ];
+    for (name, camera, problem) in cases {
+        let json = scene_json("", sphere, "").replace(
+            r#""camera": {"position": [0, 2, 6], "target": [0, 0.5, 0], "fov_y_deg": 40}"#,
+            &format!(r#""camera": {{{camera}}}"#),
+        );
+        let file = format!("{name}.json");
+        assert_rejected(&write(&dir, &file, &json), &file, problem);
+    }
+}
+
+#[test]
+fn a_full_scene_file_loads() {
+    let dir = temp_dir("full");
+    write(&dir, "tri.obj", TRIANGLE_OBJ);
+    let meshes = r#"{"obj": "tri.obj", "albedo": [0.8, 0.8, 0.8]},
+                    {"plane": {"size": [10, 10], "vertices": [3, 4]}, "albedo": [0.6, 0.6, 0.6]},
+                    {"name": "ball", "sphere": {"radius": 1, "segments": 16}, "albedo": [0.5, 0.5, 0.5]}"#;
+    let lights = r#", "lights": [{"point": {"position": [0, 3, 0], "intensity": [5, 5, 5]}},
+        {"spot": {"position": [2, 3, 0], "direction": [0, -2, 0], "fov_deg": 170, "intensity": [9, 9, 9]}}]"#;
+    let path = write(&dir, "full.json", &scene_json(r#", "rotation_deg": [0, 90, 0], "scale": 2"#, meshes, lights));
+    let scene = Scene::from_arg(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.name, "full");
+    let group = &scene.groups[0];
+    let names: Vec<_> = group.meshes.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["tri", "plane", "ball"]);
+    assert_eq!(group.meshes[1].vertex_count(), 12);
+    let turned = group.transform.matrix().transform_vector3(glam::Vec3::Z);
+    assert!((turned - glam::Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5);
+    assert_eq!(scene.lights.len(), 2);
+    if let kage::scene::Light::Spot { direction, .. } = scene.lights[1] {
+        assert_eq!(direction, glam::Vec3::NEG_Y);
+    }
+}
+
+#[test]
+fn built_in_scenes_are_listed_and_unknown_names_rejected() {
+    assert_eq!(BUILTIN[0], "teapot");
+    let message = Scene::from_arg("no-such-scene").unwrap_err().to_string();
+    assert!(BUILTIN.iter().all(|name| message.contains(name)), "{message}");
+    let hires = Scene::builtin("teapot-hires-floor").unwrap();
+    let floor = hires.groups.iter().find(|g| g.name == "floor").unwrap();
+    assert_eq!(floor.meshes[0].vertex_count(), 111 * 111);
+}
+
+#[test]
+fn exported_teapot_reads_back_identical() {
+    let dir = temp_dir("export");
+    let scene = Scene::builtin("teapot").unwrap();
+    let floor = scene.groups.iter().find(|g| g.name == "floor").unwrap();
+    assert_eq!(floor.meshes[0].vertex_count(), 31 * 31);
+    scene.export(&dir).unwrap();
+    let back = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
+    // Field by field first, so a failure says what differs; then everything at once.
+    assert_eq!(back.name, scene.name);
+    assert_eq!(back.camera, scene.camera);
+    assert_eq!(back.lights, scene.lights);
+    for (a, b) in back.groups.iter().zip(&scene.groups) {
+        assert_eq!((&a.name, a.transform), (&b.name, b.transform));
+        for (m, n) in a.meshes.iter().zip(&b.meshes) {
+            assert_eq!(m.name, n.name);
+            assert_eq!(m.albedo, n.albedo);
+            assert!(m.positions == n.positions, "positions of {} differ", m.name);
+            assert!(m.normals == n.normals, "normals of {} differ", m.name);
+            assert!(m.indices == n.indices, "indices of {} differ", m.name);
+        }
+    }
+    assert!(back.environment == scene.environment, "environment pixels differ");
+    assert!(back == scene);
+}

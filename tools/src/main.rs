@@ -1,0 +1,71 @@
+//! `kage`: the command-line front end of the Kage engine.
+mod info;
+mod render;
+mod scene_cmd;
+mod sh_cmd;
+
+use anyhow::{bail, Result};
+use clap::{Parser, Subcommand};
+use kage::backend::{Context, ContextDesc};
+use std::sync::Arc;
+
+#[derive(Parser)]
+#[command(name = "kage", version, about = "Kage (影): real-time lighting on raw Vulkan")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options every GPU command takes.
+#[derive(clap::Args, Clone, Debug)]
+pub struct GpuArgs {
+    /// Turn on VK_LAYER_KHRONOS_validation; any warning or error it reports fails the command.
+    #[arg(long)]
+    validate: bool,
+    /// Use the first Vulkan device whose name contains this (default: $KAGE_DEVICE, else a
+    /// discrete GPU, else any).
+    #[arg(long)]
+    device: Option<String>,
+}
+
+impl GpuArgs {
+    pub fn context(&self) -> Result<Arc<Context>> {
+        Ok(Context::new(&ContextDesc { validation: self.validate, device: self.device.clone() })?)
+    }
+
+    /// Fails when validation reported anything during the command.
+    pub fn finish(&self, ctx: &Context) -> Result<()> {
+        let messages = ctx.take_validation_messages();
+        if !messages.is_empty() {
+            bail!("validation reported {} message(s); the first: {}", messages.len(), messages[0]);
+        }
+        Ok(())
+    }
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene offscreen to PNG (tonemapped, sRGB) or EXR (linear radiance).
+    Render(render::RenderArgs),
+    /// Print an environment map's 9 SH coefficients per channel (projected on the GPU).
+    Sh(sh_cmd::ShArgs),
+    /// Print the device, driver, Vulkan version and each feature Kage uses.
+    Info(GpuArgs),
+    /// Scene utilities.
+    #[command(subcommand)]
+    Scene(scene_cmd::SceneCommand),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render::run(&args),
+        Command::Sh(args) => sh_cmd::run(&args),
+        Command::Info(args) => info::run(&args),
+        Command::Scene(command) => scene_cmd::run(&command),
+    };
+    if let Err(e) = result {
+        eprintln!("kage: error: {e:#}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,50 @@
+//! `kage sh MAP`: the environment's SH coefficients, and optionally the irradiance they give.
+use crate::GpuArgs;
+use anyhow::{Context as _, Result};
+use clap::Args;
+use kage::scene::EnvMap;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct ShArgs {
+    /// An equirectangular map (.exr or .hdr, 2:1).
+    map: PathBuf,
+    /// Also print the irradiance E(n) for this normal, given as x,y,z (normalised for you).
+    #[arg(long, value_parser = parse_vec3)]
+    irradiance: Option<glam::Vec3>,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match parts.as_slice() {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok(glam::Vec3::new(*x, *y, *z)),
+        _ => Err(format!("expected three finite numbers x,y,z, got {s:?}")),
+    }
+}
+
+pub fn run(args: &ShArgs) -> Result<()> {
+    let map = EnvMap::load(&args.map)?;
+    let ctx = args.gpu.context()?;
+    let sh = kage::techniques::env_sh::project(&ctx, &map).context("projecting on the GPU")?;
+    println!("# real SH, index = l*(l+1)+m, orthonormal basis (see README, \"SH basis\")");
+    println!("# {:>5} {:>3} {:>3} {:>14} {:>14} {:>14}", "index", "l", "m", "red", "green", "blue");
+    for (i, c) in sh.c.iter().enumerate() {
+        let l = (i as f64).sqrt() as i32;
+        let m = i as i32 - l * (l + 1);
+        println!("  {i:>5} {l:>3} {m:>3} {:>14.6e} {:>14.6e} {:>14.6e}", c[0], c[1], c[2]);
+    }
+    if let Some(n) = args.irradiance {
+        if n.length_squared() == 0.0 {
+            anyhow::bail!("--irradiance needs a non-zero normal");
+        }
+        let n = n.normalize();
+        let e = sh.irradiance(n);
+        println!("irradiance at n = ({:.6}, {:.6}, {:.6}): {:.6e} {:.6e} {:.6e}", n.x, n.y, n.z, e[0], e[1], e[2]);
+    }
+    args.gpu.finish(&ctx)
+}
