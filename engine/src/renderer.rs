@@ -50,15 +50,28 @@ impl GpuScene {
                 let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
                 let name = format!("{}.{}", group.name, mesh.name);
                 meshes.push(GpuMesh {
-                    vertices: Buffer::with_data(ctx, &format!("{name}.vertices"), vk::BufferUsageFlags::VERTEX_BUFFER, &vertices)?,
-                    indices: Buffer::with_data(ctx, &format!("{name}.indices"), vk::BufferUsageFlags::INDEX_BUFFER, &indices)?,
+                    vertices: Buffer::with_data(
+                        ctx,
+                        &format!("{name}.vertices"),
+                        vk::BufferUsageFlags::VERTEX_BUFFER,
+                        &vertices,
+                    )?,
+                    indices: Buffer::with_data(
+                        ctx,
+                        &format!("{name}.indices"),
+                        vk::BufferUsageFlags::INDEX_BUFFER,
+                        &indices,
+                    )?,
                     index_count: mesh.indices.len() as u32,
                     albedo: mesh.albedo,
                     group: g,
                 });
             }
         }
-        Ok(GpuScene { meshes, transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect() })
+        Ok(GpuScene {
+            meshes,
+            transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect(),
+        })
     }
 }
 
@@ -75,29 +88,42 @@ impl Targets {
                 "image size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
             )));
         }
-        let color = Image::new(ctx, &ImageDesc {
-            name: "color",
-            width,
-            height,
-            layers: 1,
-            format: COLOR_FORMAT,
-            usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-        })?;
-        let depth = Image::new(ctx, &ImageDesc {
-            name: "depth",
-            width,
-            height,
-            layers: 1,
-            format: DEPTH_FORMAT,
-            usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        })?;
-        let readback = Buffer::new(ctx, &BufferDesc {
-            name: "color.readback",
-            size: color.byte_size()?,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuToCpu,
-        })?;
-        Ok(Targets { color, depth, readback })
+        let color = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "color",
+                width,
+                height,
+                layers: 1,
+                format: COLOR_FORMAT,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            },
+        )?;
+        let depth = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "depth",
+                width,
+                height,
+                layers: 1,
+                format: DEPTH_FORMAT,
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            },
+        )?;
+        let readback = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "color.readback",
+                size: color.byte_size()?,
+                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )?;
+        Ok(Targets {
+            color,
+            depth,
+            readback,
+        })
     }
 }
 
@@ -110,7 +136,10 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { width: 512, height: 512 }
+        RenderOptions {
+            width: 512,
+            height: 512,
+        }
     }
 }
 
@@ -131,17 +160,20 @@ impl Renderer {
         let targets = Targets::new(ctx, options.width, options.height)?;
         Ok(Renderer {
             scene: GpuScene::new(ctx, scene)?,
-            camera: scene.camera.clone(),
+            camera: scene.camera,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
             env_sh: EnvSh::new(ctx, &scene.environment)?,
             env_dirty: true,
             technique: Unshadowed::new(ctx)?,
-            frame_uniforms: Buffer::new(ctx, &BufferDesc {
-                name: "frame_uniforms",
-                size: size_of::<FrameUniforms>() as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                location: MemoryLocation::CpuToGpu,
-            })?,
+            frame_uniforms: Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name: "frame_uniforms",
+                    size: size_of::<FrameUniforms>() as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?,
             targets,
             executor: FrameExecutor::new(ctx, "frame")?,
         })
@@ -151,10 +183,14 @@ impl Renderer {
     pub fn set_group_transform(&mut self, group: usize, transform: Mat4) -> Result<()> {
         let count = self.scene.transforms.len();
         if !transform.is_finite() {
-            return Err(Error::InvalidArgument(format!("transform of group {group} is not finite")));
+            return Err(Error::InvalidArgument(format!(
+                "transform of group {group} is not finite"
+            )));
         }
         let slot = self.scene.transforms.get_mut(group).ok_or_else(|| {
-            Error::InvalidArgument(format!("group {group} does not exist (the scene has {count})"))
+            Error::InvalidArgument(format!(
+                "group {group} does not exist (the scene has {count})"
+            ))
         })?;
         *slot = transform;
         Ok(())
@@ -176,11 +212,22 @@ impl Renderer {
         if self.env_dirty {
             passes.extend(self.env_sh.passes(&self.env));
         }
-        passes.extend(self.technique.passes(&self.frame_uniforms, &self.env, &self.env_sh.coefficients, &self.scene, &self.targets));
+        passes.extend(self.technique.passes(
+            &self.frame_uniforms,
+            &self.env,
+            &self.env_sh.coefficients,
+            &self.scene,
+            &self.targets,
+        ));
         let targets = &self.targets;
-        passes.push(Pass::new("readback", &["color"], &[], move |cmd| targets.color.record_copy_to(cmd, &targets.readback)));
-        let imports: &[&'static str] =
-            if self.env_dirty { &["frame_uniforms", "environment"] } else { &["frame_uniforms", "environment", "env_sh"] };
+        passes.push(Pass::new("readback", &["color"], &[], move |cmd| {
+            targets.color.record_copy_to(cmd, &targets.readback)
+        }));
+        let imports: &[&'static str] = if self.env_dirty {
+            &["frame_uniforms", "environment"]
+        } else {
+            &["frame_uniforms", "environment", "env_sh"]
+        };
         let timings = self.executor.run(imports, passes)?;
         self.env_dirty = false;
         Ok(timings)
@@ -191,9 +238,17 @@ impl Renderer {
         let bytes = self.targets.readback.read()?;
         let pixels = bytes
             .chunks_exact(16)
-            .map(|t| std::array::from_fn(|k| f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])))
+            .map(|t| {
+                std::array::from_fn(|k| {
+                    f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])
+                })
+            })
             .collect();
-        Ok(RgbaF32Image { width: self.targets.color.width, height: self.targets.color.height, pixels })
+        Ok(RgbaF32Image {
+            width: self.targets.color.width,
+            height: self.targets.color.height,
+            pixels,
+        })
     }
 
     /// The environment's SH coefficients as the renderer uses them.

@@ -20,9 +20,17 @@ fn constant_map_projects_to_the_first_coefficient_only() {
     let sh = env_sh::project(&ctx, &map).unwrap();
     for k in 0..3 {
         let expected = 2.0 * PI.sqrt() * c * (k + 1) as f32;
-        assert!((sh.c[0][k] - expected).abs() < SH_TOLERANCE * expected, "c0[{k}] = {} vs {expected}", sh.c[0][k]);
+        assert!(
+            (sh.c[0][k] - expected).abs() < SH_TOLERANCE * expected,
+            "c0[{k}] = {} vs {expected}",
+            sh.c[0][k]
+        );
         for i in 1..9 {
-            assert!(sh.c[i][k].abs() < SH_TOLERANCE * expected, "c{i}[{k}] = {}", sh.c[i][k]);
+            assert!(
+                sh.c[i][k].abs() < SH_TOLERANCE * expected,
+                "c{i}[{k}] = {}",
+                sh.c[i][k]
+            );
         }
     }
 }
@@ -34,17 +42,34 @@ fn linear_map_projects_to_bands_0_and_1() {
     let coefficients = Vec3::new(0.5, 0.25, -0.3); // radiance 1 + a.x x + a.y y + a.z z
     let pixels = (0..w * h)
         .map(|p| {
-            let uv = Vec2::new(((p % w) as f32 + 0.5) / w as f32, ((p / w) as f32 + 0.5) / h as f32);
+            let uv = Vec2::new(
+                ((p % w) as f32 + 0.5) / w as f32,
+                ((p / w) as f32 + 0.5) / h as f32,
+            );
             [1.0 + coefficients.dot(uv_to_direction(uv)); 3]
         })
         .collect();
     let sh = env_sh::project(&ctx, &EnvMap::from_pixels(w, h, pixels).unwrap()).unwrap();
     let band1 = (4.0 * PI / 3.0).sqrt();
     // Index order: y00, y1-1 (y), y10 (z), y11 (x), then band 2.
-    let expected = [2.0 * PI.sqrt(), coefficients.y * band1, coefficients.z * band1, coefficients.x * band1, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let expected = [
+        2.0 * PI.sqrt(),
+        coefficients.y * band1,
+        coefficients.z * band1,
+        coefficients.x * band1,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
     // Pixel-centre quadrature on a 256x128 map: errors below 1e-3 of c0.
     for (i, e) in expected.iter().enumerate() {
-        assert!((sh.c[i][0] - e).abs() < 1e-3 * expected[0], "c{i} = {} vs {e}", sh.c[i][0]);
+        assert!(
+            (sh.c[i][0] - e).abs() < 1e-3 * expected[0],
+            "c{i} = {} vs {e}",
+            sh.c[i][0]
+        );
     }
 }
 
@@ -59,7 +84,12 @@ fn gpu_projection_matches_the_cpu_reference_on_a_real_map() {
     for i in 0..9 {
         for k in 0..3 {
             let diff = (gpu.c[i][k] as f64 - cpu[i][k]).abs();
-            assert!(diff < SH_TOLERANCE as f64 * scale, "c{i}[{k}]: gpu {} cpu {}", gpu.c[i][k], cpu[i][k]);
+            assert!(
+                diff < SH_TOLERANCE as f64 * scale,
+                "c{i}[{k}]: gpu {} cpu {}",
+                gpu.c[i][k],
+                cpu[i][k]
+            );
         }
     }
 }
@@ -68,7 +98,10 @@ fn gpu_projection_matches_the_cpu_reference_on_a_real_map() {
 /// uses (row 0 at the top).
 fn pixel_ray(camera: &Camera, x: u32, y: u32, size: u32) -> Vec3 {
     let inv: Mat4 = (camera.projection(1.0) * camera.view()).inverse();
-    let ndc = Vec2::new((x as f32 + 0.5) / size as f32 * 2.0 - 1.0, (y as f32 + 0.5) / size as f32 * 2.0 - 1.0);
+    let ndc = Vec2::new(
+        (x as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+        (y as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+    );
     let p = inv * Vec4::new(ndc.x, ndc.y, 0.5, 1.0);
     (p.truncate() / p.w - camera.position).normalize()
 }
@@ -85,11 +118,24 @@ fn miss_distance(origin: Vec3, dir: Vec3) -> f32 {
 fn sphere_under_constant_light_has_radiance_albedo() {
     let ctx = Validated::new();
     let rho = 0.6;
-    let camera = Camera { position: Vec3::new(0.0, 0.5, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
+    let camera = Camera {
+        position: Vec3::new(0.0, 0.5, 4.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+    };
     let sphere = shapes::sphere("sphere", 1.0, 64, [rho; 3]).unwrap();
     let scene = single_mesh_scene(sphere, EnvMap::constant([1.0; 3]), camera);
     let size = 96;
-    let mut renderer = Renderer::new(&ctx, &scene, &RenderOptions { width: size, height: size }).unwrap();
+    let mut renderer = Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions {
+            width: size,
+            height: size,
+        },
+    )
+    .unwrap();
     renderer.render().unwrap();
     let image = renderer.image().unwrap();
     let (mut on_sphere, mut on_background) = (0, 0);
@@ -101,17 +147,26 @@ fn sphere_under_constant_light_has_radiance_albedo() {
             if d < 0.97 {
                 on_sphere += 1;
                 for k in 0..3 {
-                    assert!((pixel[k] - rho).abs() <= 0.01 * rho, "pixel ({x}, {y}) = {pixel:?}, expected {rho}");
+                    assert!(
+                        (pixel[k] - rho).abs() <= 0.01 * rho,
+                        "pixel ({x}, {y}) = {pixel:?}, expected {rho}"
+                    );
                 }
             } else if d > 1.03 {
                 on_background += 1;
                 for k in 0..3 {
-                    assert!((pixel[k] - 1.0).abs() < 1e-5, "background ({x}, {y}) = {pixel:?}");
+                    assert!(
+                        (pixel[k] - 1.0).abs() < 1e-5,
+                        "background ({x}, {y}) = {pixel:?}"
+                    );
                 }
             }
         }
     }
-    assert!(on_sphere > 1000 && on_background > 1000, "{on_sphere} sphere and {on_background} background pixels");
+    assert!(
+        on_sphere > 1000 && on_background > 1000,
+        "{on_sphere} sphere and {on_background} background pixels"
+    );
 }
 
 /// One bright texel must appear exactly where the camera looks along that texel's direction:
@@ -123,33 +178,84 @@ fn bright_texel_is_seen_in_its_direction() {
     let (i, j) = (10u32, 9u32);
     let mut pixels = vec![[0.0f32; 3]; (w * h) as usize];
     pixels[(j * w + i) as usize] = [100.0, 50.0, 25.0];
-    let direction = uv_to_direction(Vec2::new((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32));
-    let camera = Camera { position: Vec3::ZERO, target: direction, up: Vec3::Y, fov_y_deg: 20.0 };
-    let scene = Scene { groups: vec![], ..single_mesh_scene(shapes::sphere("unused", 1.0, 8, [0.5; 3]).unwrap(), EnvMap::from_pixels(w, h, pixels).unwrap(), camera) };
+    let direction = uv_to_direction(Vec2::new(
+        (i as f32 + 0.5) / w as f32,
+        (j as f32 + 0.5) / h as f32,
+    ));
+    let camera = Camera {
+        position: Vec3::ZERO,
+        target: direction,
+        up: Vec3::Y,
+        fov_y_deg: 20.0,
+    };
+    let scene = Scene {
+        groups: vec![],
+        ..single_mesh_scene(
+            shapes::sphere("unused", 1.0, 8, [0.5; 3]).unwrap(),
+            EnvMap::from_pixels(w, h, pixels).unwrap(),
+            camera,
+        )
+    };
     let size = 33; // odd: the centre pixel's ray is exactly the camera's axis
-    let mut renderer = Renderer::new(&ctx, &scene, &RenderOptions { width: size, height: size }).unwrap();
+    let mut renderer = Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions {
+            width: size,
+            height: size,
+        },
+    )
+    .unwrap();
     renderer.render().unwrap();
     let image = renderer.image().unwrap();
     let centre = image.pixels[(size / 2 * size + size / 2) as usize];
     // Bilinear filtering at the texel's exact centre returns the texel itself.
     for (k, expected) in [100.0f32, 50.0, 25.0].iter().enumerate() {
-        assert!((centre[k] - expected).abs() < 1e-2 * expected, "centre {centre:?}");
+        assert!(
+            (centre[k] - expected).abs() < 1e-2 * expected,
+            "centre {centre:?}"
+        );
     }
-    let brightest = image.pixels.iter().enumerate().max_by(|a, b| a.1[0].total_cmp(&b.1[0])).unwrap().0 as u32;
+    let brightest = image
+        .pixels
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1[0].total_cmp(&b.1[0]))
+        .unwrap()
+        .0 as u32;
     assert_eq!((brightest % size, brightest / size), (size / 2, size / 2));
-    assert_eq!(image.pixels[0], [0.0, 0.0, 0.0, 1.0], "a corner 10 degrees away sees black");
+    assert_eq!(
+        image.pixels[0],
+        [0.0, 0.0, 0.0, 1.0],
+        "a corner 10 degrees away sees black"
+    );
 }
 
 #[test]
 fn every_pass_reports_gpu_time() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
-    let mut renderer = Renderer::new(&ctx, &scene, &RenderOptions { width: 64, height: 64 }).unwrap();
+    let mut renderer = Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions {
+            width: 64,
+            height: 64,
+        },
+    )
+    .unwrap();
     let first = renderer.render().unwrap();
     let names: Vec<&str> = first.iter().map(|t| t.name).collect();
-    assert_eq!(names, ["sh_project", "sh_reduce", "background", "scene", "readback"]);
+    assert_eq!(
+        names,
+        ["sh_project", "sh_reduce", "background", "scene", "readback"]
+    );
     let second = renderer.render().unwrap();
-    assert_eq!(second.len(), 3, "the SH projection runs only when the environment changes");
+    assert_eq!(
+        second.len(),
+        3,
+        "the SH projection runs only when the environment changes"
+    );
     for t in first.iter().chain(&second) {
         assert!(t.gpu_ms.is_some_and(|ms| ms > 0.0), "{t:?}");
     }
@@ -160,12 +266,35 @@ fn bad_render_arguments_are_errors() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
     for (w, h) in [(0, 64), (64, 0), (9000, 64)] {
-        let err = Renderer::new(&ctx, &scene, &RenderOptions { width: w, height: h }).err().unwrap();
+        let err = Renderer::new(
+            &ctx,
+            &scene,
+            &RenderOptions {
+                width: w,
+                height: h,
+            },
+        )
+        .err()
+        .unwrap();
         assert!(err.to_string().contains("image size"), "{err}");
     }
-    let mut renderer = Renderer::new(&ctx, &scene, &RenderOptions { width: 8, height: 8 }).unwrap();
-    assert!(renderer.set_group_transform(7, Mat4::IDENTITY).unwrap_err().to_string().contains("group 7"));
-    assert!(renderer.set_group_transform(0, Mat4::from_translation(Vec3::NAN)).is_err());
+    let mut renderer = Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions {
+            width: 8,
+            height: 8,
+        },
+    )
+    .unwrap();
+    assert!(renderer
+        .set_group_transform(7, Mat4::IDENTITY)
+        .unwrap_err()
+        .to_string()
+        .contains("group 7"));
+    assert!(renderer
+        .set_group_transform(0, Mat4::from_translation(Vec3::NAN))
+        .is_err());
 }
 
 #[test]
@@ -176,9 +305,20 @@ fn exported_scene_renders_the_same_picture() {
     scene.export(&dir).unwrap();
     let reloaded = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
     let render = |s: &Scene| {
-        let mut r = Renderer::new(&ctx, s, &RenderOptions { width: 48, height: 48 }).unwrap();
+        let mut r = Renderer::new(
+            &ctx,
+            s,
+            &RenderOptions {
+                width: 48,
+                height: 48,
+            },
+        )
+        .unwrap();
         r.render().unwrap();
         r.image().unwrap().pixels
     };
-    assert!(render(&scene) == render(&reloaded), "exported scene renders differently");
+    assert!(
+        render(&scene) == render(&reloaded),
+        "exported scene renders differently"
+    );
 }

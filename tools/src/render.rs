@@ -50,12 +50,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("--exposure must be a positive number");
     }
     let scene = Scene::from_arg(&args.scene)?;
+    crate::report_clamped(&scene.environment);
     let ctx = args.gpu.context()?;
-    let mut renderer = Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height })
-        .context("setting up the renderer")?;
+    let mut renderer = Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions {
+            width: args.width,
+            height: args.height,
+        },
+    )
+    .context("setting up the renderer")?;
     let bar = ProgressBar::new(args.frames as u64).with_style(
-        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
-            .expect("static template"),
+        ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left",
+        )
+        .expect("static template"),
     );
     bar.set_message("rendering");
     let start = Instant::now();
@@ -72,14 +82,32 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.finish_and_clear();
     let image = renderer.image()?;
     kage::imageio::write(&args.out, &image, args.exposure)?;
-    println!("wrote {} ({}x{}, scene {})", args.out.display(), args.width, args.height, scene.name);
+    println!(
+        "wrote {} ({}x{}, scene {})",
+        args.out.display(),
+        args.width,
+        args.height,
+        scene.name
+    );
 
     let rows = table.rows();
-    println!("{:<16} {:>10} {:>10} {:>10} {:>7}", "pass", "median ms", "min ms", "max ms", "frames");
+    println!(
+        "{:<16} {:>10} {:>10} {:>10} {:>7}",
+        "pass", "median ms", "min ms", "max ms", "frames"
+    );
     for row in &rows {
-        println!("{:<16} {:>10.3} {:>10.3} {:>10.3} {:>7}", row.name, row.median_ms, row.min_ms, row.max_ms, row.frames);
+        println!(
+            "{:<16} {:>10.3} {:>10.3} {:>10.3} {:>7}",
+            row.name, row.median_ms, row.min_ms, row.max_ms, row.frames
+        );
     }
-    println!("{:<16} {:>10.3}   (median over {} frames, GPU, {})", "frame", table.frame_median_ms(), table.frame_count(), ctx.info().name);
+    println!(
+        "{:<16} {:>10.3}   (median over {} frames, GPU, {})",
+        "frame",
+        table.frame_median_ms(),
+        table.frame_count(),
+        ctx.info().name
+    );
     if let Some(path) = &args.timings {
         let file = TimingsFile {
             device: ctx.info().name.clone(),
@@ -87,7 +115,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             passes: rows,
             frame_median_ms: table.frame_median_ms(),
         };
-        std::fs::write(path, serde_json::to_string_pretty(&file)?).with_context(|| format!("writing {}", path.display()))?;
+        std::fs::write(path, serde_json::to_string_pretty(&file)?)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     args.gpu.finish(&ctx)
 }

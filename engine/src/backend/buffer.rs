@@ -26,7 +26,10 @@ pub struct Buffer {
 impl Buffer {
     pub fn new(ctx: &Arc<Context>, desc: &BufferDesc) -> Result<Buffer> {
         if desc.size == 0 {
-            return Err(Error::InvalidArgument(format!("buffer {} has size 0", desc.name)));
+            return Err(Error::InvalidArgument(format!(
+                "buffer {} has size 0",
+                desc.name
+            )));
         }
         let info = vk::BufferCreateInfo::default()
             .size(desc.size)
@@ -53,7 +56,10 @@ impl Buffer {
             }
         };
         // SAFETY: the allocation satisfies the buffer's requirements and is not bound elsewhere.
-        let bound = unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) };
+        let bound = unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        };
         let buffer = Buffer {
             ctx: ctx.clone(),
             raw,
@@ -67,13 +73,21 @@ impl Buffer {
     }
 
     /// A device-local buffer filled with `data` through a staging buffer.
-    pub fn with_data(ctx: &Arc<Context>, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> Result<Buffer> {
-        let buffer = Buffer::new(ctx, &BufferDesc {
-            name,
-            size: data.len() as u64,
-            usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuOnly,
-        })?;
+    pub fn with_data(
+        ctx: &Arc<Context>,
+        name: &str,
+        usage: vk::BufferUsageFlags,
+        data: &[u8],
+    ) -> Result<Buffer> {
+        let buffer = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name,
+                size: data.len() as u64,
+                usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
         buffer.upload(data)?;
         Ok(buffer)
     }
@@ -91,19 +105,25 @@ impl Buffer {
     }
 
     fn mapped(&self) -> Option<&[u8]> {
-        self.allocation.as_ref()?.mapped_slice().map(|s| &s[..self.size as usize])
+        self.allocation
+            .as_ref()?
+            .mapped_slice()
+            .map(|s| &s[..self.size as usize])
     }
 
     /// Writes into a host-visible buffer at `offset`.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
-        let end = offset.checked_add(data.len() as u64).filter(|&e| e <= self.size).ok_or_else(|| {
-            Error::InvalidArgument(format!(
-                "write of {} bytes at {offset} past the end of buffer {} ({} bytes)",
-                data.len(),
-                self.name,
-                self.size
-            ))
-        })?;
+        let end = offset
+            .checked_add(data.len() as u64)
+            .filter(|&e| e <= self.size)
+            .ok_or_else(|| {
+                Error::InvalidArgument(format!(
+                    "write of {} bytes at {offset} past the end of buffer {} ({} bytes)",
+                    data.len(),
+                    self.name,
+                    self.size
+                ))
+            })?;
         let name = &self.name;
         let slice = self
             .allocation
@@ -124,17 +144,24 @@ impl Buffer {
                 self.size
             )));
         }
-        let mut staging = Buffer::new(&self.ctx, &BufferDesc {
-            name: &format!("{}.staging", self.name),
-            size: data.len().max(1) as u64,
-            usage: vk::BufferUsageFlags::TRANSFER_SRC,
-            location: MemoryLocation::CpuToGpu,
-        })?;
+        let mut staging = Buffer::new(
+            &self.ctx,
+            &BufferDesc {
+                name: &format!("{}.staging", self.name),
+                size: data.len().max(1) as u64,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
         staging.write(0, data)?;
         let region = vk::BufferCopy::default().size(data.len() as u64);
         self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
             // SAFETY: both buffers are alive until the one-shot submission has completed.
-            unsafe { self.ctx.device.cmd_copy_buffer(cmd, staging.raw, self.raw, &[region]) }
+            unsafe {
+                self.ctx
+                    .device
+                    .cmd_copy_buffer(cmd, staging.raw, self.raw, &[region])
+            }
         })
     }
 
@@ -143,28 +170,40 @@ impl Buffer {
         if let Some(mapped) = self.mapped() {
             return Ok(mapped.to_vec());
         }
-        let staging = Buffer::new(&self.ctx, &BufferDesc {
-            name: &format!("{}.readback", self.name),
-            size: self.size,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuToCpu,
-        })?;
+        let staging = Buffer::new(
+            &self.ctx,
+            &BufferDesc {
+                name: &format!("{}.readback", self.name),
+                size: self.size,
+                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )?;
         let region = vk::BufferCopy::default().size(self.size);
-        self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| {
-            // SAFETY: both buffers are alive until the submission has completed.
-            unsafe { self.ctx.device.cmd_copy_buffer(cmd, self.raw, staging.raw, &[region]) }
-        })?;
-        staging
-            .mapped()
-            .map(<[u8]>::to_vec)
-            .ok_or_else(|| Error::InvalidArgument(format!("{} readback memory is not mapped", self.name)))
+        self.ctx
+            .one_shot(&format!("{}.readback", self.name), |cmd| {
+                // SAFETY: both buffers are alive until the submission has completed.
+                unsafe {
+                    self.ctx
+                        .device
+                        .cmd_copy_buffer(cmd, self.raw, staging.raw, &[region])
+                }
+            })?;
+        staging.mapped().map(<[u8]>::to_vec).ok_or_else(|| {
+            Error::InvalidArgument(format!("{} readback memory is not mapped", self.name))
+        })
     }
 }
 
 pub(crate) fn allocation_error(name: &str, e: gpu_allocator::AllocationError) -> Error {
     match e {
-        gpu_allocator::AllocationError::OutOfMemory => Error::OutOfDeviceMemory { call: "gpu-allocator allocate" },
-        e => Error::Allocation { name: name.to_owned(), message: e.to_string() },
+        gpu_allocator::AllocationError::OutOfMemory => Error::OutOfDeviceMemory {
+            call: "gpu-allocator allocate",
+        },
+        e => Error::Allocation {
+            name: name.to_owned(),
+            message: e.to_string(),
+        },
     }
 }
 

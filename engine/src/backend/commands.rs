@@ -27,7 +27,10 @@ impl Context {
                 .map_err(Error::vk("vkAllocateCommandBuffers"))?[0]
         };
         // SAFETY: valid device, default create info.
-        let fence = match unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) } {
+        let fence = match unsafe {
+            self.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        } {
             Ok(f) => f,
             Err(e) => {
                 self.free_command_buffer(cmd);
@@ -73,8 +76,11 @@ impl Context {
                 .map_err(Error::vk("vkQueueSubmit"))?;
         }
         // SAFETY: the fence was just submitted.
-        unsafe { self.device.wait_for_fences(&[recorder.fence], true, FENCE_TIMEOUT_NS) }
-            .map_err(Error::vk("vkWaitForFences"))?;
+        unsafe {
+            self.device
+                .wait_for_fences(&[recorder.fence], true, FENCE_TIMEOUT_NS)
+        }
+        .map_err(Error::vk("vkWaitForFences"))?;
         // SAFETY: the fence is signalled and no longer in use.
         unsafe { self.device.reset_fences(&[recorder.fence]) }.map_err(Error::vk("vkResetFences"))
     }
@@ -86,9 +92,8 @@ impl Context {
             record(recorder.cmd);
             self.submit_and_wait(&recorder)
         });
-        if result.is_ok() {
-            self.destroy_recorder(recorder);
-        } else if self.wait_idle().is_ok() {
+        // After a failed submission the buffer may still be pending: free it only once idle.
+        if result.is_ok() || self.wait_idle().is_ok() {
             self.destroy_recorder(recorder);
         }
         result

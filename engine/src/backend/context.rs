@@ -55,7 +55,12 @@ fn has_extension(list: &[vk::ExtensionProperties], name: &CStr) -> bool {
 }
 
 fn version_string(v: u32) -> String {
-    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+    format!(
+        "{}.{}.{}",
+        vk::api_version_major(v),
+        vk::api_version_minor(v),
+        vk::api_version_patch(v)
+    )
 }
 
 impl Context {
@@ -67,7 +72,9 @@ impl Context {
         let layers = unsafe { entry.enumerate_instance_layer_properties() }
             .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
         if desc.validation
-            && !layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+            && !layers
+                .iter()
+                .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
         {
             return Err(Error::Unsupported(
                 "the validation layer VK_LAYER_KHRONOS_validation (Debian: vulkan-validationlayers)"
@@ -79,10 +86,9 @@ impl Context {
             .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
         if desc.validation {
             // SAFETY: as above; the layer name is a valid C string.
-            let from_layer = unsafe {
-                entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER))
-            }
-            .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
+            let from_layer =
+                unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                    .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
             instance_exts.extend(from_layer);
         }
         let debug_utils = has_extension(&instance_exts, ash::ext::debug_utils::NAME);
@@ -92,10 +98,16 @@ impl Context {
             .application_name(app_name)
             .engine_name(app_name)
             .api_version(vk::API_VERSION_1_3);
-        let layer_ptrs: Vec<*const c_char> =
-            if desc.validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-        let ext_ptrs: Vec<*const c_char> =
-            if debug_utils { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+        let layer_ptrs: Vec<*const c_char> = if desc.validation {
+            vec![VALIDATION_LAYER.as_ptr()]
+        } else {
+            vec![]
+        };
+        let ext_ptrs: Vec<*const c_char> = if debug_utils {
+            vec![ash::ext::debug_utils::NAME.as_ptr()]
+        } else {
+            vec![]
+        };
         let instance_info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layer_ptrs)
@@ -107,7 +119,11 @@ impl Context {
         // Declared before the guard so that it outlives the messenger the guard destroys.
         let validation = desc.validation.then(|| Box::new(ValidationLog::default()));
         // From here on a failure must undo what was created: the guard does it on drop.
-        let mut guard = Guard { instance: instance.clone(), messenger: None, device: None };
+        let mut guard = Guard {
+            instance: instance.clone(),
+            messenger: None,
+            device: None,
+        };
         let (debug_instance, messenger) = match (&validation, debug_utils) {
             (Some(log), true) => {
                 let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
@@ -135,7 +151,10 @@ impl Context {
             (None, _) => (None, vk::DebugUtilsMessengerEXT::null()),
         };
 
-        let wanted = desc.device.clone().or_else(|| std::env::var("KAGE_DEVICE").ok());
+        let wanted = desc
+            .device
+            .clone()
+            .or_else(|| std::env::var("KAGE_DEVICE").ok());
         let (physical, queue_family) = pick_device(&instance, wanted.as_deref())?;
 
         // SAFETY: valid physical device from this instance.
@@ -151,7 +170,8 @@ impl Context {
             && families[queue_family as usize].timestamp_valid_bits > 0;
         // SAFETY: as above.
         let rgba32f = unsafe {
-            instance.get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
+            instance
+                .get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
         };
         let rgba32f_linear = rgba32f
             .optimal_tiling_features
@@ -163,25 +183,52 @@ impl Context {
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
         let driver_text = format!(
             "{} ({})",
-            driver.driver_name_as_c_str().unwrap_or(c"?").to_string_lossy(),
-            driver.driver_info_as_c_str().unwrap_or(c"?").to_string_lossy()
+            driver
+                .driver_name_as_c_str()
+                .unwrap_or(c"?")
+                .to_string_lossy(),
+            driver
+                .driver_info_as_c_str()
+                .unwrap_or(c"?")
+                .to_string_lossy()
         );
 
         let info = DeviceInfo {
-            name: props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned(),
+            name: props
+                .device_name_as_c_str()
+                .unwrap_or(c"?")
+                .to_string_lossy()
+                .into_owned(),
             device_type: format!("{:?}", props.device_type),
             driver: driver_text,
             api_version: version_string(props.api_version),
             timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
             features: vec![
-                ("VK_KHR_dynamic_rendering (required)", has_extension(&device_exts, ash::khr::dynamic_rendering::NAME)),
-                ("VK_KHR_push_descriptor (required)", has_extension(&device_exts, ash::khr::push_descriptor::NAME)),
+                (
+                    "VK_KHR_dynamic_rendering (required)",
+                    has_extension(&device_exts, ash::khr::dynamic_rendering::NAME),
+                ),
+                (
+                    "VK_KHR_push_descriptor (required)",
+                    has_extension(&device_exts, ash::khr::push_descriptor::NAME),
+                ),
                 ("RGBA32F linear filtering (required)", rgba32f_linear),
-                ("timestamps on the graphics/compute queue (pass timings)", timestamps),
+                (
+                    "timestamps on the graphics/compute queue (pass timings)",
+                    timestamps,
+                ),
                 ("VK_EXT_debug_utils (object names, labels)", debug_utils),
-                ("VK_LAYER_KHRONOS_validation (installed)", layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))),
+                (
+                    "VK_LAYER_KHRONOS_validation (installed)",
+                    layers
+                        .iter()
+                        .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
+                ),
                 ("shaderFloat64", features.shader_float64 == vk::TRUE),
-                ("ray query (not used: Kage casts rays through its own BVH)", has_extension(&device_exts, ash::khr::ray_query::NAME)),
+                (
+                    "ray query (not used: Kage casts rays through its own BVH)",
+                    has_extension(&device_exts, ash::khr::ray_query::NAME),
+                ),
             ],
         };
         for (name, present) in &info.features {
@@ -194,8 +241,10 @@ impl Context {
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let device_ext_ptrs =
-            [ash::khr::dynamic_rendering::NAME.as_ptr(), ash::khr::push_descriptor::NAME.as_ptr()];
+        let device_ext_ptrs = [
+            ash::khr::dynamic_rendering::NAME.as_ptr(),
+            ash::khr::push_descriptor::NAME.as_ptr(),
+        ];
         let mut dynamic_rendering_features =
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
         let enabled = vk::PhysicalDeviceFeatures::default();
@@ -219,7 +268,10 @@ impl Context {
             buffer_device_address: false,
             allocation_sizes: Default::default(),
         })
-        .map_err(|e| Error::Allocation { name: "allocator".into(), message: e.to_string() })?;
+        .map_err(|e| Error::Allocation {
+            name: "allocator".into(),
+            message: e.to_string(),
+        })?;
 
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
@@ -265,7 +317,10 @@ impl Context {
 
     /// Every validation message of warning or error severity since the last call.
     pub fn take_validation_messages(&self) -> Vec<String> {
-        self.validation.as_ref().map(|log| log.take()).unwrap_or_default()
+        self.validation
+            .as_ref()
+            .map(|log| log.take())
+            .unwrap_or_default()
     }
 
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
@@ -279,8 +334,12 @@ impl Context {
     /// Gives a Vulkan object a debug name (no-op without VK_EXT_debug_utils).
     pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         let Some(debug) = &self.debug else { return };
-        let Ok(name) = CString::new(name.replace('\0', " ")) else { return };
-        let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+        let Ok(name) = CString::new(name.replace('\0', " ")) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
         // SAFETY: the handle belongs to this device; naming has no other effect.
         // A failure to name is not worth failing the caller for.
         let _ = unsafe { debug.set_debug_utils_object_name(&info) };
@@ -300,7 +359,13 @@ impl Drop for Context {
         // makes sure no submitted work still uses the pool.
         unsafe {
             let _ = self.device.device_wait_idle();
-            self.device.destroy_command_pool(*self.command_pool.get_mut().unwrap_or_else(|e| e.into_inner()), None);
+            self.device.destroy_command_pool(
+                *self
+                    .command_pool
+                    .get_mut()
+                    .unwrap_or_else(|e| e.into_inner()),
+                None,
+            );
         }
         // The allocator frees its memory blocks through the device: drop it before the device.
         // SAFETY: dropped exactly once, here.
@@ -341,7 +406,10 @@ impl Drop for Guard {
 
 /// Chooses a Vulkan 1.2+ device with a graphics+compute queue: by name when asked, otherwise
 /// discrete GPU first, then integrated, virtual, CPU.
-fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::PhysicalDevice, u32)> {
+fn pick_device(
+    instance: &ash::Instance,
+    wanted: Option<&str>,
+) -> Result<(vk::PhysicalDevice, u32)> {
     // SAFETY: plain enumeration on a valid instance.
     let devices = unsafe { instance.enumerate_physical_devices() }
         .map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
@@ -350,7 +418,11 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
     for physical in devices {
         // SAFETY: physical device from this instance.
         let props = unsafe { instance.get_physical_device_properties(physical) };
-        let name = props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
+        let name = props
+            .device_name_as_c_str()
+            .unwrap_or(c"?")
+            .to_string_lossy()
+            .into_owned();
         names.push(name.clone());
         if props.api_version < vk::API_VERSION_1_2 {
             continue;
@@ -358,7 +430,8 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
         // SAFETY: as above.
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let Some(family) = families.iter().position(|f| {
-            f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
         }) else {
             continue;
         };
@@ -380,16 +453,28 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
             .ok_or_else(|| {
                 Error::NoDevice(format!(
                     "no Vulkan 1.2 device named like {wanted:?}; devices: {}",
-                    if names.is_empty() { "none".into() } else { names.join(", ") }
+                    if names.is_empty() {
+                        "none".into()
+                    } else {
+                        names.join(", ")
+                    }
                 ))
             });
     }
     candidates.sort_by_key(|c| c.0);
-    candidates.into_iter().next().map(|c| (c.2, c.3)).ok_or_else(|| {
-        Error::NoDevice(if names.is_empty() {
-            "the loader found no device (Debian: install mesa-vulkan-drivers for lavapipe)".into()
-        } else {
-            format!("none of {} has Vulkan 1.2 and a graphics+compute queue", names.join(", "))
+    candidates
+        .into_iter()
+        .next()
+        .map(|c| (c.2, c.3))
+        .ok_or_else(|| {
+            Error::NoDevice(if names.is_empty() {
+                "the loader found no device (Debian: install mesa-vulkan-drivers for lavapipe)"
+                    .into()
+            } else {
+                format!(
+                    "none of {} has Vulkan 1.2 and a graphics+compute queue",
+                    names.join(", ")
+                )
+            })
         })
-    })
 }

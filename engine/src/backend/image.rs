@@ -42,7 +42,11 @@ fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
 fn texel_bytes(format: vk::Format) -> Option<u64> {
     match format {
         vk::Format::R32G32B32A32_SFLOAT => Some(16),
-        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::R32_SFLOAT | vk::Format::R32_UINT | vk::Format::D32_SFLOAT => Some(4),
+        vk::Format::R8G8B8A8_UNORM
+        | vk::Format::R8G8B8A8_SRGB
+        | vk::Format::R32_SFLOAT
+        | vk::Format::R32_UINT
+        | vk::Format::D32_SFLOAT => Some(4),
         _ => None,
     }
 }
@@ -51,21 +55,31 @@ impl Image {
     pub fn new(ctx: &Arc<Context>, desc: &ImageDesc) -> Result<Image> {
         // SAFETY: plain property query.
         let limits = unsafe { ctx.instance.get_physical_device_properties(ctx.physical) }.limits;
-        if desc.width == 0 || desc.height == 0 || desc.layers == 0
+        if desc.width == 0
+            || desc.height == 0
+            || desc.layers == 0
             || desc.width > limits.max_image_dimension2_d
             || desc.height > limits.max_image_dimension2_d
             || desc.layers > limits.max_image_array_layers
         {
             return Err(Error::InvalidArgument(format!(
                 "image {} of {}x{}x{} is outside the device limits (1..={} per side, {} layers)",
-                desc.name, desc.width, desc.height, desc.layers,
-                limits.max_image_dimension2_d, limits.max_image_array_layers
+                desc.name,
+                desc.width,
+                desc.height,
+                desc.layers,
+                limits.max_image_dimension2_d,
+                limits.max_image_array_layers
             )));
         }
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
-            .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
+            .extent(vk::Extent3D {
+                width: desc.width,
+                height: desc.height,
+                depth: 1,
+            })
             .mip_levels(1)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -74,7 +88,8 @@ impl Image {
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_image(&info, None) }.map_err(Error::vk("vkCreateImage"))?;
+        let raw =
+            unsafe { ctx.device.create_image(&info, None) }.map_err(Error::vk("vkCreateImage"))?;
         // SAFETY: raw was just created on this device.
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
         let allocation = match ctx.allocator().allocate(&AllocationCreateDesc {
@@ -103,12 +118,19 @@ impl Image {
             name: desc.name.to_owned(),
         };
         // SAFETY: the allocation satisfies the image's requirements.
-        let bound = unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
+        let bound = unsafe {
+            ctx.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        };
         image.allocation = Some(allocation);
         bound.map_err(Error::vk("vkBindImageMemory"))?;
         ctx.set_name(raw, desc.name);
 
-        let view_type = if desc.layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(view_type)
@@ -171,7 +193,10 @@ impl Image {
     /// Bytes of the whole image in a tightly packed buffer.
     pub fn byte_size(&self) -> Result<u64> {
         let texel = texel_bytes(self.format).ok_or_else(|| {
-            Error::InvalidArgument(format!("no host copies of {:?} ({})", self.format, self.name))
+            Error::InvalidArgument(format!(
+                "no host copies of {:?} ({})",
+                self.format, self.name
+            ))
         })?;
         Ok(texel * self.width as u64 * self.height as u64 * self.layers as u64)
     }
@@ -184,7 +209,11 @@ impl Image {
                 base_array_layer: 0,
                 layer_count: self.layers,
             })
-            .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 })
+            .image_extent(vk::Extent3D {
+                width: self.width,
+                height: self.height,
+                depth: 1,
+            })
     }
 
     /// Records a copy of the whole image into `buffer` (tightly packed, layer after layer).
@@ -192,7 +221,15 @@ impl Image {
         let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
         self.transition(cmd, vk::ImageLayout::GENERAL, src);
         // SAFETY: recording command buffer; the image was just moved to `src`.
-        unsafe { self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, src, buffer.raw, &[self.copy_region()]) }
+        unsafe {
+            self.ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.raw,
+                src,
+                buffer.raw,
+                &[self.copy_region()],
+            )
+        }
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
 
@@ -206,32 +243,45 @@ impl Image {
                 self.name
             )));
         }
-        let mut staging = Buffer::new(&self.ctx, &BufferDesc {
-            name: &format!("{}.staging", self.name),
-            size: expected,
-            usage: vk::BufferUsageFlags::TRANSFER_SRC,
-            location: MemoryLocation::CpuToGpu,
-        })?;
+        let mut staging = Buffer::new(
+            &self.ctx,
+            &BufferDesc {
+                name: &format!("{}.staging", self.name),
+                size: expected,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
         staging.write(0, data)?;
         let region = self.copy_region();
         self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
             let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
             self.transition(cmd, vk::ImageLayout::GENERAL, dst);
             // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
-            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region]) }
+            unsafe {
+                self.ctx
+                    .device
+                    .cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region])
+            }
             self.transition(cmd, dst, vk::ImageLayout::GENERAL);
         })
     }
 
     /// Reads the whole image back (waits for the GPU).
     pub fn read(&self) -> Result<Vec<u8>> {
-        let staging = Buffer::new(&self.ctx, &BufferDesc {
-            name: &format!("{}.readback", self.name),
-            size: self.byte_size()?,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuToCpu,
-        })?;
-        self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| self.record_copy_to(cmd, &staging))?;
+        let staging = Buffer::new(
+            &self.ctx,
+            &BufferDesc {
+                name: &format!("{}.readback", self.name),
+                size: self.byte_size()?,
+                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )?;
+        self.ctx
+            .one_shot(&format!("{}.readback", self.name), |cmd| {
+                self.record_copy_to(cmd, &staging)
+            })?;
         staging.read()
     }
 }
@@ -260,8 +310,16 @@ pub struct Sampler {
 impl Sampler {
     /// Linear filtering; `u` repeats (longitude wraps around), `v` clamps (poles).
     pub fn new(ctx: &Arc<Context>, name: &str, linear: bool, repeat_u: bool) -> Result<Sampler> {
-        let filter = if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
-        let u = if repeat_u { vk::SamplerAddressMode::REPEAT } else { vk::SamplerAddressMode::CLAMP_TO_EDGE };
+        let filter = if linear {
+            vk::Filter::LINEAR
+        } else {
+            vk::Filter::NEAREST
+        };
+        let u = if repeat_u {
+            vk::SamplerAddressMode::REPEAT
+        } else {
+            vk::SamplerAddressMode::CLAMP_TO_EDGE
+        };
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(filter)
             .min_filter(filter)
@@ -271,9 +329,13 @@ impl Sampler {
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .max_lod(0.0);
         // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
+        let raw = unsafe { ctx.device.create_sampler(&info, None) }
+            .map_err(Error::vk("vkCreateSampler"))?;
         ctx.set_name(raw, name);
-        Ok(Sampler { ctx: ctx.clone(), raw })
+        Ok(Sampler {
+            ctx: ctx.clone(),
+            raw,
+        })
     }
 }
 

@@ -13,7 +13,12 @@ struct Layout {
     push_size: u32,
 }
 
-fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size: u32) -> Result<Layout> {
+fn create_layout(
+    ctx: &Context,
+    name: &str,
+    bindings: &[BindingKind],
+    push_size: u32,
+) -> Result<Layout> {
     let set_bindings = set_layout_bindings(bindings);
     let set_info = vk::DescriptorSetLayoutCreateInfo::default()
         .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
@@ -22,7 +27,11 @@ fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size:
     let set = unsafe { ctx.device.create_descriptor_set_layout(&set_info, None) }
         .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
     ctx.set_name(set, &format!("{name}.set_layout"));
-    let ranges = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::ALL, offset: 0, size: push_size }];
+    let ranges = [vk::PushConstantRange {
+        stage_flags: vk::ShaderStageFlags::ALL,
+        offset: 0,
+        size: push_size,
+    }];
     let sets = [set];
     let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(&sets);
     if push_size > 0 {
@@ -38,7 +47,12 @@ fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size:
         }
     };
     ctx.set_name(pipeline, &format!("{name}.layout"));
-    Ok(Layout { set, pipeline, bindings: bindings.to_vec(), push_size })
+    Ok(Layout {
+        set,
+        pipeline,
+        bindings: bindings.to_vec(),
+        push_size,
+    })
 }
 
 fn destroy_layout(ctx: &Context, layout: &Layout) {
@@ -76,10 +90,17 @@ impl Drop for Module<'_> {
 }
 
 fn push_bytes(ctx: &Context, cmd: vk::CommandBuffer, layout: &Layout, bytes: &[u8]) {
-    debug_assert_eq!(bytes.len() as u32, layout.push_size, "push constant size mismatch");
+    debug_assert_eq!(
+        bytes.len() as u32,
+        layout.push_size,
+        "push constant size mismatch"
+    );
     if !bytes.is_empty() {
         // SAFETY: recording command buffer; the range was declared in the layout.
-        unsafe { ctx.device.cmd_push_constants(cmd, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes) };
+        unsafe {
+            ctx.device
+                .cmd_push_constants(cmd, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes)
+        };
     }
 }
 
@@ -90,16 +111,27 @@ pub struct ComputePipeline {
 }
 
 impl ComputePipeline {
-    pub fn new(ctx: &Arc<Context>, name: &str, spirv: &[u8], bindings: &[BindingKind], push_size: u32) -> Result<ComputePipeline> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        spirv: &[u8],
+        bindings: &[BindingKind],
+        push_size: u32,
+    ) -> Result<ComputePipeline> {
         let module = Module::new(ctx, &format!("{name}.comp"), spirv)?;
         let layout = create_layout(ctx, name, bindings, push_size)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
             .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline);
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout.pipeline);
         // SAFETY: valid device, module and layout.
-        let raw = match unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) } {
+        let raw = match unsafe {
+            ctx.device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+        } {
             Ok(p) => p[0],
             Err((_, e)) => {
                 destroy_layout(ctx, &layout);
@@ -107,17 +139,42 @@ impl ComputePipeline {
             }
         };
         ctx.set_name(raw, name);
-        Ok(ComputePipeline { ctx: ctx.clone(), raw, layout })
+        Ok(ComputePipeline {
+            ctx: ctx.clone(),
+            raw,
+            layout,
+        })
     }
 
     /// Binds the pipeline, its resources and push constants, then dispatches.
-    pub fn dispatch(&self, cmd: vk::CommandBuffer, bindings: &[Binding], push: &[u8], groups: [u32; 3]) {
+    pub fn dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        bindings: &[Binding],
+        push: &[u8],
+        groups: [u32; 3],
+    ) {
         // SAFETY: recording command buffer of this device.
-        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
-        push_descriptors(&self.ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.layout.pipeline, &self.layout.bindings, bindings);
+        unsafe {
+            self.ctx
+                .device
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw)
+        };
+        push_descriptors(
+            &self.ctx,
+            cmd,
+            vk::PipelineBindPoint::COMPUTE,
+            self.layout.pipeline,
+            &self.layout.bindings,
+            bindings,
+        );
         push_bytes(&self.ctx, cmd, &self.layout, push);
         // SAFETY: pipeline and descriptors bound above.
-        unsafe { self.ctx.device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+        unsafe {
+            self.ctx
+                .device
+                .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
+        };
     }
 }
 
@@ -164,8 +221,14 @@ impl GraphicsPipeline {
         let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv)?;
         let layout = create_layout(ctx, desc.name, desc.bindings, desc.push_size)?;
         let stages = [
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs.raw).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs.raw).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vs.raw)
+                .name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fs.raw)
+                .name(c"main"),
         ];
         let vertex_bindings = [vk::VertexInputBindingDescription {
             binding: 0,
@@ -175,14 +238,23 @@ impl GraphicsPipeline {
         let attributes: Vec<vk::VertexInputAttributeDescription> = desc
             .attributes
             .iter()
-            .map(|a| vk::VertexInputAttributeDescription { location: a.location, binding: 0, format: a.format, offset: a.offset })
+            .map(|a| vk::VertexInputAttributeDescription {
+                location: a.location,
+                binding: 0,
+                format: a.format,
+                offset: a.offset,
+            })
             .collect();
         let mut vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
         if desc.vertex_stride > 0 {
-            vertex_input = vertex_input.vertex_binding_descriptions(&vertex_bindings).vertex_attribute_descriptions(&attributes);
+            vertex_input = vertex_input
+                .vertex_binding_descriptions(&vertex_bindings)
+                .vertex_attribute_descriptions(&attributes);
         }
         let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
-        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
         // Kage's surfaces are two-sided (open meshes such as the teapot show their inside), so
         // nothing is culled; shaders flip normals on back faces.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
@@ -190,7 +262,8 @@ impl GraphicsPipeline {
             .cull_mode(vk::CullModeFlags::NONE)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_test)
@@ -198,9 +271,13 @@ impl GraphicsPipeline {
         let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> = desc
             .color_formats
             .iter()
-            .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
+            .map(|_| {
+                vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            })
             .collect();
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let blend =
+            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
@@ -219,7 +296,10 @@ impl GraphicsPipeline {
             .layout(layout.pipeline)
             .push_next(&mut rendering);
         // SAFETY: every pointer in the create info refers to locals alive for the call.
-        let raw = match unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) } {
+        let raw = match unsafe {
+            ctx.device
+                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+        } {
             Ok(p) => p[0],
             Err((_, e)) => {
                 destroy_layout(ctx, &layout);
@@ -227,14 +307,29 @@ impl GraphicsPipeline {
             }
         };
         ctx.set_name(raw, desc.name);
-        Ok(GraphicsPipeline { ctx: ctx.clone(), raw, layout })
+        Ok(GraphicsPipeline {
+            ctx: ctx.clone(),
+            raw,
+            layout,
+        })
     }
 
     /// Binds the pipeline and its resources (call inside a rendering scope).
     pub fn bind(&self, cmd: vk::CommandBuffer, bindings: &[Binding]) {
         // SAFETY: recording command buffer of this device.
-        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw) };
-        push_descriptors(&self.ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.layout.pipeline, &self.layout.bindings, bindings);
+        unsafe {
+            self.ctx
+                .device
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw)
+        };
+        push_descriptors(
+            &self.ctx,
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            self.layout.pipeline,
+            &self.layout.bindings,
+            bindings,
+        );
     }
 
     pub fn push(&self, cmd: vk::CommandBuffer, bytes: &[u8]) {

@@ -6,27 +6,62 @@ use ash::vk;
 impl Context {
     /// Begins rendering into `color` (cleared to `clear` when given, else loaded) and `depth`
     /// (always cleared to 1, the far plane).
-    pub fn begin_rendering(&self, cmd: vk::CommandBuffer, color: &Image, clear: Option<[f32; 4]>, depth: Option<&Image>) {
+    pub fn begin_rendering(
+        &self,
+        cmd: vk::CommandBuffer,
+        color: &Image,
+        clear: Option<[f32; 4]>,
+        depth: Option<&Image>,
+    ) {
         let color_attachment = [vk::RenderingAttachmentInfo::default()
             .image_view(color.view)
             .image_layout(vk::ImageLayout::GENERAL)
-            .load_op(if clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
+            .load_op(if clear.is_some() {
+                vk::AttachmentLoadOp::CLEAR
+            } else {
+                vk::AttachmentLoadOp::LOAD
+            })
             .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear.unwrap_or_default() } })];
+            .clear_value(vk::ClearValue {
+                color: vk::ClearColorValue {
+                    float32: clear.unwrap_or_default(),
+                },
+            })];
         let depth_attachment = depth.map(|d| {
             vk::RenderingAttachmentInfo::default()
                 .image_view(d.view)
                 .image_layout(vk::ImageLayout::GENERAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } })
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: 1.0,
+                        stencil: 0,
+                    },
+                })
         });
-        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: color.width, height: color.height } };
-        let mut info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_attachment);
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: color.width,
+                height: color.height,
+            },
+        };
+        let mut info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&color_attachment);
         if let Some(d) = &depth_attachment {
             info = info.depth_attachment(d);
         }
-        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: color.width as f32, height: color.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: color.width as f32,
+            height: color.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
         // SAFETY: recording command buffer; attachments are alive, in GENERAL layout by policy.
         unsafe {
             self.dynamic_rendering.cmd_begin_rendering(cmd, &info);
@@ -41,11 +76,19 @@ impl Context {
     }
 
     /// Binds an interleaved vertex buffer and a u32 index buffer and draws `count` indices.
-    pub fn draw_indexed(&self, cmd: vk::CommandBuffer, vertices: &super::Buffer, indices: &super::Buffer, count: u32) {
+    pub fn draw_indexed(
+        &self,
+        cmd: vk::CommandBuffer,
+        vertices: &super::Buffer,
+        indices: &super::Buffer,
+        count: u32,
+    ) {
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {
-            self.device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw], &[0]);
-            self.device.cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
+            self.device
+                .cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw], &[0]);
+            self.device
+                .cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
             self.device.cmd_draw_indexed(cmd, count, 1, 0, 0, 0);
         }
     }

@@ -88,7 +88,9 @@ impl Scene {
     }
 
     pub fn meshes(&self) -> impl Iterator<Item = (&Group, &Mesh)> {
-        self.groups.iter().flat_map(|g| g.meshes.iter().map(move |m| (g, m)))
+        self.groups
+            .iter()
+            .flat_map(|g| g.meshes.iter().map(move |m| (g, m)))
     }
 
     pub fn triangle_count(&self) -> usize {

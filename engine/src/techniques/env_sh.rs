@@ -2,7 +2,9 @@
 //! partial sum per workgroup of texels, with exact texel solid angles) and `sh_reduce` (the
 //! partials added in a fixed order). Run when the environment changes, not every frame.
 use super::environment::GpuEnvironment;
-use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, MemoryLocation};
+use crate::backend::{
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, MemoryLocation,
+};
 use crate::error::Result;
 use crate::layouts::{bytes_of, constants, spirv, ShCoeffs, ShProjectPush};
 use crate::pass::{FrameExecutor, Pass};
@@ -40,18 +42,24 @@ impl EnvSh {
                 &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
                 size_of::<ShProjectPush>() as u32,
             )?,
-            partials: Buffer::new(ctx, &BufferDesc {
-                name: "sh_partials",
-                size: groups as u64 * size_of::<ShCoeffs>() as u64,
-                usage: storage,
-                location: MemoryLocation::GpuOnly,
-            })?,
-            coefficients: Buffer::new(ctx, &BufferDesc {
-                name: "env_sh",
-                size: size_of::<ShCoeffs>() as u64,
-                usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
-                location: MemoryLocation::GpuOnly,
-            })?,
+            partials: Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name: "sh_partials",
+                    size: groups as u64 * size_of::<ShCoeffs>() as u64,
+                    usage: storage,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
+            coefficients: Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name: "env_sh",
+                    size: size_of::<ShCoeffs>() as u64,
+                    usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
             groups,
             size: [map.width(), map.height()],
         })
@@ -59,22 +67,41 @@ impl EnvSh {
 
     /// The two passes; they read "environment" and write "env_sh".
     pub fn passes<'a>(&'a self, env: &'a GpuEnvironment) -> [Pass<'a>; 2] {
-        let project_push =
-            ShProjectPush { size: [self.size[0], self.size[1], constants::SH_TEXELS_PER_INVOCATION, 0] };
-        let reduce_push = ShProjectPush { size: [self.groups, 0, 0, 0] };
+        let project_push = ShProjectPush {
+            size: [
+                self.size[0],
+                self.size[1],
+                constants::SH_TEXELS_PER_INVOCATION,
+                0,
+            ],
+        };
+        let reduce_push = ShProjectPush {
+            size: [self.groups, 0, 0, 0],
+        };
         [
-            Pass::new("sh_project", &["environment"], &["sh_partials"], move |cmd| {
-                self.project.dispatch(
-                    cmd,
-                    &[Binding::Sampled(&env.image, &env.sampler), Binding::Storage(&self.partials)],
-                    bytes_of(&project_push),
-                    [self.groups, 1, 1],
-                )
-            }),
+            Pass::new(
+                "sh_project",
+                &["environment"],
+                &["sh_partials"],
+                move |cmd| {
+                    self.project.dispatch(
+                        cmd,
+                        &[
+                            Binding::Sampled(&env.image, &env.sampler),
+                            Binding::Storage(&self.partials),
+                        ],
+                        bytes_of(&project_push),
+                        [self.groups, 1, 1],
+                    )
+                },
+            ),
             Pass::new("sh_reduce", &["sh_partials"], &["env_sh"], move |cmd| {
                 self.reduce.dispatch(
                     cmd,
-                    &[Binding::Storage(&self.partials), Binding::Storage(&self.coefficients)],
+                    &[
+                        Binding::Storage(&self.partials),
+                        Binding::Storage(&self.coefficients),
+                    ],
                     bytes_of(&reduce_push),
                     [1, 1, 1],
                 )

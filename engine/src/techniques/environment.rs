@@ -12,14 +12,17 @@ pub struct GpuEnvironment {
 
 impl GpuEnvironment {
     pub fn new(ctx: &Arc<Context>, map: &EnvMap) -> Result<GpuEnvironment> {
-        let image = Image::new(ctx, &ImageDesc {
-            name: "environment",
-            width: map.width(),
-            height: map.height(),
-            layers: 1,
-            format: vk::Format::R32G32B32A32_SFLOAT,
-            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-        })?;
+        let image = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "environment",
+                width: map.width(),
+                height: map.height(),
+                layers: 1,
+                format: vk::Format::R32G32B32A32_SFLOAT,
+                usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+            },
+        )?;
         let texels: Vec<u8> = map
             .pixels()
             .iter()

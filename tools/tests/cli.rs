@@ -1,0 +1,165 @@
+//! The `kage` program as a user runs it: outputs, timings, and errors for bad input.
+use kage_tests::scratch_dir;
+use std::process::{Command, Output};
+
+fn kage(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kage"))
+        .args(args)
+        .output()
+        .expect("run kage")
+}
+
+fn text(output: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}
+
+#[test]
+fn render_writes_png_exr_and_timings() {
+    let dir = scratch_dir("cli-render");
+    let png = dir.join("teapot.png");
+    let exr = dir.join("teapot.exr");
+    let timings = dir.join("timings.json");
+    let out = kage(&[
+        "render",
+        "--validate",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let out = kage(&[
+        "render",
+        "--validate",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--out",
+        exr.to_str().unwrap(),
+        "--timings",
+        timings.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+
+    let exr_image = kage::imageio::read_exr(&exr).unwrap();
+    assert_eq!((exr_image.width, exr_image.height), (64, 48));
+    let png_bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&png_bytes[1..4], b"PNG");
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&timings).unwrap()).unwrap();
+    assert_eq!(json["frames"], 1);
+    assert!(json["device"].as_str().is_some_and(|d| !d.is_empty()));
+    let passes = json["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        ["sh_project", "sh_reduce", "background", "scene", "readback"]
+    );
+    for pass in passes {
+        for key in ["median_ms", "min_ms", "max_ms"] {
+            assert!(pass[key].as_f64().is_some_and(|ms| ms > 0.0), "{pass}");
+        }
+    }
+    assert!(json["frame_median_ms"].as_f64().is_some_and(|ms| ms > 0.0));
+}
+
+#[test]
+fn sh_prints_coefficients_and_irradiance() {
+    let dir = scratch_dir("cli-sh");
+    let map = dir.join("constant.exr");
+    kage::scene::EnvMap::from_pixels(256, 128, vec![[1.0; 3]; 256 * 128])
+        .unwrap()
+        .write_exr(&map)
+        .unwrap();
+    let out = kage(&[
+        "sh",
+        map.to_str().unwrap(),
+        "--irradiance",
+        "0,1,0",
+        "--validate",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        stdout
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("irradiance"))
+            .count(),
+        9,
+        "{stdout}"
+    );
+    // Radiance 1 everywhere: E = pi for every normal.
+    let e: f32 = stdout
+        .lines()
+        .find(|l| l.starts_with("irradiance"))
+        .unwrap()
+        .split_whitespace()
+        .rev()
+        .nth(2)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((e - std::f32::consts::PI).abs() < 1e-3, "{stdout}");
+}
+
+#[test]
+fn bad_input_is_a_clear_error_not_a_panic() {
+    let dir = scratch_dir("cli-bad");
+    let bad_scene = dir.join("bad.json");
+    std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["render", "--scene", "no-such-scene"],
+            "built-in scenes are",
+        ),
+        (
+            &["render", "--scene", bad_scene.to_str().unwrap()],
+            "colour",
+        ),
+        (&["render", "--width", "0"], "image size"),
+        (
+            &[
+                "render",
+                "--out",
+                "picture.jpg",
+                "--width",
+                "8",
+                "--height",
+                "8",
+            ],
+            "picture.jpg",
+        ),
+        (&["sh", "/nonexistent/map.exr"], "/nonexistent/map.exr"),
+    ];
+    for (args, expected) in cases {
+        let out = kage(args);
+        let all = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {all}");
+        assert!(
+            all.contains("kage: error:") && all.contains(expected),
+            "{args:?}: {all}"
+        );
+        assert!(!all.contains("panicked"), "{args:?}: {all}");
+    }
+}
+
+#[test]
+fn info_lists_features() {
+    let out = kage(&["info"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let all = text(&out);
+    assert!(
+        all.contains("VK_KHR_dynamic_rendering") && all.contains("timestamps"),
+        "{all}"
+    );
+}
