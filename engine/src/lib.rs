@@ -18,6 +18,8 @@ pub mod error;
 pub mod imageio;
 pub mod layouts;
 pub mod pass;
+pub mod raycast;
+pub mod reference;
 pub mod renderer;
 pub mod scene;
 pub mod sh;

@@ -2,4 +2,5 @@
 //! of them: the environment map on the GPU and its SH projection.
 pub mod env_sh;
 pub mod environment;
+pub mod prt;
 pub mod unshadowed;
