@@ -68,3 +68,16 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("temp folder");
     dir
 }
+
+/// Renders one frame of `scene` at `width`x`height` and reads it back.
+pub fn render_once(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+) -> kage::imageio::RgbaF32Image {
+    let options = kage::renderer::RenderOptions { width, height };
+    let mut renderer = kage::renderer::Renderer::new(ctx, scene, &options).expect("renderer");
+    renderer.render().expect("frame");
+    renderer.image().expect("readback")
+}

@@ -3,7 +3,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, uv_to_direction, Camera, EnvMap, Scene};
 use kage::techniques::env_sh;
-use kage_tests::{single_mesh_scene, Validated};
+use kage_tests::{render_once, single_mesh_scene, Validated};
 use std::f32::consts::PI;
 
 /// Sums over texels in f32 on the GPU: relative error of a few 1e-6 per coefficient, far below
@@ -127,17 +127,7 @@ fn sphere_under_constant_light_has_radiance_albedo() {
     let sphere = shapes::sphere("sphere", 1.0, 64, [rho; 3]).unwrap();
     let scene = single_mesh_scene(sphere, EnvMap::constant([1.0; 3]), camera);
     let size = 96;
-    let mut renderer = Renderer::new(
-        &ctx,
-        &scene,
-        &RenderOptions {
-            width: size,
-            height: size,
-        },
-    )
-    .unwrap();
-    renderer.render().unwrap();
-    let image = renderer.image().unwrap();
+    let image = render_once(&ctx, &scene, size, size);
     let (mut on_sphere, mut on_background) = (0, 0);
     for y in 0..size {
         for x in 0..size {
@@ -197,17 +187,7 @@ fn bright_texel_is_seen_in_its_direction() {
         )
     };
     let size = 33; // odd: the centre pixel's ray is exactly the camera's axis
-    let mut renderer = Renderer::new(
-        &ctx,
-        &scene,
-        &RenderOptions {
-            width: size,
-            height: size,
-        },
-    )
-    .unwrap();
-    renderer.render().unwrap();
-    let image = renderer.image().unwrap();
+    let image = render_once(&ctx, &scene, size, size);
     let centre = image.pixels[(size / 2 * size + size / 2) as usize];
     // Bilinear filtering at the texel's exact centre returns the texel itself.
     for (k, expected) in [100.0f32, 50.0, 25.0].iter().enumerate() {
@@ -304,19 +284,7 @@ fn exported_scene_renders_the_same_picture() {
     let dir = kage_tests::scratch_dir("export");
     scene.export(&dir).unwrap();
     let reloaded = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
-    let render = |s: &Scene| {
-        let mut r = Renderer::new(
-            &ctx,
-            s,
-            &RenderOptions {
-                width: 48,
-                height: 48,
-            },
-        )
-        .unwrap();
-        r.render().unwrap();
-        r.image().unwrap().pixels
-    };
+    let render = |s: &Scene| render_once(&ctx, s, 48, 48).pixels;
     assert!(
         render(&scene) == render(&reloaded),
         "exported scene renders differently"
