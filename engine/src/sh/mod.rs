@@ -23,6 +23,8 @@
 //! as they are: here z is just an axis and the "zonal" functions (m = 0) are symmetric about
 //! Kage's z axis, not about up. Keeping the textbook form means coefficients can be compared
 //! with published values and the shaders can copy the polynomials verbatim.
+pub mod rotation;
+
 use glam::{DVec3, Mat4, Vec3};
 use std::f64::consts::PI;
 
