@@ -23,6 +23,8 @@ pub struct Image {
     ctx: Arc<Context>,
     pub(crate) raw: vk::Image,
     pub(crate) view: vk::ImageView,
+    /// One 2D view per layer of a layered attachment, to render into a single layer.
+    layer_views: Vec<vk::ImageView>,
     allocation: Option<Allocation>,
     pub width: u32,
     pub height: u32,
@@ -110,6 +112,7 @@ impl Image {
             ctx: ctx.clone(),
             raw,
             view: vk::ImageView::null(),
+            layer_views: Vec::new(),
             allocation: None,
             width: desc.width,
             height: desc.height,
@@ -141,6 +144,27 @@ impl Image {
             .map_err(Error::vk("vkCreateImageView"))?;
         ctx.set_name(image.view, &format!("{}.view", desc.name));
 
+        let attachment =
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
+        if desc.layers > 1 && desc.usage.intersects(attachment) {
+            for layer in 0..desc.layers {
+                let range = vk::ImageSubresourceRange {
+                    base_array_layer: layer,
+                    layer_count: 1,
+                    ..image.range()
+                };
+                let info = vk::ImageViewCreateInfo::default()
+                    .image(raw)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(desc.format)
+                    .subresource_range(range);
+                // SAFETY: the image is bound; the view covers one existing layer.
+                let view = unsafe { ctx.device.create_image_view(&info, None) }
+                    .map_err(Error::vk("vkCreateImageView"))?;
+                ctx.set_name(view, &format!("{}.layer{layer}", desc.name));
+                image.layer_views.push(view);
+            }
+        }
         ctx.one_shot(&format!("{}.to_general", desc.name), |cmd| {
             image.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL)
         })?;
@@ -188,6 +212,14 @@ impl Image {
 
     pub fn view(&self) -> vk::ImageView {
         self.view
+    }
+
+    /// The view to render into `layer` (the whole image when it has one layer).
+    pub(crate) fn attachment_view(&self, layer: u32) -> vk::ImageView {
+        self.layer_views
+            .get(layer as usize)
+            .copied()
+            .unwrap_or(self.view)
     }
 
     /// Bytes of the whole image in a tightly packed buffer.
@@ -290,8 +322,10 @@ impl Drop for Image {
     fn drop(&mut self) {
         // SAFETY: no submission using the image is pending (frames and one-shots wait).
         unsafe {
-            if self.view != vk::ImageView::null() {
-                self.ctx.device.destroy_image_view(self.view, None);
+            for &view in self.layer_views.iter().chain([&self.view]) {
+                if view != vk::ImageView::null() {
+                    self.ctx.device.destroy_image_view(view, None);
+                }
             }
             self.ctx.device.destroy_image(self.raw, None);
         }

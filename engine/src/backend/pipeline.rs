@@ -186,12 +186,20 @@ impl Drop for ComputePipeline {
     }
 }
 
-/// One vertex attribute read from binding 0 (one interleaved vertex buffer).
+/// One vertex attribute of a vertex buffer.
 #[derive(Clone, Copy, Debug)]
 pub struct VertexAttribute {
     pub location: u32,
     pub format: vk::Format,
     pub offset: u32,
+}
+
+/// One interleaved vertex buffer; its binding number is its index in
+/// `GraphicsDesc::vertex_buffers`.
+#[derive(Clone, Copy, Debug)]
+pub struct VertexBuffer<'a> {
+    pub stride: u32,
+    pub attributes: &'a [VertexAttribute],
 }
 
 pub struct GraphicsDesc<'a> {
@@ -200,13 +208,14 @@ pub struct GraphicsDesc<'a> {
     pub fragment_spirv: &'a [u8],
     pub bindings: &'a [BindingKind],
     pub push_size: u32,
-    /// Stride of the vertex buffer; 0 means no vertex input (vertices made in the shader).
-    pub vertex_stride: u32,
-    pub attributes: &'a [VertexAttribute],
+    /// Vertex buffers, bound in this order; none means vertices are made in the shader.
+    pub vertex_buffers: &'a [VertexBuffer<'a>],
     pub topology: vk::PrimitiveTopology,
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
     pub depth_test: bool,
+    /// Add to the colour target instead of replacing it (accumulating lights).
+    pub additive: bool,
 }
 
 pub struct GraphicsPipeline {
@@ -230,27 +239,35 @@ impl GraphicsPipeline {
                 .module(fs.raw)
                 .name(c"main"),
         ];
-        let vertex_bindings = [vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: desc.vertex_stride,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        let attributes: Vec<vk::VertexInputAttributeDescription> = desc
-            .attributes
+        let vertex_bindings: Vec<vk::VertexInputBindingDescription> = desc
+            .vertex_buffers
             .iter()
-            .map(|a| vk::VertexInputAttributeDescription {
-                location: a.location,
-                binding: 0,
-                format: a.format,
-                offset: a.offset,
+            .enumerate()
+            .map(|(b, buffer)| vk::VertexInputBindingDescription {
+                binding: b as u32,
+                stride: buffer.stride,
+                input_rate: vk::VertexInputRate::VERTEX,
             })
             .collect();
-        let mut vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        if desc.vertex_stride > 0 {
-            vertex_input = vertex_input
-                .vertex_binding_descriptions(&vertex_bindings)
-                .vertex_attribute_descriptions(&attributes);
-        }
+        let attributes: Vec<vk::VertexInputAttributeDescription> = desc
+            .vertex_buffers
+            .iter()
+            .enumerate()
+            .flat_map(|(b, buffer)| {
+                buffer
+                    .attributes
+                    .iter()
+                    .map(move |a| vk::VertexInputAttributeDescription {
+                        location: a.location,
+                        binding: b as u32,
+                        format: a.format,
+                        offset: a.offset,
+                    })
+            })
+            .collect();
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&vertex_bindings)
+            .vertex_attribute_descriptions(&attributes);
         let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
         let viewport = vk::PipelineViewportStateCreateInfo::default()
             .viewport_count(1)
@@ -268,14 +285,16 @@ impl GraphicsPipeline {
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_test)
             .depth_compare_op(vk::CompareOp::LESS);
-        let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> = desc
-            .color_formats
-            .iter()
-            .map(|_| {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
-            })
-            .collect();
+        let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)
+            .blend_enable(desc.additive)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
+            .alpha_blend_op(vk::BlendOp::ADD);
+        let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
         let blend =
             vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];

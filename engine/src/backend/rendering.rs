@@ -3,33 +3,51 @@
 use super::{Context, Image};
 use ash::vk;
 
+/// One layer of an image used as an attachment.
+#[derive(Clone, Copy)]
+pub struct Target<'a> {
+    pub image: &'a Image,
+    pub layer: u32,
+}
+
+impl<'a> From<&'a Image> for Target<'a> {
+    fn from(image: &'a Image) -> Target<'a> {
+        Target { image, layer: 0 }
+    }
+}
+
 impl Context {
     /// Begins rendering into `color` (cleared to `clear` when given, else loaded) and `depth`
-    /// (always cleared to 1, the far plane).
+    /// (always cleared to 1, the far plane). Either may be absent (depth-only shadow maps).
     pub fn begin_rendering(
         &self,
         cmd: vk::CommandBuffer,
-        color: &Image,
+        color: Option<Target>,
         clear: Option<[f32; 4]>,
-        depth: Option<&Image>,
+        depth: Option<Target>,
     ) {
-        let color_attachment = [vk::RenderingAttachmentInfo::default()
-            .image_view(color.view)
-            .image_layout(vk::ImageLayout::GENERAL)
-            .load_op(if clear.is_some() {
-                vk::AttachmentLoadOp::CLEAR
-            } else {
-                vk::AttachmentLoadOp::LOAD
+        let color_attachment: Vec<vk::RenderingAttachmentInfo> = color
+            .iter()
+            .map(|c| {
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(c.image.attachment_view(c.layer))
+                    .image_layout(vk::ImageLayout::GENERAL)
+                    .load_op(if clear.is_some() {
+                        vk::AttachmentLoadOp::CLEAR
+                    } else {
+                        vk::AttachmentLoadOp::LOAD
+                    })
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue {
+                        color: vk::ClearColorValue {
+                            float32: clear.unwrap_or_default(),
+                        },
+                    })
             })
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                color: vk::ClearColorValue {
-                    float32: clear.unwrap_or_default(),
-                },
-            })];
+            .collect();
         let depth_attachment = depth.map(|d| {
             vk::RenderingAttachmentInfo::default()
-                .image_view(d.view)
+                .image_view(d.image.attachment_view(d.layer))
                 .image_layout(vk::ImageLayout::GENERAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::STORE)
@@ -40,11 +58,15 @@ impl Context {
                     },
                 })
         });
+        let size = color
+            .or(depth)
+            .map(|t| (t.image.width, t.image.height))
+            .unwrap_or((1, 1));
         let area = vk::Rect2D {
             offset: vk::Offset2D::default(),
             extent: vk::Extent2D {
-                width: color.width,
-                height: color.height,
+                width: size.0,
+                height: size.1,
             },
         };
         let mut info = vk::RenderingInfo::default()
@@ -57,8 +79,8 @@ impl Context {
         let viewport = vk::Viewport {
             x: 0.0,
             y: 0.0,
-            width: color.width as f32,
-            height: color.height as f32,
+            width: size.0 as f32,
+            height: size.1 as f32,
             min_depth: 0.0,
             max_depth: 1.0,
         };
@@ -75,18 +97,20 @@ impl Context {
         unsafe { self.dynamic_rendering.cmd_end_rendering(cmd) };
     }
 
-    /// Binds an interleaved vertex buffer and a u32 index buffer and draws `count` indices.
+    /// Binds vertex buffers (binding i = `vertices[i]`) and a u32 index buffer and draws `count`
+    /// indices.
     pub fn draw_indexed(
         &self,
         cmd: vk::CommandBuffer,
-        vertices: &super::Buffer,
+        vertices: &[&super::Buffer],
         indices: &super::Buffer,
         count: u32,
     ) {
+        let raw: Vec<vk::Buffer> = vertices.iter().map(|b| b.raw).collect();
+        let offsets = vec![0; raw.len()];
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {
-            self.device
-                .cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw], &[0]);
+            self.device.cmd_bind_vertex_buffers(cmd, 0, &raw, &offsets);
             self.device
                 .cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
             self.device.cmd_draw_indexed(cmd, count, 1, 0, 0, 0);

@@ -3,6 +3,7 @@
 use super::environment::GpuEnvironment;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute,
+    VertexBuffer,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, DrawPush};
@@ -18,6 +19,18 @@ pub struct Unshadowed {
 
 /// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
 pub const VERTEX_STRIDE: u32 = 24;
+pub const MESH_ATTRIBUTES: [VertexAttribute; 2] = [
+    VertexAttribute {
+        location: 0,
+        format: vk::Format::R32G32B32_SFLOAT,
+        offset: 0,
+    },
+    VertexAttribute {
+        location: 1,
+        format: vk::Format::R32G32B32_SFLOAT,
+        offset: 12,
+    },
+];
 
 impl Unshadowed {
     pub fn new(ctx: &Arc<Context>) -> Result<Unshadowed> {
@@ -29,12 +42,12 @@ impl Unshadowed {
                 fragment_spirv: spirv::BACKGROUND_FRAG,
                 bindings: &[BindingKind::UniformBuffer, BindingKind::SampledImage],
                 push_size: 0,
-                vertex_stride: 0,
-                attributes: &[],
+                vertex_buffers: &[],
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 color_formats: &[COLOR_FORMAT],
                 depth_format: None,
                 depth_test: false,
+                additive: false,
             },
         )?;
         let scene = GraphicsPipeline::new(
@@ -45,23 +58,15 @@ impl Unshadowed {
                 fragment_spirv: spirv::SCENE_FRAG,
                 bindings: &[BindingKind::UniformBuffer, BindingKind::StorageBuffer],
                 push_size: size_of::<DrawPush>() as u32,
-                vertex_stride: VERTEX_STRIDE,
-                attributes: &[
-                    VertexAttribute {
-                        location: 0,
-                        format: vk::Format::R32G32B32_SFLOAT,
-                        offset: 0,
-                    },
-                    VertexAttribute {
-                        location: 1,
-                        format: vk::Format::R32G32B32_SFLOAT,
-                        offset: 12,
-                    },
-                ],
+                vertex_buffers: &[VertexBuffer {
+                    stride: VERTEX_STRIDE,
+                    attributes: &MESH_ATTRIBUTES,
+                }],
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 color_formats: &[COLOR_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
+                additive: false,
             },
         )?;
         Ok(Unshadowed {
@@ -88,7 +93,7 @@ impl Unshadowed {
                 &["frame_uniforms", "environment"],
                 &["color"],
                 move |cmd| {
-                    ctx.begin_rendering(cmd, &targets.color, Some([0.0; 4]), None);
+                    ctx.begin_rendering(cmd, Some((&targets.color).into()), Some([0.0; 4]), None);
                     self.background.bind(
                         cmd,
                         &[
@@ -105,7 +110,12 @@ impl Unshadowed {
                 &["frame_uniforms", "env_sh", "color"],
                 &["color", "depth"],
                 move |cmd| {
-                    ctx.begin_rendering(cmd, &targets.color, None, Some(&targets.depth));
+                    ctx.begin_rendering(
+                        cmd,
+                        Some((&targets.color).into()),
+                        None,
+                        Some((&targets.depth).into()),
+                    );
                     self.scene.bind(
                         cmd,
                         &[Binding::Uniform(frame_uniforms), Binding::Storage(env_sh)],
@@ -116,7 +126,7 @@ impl Unshadowed {
                             albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
                         };
                         self.scene.push(cmd, bytes_of(&push));
-                        ctx.draw_indexed(cmd, &mesh.vertices, &mesh.indices, mesh.index_count);
+                        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
                     }
                     ctx.end_rendering(cmd);
                 },
