@@ -8,7 +8,12 @@ use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::Scene;
 use crate::techniques::env_sh::EnvSh;
 use crate::techniques::environment::GpuEnvironment;
+use crate::techniques::background::Background;
+use crate::techniques::prt::TransferSet;
+use crate::techniques::tamura::technique::OcclusionSettings;
+use crate::techniques::tamura::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
+use crate::techniques::{FrameInputs, FrameState, Technique};
 use glam::Mat4;
 use std::sync::Arc;
 
@@ -22,11 +27,16 @@ pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 pub const MAX_SIZE: u32 = 8192;
 
 pub struct GpuMesh {
+    /// `group.mesh`, for names and messages.
+    pub name: String,
     pub vertices: Buffer,
     pub indices: Buffer,
     pub index_count: u32,
+    pub vertex_count: u32,
     pub albedo: [f32; 3],
     pub group: usize,
+    /// Index of the mesh within its group.
+    pub mesh: usize,
 }
 
 /// Geometry on the GPU: one vertex and index buffer per mesh, one transform per group.
@@ -39,7 +49,7 @@ impl GpuScene {
     pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
         let mut meshes = Vec::new();
         for (g, group) in scene.groups.iter().enumerate() {
-            for mesh in &group.meshes {
+            for (m, mesh) in group.meshes.iter().enumerate() {
                 let vertices: Vec<u8> = mesh
                     .positions
                     .iter()
@@ -50,6 +60,7 @@ impl GpuScene {
                 let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
                 let name = format!("{}.{}", group.name, mesh.name);
                 meshes.push(GpuMesh {
+                    name: name.clone(),
                     vertices: Buffer::with_data(
                         ctx,
                         &format!("{name}.vertices"),
@@ -63,6 +74,8 @@ impl GpuScene {
                         &indices,
                     )?,
                     index_count: mesh.indices.len() as u32,
+                    vertex_count: mesh.positions.len() as u32,
+                    mesh: m,
                     albedo: mesh.albedo,
                     group: g,
                 });
@@ -95,6 +108,7 @@ impl Targets {
                 width,
                 height,
                 layers: 1,
+                array: false,
                 format: COLOR_FORMAT,
                 usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             },
@@ -106,6 +120,7 @@ impl Targets {
                 width,
                 height,
                 layers: 1,
+                array: false,
                 format: DEPTH_FORMAT,
                 usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
             },
@@ -127,29 +142,41 @@ impl Targets {
     }
 }
 
+/// Which technique lights the scene.
+#[derive(Clone, Debug, Default)]
+pub enum TechniqueChoice {
+    /// SH irradiance, no shadows.
+    #[default]
+    Unshadowed,
+    /// PRT: with `occlusion.regions == 0` Sloan's self-shadowing alone, otherwise the
+    /// Tamura–Johan–Nishita technique with that many regions.
+    Prt { transfer: Arc<TransferSet>, occlusion: OcclusionSettings },
+}
+
 /// What to render and how large.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
     pub width: u32,
     pub height: u32,
+    pub technique: TechniqueChoice,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions {
-            width: 512,
-            height: 512,
-        }
+        RenderOptions { width: 512, height: 512, technique: TechniqueChoice::Unshadowed }
     }
 }
 
 pub struct Renderer {
+    ctx: Arc<Context>,
     scene: GpuScene,
     camera: crate::scene::Camera,
     env: GpuEnvironment,
     env_sh: EnvSh,
     env_dirty: bool,
-    technique: Unshadowed,
+    env_rotation: f32,
+    background: Background,
+    technique: Box<dyn Technique>,
     frame_uniforms: Buffer,
     targets: Targets,
     executor: FrameExecutor,
@@ -158,25 +185,41 @@ pub struct Renderer {
 impl Renderer {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, options: &RenderOptions) -> Result<Renderer> {
         let targets = Targets::new(ctx, options.width, options.height)?;
+        let gpu = GpuScene::new(ctx, scene)?;
+        let technique: Box<dyn Technique> = match &options.technique {
+            TechniqueChoice::Unshadowed => Box::new(Unshadowed::new(ctx)?),
+            TechniqueChoice::Prt { transfer, occlusion } => {
+                Box::new(PrtTechnique::new(ctx, scene, &gpu, transfer, *occlusion)?)
+            }
+        };
         Ok(Renderer {
-            scene: GpuScene::new(ctx, scene)?,
+            ctx: ctx.clone(),
+            scene: gpu,
             camera: scene.camera,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
             env_sh: EnvSh::new(ctx, &scene.environment)?,
             env_dirty: true,
-            technique: Unshadowed::new(ctx)?,
-            frame_uniforms: Buffer::new(
-                ctx,
-                &BufferDesc {
-                    name: "frame_uniforms",
-                    size: size_of::<FrameUniforms>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
-                },
-            )?,
+            env_rotation: 0.0,
+            background: Background::new(ctx)?,
+            technique,
+            frame_uniforms: Buffer::new(ctx, &BufferDesc {
+                name: "frame_uniforms",
+                size: size_of::<FrameUniforms>() as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })?,
             targets,
             executor: FrameExecutor::new(ctx, "frame")?,
         })
+    }
+
+    /// Turns the environment about +Y (counter-clockwise seen from above), in radians.
+    pub fn set_env_rotation(&mut self, radians: f32) -> Result<()> {
+        if !radians.is_finite() {
+            return Err(Error::InvalidArgument(format!("environment rotation {radians} is not finite")));
+        }
+        self.env_rotation = radians;
+        Ok(())
     }
 
     /// Moves a group (a rigid transform: rotation, translation, uniform scale).
@@ -204,31 +247,37 @@ impl Renderer {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             camera_pos: self.camera.position.extend(1.0).to_array(),
-            env_params: [1.0, 0.0, 0.0, 0.0],
+            env_params: [1.0, self.env_rotation, 0.0, 0.0],
         };
         self.frame_uniforms.write(0, bytes_of(&uniforms))?;
 
+        self.technique
+            .update(&FrameState { transforms: &self.scene.transforms, env_rotation: self.env_rotation })?;
+
+        let inputs = FrameInputs {
+            ctx: &self.ctx,
+            uniforms: &self.frame_uniforms,
+            environment: &self.env,
+            env_sh: &self.env_sh.coefficients,
+            scene: &self.scene,
+            targets: &self.targets,
+        };
         let mut passes: Vec<Pass> = Vec::new();
         if self.env_dirty {
             passes.extend(self.env_sh.passes(&self.env));
         }
-        passes.extend(self.technique.passes(
-            &self.frame_uniforms,
-            &self.env,
-            &self.env_sh.coefficients,
-            &self.scene,
-            &self.targets,
-        ));
+        passes.push(self.background.pass(&inputs));
+        passes.extend(self.technique.passes(&inputs));
         let targets = &self.targets;
         passes.push(Pass::new("readback", &["color"], &[], move |cmd| {
             targets.color.record_copy_to(cmd, &targets.readback)
         }));
-        let imports: &[&'static str] = if self.env_dirty {
-            &["frame_uniforms", "environment"]
-        } else {
-            &["frame_uniforms", "environment", "env_sh"]
-        };
-        let timings = self.executor.run(imports, passes)?;
+        let mut imports = vec!["frame_uniforms", "environment"];
+        if !self.env_dirty {
+            imports.push("env_sh");
+        }
+        imports.extend_from_slice(self.technique.persistent());
+        let timings = self.executor.run(&imports, passes)?;
         self.env_dirty = false;
         Ok(timings)
     }

@@ -12,4 +12,40 @@
 // Environment texels each SH projection invocation adds up.
 #define KAGE_SH_TEXELS_PER_INVOCATION 16
 
+// Storage buffers that bvh.glsl declares at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1; a shader
+// that includes it numbers its own bindings from here.
+#define KAGE_BVH_BINDINGS 5
+// RayHit.instance of a ray that hit nothing (0xffffffff).
+#define KAGE_NO_HIT 4294967295u
+// Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.
+#define KAGE_BVH_STACK 32
+// Invocations per workgroup of the ray casting test and benchmark shader.
+#define KAGE_RAYCAST_GROUP 64
+
+// Samples one invocation of the reference shaders takes per dispatch. llvmpipe silently ends an
+// invocation's loops after about 65,535 iterations in all; with BVH traversals inside every
+// sample, 16 samples stay far below that. Larger batches are split into several dispatches.
+#define KAGE_SAMPLES_PER_DISPATCH 16
+// Workgroup of the reference renderer: 8x8 pixels.
+#define KAGE_REFERENCE_GROUP 8
+// Invocations per workgroup of the reference irradiance shader (one point each).
+#define KAGE_IRRADIANCE_GROUP 64
+
+// Invocations per workgroup of the PRT transfer shader (one vertex each).
+#define KAGE_PRT_GROUP 64
+
+// vec4s per vertex holding its PRT transfer vector: ceil(25 / 4), enough for 5 SH bands
+// (fewer bands leave the rest zero).
+#define KAGE_TRANSFER_VEC4 7
+// Texels per row of the self-shadow texture (one texel per vertex).
+#define KAGE_SELF_SHADOW_WIDTH 1024
+// Most environment regions the Tamura technique handles (interpolated as vertex outputs).
+#define KAGE_MAX_REGIONS 64
+// Most occlusion layers per frame: their records sit in a uniform buffer (cheaper to read per
+// fragment than a storage buffer on CPU drivers), 64 bytes each, within the 16 KiB every
+// Vulkan device offers.
+#define KAGE_MAX_OCCLUSION_LAYERS 256
+// Invocations per workgroup of the occlusion box filter (one row or column each).
+#define KAGE_BLUR_GROUP 64
+
 #endif

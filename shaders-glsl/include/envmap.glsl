@@ -14,4 +14,11 @@ vec3 env_uv_to_dir(vec2 uv) {
     return vec3(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
 }
 
+// A world direction as the map sees it when the environment is turned by `angle` radians about
+// +Y (counter-clockwise seen from above): the inverse rotation.
+vec3 env_world_to_map(vec3 d, float angle) {
+    float c = cos(angle), s = sin(angle);
+    return vec3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+
 #endif

@@ -33,4 +33,151 @@ struct ShProjectPush {
     uvec4 size; // x: width, y: height, z: groups in x, w: unused
 };
 
+// A BVH node, 32 bytes; the children of an interior node are adjacent (index, index + 1).
+// Bottom-level nodes (one tree per scene group) bound object-space triangles and a leaf holds
+// triangles [index, index + count) of the BVH triangle buffer; top-level nodes bound world-space
+// instances and a leaf holds exactly one instance, `index`.
+struct BvhNode {
+    vec4 lo; // xyz: box minimum, w: floatBitsToUint = index (first child, first triangle or instance)
+    vec4 hi; // xyz: box maximum, w: floatBitsToUint = count (0: interior node)
+};
+
+// A triangle's object-space vertex positions (w unused), for the intersection test.
+struct BvhTriangle {
+    vec4 v0;
+    vec4 v1;
+    vec4 v2;
+};
+
+// What shading needs of a triangle, at the same index as its BvhTriangle.
+struct BvhTriangleAttributes {
+    vec4 n0; // xyz: unit object-space vertex normal of v0, w: unused
+    vec4 n1;
+    vec4 n2;
+    vec4 albedo; // rgb: diffuse albedo, a: unused
+};
+
+// A scene group placed in the world; instance index == group index.
+struct BvhInstance {
+    mat4 object_to_world;
+    mat4 world_to_object;
+    uvec4 info; // x: BLAS root node, y: first triangle, z: triangle count, w: unused
+};
+
+// A ray of the ray casting test and benchmark shader.
+struct CastRay {
+    vec4 origin; // xyz: origin, w: tmax
+    vec4 direction; // xyz: unit direction (object space for object-space queries), w: unused
+};
+
+// What the ray casting shader writes per ray; the surface members only for surface queries.
+struct CastResult {
+    vec4 hit; // x: t, yz: barycentric weights of v1 and v2, w: unused
+    uvec4 ids; // x: instance (KAGE_NO_HIT on a miss), y: triangle, z, w: unused
+    vec4 position; // xyz: bvh_surface's world-space position, w: unused
+    vec4 geometric_normal; // xyz: bvh_surface's geometric normal, w: unused
+    vec4 shading_normal; // xyz: bvh_surface's shading normal, w: unused
+    vec4 albedo; // rgb: bvh_surface's albedo, a: unused
+};
+
+// Push constants of the ray casting shader.
+struct CastPush {
+    uvec4 params; // x: ray count, y: query (0 closest, 1 occluded, 2 occluded in object space, 3 closest with surface), z: instance, w: first ray
+};
+
+// The reference's running statistics of one pixel or point: mean and sum of squared deviations
+// of its samples (Welford), merged batch by batch with Chan et al.'s formula, which stays
+// accurate where a raw sum of squares would cancel.
+struct ReferenceAccum {
+    vec4 mean; // rgb: mean of the samples so far, w: unused
+    vec4 m2; // rgb: sum of squared deviations from the mean, w: unused
+};
+
+// A point or spot light as the reference's --light local mode reads it.
+struct ReferenceLight {
+    vec4 position; // xyz: world position, w: 0 point light, 1 spot light
+    vec4 direction; // xyz: unit spot axis, w: cosine of half the spot's fov_deg
+    vec4 intensity; // rgb: radiant intensity (W/sr), w: unused
+};
+
+// Push constants of the reference renderer (reference_render.comp).
+struct ReferencePush {
+    mat4 inv_view_proj;
+    vec4 camera_pos; // xyz: camera position, w: the environment's sum of luminance x solid angle (0: no environment sampling)
+    uvec4 frame; // x: width, y: height, z: samples accumulated before this batch, w: samples in this batch
+    uvec4 params; // x: 0 environment light, 1 local lights, y: light count, z: seed, w: unused
+};
+
+// A point of the reference's irradiance mode.
+struct IrradiancePoint {
+    vec4 position; // xyz: world position, w: unused
+    vec4 normal; // xyz: unit normal, w: unused
+};
+
+// Push constants of the reference irradiance shader (reference_irradiance.comp).
+struct IrradiancePush {
+    uvec4 params; // x: point count, y: samples accumulated before this batch, z: samples in this batch, w: seed
+    vec4 env; // x: the environment's sum of luminance x solid angle (0: no environment sampling), yzw: unused
+};
+
+// A vertex of the PRT precomputation, in its group's object space.
+struct PrtVertex {
+    vec4 position; // xyz: position, w: unused
+    vec4 normal; // xyz: unit vertex normal, w: unused
+};
+
+// Push constants of the PRT transfer shader; one dispatch covers some rays of some vertices of one mesh.
+struct PrtTransferPush {
+    uvec4 range; // x: first vertex (into the vertex buffer), y: vertex count, z: group (BVH instance), w: rays per vertex
+    uvec4 params; // x: coefficients per vertex (bands squared), y: first ray of this dispatch, z: rays in it, w: unused
+};
+
+// The environment's SH as one group's object space sees it, for the self-shadow pass: one
+// vec4-padded coefficient vector per colour channel.
+struct GroupLight {
+    vec4 red[KAGE_TRANSFER_VEC4];
+    vec4 green[KAGE_TRANSFER_VEC4];
+    vec4 blue[KAGE_TRANSFER_VEC4];
+};
+
+// Push constants of the self-shadow pass (one draw of points per mesh).
+struct SelfShadowPush {
+    uvec4 target; // x: first texel, y: texture width, z: texture height, w: group
+    vec4 albedo; // rgb: the mesh's diffuse albedo, a: unused
+};
+
+// The SH basis evaluated at one region's direction in one group's object space.
+struct RegionBasis {
+    vec4 y[KAGE_TRANSFER_VEC4];
+};
+
+// Push constants of the PRT scene pass (Sloan and Tamura): one draw per mesh.
+struct PrtDrawPush {
+    mat4 model;
+    vec4 albedo; // rgb: diffuse albedo, a: unused
+    uvec4 mesh; // x: first self-shadow texel, y: texture width, z: group, w: regions (0: self-shadow only)
+    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z, w: unused
+};
+
+// One occlusion layer: the shadow of one occluder group on one receiver group for one region,
+// on the plane through the receiver's bounding-sphere centre perpendicular to the region's
+// direction.
+struct OcclusionLayer {
+    vec4 centre; // xyz: receiver bounding-sphere centre (world), w: 1 / (2 x half-extent of the mask)
+    vec4 axis_u; // xyz: first unit axis of the plane, w: box filter width in texels (odd)
+    vec4 axis_v; // xyz: second unit axis, w: unused
+    uvec4 ids; // x: region, y: receiver group, z: occluder group, w: unused
+};
+
+// Push constants of the occluder mask pass: one draw per occluder mesh per layer.
+struct MaskPush {
+    mat4 model;
+    uvec4 layer; // x: occlusion layer index, y, z, w: unused
+};
+
+// Push constants of the occlusion box filter.
+struct BlurPush {
+    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: unused
+};
+
 #endif

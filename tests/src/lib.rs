@@ -76,7 +76,7 @@ pub fn render_once(
     width: u32,
     height: u32,
 ) -> kage::imageio::RgbaF32Image {
-    let options = kage::renderer::RenderOptions { width, height };
+    let options = kage::renderer::RenderOptions { width, height, ..Default::default() };
     let mut renderer = kage::renderer::Renderer::new(ctx, scene, &options).expect("renderer");
     renderer.render().expect("frame");
     renderer.image().expect("readback")

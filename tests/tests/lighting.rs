@@ -218,10 +218,7 @@ fn every_pass_reports_gpu_time() {
     let mut renderer = Renderer::new(
         &ctx,
         &scene,
-        &RenderOptions {
-            width: 64,
-            height: 64,
-        },
+        &RenderOptions { width: 64, height: 64, ..Default::default() },
     )
     .unwrap();
     let first = renderer.render().unwrap();
@@ -249,10 +246,7 @@ fn bad_render_arguments_are_errors() {
         let err = Renderer::new(
             &ctx,
             &scene,
-            &RenderOptions {
-                width: w,
-                height: h,
-            },
+            &RenderOptions { width: w, height: h, ..Default::default() },
         )
         .err()
         .unwrap();
@@ -261,10 +255,7 @@ fn bad_render_arguments_are_errors() {
     let mut renderer = Renderer::new(
         &ctx,
         &scene,
-        &RenderOptions {
-            width: 8,
-            height: 8,
-        },
+        &RenderOptions { width: 8, height: 8, ..Default::default() },
     )
     .unwrap();
     assert!(renderer

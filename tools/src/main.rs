@@ -1,8 +1,13 @@
 //! `kage`: the command-line front end of the Kage engine.
+mod bench;
+mod compare;
 mod info;
+mod precompute;
+mod reference;
 mod render;
 mod scene_cmd;
 mod sh_cmd;
+mod transfer_source;
 
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
@@ -72,9 +77,19 @@ enum Command {
     Sh(sh_cmd::ShArgs),
     /// Print the device, driver, Vulkan version and each feature Kage uses.
     Info(GpuArgs),
+    /// Precompute the PRT transfer of every vertex (cached; prints time and bytes).
+    Precompute(precompute::PrecomputeArgs),
     /// Scene utilities.
     #[command(subcommand)]
     Scene(scene_cmd::SceneCommand),
+    /// Ray-traced ground truth: Monte Carlo direct lighting with full visibility (an image,
+    /// or irradiance at listed points).
+    Reference(reference::ReferenceArgs),
+    /// Error metrics of one EXR image against a reference, and a false-colour difference.
+    Compare(compare::CompareArgs),
+    /// Benchmarks.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
 }
 
 fn main() {
@@ -83,7 +98,11 @@ fn main() {
         Command::Render(args) => render::run(&args),
         Command::Sh(args) => sh_cmd::run(&args),
         Command::Info(args) => info::run(&args),
+        Command::Precompute(args) => precompute::run(&args),
         Command::Scene(command) => scene_cmd::run(&command),
+        Command::Reference(args) => reference::run(&args),
+        Command::Compare(args) => compare::run(&args),
+        Command::Bench(command) => bench::run(&command),
     };
     if let Err(e) = result {
         eprintln!("kage: error: {e:#}");

@@ -4,13 +4,42 @@ use anyhow::{Context as _, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
-use kage::renderer::{RenderOptions, Renderer};
+use crate::transfer_source::{Origin, PrtArgs};
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::techniques::tamura::technique::OcclusionSettings;
 use kage::scene::Scene;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// The lighting techniques `kage render` offers.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TechniqueName {
+    /// SH irradiance, no shadows.
+    Unshadowed,
+    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only.
+    Sloan,
+    /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups, q regions.
+    Tamura,
+}
+
 #[derive(Args)]
 pub struct RenderArgs {
+    #[arg(long, value_enum, default_value_t = TechniqueName::Unshadowed)]
+    technique: TechniqueName,
+    /// Environment regions q of the Tamura technique (1 to 64).
+    #[arg(long, default_value_t = OcclusionSettings::default().regions)]
+    regions: usize,
+    /// Side of a Tamura occlusion mask layer, texels.
+    #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
+    mask_size: u32,
+    /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
+    #[arg(long, default_value_t = 0.0)]
+    env_rotation: f32,
+    /// Play the scripted motion of the scene's first group over the frames (see README).
+    #[arg(long)]
+    animate: bool,
+    #[command(flatten)]
+    prt: PrtArgs,
     /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
@@ -52,15 +81,31 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = Scene::from_arg(&args.scene)?;
     crate::report_clamped(&scene.environment);
     let ctx = args.gpu.context()?;
-    let mut renderer = Renderer::new(
-        &ctx,
-        &scene,
-        &RenderOptions {
-            width: args.width,
-            height: args.height,
-        },
-    )
-    .context("setting up the renderer")?;
+    let technique = match args.technique {
+        TechniqueName::Unshadowed => TechniqueChoice::Unshadowed,
+        TechniqueName::Sloan | TechniqueName::Tamura => {
+            let (transfer, origin) = args.prt.obtain(&ctx, &scene)?;
+            match origin {
+                Origin::Cached(path) => eprintln!("transfer: from {}", path.display()),
+                Origin::Computed { path, .. } => {
+                    eprintln!("transfer: computed in {:.2} s, cached in {}", transfer.seconds, path.display())
+                }
+            }
+            let regions = if args.technique == TechniqueName::Sloan { 0 } else { args.regions };
+            if args.technique == TechniqueName::Tamura && regions == 0 {
+                anyhow::bail!("--regions must be at least 1 for the Tamura technique");
+            }
+            TechniqueChoice::Prt {
+                transfer: std::sync::Arc::new(transfer),
+                occlusion: OcclusionSettings { regions, mask_size: args.mask_size, ..OcclusionSettings::default() },
+            }
+        }
+    };
+    let mut renderer =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height, technique })
+            .context("setting up the renderer")?;
+    renderer.set_env_rotation(args.env_rotation.to_radians())?;
+    let animated = scene.groups.first().map(|g| (g.transform, group_height(g)));
     let bar = ProgressBar::new(args.frames as u64).with_style(
         ProgressStyle::with_template(
             "{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left",
@@ -70,7 +115,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.set_message("rendering");
     let start = Instant::now();
     let mut table = TimingTable::default();
-    for _ in 0..args.frames {
+    for frame in 0..args.frames {
+        if let (true, Some((base, height))) = (args.animate, animated) {
+            let t = frame as f32 / args.frames as f32;
+            renderer.set_group_transform(0, kage::scene::animation::pose(&base, height, t))?;
+        }
         table.add_frame(&renderer.render()?);
         bar.inc(1);
         if start.elapsed().as_secs_f32() < 1.0 {
@@ -119,4 +168,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     args.gpu.finish(&ctx)
+}
+
+/// The group's height in world units (its object-space extent along Y times its scale).
+fn group_height(group: &kage::scene::Group) -> f32 {
+    let ys = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| p[1]));
+    let (lo, hi) = ys.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
+    if lo <= hi {
+        (hi - lo) * group.transform.scale
+    } else {
+        0.0
+    }
 }

@@ -224,6 +224,7 @@ impl Context {
                         .iter()
                         .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
                 ),
+                ("shaderClipDistance (required)", features.shader_clip_distance == vk::TRUE),
                 ("shaderFloat64", features.shader_float64 == vk::TRUE),
                 (
                     "ray query (not used: Kage casts rays through its own BVH)",
@@ -247,7 +248,7 @@ impl Context {
         ];
         let mut dynamic_rendering_features =
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
-        let enabled = vk::PhysicalDeviceFeatures::default();
+        let enabled = vk::PhysicalDeviceFeatures::default().shader_clip_distance(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&device_ext_ptrs)

@@ -15,6 +15,8 @@ pub struct ImageDesc<'a> {
     pub width: u32,
     pub height: u32,
     pub layers: u32,
+    /// Viewed as a 2D array even with one layer (shaders declare `*2DArray`).
+    pub array: bool,
     pub format: vk::Format,
     pub usage: vk::ImageUsageFlags,
 }
@@ -129,7 +131,7 @@ impl Image {
         bound.map_err(Error::vk("vkBindImageMemory"))?;
         ctx.set_name(raw, desc.name);
 
-        let view_type = if desc.layers > 1 {
+        let view_type = if desc.array || desc.layers > 1 {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
             vk::ImageViewType::TYPE_2D

@@ -117,9 +117,16 @@ impl Context {
         }
     }
 
-    /// Draws `count` vertices with no vertex buffer (vertices made in the shader).
-    pub fn draw(&self, cmd: vk::CommandBuffer, count: u32) {
+    /// Binds vertex buffers (binding i = `vertices[i]`, possibly none) and draws `count`
+    /// vertices.
+    pub fn draw(&self, cmd: vk::CommandBuffer, vertices: &[&super::Buffer], count: u32) {
+        let raw: Vec<vk::Buffer> = vertices.iter().map(|b| b.raw).collect();
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
-        unsafe { self.device.cmd_draw(cmd, count, 1, 0, 0) };
+        unsafe {
+            if !raw.is_empty() {
+                self.device.cmd_bind_vertex_buffers(cmd, 0, &raw, &vec![0; raw.len()]);
+            }
+            self.device.cmd_draw(cmd, count, 1, 0, 0);
+        }
     }
 }

@@ -1,2 +1,25 @@
 //! The ground truth every technique is measured against: Monte Carlo direct lighting with full
 //! visibility, cast through the BVH on the GPU.
+//!
+//! - [`render`]: the reference image, progressive (batches of samples per pixel), environment
+//!   light with multiple importance sampling or local lights with hard shadows;
+//! - [`irradiance`]: E(p, n) at listed points, for light probes;
+//! - [`env_sampling`]: the environment map's 2D sampling distribution;
+//! - [`statistics`]: the mean and standard error per pixel or point;
+//! - [`metrics`]: error metrics between images, and a false-colour difference picture.
+//!
+//! Estimator (shaders-glsl/include/reference.glsl): per sample, one direction drawn from the
+//! environment distribution and one cosine-weighted, each with one shadow ray, combined by the
+//! power heuristic. The map is treated as constant per texel in the lighting (the function its
+//! SH projection integrates); a black map falls back to cosine sampling alone.
+pub mod env_sampling;
+pub mod irradiance;
+mod lighting;
+pub mod metrics;
+pub mod render;
+pub mod statistics;
+
+pub use irradiance::{IrradianceFile, IrradianceReference, PointsFile};
+pub use metrics::{compare, diff_image, ImageMetrics};
+pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
+pub use statistics::Statistics;

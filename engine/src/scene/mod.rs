@@ -20,6 +20,7 @@ use std::path::Path;
 
 mod builtin;
 mod camera;
+pub mod animation;
 pub mod envmap;
 mod error;
 mod export;

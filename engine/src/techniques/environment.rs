@@ -19,6 +19,7 @@ impl GpuEnvironment {
                 width: map.width(),
                 height: map.height(),
                 layers: 1,
+                array: false,
                 format: vk::Format::R32G32B32A32_SFLOAT,
                 usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
             },

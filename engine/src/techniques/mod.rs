@@ -1,6 +1,49 @@
-//! Lighting techniques, each built from passes. `environment` and `env_sh` are shared by all
-//! of them: the environment map on the GPU and its SH projection.
+//! Lighting techniques, each built from passes. `environment`, `env_sh` and `background` are
+//! shared by all of them: the environment map on the GPU, its SH projection, and the pass that
+//! shows it behind the scene.
+pub mod background;
 pub mod env_sh;
 pub mod environment;
 pub mod prt;
+pub mod tamura;
 pub mod unshadowed;
+
+use crate::backend::{Buffer, Context};
+use crate::error::Result;
+use crate::pass::Pass;
+use crate::renderer::{GpuScene, Targets};
+use environment::GpuEnvironment;
+use glam::Mat4;
+use std::sync::Arc;
+
+/// What every technique may read while recording a frame.
+pub struct FrameInputs<'a> {
+    pub ctx: &'a Arc<Context>,
+    /// `FrameUniforms` of this frame.
+    pub uniforms: &'a Buffer,
+    pub environment: &'a GpuEnvironment,
+    /// The environment's 9 SH coefficients per channel (`ShCoeffs`), in the map's frame.
+    pub env_sh: &'a Buffer,
+    pub scene: &'a GpuScene,
+    pub targets: &'a Targets,
+}
+
+/// The state of the frame about to be recorded.
+pub struct FrameState<'a> {
+    /// Object-to-world transform of every group.
+    pub transforms: &'a [Mat4],
+    /// The environment's rotation about +Y, in radians (counter-clockwise seen from above).
+    pub env_rotation: f32,
+}
+
+/// A lighting technique: host-side updates, then the passes that draw the scene over the
+/// background (the colour target is cleared and holds the environment when they start).
+pub trait Technique {
+    fn update(&mut self, state: &FrameState) -> Result<()>;
+    /// Resources the technique keeps from frame to frame, which its passes may read without a
+    /// pass of the same frame writing them.
+    fn persistent(&self) -> &'static [&'static str] {
+        &[]
+    }
+    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>>;
+}

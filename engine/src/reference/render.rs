@@ -1,0 +1,190 @@
+//! The reference renderer: progressive Monte Carlo direct lighting of the scene, a batch of
+//! samples per pixel per submission (shaders-glsl/reference_render.comp).
+//!
+//! Same camera and pixel grid as [`crate::renderer::Renderer`]: the camera's view and
+//! projection matrices and one primary ray through each pixel centre ((i + ½) / width, row 0 at
+//! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
+use super::lighting::{ReferenceLighting, IMPORTS};
+use super::statistics::{accum_buffer, Statistics};
+use crate::backend::{vk, BindingKind, Buffer, ComputePipeline, Context};
+use crate::error::{Error, Result};
+use crate::imageio::RgbaF32Image;
+use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, ReferenceLight, ReferencePush};
+use crate::pass::{FrameExecutor, Pass};
+use crate::renderer::MAX_SIZE;
+use crate::scene::{Camera, Light, Scene};
+use std::sync::Arc;
+
+/// Which light the reference renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightMode {
+    /// The environment map, Monte Carlo with multiple importance sampling; misses show the map.
+    Environment,
+    /// The scene's point and spot lights with hard shadows; no environment, black background.
+    /// Deterministic: one sample per pixel is exact.
+    Local,
+}
+
+#[derive(Clone, Debug)]
+pub struct ReferenceOptions {
+    pub width: u32,
+    pub height: u32,
+    pub light: LightMode,
+    /// Picks the random sequence; renders with different seeds are independent.
+    pub seed: u32,
+}
+
+pub struct ReferenceRenderer {
+    lighting: ReferenceLighting,
+    pipeline: ComputePipeline,
+    accum: Buffer,
+    lights: Buffer,
+    light_count: u32,
+    camera: Camera,
+    options: ReferenceOptions,
+    samples: u32,
+    executor: FrameExecutor,
+}
+
+impl ReferenceRenderer {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        options: &ReferenceOptions,
+    ) -> Result<ReferenceRenderer> {
+        let (width, height) = (options.width, options.height);
+        if !(1..=MAX_SIZE).contains(&width) || !(1..=MAX_SIZE).contains(&height) {
+            return Err(Error::InvalidArgument(format!(
+                "image size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
+            )));
+        }
+        let mut lights: Vec<ReferenceLight> = scene.lights.iter().map(reference_light).collect();
+        let light_count = lights.len() as u32;
+        // A storage buffer may not be empty: a scene without lights binds one unused entry.
+        if lights.is_empty() {
+            lights.push(ReferenceLight::default());
+        }
+        Ok(ReferenceRenderer {
+            lighting: ReferenceLighting::new(ctx, scene)?,
+            pipeline: ComputePipeline::new(
+                ctx,
+                "reference_render",
+                spirv::REFERENCE_RENDER_COMP,
+                &ReferenceLighting::binding_kinds(&[
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                ]),
+                size_of::<ReferencePush>() as u32,
+            )?,
+            accum: accum_buffer(ctx, "reference_accum", width as usize * height as usize)?,
+            lights: Buffer::with_data(
+                ctx,
+                "reference_lights",
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                bytes_of_slice(&lights),
+            )?,
+            light_count,
+            camera: scene.camera,
+            options: options.clone(),
+            samples: 0,
+            executor: FrameExecutor::new(ctx, "reference")?,
+        })
+    }
+
+    /// Adds `spp` samples per pixel in one submission (keep it short: a submission must finish
+    /// well within the driver's timeout).
+    pub fn run_batch(&mut self, spp: u32) -> Result<()> {
+        if spp == 0 {
+            return Err(Error::InvalidArgument(
+                "a reference batch needs at least one sample per pixel".into(),
+            ));
+        }
+        let after = self.samples.checked_add(spp).ok_or_else(|| {
+            Error::InvalidArgument(format!(
+                "{} + {spp} samples per pixel overflow the sample counter",
+                self.samples
+            ))
+        })?;
+        let (width, height) = (self.options.width, self.options.height);
+        let view_proj = self.camera.projection(width as f32 / height as f32) * self.camera.view();
+        let group = constants::REFERENCE_GROUP;
+        let groups = [width.div_ceil(group), height.div_ceil(group), 1];
+        let pipeline = &self.pipeline;
+        // One dispatch per KAGE_SAMPLES_PER_DISPATCH samples (see constants.glsl), one submission.
+        let mut passes = Vec::new();
+        let mut done = 0;
+        while done < spp {
+            let count = (spp - done).min(constants::SAMPLES_PER_DISPATCH);
+            let push = ReferencePush {
+                inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+                camera_pos: self.camera.position.extend(self.lighting.env_total).to_array(),
+                frame: [width, height, self.samples + done, count],
+                params: [(self.options.light == LightMode::Local) as u32, self.light_count, self.options.seed, 0],
+            };
+            let bindings = self.lighting.bindings(&[&self.accum, &self.lights]);
+            passes.push(Pass::new("reference_render", &IMPORTS, &["reference_accum"], move |cmd| {
+                pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
+            }));
+            done += count;
+        }
+        self.executor.run(&IMPORTS, passes)?;
+        self.samples = after;
+        Ok(())
+    }
+
+    /// Samples per pixel accumulated so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Per-pixel means (the image) and standard errors so far.
+    pub fn statistics(&self) -> Result<Statistics> {
+        Statistics::read(&self.accum, self.samples)
+    }
+
+    /// The image so far: linear radiance, row 0 at the top, alpha 1.
+    pub fn image(&self) -> Result<RgbaF32Image> {
+        Ok(self.to_image(&self.statistics()?))
+    }
+
+    pub fn to_image(&self, statistics: &Statistics) -> RgbaF32Image {
+        RgbaF32Image {
+            width: self.options.width,
+            height: self.options.height,
+            pixels: statistics
+                .mean
+                .iter()
+                .map(|&[r, g, b]| [r, g, b, 1.0])
+                .collect(),
+        }
+    }
+}
+
+/// Light units: `intensity` is radiant intensity (W/sr per channel); the irradiance at distance
+/// d is I cos θ / d² (inverse square, nothing else); a spot light is a hard-edged cone of full
+/// angle `fov_deg`.
+fn reference_light(light: &Light) -> ReferenceLight {
+    match *light {
+        Light::Point {
+            position,
+            intensity,
+        } => ReferenceLight {
+            position: position.extend(0.0).to_array(),
+            direction: [0.0, -1.0, 0.0, -1.0],
+            intensity: [intensity[0], intensity[1], intensity[2], 0.0],
+        },
+        Light::Spot {
+            position,
+            direction,
+            fov_deg,
+            intensity,
+        } => ReferenceLight {
+            position: position.extend(1.0).to_array(),
+            direction: direction
+                .normalize()
+                .extend((0.5 * fov_deg).to_radians().cos())
+                .to_array(),
+            intensity: [intensity[0], intensity[1], intensity[2], 0.0],
+        },
+    }
+}

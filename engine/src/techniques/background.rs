@@ -1,0 +1,43 @@
+//! The environment seen directly, behind everything: one full-screen triangle that clears the
+//! colour target and looks up the map along each pixel's view ray.
+use super::FrameInputs;
+use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline};
+use crate::error::Result;
+use crate::layouts::spirv;
+use crate::pass::Pass;
+use crate::renderer::COLOR_FORMAT;
+use std::sync::Arc;
+
+pub struct Background {
+    pipeline: GraphicsPipeline,
+}
+
+impl Background {
+    pub fn new(ctx: &Arc<Context>) -> Result<Background> {
+        let pipeline = GraphicsPipeline::new(ctx, &GraphicsDesc {
+            name: "background",
+            vertex_spirv: spirv::BACKGROUND_VERT,
+            fragment_spirv: spirv::BACKGROUND_FRAG,
+            bindings: &[BindingKind::UniformBuffer, BindingKind::SampledImage],
+            push_size: 0,
+            vertex_buffers: &[],
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[COLOR_FORMAT],
+            depth_format: None,
+            depth_test: false,
+            additive: false,
+        })?;
+        Ok(Background { pipeline })
+    }
+
+    pub fn pass<'a>(&'a self, inputs: &FrameInputs<'a>) -> Pass<'a> {
+        let (ctx, uniforms, env, color) =
+            (inputs.ctx, inputs.uniforms, inputs.environment, &inputs.targets.color);
+        Pass::new("background", &["frame_uniforms", "environment"], &["color"], move |cmd| {
+            ctx.begin_rendering(cmd, Some(color.into()), Some([0.0; 4]), None);
+            self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Sampled(&env.image, &env.sampler)]);
+            ctx.draw(cmd, &[], 3);
+            ctx.end_rendering(cmd);
+        })
+    }
+}

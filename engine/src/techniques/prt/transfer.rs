@@ -1,0 +1,215 @@
+//! The transfer precomputation as compute jobs over the BVH (`shaders-glsl/prt_transfer.comp`,
+//! one invocation per vertex). The work is cut into submissions of at most
+//! [`RAYS_PER_SUBMISSION`] rays, so that no single submission runs long on a CPU driver and the
+//! caller can show progress between them; within a submission, each dispatch casts only
+//! [`RAYS_PER_DISPATCH`] rays per vertex (the shader says why).
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet};
+use crate::backend::MemoryLocation;
+use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context};
+use crate::error::{Error, Result};
+use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, PrtTransferPush, PrtVertex};
+use crate::pass::{FrameExecutor, Pass};
+use crate::raycast::{GpuBvh, SceneBvh};
+use crate::scene::Scene;
+
+/// Rays per submission: a fraction of a second on lavapipe with two cores, a few milliseconds
+/// on a discrete GPU, where the per-submission cost is still small beside it.
+pub const RAYS_PER_SUBMISSION: u64 = 1 << 21;
+
+/// Rays per vertex per dispatch: few enough that llvmpipe's limit of 65,535 loop iterations
+/// per invocation leaves each ray's traversal about 2,000 iterations.
+pub const RAYS_PER_DISPATCH: u32 = 32;
+
+/// Computes the transfer of every vertex of `scene`: builds and uploads the BVH, runs the
+/// compute jobs and reads the result back. `progress(done, total)` is called with vertex counts
+/// after each submission. [`TransferSet::seconds`] is the wall-clock time of all of it.
+pub fn precompute(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    params: PrtParams,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<TransferSet> {
+    let params = params.validated()?;
+    let start = Instant::now();
+    let layout = mesh_layout(scene);
+    let total: usize = layout.iter().map(|m| m.2).sum();
+    let coefficients = if total == 0 {
+        Vec::new()
+    } else {
+        let bvh = GpuBvh::new(ctx, &SceneBvh::build(scene)?)?;
+        run_jobs(ctx, scene, &bvh, params, total, progress)?
+    };
+    let mut rest = coefficients.as_slice();
+    let meshes = layout
+        .into_iter()
+        .map(|(group, mesh, vertices)| {
+            let (mine, others) = rest.split_at(vertices * params.coeffs());
+            rest = others;
+            MeshTransfer { group, mesh, coefficients: mine.to_vec() }
+        })
+        .collect();
+    Ok(TransferSet { params, seconds: start.elapsed().as_secs_f64(), meshes })
+}
+
+/// Runs the shader over all `total` vertices; returns their coefficients in scene order.
+fn run_jobs(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    bvh: &GpuBvh,
+    params: PrtParams,
+    total: usize,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<f32>> {
+    let too_many = || {
+        Error::InvalidArgument(format!(
+            "PRT over {total} vertices × {} coefficients exceeds the 32-bit indices of the \
+             transfer shader",
+            params.coeffs()
+        ))
+    };
+    let out_floats = total.checked_mul(params.coeffs()).ok_or_else(too_many)?;
+    u32::try_from(out_floats).map_err(|_| too_many())?;
+
+    let vertices: Vec<PrtVertex> = scene
+        .meshes()
+        .flat_map(|(_, mesh)| mesh.positions.iter().zip(&mesh.normals))
+        .map(|(p, n)| PrtVertex { position: [p[0], p[1], p[2], 0.0], normal: [n[0], n[1], n[2], 0.0] })
+        .collect();
+    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    let vertex_buffer = Buffer::with_data(ctx, "prt_vertices", storage, bytes_of_slice(&vertices))?;
+    let readback = |name, size| {
+        Buffer::new(
+            ctx,
+            &BufferDesc {
+                name,
+                size,
+                usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::GpuOnly,
+            },
+        )
+    };
+    let output = readback("prt_transfer", out_floats as u64 * 4)?;
+    let rays_cast = readback("prt_rays_cast", total as u64 * 4)?;
+    let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
+    kinds.extend([BindingKind::StorageBuffer; 3]);
+    let pipeline = ComputePipeline::new(
+        ctx,
+        "prt_transfer",
+        spirv::PRT_TRANSFER_COMP,
+        &kinds,
+        size_of::<PrtTransferPush>() as u32,
+    )?;
+    let mut bindings: Vec<Binding> = bvh.bindings().into_iter().collect();
+    bindings.extend([
+        Binding::Storage(&vertex_buffer),
+        Binding::Storage(&output),
+        Binding::Storage(&rays_cast),
+    ]);
+
+    let mut executor = FrameExecutor::new(ctx, "prt_precompute")?;
+    let mut done = 0;
+    progress(done, total);
+    for batch in submissions(&mesh_layout(scene), params) {
+        let pass = Pass::new("prt_transfer", &["bvh"], &["prt_transfer"], |cmd| {
+            for first_ray in (0..params.rays).step_by(RAYS_PER_DISPATCH as usize) {
+                // Each dispatch adds to the sums the previous one wrote.
+                if first_ray > 0 {
+                    ctx.full_barrier(cmd);
+                }
+                let count = RAYS_PER_DISPATCH.min(params.rays - first_ray);
+                for push in &batch {
+                    let push = PrtTransferPush { params: [push.params[0], first_ray, count, 0], ..*push };
+                    let groups = push.range[1].div_ceil(constants::PRT_GROUP);
+                    pipeline.dispatch(cmd, &bindings, bytes_of(&push), [groups, 1, 1]);
+                }
+            }
+        });
+        executor.run(&["bvh"], vec![pass])?;
+        done += batch.iter().map(|p| p.range[1] as usize).sum::<usize>();
+        progress(done, total);
+    }
+    let counts = rays_cast.read()?;
+    if let Some((vertex, got)) = counts
+        .chunks_exact(4)
+        .map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]]))
+        .enumerate()
+        .find(|(_, n)| *n != params.rays)
+    {
+        return Err(Error::Unsupported(format!(
+            "shader loops as long as the PRT needs: the driver stopped after {got} of {} rays \
+             for vertex {vertex}, so the transfer would be wrong",
+            params.rays
+        )));
+    }
+    let bytes = output.read()?;
+    Ok(bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect())
+}
+
+/// Splits the meshes into dispatches (a dispatch never spans two meshes: the group is a push
+/// constant) and packs consecutive dispatches into submissions of at most
+/// [`RAYS_PER_SUBMISSION`] rays; a vertex's rays are never split.
+fn submissions(layout: &[(usize, usize, usize)], params: PrtParams) -> Vec<Vec<PrtTransferPush>> {
+    let budget = (RAYS_PER_SUBMISSION / u64::from(params.rays)).max(1) as usize;
+    let mut out = Vec::new();
+    let mut batch = Vec::new();
+    let (mut used, mut first) = (0, 0);
+    for &(group, _, vertices) in layout {
+        let mut left = vertices;
+        while left > 0 {
+            let count = left.min(budget - used);
+            batch.push(PrtTransferPush {
+                range: [first as u32, count as u32, group as u32, params.rays],
+                // The ray range is filled in per dispatch.
+                params: [params.coeffs() as u32, 0, 0, 0],
+            });
+            first += count;
+            left -= count;
+            used += count;
+            if used == budget {
+                out.push(std::mem::take(&mut batch));
+                used = 0;
+            }
+        }
+    }
+    if !batch.is_empty() {
+        out.push(batch);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn submissions_cover_every_vertex_once_within_budget() {
+        let params = PrtParams { bands: 3, rays: (RAYS_PER_SUBMISSION / 100) as u32 };
+        let layout = [(0, 0, 250), (0, 1, 30), (1, 0, 5), (2, 0, 101)];
+        let batches = submissions(&layout, params);
+        let mut next = 0;
+        for batch in &batches {
+            let rays: u64 = batch.iter().map(|p| u64::from(p.range[1]) * u64::from(params.rays)).sum();
+            assert!(rays <= RAYS_PER_SUBMISSION, "{rays} rays in one submission");
+            for push in batch {
+                assert_eq!(push.range[0], next, "dispatches are contiguous");
+                next += push.range[1];
+            }
+        }
+        assert_eq!(next, 386);
+        // The group of each dispatch is its mesh's.
+        let groups: Vec<u32> = batches.iter().flatten().map(|p| p.range[2]).collect();
+        assert_eq!(groups.first(), Some(&0));
+        assert_eq!(groups.last(), Some(&2));
+    }
+
+    #[test]
+    fn more_rays_than_the_budget_still_make_progress() {
+        let params = PrtParams { bands: 2, rays: (RAYS_PER_SUBMISSION * 2) as u32 };
+        let batches = submissions(&[(0, 0, 3)], params);
+        assert_eq!(batches.len(), 3);
+        assert!(batches.iter().all(|b| b.len() == 1 && b[0].range[1] == 1));
+    }
+}

@@ -1,0 +1,164 @@
+//! The PRT scene technique: self-shadowed radiance per vertex (Sloan et al.), minus, with
+//! regions, the light other groups block (Tamura et al. eq. (15)).
+use super::occlusion::{group_bounds, Occlusion};
+use super::regions::Regions;
+use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
+use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer};
+use crate::error::{Error, Result};
+use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush};
+use crate::pass::Pass;
+use crate::renderer::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::scene::Scene;
+use crate::techniques::prt::TransferSet;
+use crate::techniques::unshadowed::MESH_POSITIONS;
+use crate::techniques::{FrameInputs, FrameState, Technique};
+use std::sync::Arc;
+
+/// Settings of the occlusion between groups.
+#[derive(Clone, Copy, Debug)]
+pub struct OcclusionSettings {
+    /// q: environment regions (0: Sloan's PRT, self-shadowing only).
+    pub regions: usize,
+    /// Side of a mask layer, texels.
+    pub mask_size: u32,
+    /// Most layers filtered per frame.
+    pub max_layers: u32,
+}
+
+impl Default for OcclusionSettings {
+    fn default() -> Self {
+        OcclusionSettings { regions: 32, mask_size: 128, max_layers: constants::MAX_OCCLUSION_LAYERS }
+    }
+}
+
+pub struct PrtTechnique {
+    self_shadow: SelfShadow,
+    occlusion: Occlusion,
+    scene_pipeline: GraphicsPipeline,
+    nearest: Sampler,
+}
+
+impl PrtTechnique {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        gpu: &GpuScene,
+        transfer: &TransferSet,
+        settings: OcclusionSettings,
+    ) -> Result<PrtTechnique> {
+        if settings.regions > constants::MAX_REGIONS as usize {
+            return Err(Error::InvalidArgument(format!(
+                "{} regions: the Tamura technique interpolates at most {} per vertex",
+                settings.regions,
+                constants::MAX_REGIONS
+            )));
+        }
+        if settings.max_layers > constants::MAX_OCCLUSION_LAYERS {
+            return Err(Error::InvalidArgument(format!(
+                "{} occlusion layers: at most {} fit the uniform buffer",
+                settings.max_layers,
+                constants::MAX_OCCLUSION_LAYERS
+            )));
+        }
+        if !(8..=2048).contains(&settings.mask_size) {
+            return Err(Error::InvalidArgument(format!("mask size {} must be 8 to 2048 texels", settings.mask_size)));
+        }
+        let bands = transfer.params.bands as usize;
+        let env = crate::sh::project_equirect(
+            scene.environment.width(),
+            scene.environment.height(),
+            scene.environment.pixels(),
+            bands,
+        )?;
+        let regions = if settings.regions == 0 {
+            Regions { regions: Vec::new(), texel_region: Vec::new() }
+        } else {
+            Regions::new(&scene.environment, settings.regions)?
+        };
+        let capacity = if settings.regions == 0 || scene.groups.len() < 2 { 0 } else { settings.max_layers };
+        let transfer_attributes = transfer_vertex_buffer(2);
+        Ok(PrtTechnique {
+            self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
+            occlusion: Occlusion::new(ctx, regions, bands, group_bounds(scene), settings.mask_size, capacity)?,
+            scene_pipeline: GraphicsPipeline::new(ctx, &GraphicsDesc {
+                name: "scene_prt",
+                vertex_spirv: spirv::PRT_SCENE_VERT,
+                fragment_spirv: spirv::PRT_SCENE_FRAG,
+                bindings: &[
+                    BindingKind::UniformBuffer,
+                    BindingKind::SampledImage,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::SampledImage,
+                    BindingKind::UniformBuffer,
+                ],
+                push_size: size_of::<PrtDrawPush>() as u32,
+                vertex_buffers: &[
+                    MESH_POSITIONS,
+                    VertexBuffer { stride: TRANSFER_STRIDE, attributes: &transfer_attributes },
+                ],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[COLOR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                additive: false,
+            })?,
+            nearest: Sampler::new(ctx, "self_shadow.sampler", false, false)?,
+        })
+    }
+
+    /// Occlusion layers wanted last frame that did not fit (see `OcclusionSettings::max_layers`).
+    pub fn dropped_layers(&self) -> usize {
+        self.occlusion.dropped
+    }
+}
+
+impl Technique for PrtTechnique {
+    fn update(&mut self, state: &FrameState) -> Result<()> {
+        let env = env_rotation(state.env_rotation);
+        self.self_shadow.update(state.transforms, env)?;
+        self.occlusion.update(state.transforms, env)
+    }
+
+    fn persistent(&self) -> &'static [&'static str] {
+        &["self_shadow"]
+    }
+
+    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
+        let mut passes: Vec<Pass> = self.self_shadow.pass(ctx, scene).into_iter().collect();
+        passes.extend(self.occlusion.passes(ctx, scene));
+        let q = self.occlusion.region_count() as u32;
+        let occlusion = &self.occlusion;
+        let self_shadow = &self.self_shadow;
+        let reads: &'static [&'static str] = if passes.iter().any(|p| p.name == "blur_vertical") {
+            &["frame_uniforms", "self_shadow", "occlusion", "color"]
+        } else {
+            &["frame_uniforms", "self_shadow", "color"]
+        };
+        passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
+            ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
+            self.scene_pipeline.bind(cmd, &[
+                Binding::Uniform(uniforms),
+                Binding::Sampled(&self_shadow.texture, &self.nearest),
+                Binding::Storage(&occlusion.region_basis),
+                Binding::Storage(&occlusion.energy),
+                Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
+                Binding::Uniform(&occlusion.layers),
+            ]);
+            for (i, mesh) in scene.meshes.iter().enumerate() {
+                let (first_layer, layer_count) = occlusion.ranges[mesh.group];
+                let push = PrtDrawPush {
+                    model: scene.transforms[mesh.group].to_cols_array_2d(),
+                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                    mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
+                    layers: [first_layer, layer_count, 0, 0],
+                };
+                self.scene_pipeline.push(cmd, bytes_of(&push));
+                ctx.draw_indexed(cmd, &[&mesh.vertices, &self_shadow.transfer[i]], &mesh.indices, mesh.index_count);
+            }
+            ctx.end_rendering(cmd);
+        }));
+        passes
+    }
+}

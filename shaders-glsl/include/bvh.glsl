@@ -1,0 +1,269 @@
+// Ray casting against the scene BVH built by engine/src/raycast (see its module doc for the
+// node layout). Two levels: a top-level tree over the instances (world space) and one
+// bottom-level tree per scene group (object space). Rays enter an instance through its
+// world_to_object matrix without renormalising the direction, so the ray parameter t is the
+// same in both spaces and every t returned is a world-space distance along a unit ray.
+//
+// Declares storage buffers at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1.
+#ifndef KAGE_BVH_GLSL
+#define KAGE_BVH_GLSL
+
+#include "constants.glsl"
+#include "layouts.glsl"
+
+layout(set = 0, binding = 0, std430) readonly buffer BvhBlasNodes { BvhNode bvh_blas_nodes[]; };
+layout(set = 0, binding = 1, std430) readonly buffer BvhTlasNodes { BvhNode bvh_tlas_nodes[]; };
+layout(set = 0, binding = 2, std430) readonly buffer BvhInstances { BvhInstance bvh_instances[]; };
+layout(set = 0, binding = 3, std430) readonly buffer BvhTriangles { BvhTriangle bvh_triangles[]; };
+layout(set = 0, binding = 4, std430) readonly buffer BvhAttributes {
+    BvhTriangleAttributes bvh_attributes[];
+};
+
+// instance == KAGE_NO_HIT on a miss; triangle indexes the BVH triangle buffer; barycentric holds
+// the weights of the triangle's v1 and v2 (v0's is 1 - x - y).
+struct RayHit {
+    float t;
+    uint instance;
+    uint triangle;
+    vec2 barycentric;
+};
+
+struct SurfacePoint {
+    vec3 position;
+    vec3 geometric_normal;
+    vec3 shading_normal;
+    vec3 albedo;
+};
+
+// The per-ray set-up of the watertight test (Woop, Benthin, Wald 2013): the axis kz where the
+// direction is largest, and the shear that maps the ray onto +kz.
+struct WatertightRay {
+    vec3 origin;
+    ivec3 k; // kx, ky, kz
+    vec3 shear; // Sx, Sy, Sz
+};
+
+WatertightRay bvh_watertight_ray(vec3 origin, vec3 dir) {
+    vec3 a = abs(dir);
+    int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+    int kx = (kz + 1) % 3;
+    int ky = (kx + 1) % 3;
+    // Keeps the triangle's winding as seen along the ray, so the sign tests below stay valid.
+    if (dir[kz] < 0.0) {
+        int swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    return WatertightRay(origin, ivec3(kx, ky, kz),
+                         vec3(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]));
+}
+
+// Hit with t in (0, tmax): returns t and the weights of v1 and v2. `precise` forbids fused
+// multiply-adds, so that an edge shared by two triangles gets bit-identical (negated) edge
+// functions in both and no ray slips between them. Edge functions of exactly zero count as
+// inside, so a ray exactly through a shared edge hits both triangles rather than neither.
+bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, out vec2 bary) {
+    BvhTriangle v = bvh_triangles[tri];
+    precise vec3 a = v.v0.xyz - r.origin;
+    precise vec3 b = v.v1.xyz - r.origin;
+    precise vec3 c = v.v2.xyz - r.origin;
+    precise float ax = a[r.k.x] - r.shear.x * a[r.k.z];
+    precise float ay = a[r.k.y] - r.shear.y * a[r.k.z];
+    precise float bx = b[r.k.x] - r.shear.x * b[r.k.z];
+    precise float by = b[r.k.y] - r.shear.y * b[r.k.z];
+    precise float cx = c[r.k.x] - r.shear.x * c[r.k.z];
+    precise float cy = c[r.k.y] - r.shear.y * c[r.k.z];
+    precise float u = cx * by - cy * bx;
+    precise float w1 = ax * cy - ay * cx;
+    precise float w2 = bx * ay - by * ax;
+    if ((u < 0.0 || w1 < 0.0 || w2 < 0.0) && (u > 0.0 || w1 > 0.0 || w2 > 0.0)) return false;
+    precise float det = u + w1 + w2;
+    if (det == 0.0) return false;
+    precise float tt = u * (r.shear.z * a[r.k.z]) + w1 * (r.shear.z * b[r.k.z])
+                     + w2 * (r.shear.z * c[r.k.z]);
+    // t = tt / det in (0, tmax), tested without the division and for either sign of det.
+    if (det > 0.0 ? (tt <= 0.0 || tt >= tmax * det) : (tt >= 0.0 || tt <= tmax * det)) {
+        return false;
+    }
+    float inv = 1.0 / det;
+    t = tt * inv;
+    bary = vec2(w1, w2) * inv;
+    return t > 0.0 && t < tmax;
+}
+
+// Entry distance of the ray into the node's box, or +inf when it misses the box or enters at
+// or past tmax. inv_dir may hold infinities (axis-parallel rays); max/min discard the NaN of
+// 0 * inf, which happens only for origins exactly on a slab plane.
+float bvh_enter_box(BvhNode node, vec3 origin, vec3 inv_dir, float tmax) {
+    vec3 t0 = (node.lo.xyz - origin) * inv_dir;
+    vec3 t1 = (node.hi.xyz - origin) * inv_dir;
+    vec3 near = min(t0, t1);
+    vec3 far = max(t0, t1);
+    float enter = max(max(near.x, near.y), max(near.z, 0.0));
+    float leave = min(min(far.x, far.y), min(far.z, tmax));
+    return enter <= leave ? enter : 1.0 / 0.0;
+}
+
+uint bvh_node_index(BvhNode node) { return floatBitsToUint(node.lo.w); }
+uint bvh_node_count(BvhNode node) { return floatBitsToUint(node.hi.w); }
+
+// Traverses one bottom-level tree, ray in object space. With any_hit it returns at the first
+// hit found; otherwise it narrows hit.t to the closest one. hit.t is the running tmax.
+bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
+    uint root = bvh_instances[instance].info.x;
+    WatertightRay wray = bvh_watertight_ray(origin, dir);
+    vec3 inv_dir = 1.0 / dir;
+    bool found = false;
+    uint stack[KAGE_BVH_STACK];
+    int top = 0;
+    BvhNode node = bvh_blas_nodes[root];
+    if (bvh_enter_box(node, origin, inv_dir, hit.t) == 1.0 / 0.0) return false;
+    while (true) {
+        uint count = bvh_node_count(node);
+        uint index = bvh_node_index(node);
+        if (count > 0u) {
+            for (uint tri = index; tri < index + count; ++tri) {
+                float t;
+                vec2 bary;
+                if (bvh_intersect_triangle(wray, tri, hit.t, t, bary)) {
+                    hit = RayHit(t, instance, tri, bary);
+                    found = true;
+                    if (any_hit) return true;
+                }
+            }
+        } else {
+            // Nearer child first, so that hit.t shrinks early and prunes the farther one.
+            BvhNode left_node = bvh_blas_nodes[index];
+            BvhNode right_node = bvh_blas_nodes[index + 1u];
+            float enter_left = bvh_enter_box(left_node, origin, inv_dir, hit.t);
+            float enter_right = bvh_enter_box(right_node, origin, inv_dir, hit.t);
+            bool left = enter_left != 1.0 / 0.0;
+            bool right = enter_right != 1.0 / 0.0;
+            if (left && right) {
+                bool left_first = enter_left <= enter_right;
+                stack[top++] = left_first ? index + 1u : index;
+                node = left_first ? left_node : right_node;
+                continue;
+            }
+            if (left || right) {
+                node = left ? left_node : right_node;
+                continue;
+            }
+        }
+        // Entries pushed earlier may lie beyond a hit found since: test them again on pop.
+        bool next = false;
+        while (top > 0) {
+            node = bvh_blas_nodes[stack[--top]];
+            if (bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0) {
+                next = true;
+                break;
+            }
+        }
+        if (!next) break;
+    }
+    return found;
+}
+
+// Traverses the top-level tree (world space) and, at each instance leaf, that instance's tree.
+bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
+    vec3 inv_dir = 1.0 / dir;
+    bool found = false;
+    uint stack[KAGE_BVH_STACK];
+    int top = 0;
+    BvhNode node = bvh_tlas_nodes[0u];
+    if (bvh_enter_box(node, origin, inv_dir, hit.t) == 1.0 / 0.0) return false;
+    while (true) {
+        uint index = bvh_node_index(node);
+        if (bvh_node_count(node) > 0u) {
+            mat4 to_object = bvh_instances[index].world_to_object;
+            vec3 o = (to_object * vec4(origin, 1.0)).xyz;
+            vec3 d = mat3(to_object) * dir;
+            if (bvh_traverse_blas(index, o, d, any_hit, hit)) {
+                found = true;
+                if (any_hit) return true;
+            }
+        } else {
+            BvhNode left_node = bvh_tlas_nodes[index];
+            BvhNode right_node = bvh_tlas_nodes[index + 1u];
+            float enter_left = bvh_enter_box(left_node, origin, inv_dir, hit.t);
+            float enter_right = bvh_enter_box(right_node, origin, inv_dir, hit.t);
+            bool left = enter_left != 1.0 / 0.0;
+            bool right = enter_right != 1.0 / 0.0;
+            if (left && right) {
+                bool left_first = enter_left <= enter_right;
+                stack[top++] = left_first ? index + 1u : index;
+                node = left_first ? left_node : right_node;
+                continue;
+            }
+            if (left || right) {
+                node = left ? left_node : right_node;
+                continue;
+            }
+        }
+        bool next = false;
+        while (top > 0) {
+            node = bvh_tlas_nodes[stack[--top]];
+            if (bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0) {
+                next = true;
+                break;
+            }
+        }
+        if (!next) break;
+    }
+    return found;
+}
+
+// Closest hit along a unit world-space ray within (0, tmax), over every group.
+RayHit bvh_closest_hit(vec3 origin, vec3 dir, float tmax) {
+    RayHit hit = RayHit(tmax, KAGE_NO_HIT, 0u, vec2(0.0));
+    bvh_traverse(origin, dir, false, hit);
+    return hit;
+}
+
+// Whether anything lies along the world-space ray within (0, tmax).
+bool bvh_occluded(vec3 origin, vec3 dir, float tmax) {
+    RayHit hit = RayHit(tmax, KAGE_NO_HIT, 0u, vec2(0.0));
+    return bvh_traverse(origin, dir, true, hit);
+}
+
+// Whether any triangle of group `instance` lies along the ray, given in that group's object
+// space, within (0, tmax).
+bool bvh_occluded_object_space(uint instance, vec3 origin, vec3 dir, float tmax) {
+    RayHit hit = RayHit(tmax, KAGE_NO_HIT, 0u, vec2(0.0));
+    return bvh_traverse_blas(instance, origin, dir, true, hit);
+}
+
+// The world-space surface at a hit. Both normals face against ray_dir; the shading normal flips
+// together with the geometric one, as the rasterizer's gl_FrontFacing does.
+SurfacePoint bvh_surface(RayHit hit, vec3 ray_dir) {
+    BvhTriangle v = bvh_triangles[hit.triangle];
+    BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+    mat4 to_world = bvh_instances[hit.instance].object_to_world;
+    vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
+    vec3 p = w.x * v.v0.xyz + w.y * v.v1.xyz + w.z * v.v2.xyz;
+    // The scale is uniform, so the rotation part carries normals too.
+    mat3 rotate = mat3(to_world);
+    vec3 ng = normalize(rotate * cross(v.v1.xyz - v.v0.xyz, v.v2.xyz - v.v0.xyz));
+    vec3 ns = normalize(rotate * (w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz));
+    float facing = dot(ng, ray_dir) > 0.0 ? -1.0 : 1.0;
+    return SurfacePoint((to_world * vec4(p, 1.0)).xyz, facing * ng, facing * ns, a.albedo.rgb);
+}
+
+// Moves p off its surface along n (to the side the new ray leaves on), by a few ulps of p's
+// coordinates, or by a fixed tiny distance near the origin where ulps vanish (Wächter and
+// Binder 2019, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems
+// ch. 6).
+vec3 offset_ray_origin(vec3 p, vec3 n) {
+    const float origin = 1.0 / 32.0;
+    const float float_scale = 1.0 / 65536.0;
+    const float int_scale = 256.0;
+    ivec3 of_i = ivec3(int_scale * n);
+    vec3 p_i = intBitsToFloat(floatBitsToInt(p) + ivec3(p.x < 0.0 ? -of_i.x : of_i.x,
+                                                         p.y < 0.0 ? -of_i.y : of_i.y,
+                                                         p.z < 0.0 ? -of_i.z : of_i.z));
+    return vec3(abs(p.x) < origin ? p.x + float_scale * n.x : p_i.x,
+                abs(p.y) < origin ? p.y + float_scale * n.y : p_i.y,
+                abs(p.z) < origin ? p.z + float_scale * n.z : p_i.z);
+}
+
+#endif

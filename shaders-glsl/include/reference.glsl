@@ -1,0 +1,128 @@
+// The Monte Carlo reference's shared half: the environment map and its sampling distribution
+// (engine/src/reference/env_sampling.rs builds it), the per-item statistics, and the estimator
+// of direct environment lighting with full visibility. The including shader includes bvh.glsl
+// first and declares its own bindings from KAGE_BVH_BINDINGS + 4 on.
+#ifndef KAGE_REFERENCE_GLSL
+#define KAGE_REFERENCE_GLSL
+
+#include "constants.glsl"
+#include "layouts.glsl"
+#include "envmap.glsl"
+#include "sampling.glsl"
+
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 0) uniform sampler2D env;
+// height + 1 entries, P(row < j).
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) readonly buffer EnvMarginal {
+    float env_marginal[];
+};
+// height runs of width + 1 entries, P(column < i | row j).
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) readonly buffer EnvConditional {
+    float env_conditional[];
+};
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer Accum { ReferenceAccum accum[]; };
+
+const float REFERENCE_PI = 3.14159265358979323846;
+// "Infinite" ray length: the environment is at infinity.
+const float REFERENCE_FAR = 1e30;
+
+// The lighting treats the map as constant over each texel (nearest texel, no filtering), the
+// same function the sampling distribution and the SH projection use.
+ivec2 env_texel_of(vec3 dir) {
+    ivec2 size = textureSize(env, 0);
+    vec2 uv = env_dir_to_uv(dir);
+    return min(ivec2(uv * vec2(size)), size - 1);
+}
+
+// First entry of env_marginal[0 .. n] greater than u, minus one: never an empty interval.
+uint env_pick_row(float u, uint n) {
+    uint lo = 0u, hi = n + 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (env_marginal[mid] <= u) lo = mid + 1u; else hi = mid;
+    }
+    return clamp(lo, 1u, n) - 1u;
+}
+
+// The same over the run of row j in env_conditional.
+uint env_pick_column(float u, uint j, uint n) {
+    uint base = j * (n + 1u);
+    uint lo = 0u, hi = n + 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (env_conditional[base + mid] <= u) lo = mid + 1u; else hi = mid;
+    }
+    return clamp(lo, 1u, n) - 1u;
+}
+
+float env_within(float u, float c0, float c1) {
+    return c1 > c0 ? clamp((u - c0) / (c1 - c0), 0.0, 1.0) : 0.5;
+}
+
+// A direction drawn in proportion to luminance x solid angle: texel by the CDFs, then uniform in
+// solid angle inside it, so the pdf is luminance / total everywhere in the texel.
+// Needs total > 0.
+void env_sample(vec2 u, float total, out vec3 dir, out vec3 radiance, out float pdf) {
+    ivec2 size = textureSize(env, 0);
+    uint w = uint(size.x), h = uint(size.y);
+    uint j = env_pick_row(u.x, h);
+    float v_in = env_within(u.x, env_marginal[j], env_marginal[j + 1u]);
+    uint i = env_pick_column(u.y, j, w);
+    uint base = j * (w + 1u);
+    float u_in = env_within(u.y, env_conditional[base + i], env_conditional[base + i + 1u]);
+    float cos0 = cos(REFERENCE_PI * float(j) / float(h));
+    float cos1 = cos(REFERENCE_PI * float(j + 1u) / float(h));
+    float cos_theta = mix(cos0, cos1, v_in);
+    float sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    float phi = 2.0 * REFERENCE_PI * (float(i) + u_in) / float(w);
+    dir = vec3(sin_theta * sin(phi), cos_theta, -sin_theta * cos(phi));
+    radiance = texelFetch(env, ivec2(i, j), 0).rgb;
+    pdf = luminance(radiance) / total;
+}
+
+// One two-sample estimate of E = integral of L_env(w) V(w) max(dot(n, w), 0) dw at p: one
+// direction from the environment distribution and one cosine-weighted, combined by the power
+// heuristic. `ng` is the geometric normal on the side the light arrives from: directions below
+// it are blocked by the surface itself (with smooth shading normals they exist), and shadow
+// rays leave from p offset along it. total == 0 (a black map) means cosine sampling alone.
+vec3 env_irradiance_sample(vec3 p, vec3 n, vec3 ng, float total, inout Rng rng) {
+    vec3 origin = offset_ray_origin(p, ng);
+    vec3 sum = vec3(0.0);
+    vec2 u_env = vec2(rng_next(rng), rng_next(rng));
+    vec2 u_cos = vec2(rng_next(rng), rng_next(rng));
+    if (total > 0.0) {
+        vec3 dir, radiance;
+        float pdf;
+        env_sample(u_env, total, dir, radiance, pdf);
+        float cos_n = dot(n, dir);
+        if (pdf > 0.0 && cos_n > 0.0 && dot(ng, dir) > 0.0
+            && !bvh_occluded(origin, dir, REFERENCE_FAR)) {
+            sum += power_heuristic(pdf, cos_n / REFERENCE_PI) * radiance * (cos_n / pdf);
+        }
+    }
+    vec3 dir = sample_cosine(n, u_cos);
+    float cos_n = dot(n, dir);
+    if (cos_n > 0.0 && dot(ng, dir) > 0.0 && !bvh_occluded(origin, dir, REFERENCE_FAR)) {
+        vec3 radiance = texelFetch(env, env_texel_of(dir), 0).rgb;
+        float pdf_env = total > 0.0 ? luminance(radiance) / total : 0.0;
+        // radiance * cos / (cos / pi), weighted.
+        sum += power_heuristic(cos_n / REFERENCE_PI, pdf_env) * radiance * REFERENCE_PI;
+    }
+    return sum;
+}
+
+// Adds a batch (count, mean, m2 over its samples) to item `index`'s statistics (Chan et al.
+// 1979, the pairwise form of Welford's update).
+void accum_merge(uint index, uint before, uint count, vec3 mean, vec3 m2) {
+    if (before == 0u) {
+        accum[index] = ReferenceAccum(vec4(mean, 0.0), vec4(m2, 0.0));
+        return;
+    }
+    ReferenceAccum a = accum[index];
+    float total = float(before + count);
+    vec3 delta = mean - a.mean.rgb;
+    a.mean.rgb += delta * (float(count) / total);
+    a.m2.rgb += m2 + delta * delta * (float(before) * float(count) / total);
+    accum[index] = a;
+}
+
+#endif

@@ -1,0 +1,124 @@
+#version 460
+// PRT transfer vectors (engine/src/techniques/prt): estimates, per vertex,
+// T_i = ∫ (1/π) v_s(ω) max(ω·n, 0) y_i(ω) dω from cosine-weighted directions, for which the
+// estimator is the mean of v_s(ω_k) y_i(ω_k). The directions are a Hammersley point set
+// (k/N, radical inverse of k) shifted per vertex by a hashed Cranley–Patterson rotation: the
+// unshadowed error falls about as 1/N, and neighbouring vertices do not share one pattern of
+// error. Visibility is tested against the vertex's own group, in its object space.
+//
+// One dispatch casts rays [first, first + count) of every vertex in its range and adds their
+// sums to the vertex's running sums (the first dispatch stores), so one invocation never loops
+// long: llvmpipe (Mesa 22.3) ends every loop of an invocation, silently, once all its loops
+// together have run 65,535 iterations (its loop limiter), which per-ray BVH traversals reached
+// after 1,728 rays from the vertices of a 62-vertex sphere.
+// `rays_cast` counts the rays each vertex really got, so that the host can prove no loop was cut.
+#include "constants.glsl"
+#include "layouts.glsl"
+#include "sh.glsl"
+#include "bvh.glsl"
+
+layout(local_size_x = KAGE_PRT_GROUP) in;
+layout(set = 0, binding = KAGE_BVH_BINDINGS, std430) readonly buffer Vertices { PrtVertex vertices[]; };
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) buffer Transfer { float transfer[]; };
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) buffer RaysCast { uint rays_cast[]; };
+layout(push_constant) uniform Push { PrtTransferPush p; };
+
+// The 25 real SH basis functions of engine/src/sh.rs (index l(l+1)+m, no Condon–Shortley
+// phase), four to a vec4: y[4j + c] is y_j[c]. Vectors rather than a float[25]: lavapipe
+// (Mesa 22.3) miscompiled the accumulation loop when it held local arrays next to the
+// traversal's stack, ending the loop over rays early.
+void sh25_basis(vec3 d, out vec4 c0, out vec4 c1, out vec4 c2, out vec4 c3, out vec4 c4,
+                out vec4 c5, out vec4 c6) {
+    float x = d.x, y = d.y, z = d.z;
+    float xx = x * x, yy = y * y, zz = z * z;
+    c0 = vec4(0.282094791773878, 0.488602511902920 * y, 0.488602511902920 * z,
+              0.488602511902920 * x);
+    c1 = vec4(1.092548430592079 * x * y, 1.092548430592079 * y * z,
+              0.315391565252520 * (3.0 * zz - 1.0), 1.092548430592079 * x * z);
+    c2 = vec4(0.546274215296040 * (xx - yy), 0.590043589926644 * y * (3.0 * xx - yy),
+              2.890611442640554 * x * y * z, 0.457045799464466 * y * (5.0 * zz - 1.0));
+    c3 = vec4(0.373176332590115 * z * (5.0 * zz - 3.0), 0.457045799464466 * x * (5.0 * zz - 1.0),
+              1.445305721320277 * z * (xx - yy), 0.590043589926644 * x * (xx - 3.0 * yy));
+    c4 = vec4(2.503342941796705 * x * y * (xx - yy), 1.770130769779930 * y * z * (3.0 * xx - yy),
+              0.946174695757560 * x * y * (7.0 * zz - 1.0), 0.669046543557289 * y * z * (7.0 * zz - 3.0));
+    c5 = vec4(0.105785546915204 * ((35.0 * zz - 30.0) * zz + 3.0),
+              0.669046543557289 * x * z * (7.0 * zz - 3.0),
+              0.473087347878780 * (xx - yy) * (7.0 * zz - 1.0),
+              1.770130769779930 * x * z * (xx - 3.0 * yy));
+    c6 = vec4(0.625835735449176 * (xx * (xx - 3.0 * yy) - yy * (3.0 * xx - yy)), 0.0, 0.0, 0.0);
+}
+
+// PCG output permutation (Jarzynski and Olano 2020, "Hash Functions for GPU Rendering").
+uint pcg_hash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// An orthonormal basis around unit n without a branch on its direction (Duff et al. 2017).
+void tangent_frame(vec3 n, out vec3 t, out vec3 b) {
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+// Adds sums 4j .. 4j + 3 of a vertex to its running sums (stores them on the first
+// dispatch), those below `coeffs`; on the last dispatch divides by the ray count.
+void add(uint base, uint coeffs, uint j, vec4 sums, bool first, float scale) {
+    for (uint c = 0u; c < 4u; ++c) {
+        uint i = 4u * j + c;
+        if (i < coeffs) {
+            float before = first ? 0.0 : transfer[base + i];
+            transfer[base + i] = (before + sums[c]) * scale;
+        }
+    }
+}
+
+void main() {
+    uint local = gl_GlobalInvocationID.x;
+    if (local >= p.range.y) return;
+    uint vertex = p.range.x + local;
+    uint group = p.range.z;
+    uint rays = p.range.w;
+    uint coeffs = p.params.x;
+
+    vec3 n = normalize(vertices[vertex].normal.xyz);
+    vec3 origin = offset_ray_origin(vertices[vertex].position.xyz, n);
+    vec3 tangent, bitangent;
+    tangent_frame(n, tangent, bitangent);
+    const float to_unit = 1.0 / 4294967296.0;
+    vec2 shift = vec2(pcg_hash(2u * vertex), pcg_hash(2u * vertex + 1u)) * to_unit;
+
+    vec4 s0 = vec4(0.0), s1 = vec4(0.0), s2 = vec4(0.0), s3 = vec4(0.0), s4 = vec4(0.0),
+         s5 = vec4(0.0), s6 = vec4(0.0);
+    uint first = p.params.y;
+    uint done = 0u;
+    for (uint k = first; k < first + p.params.z; ++k) {
+        vec2 u = fract(vec2(float(k) / float(rays), float(bitfieldReverse(k)) * to_unit) + shift);
+        // Cosine-weighted: a uniform point on the unit disc lifted onto the hemisphere.
+        float r = sqrt(u.x);
+        float phi = 2.0 * KAGE_PI * u.y;
+        vec3 dir = normalize(r * cos(phi) * tangent + r * sin(phi) * bitangent
+                             + sqrt(max(1.0 - u.x, 0.0)) * n);
+        if (!bvh_occluded_object_space(group, origin, dir, 1e30)) {
+            vec4 c0, c1, c2, c3, c4, c5, c6;
+            sh25_basis(dir, c0, c1, c2, c3, c4, c5, c6);
+            s0 += c0; s1 += c1; s2 += c2; s3 += c3; s4 += c4; s5 += c5; s6 += c6;
+        }
+        ++done;
+    }
+    bool first_dispatch = first == 0u;
+    // The last dispatch turns the sums into means.
+    float scale = first + p.params.z == rays ? 1.0 / float(rays) : 1.0;
+    uint base = vertex * coeffs;
+    add(base, coeffs, 0u, s0, first_dispatch, scale);
+    add(base, coeffs, 1u, s1, first_dispatch, scale);
+    add(base, coeffs, 2u, s2, first_dispatch, scale);
+    add(base, coeffs, 3u, s3, first_dispatch, scale);
+    add(base, coeffs, 4u, s4, first_dispatch, scale);
+    add(base, coeffs, 5u, s5, first_dispatch, scale);
+    add(base, coeffs, 6u, s6, first_dispatch, scale);
+    rays_cast[vertex] = (first_dispatch ? 0u : rays_cast[vertex]) + done;
+}

@@ -1,0 +1,222 @@
+//! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU.
+use crate::GpuArgs;
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Subcommand};
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use kage::layouts::CastRay;
+use kage::raycast::{offset_ray_origin, GpuBvh, GpuRays, Query, RayCaster, SceneBvh};
+use kage::scene::Scene;
+use std::time::Instant;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// BVH build time and size, and rays per second for coherent (camera) and incoherent
+    /// (random directions from random surface points) rays, closest hit and any hit.
+    Rays(RaysArgs),
+}
+
+#[derive(Args)]
+pub struct RaysArgs {
+    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    #[arg(long, default_value = "teapot")]
+    scene: String,
+    /// Rays per cast, rounded down to a square number for the camera's square image.
+    #[arg(long, default_value_t = 262_144)]
+    rays: u32,
+    /// Timed casts per measurement, after one untimed warm-up (which includes a JIT compile
+    /// on CPU drivers); the median is reported.
+    #[arg(long, default_value_t = 5)]
+    runs: u32,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+pub fn run(command: &BenchCommand) -> Result<()> {
+    match command {
+        BenchCommand::Rays(args) => rays(args),
+    }
+}
+
+fn rays(args: &RaysArgs) -> Result<()> {
+    if args.runs == 0 {
+        bail!("--runs must be at least 1");
+    }
+    let side = (args.rays as f64).sqrt() as u32;
+    if side == 0 {
+        bail!("--rays must be at least 1");
+    }
+    let scene = Scene::from_arg(&args.scene)?;
+    if scene.triangle_count() == 0 {
+        bail!("scene {} has no triangles to cast rays at", scene.name);
+    }
+    let start = Instant::now();
+    let bvh = SceneBvh::build(&scene).context("building the BVH")?;
+    let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    println!(
+        "scene {}: {} triangles in {} groups; BVH built in {build_ms:.1} ms (CPU), {} nodes, {:.2} MiB",
+        scene.name,
+        scene.triangle_count(),
+        scene.groups.len(),
+        bvh.node_count(),
+        bvh.byte_size() as f64 / (1 << 20) as f64
+    );
+
+    let ctx = args.gpu.context()?;
+    if ctx.info().timestamp_period_ns.is_none() {
+        bail!(
+            "{} has no GPU timestamps, so cast times cannot be measured",
+            ctx.info().name
+        );
+    }
+    let gpu = GpuBvh::new(&ctx, &bvh)?;
+    let mut caster = RayCaster::new(&ctx)?;
+    let sets = [
+        ("coherent", GpuRays::new(&ctx, &camera_rays(&scene, side))?),
+        (
+            "incoherent",
+            GpuRays::new(&ctx, &surface_rays(&scene, side * side))?,
+        ),
+    ];
+    let queries = [
+        ("closest hit", Query::ClosestHit),
+        ("any hit", Query::Occluded),
+    ];
+
+    let bar = ProgressBar::new((sets.len() * queries.len()) as u64 * (args.runs as u64 + 1))
+        .with_style(
+            ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} casts, {elapsed} elapsed, {eta} left",
+            )
+            .expect("static template"),
+        );
+    bar.set_draw_target(ProgressDrawTarget::hidden());
+    bar.set_message("casting");
+    let count = (side * side) as f64;
+    let mut rates = Vec::new();
+    for (query_name, query) in queries {
+        let mut row = Vec::new();
+        for (set_name, rays) in &sets {
+            let mut ms = Vec::new();
+            for run in 0..=args.runs {
+                let gpu_ms = caster
+                    .cast(&gpu, rays, query)?
+                    .context("the cast pass returned no GPU time")?;
+                if run > 0 {
+                    ms.push(gpu_ms);
+                }
+                bar.inc(1);
+                if start.elapsed().as_secs_f32() > 1.0 && bar.is_hidden() {
+                    bar.set_draw_target(ProgressDrawTarget::stderr());
+                }
+            }
+            ms.sort_by(f64::total_cmp);
+            let median = ms[ms.len() / 2];
+            row.push((*set_name, median, count / (median * 1e-3)));
+        }
+        rates.push((query_name, row));
+    }
+    bar.finish_and_clear();
+
+    println!("{} rays per cast ({side}x{side} camera image; as many random surface rays), median of {} runs, GPU time, {}", side * side, args.runs, ctx.info().name);
+    println!(
+        "{:<12} {:>10} {:>14} {:>10} {:>14} {:>10}",
+        "query", "coh. ms", "coh. Mrays/s", "inc. ms", "inc. Mrays/s", "coh./inc."
+    );
+    for (query_name, row) in &rates {
+        let [(_, coherent_ms, coherent), (_, incoherent_ms, incoherent)] = row[..] else {
+            unreachable!("two ray sets")
+        };
+        println!(
+            "{query_name:<12} {coherent_ms:>10.2} {:>14.3} {incoherent_ms:>10.2} {:>14.3} {:>10.2}",
+            coherent * 1e-6,
+            incoherent * 1e-6,
+            coherent / incoherent
+        );
+    }
+    args.gpu.finish(&ctx)
+}
+
+/// One ray through each pixel centre of a side x side image from the scene camera.
+fn camera_rays(scene: &Scene, side: u32) -> Vec<CastRay> {
+    let camera = &scene.camera;
+    let forward = (camera.target - camera.position).normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    let half = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    (0..side * side)
+        .map(|i| {
+            let x = ((i % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let y = 1.0 - ((i / side) as f32 + 0.5) / side as f32 * 2.0;
+            let dir = (forward + half * (x * right + y * up)).normalize();
+            ray(camera.position, dir)
+        })
+        .collect()
+}
+
+/// Uniformly distributed points on the scene's surfaces (by area), each with a uniformly
+/// random direction, leaving the surface on the side the direction points to.
+fn surface_rays(scene: &Scene, count: u32) -> Vec<CastRay> {
+    let triangles: Vec<[Vec3; 3]> = scene
+        .meshes()
+        .flat_map(|(group, mesh)| {
+            let to_world = group.transform.matrix();
+            mesh.indices.chunks_exact(3).map(move |t| {
+                [0, 1, 2].map(|k| to_world.transform_point3(mesh.positions[t[k] as usize].into()))
+            })
+        })
+        .collect();
+    let mut cumulative = Vec::with_capacity(triangles.len());
+    let mut total = 0.0f64;
+    for t in &triangles {
+        total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length() as f64;
+        cumulative.push(total);
+    }
+    let mut rng = Pcg32(0x853c_49e6_748f_ea9b);
+    (0..count)
+        .map(|_| {
+            let pick = rng.next() as f64 * total;
+            let t = triangles[cumulative
+                .partition_point(|&c| c < pick)
+                .min(triangles.len() - 1)];
+            let (mut a, mut b) = (rng.next(), rng.next());
+            if a + b > 1.0 {
+                (a, b) = (1.0 - a, 1.0 - b);
+            }
+            let p = t[0] + a * (t[1] - t[0]) + b * (t[2] - t[0]);
+            let z = 2.0 * rng.next() - 1.0;
+            let phi = std::f32::consts::TAU * rng.next();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+            let side = if normal.dot(dir) >= 0.0 {
+                normal
+            } else {
+                -normal
+            };
+            ray(offset_ray_origin(p, side), dir)
+        })
+        .collect()
+}
+
+fn ray(origin: Vec3, dir: Vec3) -> CastRay {
+    CastRay {
+        origin: origin.extend(1e30).to_array(),
+        direction: dir.extend(0.0).to_array(),
+    }
+}
+
+/// PCG32 (O'Neill 2014): reproducible ray sets without a dependency.
+struct Pcg32(u64);
+
+impl Pcg32 {
+    /// Uniform in [0, 1).
+    fn next(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let x = ((((self.0 >> 18) ^ self.0) >> 27) as u32).rotate_right((self.0 >> 59) as u32);
+        (x >> 8) as f32 / (1 << 24) as f32
+    }
+}

@@ -1,0 +1,81 @@
+//! Where a PRT transfer comes from: the cache when a valid file is there, else the GPU (and
+//! then the cache). Shared by `kage precompute` and the PRT techniques of `kage render`.
+use anyhow::{Context as _, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use kage::backend::Context;
+use kage::scene::Scene;
+use kage::techniques::prt::{cache, transfer, PrtParams, TransferSet};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Args, Clone, Debug)]
+pub struct PrtArgs {
+    /// Visibility rays per vertex of the PRT precomputation.
+    #[arg(long, default_value_t = PrtParams::DEFAULT.rays)]
+    pub rays: u32,
+    /// SH bands of the PRT transfer, 2 to 5 (bands² coefficients per vertex).
+    #[arg(long, default_value_t = PrtParams::DEFAULT.bands)]
+    pub bands: u32,
+    /// Cache folder (default: $KAGE_CACHE_DIR, else $XDG_CACHE_HOME/kage, else ~/.cache/kage).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Recompute the transfer even when the cache file is valid.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// How a transfer was obtained.
+pub enum Origin {
+    /// Read from this valid cache file.
+    Cached(PathBuf),
+    /// Computed on the GPU and written to this file, of this many bytes.
+    Computed { path: PathBuf, file_bytes: u64 },
+}
+
+impl PrtArgs {
+    pub fn params(&self) -> Result<PrtParams> {
+        Ok(PrtParams { bands: self.bands, rays: self.rays }.validated()?)
+    }
+
+    /// The transfer of `scene`: cached when valid (saying why not otherwise), else computed with
+    /// a progress bar and cached.
+    pub fn obtain(&self, ctx: &Arc<Context>, scene: &Scene) -> Result<(TransferSet, Origin)> {
+        let params = self.params()?;
+        let dir = match &self.cache {
+            Some(dir) => dir.clone(),
+            None => cache::default_dir()
+                .context("no cache folder: pass --cache DIR, or set KAGE_CACHE_DIR, XDG_CACHE_HOME or HOME")?,
+        };
+        let key = cache::CacheKey::new(scene, params);
+        let path = dir.join(key.file_name(&scene.name));
+        if self.force {
+            eprintln!("cache: rebuilding {} (--force)", path.display());
+        } else {
+            match cache::load(&path, &key) {
+                Ok(set) => return Ok((set, Origin::Cached(path))),
+                Err(cache::Stale::Missing) => eprintln!("cache: no file {} yet; computing", path.display()),
+                Err(reason) => eprintln!("cache: rebuilding {}: {reason}", path.display()),
+            }
+        }
+        let bar = ProgressBar::hidden().with_style(
+            ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} vertices, {elapsed} elapsed, {eta} left")
+                .expect("static template"),
+        );
+        bar.set_message("precomputing transfer");
+        let start = Instant::now();
+        let set = transfer::precompute(ctx, scene, params, &mut |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+            // Only work that lasts shows a bar.
+            if start.elapsed().as_secs_f32() >= 1.0 && bar.is_hidden() {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+            }
+        })
+        .context("precomputing the transfer on the GPU")?;
+        bar.finish_and_clear();
+        let file_bytes = cache::save(&path, &set, &key)?;
+        Ok((set, Origin::Computed { path, file_bytes }))
+    }
+}
