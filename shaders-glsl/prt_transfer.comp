@@ -23,31 +23,6 @@ layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) buffer Transfer { float
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) buffer RaysCast { uint rays_cast[]; };
 layout(push_constant) uniform Push { PrtTransferPush p; };
 
-// The 25 real SH basis functions of engine/src/sh.rs (index l(l+1)+m, no Condon–Shortley
-// phase), four to a vec4: y[4j + c] is y_j[c]. Vectors rather than a float[25]: lavapipe
-// (Mesa 22.3) miscompiled the accumulation loop when it held local arrays next to the
-// traversal's stack, ending the loop over rays early.
-void sh25_basis(vec3 d, out vec4 c0, out vec4 c1, out vec4 c2, out vec4 c3, out vec4 c4,
-                out vec4 c5, out vec4 c6) {
-    float x = d.x, y = d.y, z = d.z;
-    float xx = x * x, yy = y * y, zz = z * z;
-    c0 = vec4(0.282094791773878, 0.488602511902920 * y, 0.488602511902920 * z,
-              0.488602511902920 * x);
-    c1 = vec4(1.092548430592079 * x * y, 1.092548430592079 * y * z,
-              0.315391565252520 * (3.0 * zz - 1.0), 1.092548430592079 * x * z);
-    c2 = vec4(0.546274215296040 * (xx - yy), 0.590043589926644 * y * (3.0 * xx - yy),
-              2.890611442640554 * x * y * z, 0.457045799464466 * y * (5.0 * zz - 1.0));
-    c3 = vec4(0.373176332590115 * z * (5.0 * zz - 3.0), 0.457045799464466 * x * (5.0 * zz - 1.0),
-              1.445305721320277 * z * (xx - yy), 0.590043589926644 * x * (xx - 3.0 * yy));
-    c4 = vec4(2.503342941796705 * x * y * (xx - yy), 1.770130769779930 * y * z * (3.0 * xx - yy),
-              0.946174695757560 * x * y * (7.0 * zz - 1.0), 0.669046543557289 * y * z * (7.0 * zz - 3.0));
-    c5 = vec4(0.105785546915204 * ((35.0 * zz - 30.0) * zz + 3.0),
-              0.669046543557289 * x * z * (7.0 * zz - 3.0),
-              0.473087347878780 * (xx - yy) * (7.0 * zz - 1.0),
-              1.770130769779930 * x * z * (xx - 3.0 * yy));
-    c6 = vec4(0.625835735449176 * (xx * (xx - 3.0 * yy) - yy * (3.0 * xx - yy)), 0.0, 0.0, 0.0);
-}
-
 // PCG output permutation (Jarzynski and Olano 2020, "Hash Functions for GPU Rendering").
 uint pcg_hash(uint v) {
     uint state = v * 747796405u + 2891336453u;
