@@ -19,10 +19,7 @@ pub enum Error {
     #[error("the Vulkan device was lost in {call}")]
     DeviceLost { call: &'static str },
     #[error("{call} failed: {result:?}")]
-    Vulkan {
-        call: &'static str,
-        result: vk::Result,
-    },
+    Vulkan { call: &'static str, result: vk::Result },
     #[error("GPU memory allocation for {name} failed: {message}")]
     Allocation { name: String, message: String },
     #[error("timed out waiting for the GPU in {0}")]

@@ -14,12 +14,7 @@ pub enum ImageIoError {
         "{}: a {width}×{height} image needs a non-zero size and width × height pixels, but has {pixels}",
         path.display()
     )]
-    Size {
-        path: PathBuf,
-        width: u32,
-        height: u32,
-        pixels: usize,
-    },
+    Size { path: PathBuf, width: u32, height: u32, pixels: usize },
     #[error("{}: pixel ({x}, {y}) is NaN or infinite", path.display())]
     NonFinite { path: PathBuf, x: u32, y: u32 },
     #[error("{}: exposure {exposure} is not a finite, non-negative number", path.display())]
@@ -27,15 +22,9 @@ pub enum ImageIoError {
     // The causes are printed in the message rather than chained as `source`, so that the
     // reason reaches the user whichever way the error is printed.
     #[error("{}: PNG failed: {error}", path.display())]
-    Png {
-        path: PathBuf,
-        error: image::ImageError,
-    },
+    Png { path: PathBuf, error: image::ImageError },
     #[error("{}: OpenEXR failed: {error}", path.display())]
-    Exr {
-        path: PathBuf,
-        error: exr::error::Error,
-    },
+    Exr { path: PathBuf, error: exr::error::Error },
 }
 
 /// Linear RGBA radiance, row-major, row 0 at the top.
@@ -97,15 +86,10 @@ fn format_of(path: &Path) -> Option<Format> {
 ///
 /// Alpha is dropped in both. NaN or infinite pixels are refused rather than written, since they
 /// mean the render went wrong.
-pub fn write(
-    path: impl AsRef<Path>,
-    image: &RgbaF32Image,
-    exposure: f32,
-) -> Result<(), ImageIoError> {
+pub fn write(path: impl AsRef<Path>, image: &RgbaF32Image, exposure: f32) -> Result<(), ImageIoError> {
     let path = path.as_ref();
-    let format = format_of(path).ok_or_else(|| ImageIoError::UnsupportedExtension {
-        path: path.to_owned(),
-    })?;
+    let format =
+        format_of(path).ok_or_else(|| ImageIoError::UnsupportedExtension { path: path.to_owned() })?;
     image.validate(path)?;
     match format {
         Format::Png => write_png(path, image, exposure),
@@ -115,16 +99,10 @@ pub fn write(
 
 fn write_png(path: &Path, image: &RgbaF32Image, exposure: f32) -> Result<(), ImageIoError> {
     if !(exposure.is_finite() && exposure >= 0.0) {
-        return Err(ImageIoError::Exposure {
-            path: path.to_owned(),
-            exposure,
-        });
+        return Err(ImageIoError::Exposure { path: path.to_owned(), exposure });
     }
-    let bytes: Vec<u8> = image
-        .pixels
-        .iter()
-        .flat_map(|&[r, g, b, _]| tonemap_srgb8([r, g, b], exposure))
-        .collect();
+    let bytes: Vec<u8> =
+        image.pixels.iter().flat_map(|&[r, g, b, _]| tonemap_srgb8([r, g, b], exposure)).collect();
     image::save_buffer_with_format(
         path,
         &bytes,
@@ -133,10 +111,7 @@ fn write_png(path: &Path, image: &RgbaF32Image, exposure: f32) -> Result<(), Ima
         image::ExtendedColorType::Rgb8,
         image::ImageFormat::Png,
     )
-    .map_err(|error| ImageIoError::Png {
-        path: path.to_owned(),
-        error,
-    })
+    .map_err(|error| ImageIoError::Png { path: path.to_owned(), error })
 }
 
 fn write_exr(path: &Path, image: &RgbaF32Image) -> Result<(), ImageIoError> {
@@ -145,10 +120,7 @@ fn write_exr(path: &Path, image: &RgbaF32Image) -> Result<(), ImageIoError> {
         let [r, g, b, _] = image.pixels[y * width + x];
         (r, g, b)
     })
-    .map_err(|error| ImageIoError::Exr {
-        path: path.to_owned(),
-        error,
-    })
+    .map_err(|error| ImageIoError::Exr { path: path.to_owned(), error })
 }
 
 /// Reads the first RGB or RGBA layer of an OpenEXR file, half or float, as linear f32 (alpha 1
@@ -162,19 +134,12 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<RgbaF32Image, ImageIoError> {
             pixels[pos.y() * *width + pos.x()] = [r, g, b, a];
         },
     )
-    .map_err(|error| ImageIoError::Exr {
-        path: path.to_owned(),
-        error,
-    })?;
+    .map_err(|error| ImageIoError::Exr { path: path.to_owned(), error })?;
     let size = image.layer_data.size;
     let pixels = image.layer_data.channel_data.pixels.1;
     // OpenEXR keeps its data window in i32s, so both sides fit a u32.
     let (width, height) = (size.width() as u32, size.height() as u32);
-    let image = RgbaF32Image {
-        width,
-        height,
-        pixels,
-    };
+    let image = RgbaF32Image { width, height, pixels };
     image.validate(path)?;
     Ok(image)
 }
@@ -224,19 +189,10 @@ mod tests {
             .map(|i| {
                 let t = i as f32;
                 // Values that are not exactly representable in half, to catch a lossy path.
-                [
-                    t * 0.123_456_7,
-                    1.0 / (t + 3.0),
-                    (t * 0.7).sin().abs() * 1e3,
-                    1.0,
-                ]
+                [t * 0.123_456_7, 1.0 / (t + 3.0), (t * 0.7).sin().abs() * 1e3, 1.0]
             })
             .collect();
-        RgbaF32Image {
-            width,
-            height,
-            pixels,
-        }
+        RgbaF32Image { width, height, pixels }
     }
 
     #[test]
@@ -304,10 +260,7 @@ mod tests {
             assert!(matches!(err, ImageIoError::UnsupportedExtension { .. }));
             let message = err.to_string();
             assert!(message.contains(&path.display().to_string()), "{message}");
-            assert!(
-                message.contains(".png") && message.contains(".exr"),
-                "{message}"
-            );
+            assert!(message.contains(".png") && message.contains(".exr"), "{message}");
         }
     }
 
@@ -316,26 +269,13 @@ mod tests {
         let path = scratch("bad.exr");
         let mut image = sample_image(4, 4);
         image.pixels.pop();
-        assert!(matches!(
-            write(&path, &image, 1.0),
-            Err(ImageIoError::Size { .. })
-        ));
-        let empty = RgbaF32Image {
-            width: 0,
-            height: 0,
-            pixels: vec![],
-        };
-        assert!(matches!(
-            write(&path, &empty, 1.0),
-            Err(ImageIoError::Size { .. })
-        ));
+        assert!(matches!(write(&path, &image, 1.0), Err(ImageIoError::Size { .. })));
+        let empty = RgbaF32Image { width: 0, height: 0, pixels: vec![] };
+        assert!(matches!(write(&path, &empty, 1.0), Err(ImageIoError::Size { .. })));
         let mut image = sample_image(4, 4);
         image.pixels[9][2] = f32::INFINITY;
         let err = write(&path, &image, 1.0).unwrap_err();
-        assert!(
-            matches!(err, ImageIoError::NonFinite { x: 1, y: 2, .. }),
-            "{err}"
-        );
+        assert!(matches!(err, ImageIoError::NonFinite { x: 1, y: 2, .. }), "{err}");
         let png = scratch("bad-exposure.png");
         let err = write(&png, &sample_image(2, 2), f32::NAN).unwrap_err();
         assert!(matches!(err, ImageIoError::Exposure { .. }), "{err}");
@@ -345,10 +285,7 @@ mod tests {
     fn reading_a_missing_or_corrupt_exr_is_an_error() {
         let missing = scratch("missing.exr");
         let err = read_exr(&missing).unwrap_err();
-        assert!(
-            err.to_string().contains(&missing.display().to_string()),
-            "{err}"
-        );
+        assert!(err.to_string().contains(&missing.display().to_string()), "{err}");
         let corrupt = scratch("corrupt.exr");
         std::fs::write(&corrupt, b"not an exr").unwrap();
         assert!(matches!(read_exr(&corrupt), Err(ImageIoError::Exr { .. })));

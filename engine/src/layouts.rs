@@ -41,9 +41,7 @@ pub fn bytes_of_slice<T: Pod>(values: &[T]) -> &[u8] {
     // (arrays), whose padding is explicit fields and whose size is asserted equal to the sum of
     // the field sizes, so every byte of `values` is initialised; u8 has no alignment, and the
     // length is that of the borrowed slice, whose lifetime the result keeps.
-    unsafe {
-        std::slice::from_raw_parts(values.as_ptr().cast::<u8>(), std::mem::size_of_val(values))
-    }
+    unsafe { std::slice::from_raw_parts(values.as_ptr().cast::<u8>(), std::mem::size_of_val(values)) }
 }
 
 include!(concat!(env!("OUT_DIR"), "/layouts.rs"));
@@ -53,25 +51,16 @@ mod tests {
     use super::*;
 
     fn floats(bytes: &[u8]) -> Vec<f32> {
-        bytes
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-            .collect()
+        bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
     }
 
     #[test]
     fn draw_push_bytes_are_column_major_model_then_albedo() {
         let model = glam::Mat4::from_cols_array(&std::array::from_fn(|i| i as f32));
-        let push = DrawPush {
-            model: model.to_cols_array_2d(),
-            albedo: [0.25, 0.5, 0.75, 1.0],
-        };
+        let push = DrawPush { model: model.to_cols_array_2d(), albedo: [0.25, 0.5, 0.75, 1.0] };
         let bytes = push.as_bytes();
         assert_eq!(bytes.len(), 80);
-        let expected: Vec<f32> = (0..16)
-            .map(|i| i as f32)
-            .chain([0.25, 0.5, 0.75, 1.0])
-            .collect();
+        let expected: Vec<f32> = (0..16).map(|i| i as f32).chain([0.25, 0.5, 0.75, 1.0]).collect();
         assert_eq!(floats(bytes), expected);
         // Column 3 (translation in glam) starts at byte 48, as GLSL's `model[3]`.
         assert_eq!(floats(&bytes[48..64]), model.w_axis.to_array());
@@ -102,10 +91,7 @@ mod tests {
 
     #[test]
     fn slices_are_packed_at_the_std430_stride() {
-        let pushes = [
-            ShProjectPush { size: [1, 2, 3, 4] },
-            ShProjectPush { size: [5, 6, 7, 8] },
-        ];
+        let pushes = [ShProjectPush { size: [1, 2, 3, 4] }, ShProjectPush { size: [5, 6, 7, 8] }];
         let words: Vec<u32> = bytes_of_slice(&pushes)
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes(c.try_into().unwrap()))

@@ -6,9 +6,9 @@ use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::Scene;
+use crate::techniques::background::Background;
 use crate::techniques::env_sh::EnvSh;
 use crate::techniques::environment::GpuEnvironment;
-use crate::techniques::background::Background;
 use crate::techniques::prt::TransferSet;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
@@ -81,10 +81,7 @@ impl GpuScene {
                 });
             }
         }
-        Ok(GpuScene {
-            meshes,
-            transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect(),
-        })
+        Ok(GpuScene { meshes, transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect() })
     }
 }
 
@@ -134,11 +131,7 @@ impl Targets {
                 location: MemoryLocation::GpuToCpu,
             },
         )?;
-        Ok(Targets {
-            color,
-            depth,
-            readback,
-        })
+        Ok(Targets { color, depth, readback })
     }
 }
 
@@ -202,12 +195,15 @@ impl Renderer {
             env_rotation: 0.0,
             background: Background::new(ctx)?,
             technique,
-            frame_uniforms: Buffer::new(ctx, &BufferDesc {
-                name: "frame_uniforms",
-                size: size_of::<FrameUniforms>() as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                location: MemoryLocation::CpuToGpu,
-            })?,
+            frame_uniforms: Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name: "frame_uniforms",
+                    size: size_of::<FrameUniforms>() as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?,
             targets,
             executor: FrameExecutor::new(ctx, "frame")?,
         })
@@ -226,14 +222,10 @@ impl Renderer {
     pub fn set_group_transform(&mut self, group: usize, transform: Mat4) -> Result<()> {
         let count = self.scene.transforms.len();
         if !transform.is_finite() {
-            return Err(Error::InvalidArgument(format!(
-                "transform of group {group} is not finite"
-            )));
+            return Err(Error::InvalidArgument(format!("transform of group {group} is not finite")));
         }
         let slot = self.scene.transforms.get_mut(group).ok_or_else(|| {
-            Error::InvalidArgument(format!(
-                "group {group} does not exist (the scene has {count})"
-            ))
+            Error::InvalidArgument(format!("group {group} does not exist (the scene has {count})"))
         })?;
         *slot = transform;
         Ok(())
@@ -293,11 +285,7 @@ impl Renderer {
                 })
             })
             .collect();
-        Ok(RgbaF32Image {
-            width: self.targets.color.width,
-            height: self.targets.color.height,
-            pixels,
-        })
+        Ok(RgbaF32Image { width: self.targets.color.width, height: self.targets.color.height, pixels })
     }
 
     /// The environment's SH coefficients as the renderer uses them.

@@ -11,11 +11,8 @@ pub struct Validated(pub Arc<Context>);
 
 impl Validated {
     pub fn new() -> Validated {
-        let ctx = Context::new(&ContextDesc {
-            validation: true,
-            device: None,
-        })
-        .expect("a Vulkan device with validation layers (run scripts/deps.sh)");
+        let ctx = Context::new(&ContextDesc { validation: true, device: None })
+            .expect("a Vulkan device with validation layers (run scripts/deps.sh)");
         Validated(ctx)
     }
 }
@@ -37,11 +34,7 @@ impl Drop for Validated {
     fn drop(&mut self) {
         let messages = self.0.take_validation_messages();
         if !std::thread::panicking() {
-            assert!(
-                messages.is_empty(),
-                "validation reported:\n{}",
-                messages.join("\n")
-            );
+            assert!(messages.is_empty(), "validation reported:\n{}", messages.join("\n"));
         }
     }
 }
@@ -50,11 +43,7 @@ impl Drop for Validated {
 pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Scene {
     Scene {
         name: "test".into(),
-        groups: vec![Group {
-            name: "object".into(),
-            meshes: vec![mesh],
-            transform: Transform::default(),
-        }],
+        groups: vec![Group { name: "object".into(), meshes: vec![mesh], transform: Transform::default() }],
         environment,
         lights: vec![],
         camera,

@@ -1,8 +1,7 @@
 //! The Vulkan backend on the real driver: device creation, memory round trips, a compute
 //! shader checked exactly, and the validation canary.
 use kage::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, ContextDesc,
-    MemoryLocation,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, ContextDesc, MemoryLocation,
 };
 use kage::layouts::{bytes_of, bytes_of_slice, constants, spirv, ShCoeffs, ShProjectPush};
 use kage::pass::{FrameExecutor, Pass};
@@ -13,39 +12,23 @@ fn device_is_created_and_described() {
     let ctx = Validated::new();
     let info = ctx.info();
     assert!(!info.name.is_empty());
-    assert!(info
-        .features
-        .iter()
-        .filter(|(n, _)| n.ends_with("(required)"))
-        .all(|(_, present)| *present));
+    assert!(info.features.iter().filter(|(n, _)| n.ends_with("(required)")).all(|(_, present)| *present));
 }
 
 #[test]
 fn unknown_device_name_is_a_clear_error() {
-    let err = Context::new(&ContextDesc {
-        validation: false,
-        device: Some("no such gpu 1234".into()),
-    })
-    .err()
-    .expect("no device has that name");
+    let err = Context::new(&ContextDesc { validation: false, device: Some("no such gpu 1234".into()) })
+        .err()
+        .expect("no device has that name");
     let text = err.to_string();
-    assert!(
-        text.contains("no such gpu 1234") && text.contains("devices:"),
-        "{text}"
-    );
+    assert!(text.contains("no such gpu 1234") && text.contains("devices:"), "{text}");
 }
 
 #[test]
 fn upload_and_readback_round_trip() {
     let ctx = Validated::new();
     let data: Vec<u8> = (0..100_003u32).map(|i| (i * 7 + 3) as u8).collect();
-    let buffer = Buffer::with_data(
-        &ctx,
-        "round_trip",
-        vk::BufferUsageFlags::TRANSFER_SRC,
-        &data,
-    )
-    .unwrap();
+    let buffer = Buffer::with_data(&ctx, "round_trip", vk::BufferUsageFlags::TRANSFER_SRC, &data).unwrap();
     assert_eq!(buffer.read().unwrap(), data);
 }
 
@@ -84,9 +67,7 @@ fn compute_shader_result_is_exact() {
         size_of::<ShProjectPush>() as u32,
     )
     .unwrap();
-    let push = ShProjectPush {
-        size: [count, 0, 0, 0],
-    };
+    let push = ShProjectPush { size: [count, 0, 0, 0] };
     let mut executor = FrameExecutor::new(&ctx, "exact").unwrap();
     let timings = executor
         .run(
@@ -105,10 +86,7 @@ fn compute_shader_result_is_exact() {
     assert_eq!(constants::SH_COEFFS, 9);
 
     let bytes = output.read().unwrap();
-    let got: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    let got: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
     for i in 0..9 {
         let expected = [
             partials.iter().map(|p| p.c[i][0] as f64).sum::<f64>(),
@@ -116,11 +94,7 @@ fn compute_shader_result_is_exact() {
             partials.iter().map(|p| p.c[i][2] as f64).sum::<f64>(),
         ];
         for k in 0..3 {
-            assert_eq!(
-                got[i * 4 + k] as f64,
-                expected[k],
-                "coefficient {i}, channel {k}"
-            );
+            assert_eq!(got[i * 4 + k] as f64, expected[k], "coefficient {i}, channel {k}");
         }
     }
 }
@@ -138,25 +112,16 @@ fn frame_with_unordered_passes_is_rejected() {
             ],
         )
         .unwrap_err();
-    assert!(
-        err.to_string().contains("pass consumer reads thing"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("pass consumer reads thing"), "{err}");
 }
 
 /// The canary: a deliberate misuse must reach the collected messages, or every other test's
 /// "no validation message" would prove nothing.
 #[test]
 fn planted_validation_error_is_caught() {
-    let ctx = Context::new(&ContextDesc {
-        validation: true,
-        device: None,
-    })
-    .unwrap();
+    let ctx = Context::new(&ContextDesc { validation: true, device: None }).unwrap();
     // Usage flags must not be empty (VUID-VkBufferCreateInfo-usage-requiredbitmask).
-    let info = vk::BufferCreateInfo::default()
-        .size(64)
-        .usage(vk::BufferUsageFlags::empty());
+    let info = vk::BufferCreateInfo::default().size(64).usage(vk::BufferUsageFlags::empty());
     // SAFETY: deliberately invalid create info; lavapipe creates the buffer anyway, and it is
     // destroyed right after.
     let buffer = unsafe { ctx.device().create_buffer(&info, None) }.unwrap();
@@ -164,13 +129,8 @@ fn planted_validation_error_is_caught() {
     unsafe { ctx.device().destroy_buffer(buffer, None) };
     let messages = ctx.take_validation_messages();
     assert!(
-        messages
-            .iter()
-            .any(|m| m.contains("VUID-VkBufferCreateInfo-usage-requiredbitmask")),
+        messages.iter().any(|m| m.contains("VUID-VkBufferCreateInfo-usage-requiredbitmask")),
         "the planted error was not reported: {messages:?}"
     );
-    assert!(
-        ctx.take_validation_messages().is_empty(),
-        "take() clears the log"
-    );
+    assert!(ctx.take_validation_messages().is_empty(), "take() clears the log");
 }

@@ -8,8 +8,8 @@
 use glam::{Mat4, Quat, Vec3};
 use kage::layouts::{constants, CastRay, CastResult};
 use kage::raycast::{
-    closest_hit_brute_force, edge_distance, occluded_object_space_brute_force, offset_ray_origin,
-    GpuBvh, GpuRays, Query, RayCaster, SceneBvh,
+    closest_hit_brute_force, edge_distance, occluded_object_space_brute_force, offset_ray_origin, GpuBvh,
+    GpuRays, Query, RayCaster, SceneBvh,
 };
 use kage::scene::{Camera, EnvMap, Group, Mesh, Scene, Transform};
 use kage_tests::Validated;
@@ -23,10 +23,7 @@ struct Rng(u64);
 
 impl Rng {
     fn next(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         let x = (((self.0 >> 18) ^ self.0) >> 27) as u32;
         let x = x.rotate_right((self.0 >> 59) as u32);
         (x >> 8) as f32 / (1 << 24) as f32
@@ -37,11 +34,7 @@ impl Rng {
     }
 
     fn vec(&mut self, half: f32) -> Vec3 {
-        Vec3::new(
-            self.range(-half, half),
-            self.range(-half, half),
-            self.range(-half, half),
-        )
+        Vec3::new(self.range(-half, half), self.range(-half, half), self.range(-half, half))
     }
 
     fn direction(&mut self) -> Vec3 {
@@ -72,7 +65,7 @@ fn scene(groups: Vec<Group>) -> Scene {
 fn random_transform(rng: &mut Rng) -> Transform {
     Transform {
         translation: rng.vec(3.0),
-        rotation: Quat::from_axis_angle(rng.direction(), rng.range(0.0, 6.28)),
+        rotation: Quat::from_axis_angle(rng.direction(), rng.range(0.0, std::f32::consts::TAU)),
         scale: rng.range(0.5, 2.0),
     }
 }
@@ -122,11 +115,7 @@ fn random_rays(rng: &mut Rng, scene: &Scene, count: usize) -> Vec<(Vec3, Vec3)> 
             if i % 2 == 0 && !triangles.is_empty() {
                 let t = triangles[(rng.next() * triangles.len() as f32) as usize % triangles.len()];
                 let (a, b) = (rng.next(), rng.next());
-                let (a, b) = if a + b > 1.0 {
-                    (1.0 - a, 1.0 - b)
-                } else {
-                    (a, b)
-                };
+                let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
                 let target = t[0] + a * (t[1] - t[0]) + b * (t[2] - t[0]);
                 (origin, (target - origin).normalize())
             } else {
@@ -176,21 +165,13 @@ fn check_world_rays(
     let infinite: Vec<(Vec3, Vec3, f32)> = rays.iter().map(|&(o, d)| (o, d, INFINITE)).collect();
     let closest = cast(ctx, caster, gpu, &infinite, Query::ClosestHit);
     let occluded = cast(ctx, caster, gpu, &infinite, Query::Occluded);
-    let expected: Vec<Option<f32>> = rays
-        .iter()
-        .map(|&(o, d)| closest_hit_brute_force(scene, o, d, INFINITE).map(|h| h.0))
-        .collect();
+    let expected: Vec<Option<f32>> =
+        rays.iter().map(|&(o, d)| closest_hit_brute_force(scene, o, d, INFINITE).map(|h| h.0)).collect();
     // Just short of the closest hit nothing may occlude; just beyond it something must.
-    let short: Vec<(Vec3, Vec3, f32)> = rays
-        .iter()
-        .zip(&expected)
-        .map(|(&(o, d), e)| (o, d, e.map_or(INFINITE, |t| t * 0.999)))
-        .collect();
-    let long: Vec<(Vec3, Vec3, f32)> = rays
-        .iter()
-        .zip(&expected)
-        .map(|(&(o, d), e)| (o, d, e.map_or(INFINITE, |t| t * 1.001)))
-        .collect();
+    let short: Vec<(Vec3, Vec3, f32)> =
+        rays.iter().zip(&expected).map(|(&(o, d), e)| (o, d, e.map_or(INFINITE, |t| t * 0.999))).collect();
+    let long: Vec<(Vec3, Vec3, f32)> =
+        rays.iter().zip(&expected).map(|(&(o, d), e)| (o, d, e.map_or(INFINITE, |t| t * 1.001))).collect();
     let occluded_short = cast(ctx, caster, gpu, &short, Query::Occluded);
     let occluded_long = cast(ctx, caster, gpu, &long, Query::Occluded);
     let (mut compared, mut hits) = (0, 0);
@@ -225,14 +206,8 @@ fn check_world_rays(
             "ray {i}: any hit disagrees with closest hit"
         );
         if want.is_some() {
-            assert!(
-                hit(&occluded_short[i]).is_none(),
-                "ray {i}: occluded before its closest hit"
-            );
-            assert!(
-                hit(&occluded_long[i]).is_some(),
-                "ray {i}: not occluded just past its closest hit"
-            );
+            assert!(hit(&occluded_short[i]).is_none(), "ray {i}: occluded before its closest hit");
+            assert!(hit(&occluded_long[i]).is_some(), "ray {i}: not occluded just past its closest hit");
         }
     }
     (compared, hits)
@@ -260,32 +235,19 @@ fn check_surfaces(
             continue;
         }
         let origin = cpu.triangle_origin(s.ids[1]).unwrap();
-        assert_eq!(
-            origin, want,
-            "ray {i}: GPU hit another triangle than brute force"
-        );
+        assert_eq!(origin, want, "ray {i}: GPU hit another triangle than brute force");
         let group = &scene.groups[origin.group as usize];
         let mesh = &group.meshes[origin.mesh as usize];
         let corners = &mesh.indices[3 * origin.triangle as usize..][..3];
         let to_world = group.transform.matrix();
-        let p: Vec<Vec3> = corners
-            .iter()
-            .map(|&c| to_world.transform_point3(mesh.positions[c as usize].into()))
-            .collect();
+        let p: Vec<Vec3> =
+            corners.iter().map(|&c| to_world.transform_point3(mesh.positions[c as usize].into())).collect();
         let w = [1.0 - s.hit[1] - s.hit[2], s.hit[1], s.hit[2]];
-        let facing = if (p[1] - p[0]).cross(p[2] - p[0]).dot(d) > 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
+        let facing = if (p[1] - p[0]).cross(p[2] - p[0]).dot(d) > 0.0 { -1.0 } else { 1.0 };
         let geometric = facing * (p[1] - p[0]).cross(p[2] - p[0]).normalize();
         let shading = facing
             * to_world
-                .transform_vector3(
-                    (0..3)
-                        .map(|k| w[k] * Vec3::from(mesh.normals[corners[k] as usize]))
-                        .sum(),
-                )
+                .transform_vector3((0..3).map(|k| w[k] * Vec3::from(mesh.normals[corners[k] as usize])).sum())
                 .normalize();
         assert!(
             (v3(s.position) - (o + t * d)).length() < 1e-4 * (1.0 + o.length()),
@@ -302,10 +264,7 @@ fn check_surfaces(
             "ray {i}: shading normal {:?}, expected {shading}",
             s.shading_normal
         );
-        assert!(
-            (v3(s.albedo) - Vec3::from(mesh.albedo)).length() < 1e-6,
-            "ray {i}: albedo"
-        );
+        assert!((v3(s.albedo) - Vec3::from(mesh.albedo)).length() < 1e-6, "ray {i}: albedo");
     }
 }
 
@@ -320,10 +279,7 @@ fn random_groups_match_brute_force() {
     let rays = random_rays(&mut rng, &scene, 1500);
     let (compared, hits) = check_world_rays(&ctx, &mut caster, &scene, &bvh, &gpu, &rays);
     // The edge margin may skip a handful; the test is void if it skips many or nothing hits.
-    assert!(
-        compared > 1450 && hits > 500 && hits < compared,
-        "{compared} rays compared, {hits} hit"
-    );
+    assert!(compared > 1450 && hits > 500 && hits < compared, "{compared} rays compared, {hits} hit");
 }
 
 #[test]
@@ -342,21 +298,13 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
         })
         .collect();
     let (compared, hits) = check_world_rays(&ctx, &mut caster, &scene, &bvh, &gpu, &rays);
-    assert!(
-        compared > 550 && hits > 300,
-        "{compared} rays compared, {hits} hit"
-    );
+    assert!(compared > 550 && hits > 300, "{compared} rays compared, {hits} hit");
     check_surfaces(&ctx, &mut caster, &scene, &bvh, &gpu, &rays);
 
     // Self-visibility of the teapot in its object space, from its own surface (PRT's rays).
     let teapot = &scene.groups[0];
-    let alone = Scene {
-        groups: vec![Group {
-            transform: Transform::default(),
-            ..teapot.clone()
-        }],
-        ..scene.clone()
-    };
+    let alone =
+        Scene { groups: vec![Group { transform: Transform::default(), ..teapot.clone() }], ..scene.clone() };
     let mesh = &teapot.meshes[0];
     let rays: Vec<(Vec3, Vec3, f32)> = (0..600)
         .map(|_| {
@@ -373,13 +321,7 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
             (offset_ray_origin(p, side), dir, INFINITE)
         })
         .collect();
-    let occluded = cast(
-        &ctx,
-        &mut caster,
-        &gpu,
-        &rays,
-        Query::OccludedObjectSpace { instance: 0 },
-    );
+    let occluded = cast(&ctx, &mut caster, &gpu, &rays, Query::OccludedObjectSpace { instance: 0 });
     let (mut compared, mut blocked) = (0, 0);
     for (i, &(o, d, tmax)) in rays.iter().enumerate() {
         if edge_distance(&alone, o, d, tmax) < EDGE_MARGIN {
@@ -388,16 +330,8 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
         compared += 1;
         let want = occluded_object_space_brute_force(&scene, 0, o, d, tmax);
         blocked += want as usize;
-        assert_eq!(
-            hit(&occluded[i]).is_some(),
-            want,
-            "object-space ray {i} from {o} along {d}"
-        );
-        assert_eq!(
-            bvh.occluded_object_space(0, o, d, tmax),
-            want,
-            "CPU BVH, object-space ray {i}"
-        );
+        assert_eq!(hit(&occluded[i]).is_some(), want, "object-space ray {i} from {o} along {d}");
+        assert_eq!(bvh.occluded_object_space(0, o, d, tmax), want, "CPU BVH, object-space ray {i}");
     }
     assert!(
         compared > 450 && blocked > 50 && blocked < compared,
@@ -420,17 +354,10 @@ fn moving_a_group_rewrites_only_the_top_level() {
     bvh.set_transform(1, moved.matrix()).unwrap();
     gpu.update(&bvh).unwrap();
 
-    assert_eq!(
-        gpu.blas_node_buffer().read().unwrap(),
-        blas_before,
-        "update rewrote bottom-level nodes"
-    );
+    assert_eq!(gpu.blas_node_buffer().read().unwrap(), blas_before, "update rewrote bottom-level nodes");
     let rays = random_rays(&mut rng, &scene, 800);
     let (compared, hits) = check_world_rays(&ctx, &mut caster, &scene, &bvh, &gpu, &rays);
-    assert!(
-        compared > 750 && hits > 250,
-        "{compared} rays compared, {hits} hit"
-    );
+    assert!(compared > 750 && hits > 250, "{compared} rays compared, {hits} hit");
 }
 
 #[test]
@@ -438,34 +365,19 @@ fn scenes_without_triangles_miss_everything() {
     let ctx = Validated::new();
     let mut caster = RayCaster::new(&ctx).unwrap();
     let mut rng = Rng(4);
-    let rays: Vec<(Vec3, Vec3, f32)> = (0..64)
-        .map(|_| (rng.vec(2.0), rng.direction(), INFINITE))
-        .collect();
-    let empty_group = Group {
-        name: "empty".into(),
-        meshes: vec![],
-        transform: Transform::default(),
-    };
+    let rays: Vec<(Vec3, Vec3, f32)> = (0..64).map(|_| (rng.vec(2.0), rng.direction(), INFINITE)).collect();
+    let empty_group = Group { name: "empty".into(), meshes: vec![], transform: Transform::default() };
     for groups in [vec![], vec![empty_group]] {
         let instances = groups.len() as u32;
         let mut bvh = SceneBvh::build(&scene(groups)).unwrap();
         let mut gpu = GpuBvh::new(&ctx, &bvh).unwrap();
         for query in [Query::ClosestHit, Query::Occluded] {
-            assert!(cast(&ctx, &mut caster, &gpu, &rays, query)
-                .iter()
-                .all(|r| hit(r).is_none()));
+            assert!(cast(&ctx, &mut caster, &gpu, &rays, query).iter().all(|r| hit(r).is_none()));
         }
         if instances > 0 {
-            bvh.set_transform(0, Mat4::from_translation(Vec3::X))
-                .unwrap();
+            bvh.set_transform(0, Mat4::from_translation(Vec3::X)).unwrap();
             gpu.update(&bvh).unwrap();
-            let results = cast(
-                &ctx,
-                &mut caster,
-                &gpu,
-                &rays,
-                Query::OccludedObjectSpace { instance: 0 },
-            );
+            let results = cast(&ctx, &mut caster, &gpu, &rays, Query::OccludedObjectSpace { instance: 0 });
             assert!(results.iter().all(|r| hit(r).is_none()));
         }
     }

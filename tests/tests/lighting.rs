@@ -26,11 +26,7 @@ fn constant_map_projects_to_the_first_coefficient_only() {
             sh.c[0][k]
         );
         for i in 1..9 {
-            assert!(
-                sh.c[i][k].abs() < SH_TOLERANCE * expected,
-                "c{i}[{k}] = {}",
-                sh.c[i][k]
-            );
+            assert!(sh.c[i][k].abs() < SH_TOLERANCE * expected, "c{i}[{k}] = {}", sh.c[i][k]);
         }
     }
 }
@@ -42,10 +38,7 @@ fn linear_map_projects_to_bands_0_and_1() {
     let coefficients = Vec3::new(0.5, 0.25, -0.3); // radiance 1 + a.x x + a.y y + a.z z
     let pixels = (0..w * h)
         .map(|p| {
-            let uv = Vec2::new(
-                ((p % w) as f32 + 0.5) / w as f32,
-                ((p / w) as f32 + 0.5) / h as f32,
-            );
+            let uv = Vec2::new(((p % w) as f32 + 0.5) / w as f32, ((p / w) as f32 + 0.5) / h as f32);
             [1.0 + coefficients.dot(uv_to_direction(uv)); 3]
         })
         .collect();
@@ -65,11 +58,7 @@ fn linear_map_projects_to_bands_0_and_1() {
     ];
     // Pixel-centre quadrature on a 256x128 map: errors below 1e-3 of c0.
     for (i, e) in expected.iter().enumerate() {
-        assert!(
-            (sh.c[i][0] - e).abs() < 1e-3 * expected[0],
-            "c{i} = {} vs {e}",
-            sh.c[i][0]
-        );
+        assert!((sh.c[i][0] - e).abs() < 1e-3 * expected[0], "c{i} = {} vs {e}", sh.c[i][0]);
     }
 }
 
@@ -81,15 +70,10 @@ fn gpu_projection_matches_the_cpu_reference_on_a_real_map() {
     let gpu = env_sh::project(&ctx, map).unwrap();
     let cpu = kage::sh::project_equirect(map.width(), map.height(), map.pixels(), 3).unwrap();
     let scale = cpu[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    for i in 0..9 {
+    for (i, (g, c)) in gpu.c.iter().zip(&cpu).enumerate() {
         for k in 0..3 {
-            let diff = (gpu.c[i][k] as f64 - cpu[i][k]).abs();
-            assert!(
-                diff < SH_TOLERANCE as f64 * scale,
-                "c{i}[{k}]: gpu {} cpu {}",
-                gpu.c[i][k],
-                cpu[i][k]
-            );
+            let diff = (g[k] as f64 - c[k]).abs();
+            assert!(diff < SH_TOLERANCE as f64 * scale, "c{i}[{k}]: gpu {} cpu {}", g[k], c[k]);
         }
     }
 }
@@ -98,10 +82,8 @@ fn gpu_projection_matches_the_cpu_reference_on_a_real_map() {
 /// uses (row 0 at the top).
 fn pixel_ray(camera: &Camera, x: u32, y: u32, size: u32) -> Vec3 {
     let inv: Mat4 = (camera.projection(1.0) * camera.view()).inverse();
-    let ndc = Vec2::new(
-        (x as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-        (y as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-    );
+    let ndc =
+        Vec2::new((x as f32 + 0.5) / size as f32 * 2.0 - 1.0, (y as f32 + 0.5) / size as f32 * 2.0 - 1.0);
     let p = inv * Vec4::new(ndc.x, ndc.y, 0.5, 1.0);
     (p.truncate() / p.w - camera.position).normalize()
 }
@@ -118,12 +100,8 @@ fn miss_distance(origin: Vec3, dir: Vec3) -> f32 {
 fn sphere_under_constant_light_has_radiance_albedo() {
     let ctx = Validated::new();
     let rho = 0.6;
-    let camera = Camera {
-        position: Vec3::new(0.0, 0.5, 4.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 40.0,
-    };
+    let camera =
+        Camera { position: Vec3::new(0.0, 0.5, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
     let sphere = shapes::sphere("sphere", 1.0, 64, [rho; 3]).unwrap();
     let scene = single_mesh_scene(sphere, EnvMap::constant([1.0; 3]), camera);
     let size = 96;
@@ -145,10 +123,7 @@ fn sphere_under_constant_light_has_radiance_albedo() {
             } else if d > 1.03 {
                 on_background += 1;
                 for k in 0..3 {
-                    assert!(
-                        (pixel[k] - 1.0).abs() < 1e-5,
-                        "background ({x}, {y}) = {pixel:?}"
-                    );
+                    assert!((pixel[k] - 1.0).abs() < 1e-5, "background ({x}, {y}) = {pixel:?}");
                 }
             }
         }
@@ -168,16 +143,8 @@ fn bright_texel_is_seen_in_its_direction() {
     let (i, j) = (10u32, 9u32);
     let mut pixels = vec![[0.0f32; 3]; (w * h) as usize];
     pixels[(j * w + i) as usize] = [100.0, 50.0, 25.0];
-    let direction = uv_to_direction(Vec2::new(
-        (i as f32 + 0.5) / w as f32,
-        (j as f32 + 0.5) / h as f32,
-    ));
-    let camera = Camera {
-        position: Vec3::ZERO,
-        target: direction,
-        up: Vec3::Y,
-        fov_y_deg: 20.0,
-    };
+    let direction = uv_to_direction(Vec2::new((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32));
+    let camera = Camera { position: Vec3::ZERO, target: direction, up: Vec3::Y, fov_y_deg: 20.0 };
     let scene = Scene {
         groups: vec![],
         ..single_mesh_scene(
@@ -191,48 +158,25 @@ fn bright_texel_is_seen_in_its_direction() {
     let centre = image.pixels[(size / 2 * size + size / 2) as usize];
     // Bilinear filtering at the texel's exact centre returns the texel itself.
     for (k, expected) in [100.0f32, 50.0, 25.0].iter().enumerate() {
-        assert!(
-            (centre[k] - expected).abs() < 1e-2 * expected,
-            "centre {centre:?}"
-        );
+        assert!((centre[k] - expected).abs() < 1e-2 * expected, "centre {centre:?}");
     }
-    let brightest = image
-        .pixels
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1[0].total_cmp(&b.1[0]))
-        .unwrap()
-        .0 as u32;
+    let brightest =
+        image.pixels.iter().enumerate().max_by(|a, b| a.1[0].total_cmp(&b.1[0])).unwrap().0 as u32;
     assert_eq!((brightest % size, brightest / size), (size / 2, size / 2));
-    assert_eq!(
-        image.pixels[0],
-        [0.0, 0.0, 0.0, 1.0],
-        "a corner 10 degrees away sees black"
-    );
+    assert_eq!(image.pixels[0], [0.0, 0.0, 0.0, 1.0], "a corner 10 degrees away sees black");
 }
 
 #[test]
 fn every_pass_reports_gpu_time() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
-    let mut renderer = Renderer::new(
-        &ctx,
-        &scene,
-        &RenderOptions { width: 64, height: 64, ..Default::default() },
-    )
-    .unwrap();
+    let mut renderer =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: 64, height: 64, ..Default::default() }).unwrap();
     let first = renderer.render().unwrap();
     let names: Vec<&str> = first.iter().map(|t| t.name).collect();
-    assert_eq!(
-        names,
-        ["sh_project", "sh_reduce", "background", "scene", "readback"]
-    );
+    assert_eq!(names, ["sh_project", "sh_reduce", "background", "scene", "readback"]);
     let second = renderer.render().unwrap();
-    assert_eq!(
-        second.len(),
-        3,
-        "the SH projection runs only when the environment changes"
-    );
+    assert_eq!(second.len(), 3, "the SH projection runs only when the environment changes");
     for t in first.iter().chain(&second) {
         assert!(t.gpu_ms.is_some_and(|ms| ms > 0.0), "{t:?}");
     }
@@ -243,29 +187,15 @@ fn bad_render_arguments_are_errors() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
     for (w, h) in [(0, 64), (64, 0), (9000, 64)] {
-        let err = Renderer::new(
-            &ctx,
-            &scene,
-            &RenderOptions { width: w, height: h, ..Default::default() },
-        )
-        .err()
-        .unwrap();
+        let err = Renderer::new(&ctx, &scene, &RenderOptions { width: w, height: h, ..Default::default() })
+            .err()
+            .unwrap();
         assert!(err.to_string().contains("image size"), "{err}");
     }
-    let mut renderer = Renderer::new(
-        &ctx,
-        &scene,
-        &RenderOptions { width: 8, height: 8, ..Default::default() },
-    )
-    .unwrap();
-    assert!(renderer
-        .set_group_transform(7, Mat4::IDENTITY)
-        .unwrap_err()
-        .to_string()
-        .contains("group 7"));
-    assert!(renderer
-        .set_group_transform(0, Mat4::from_translation(Vec3::NAN))
-        .is_err());
+    let mut renderer =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: 8, height: 8, ..Default::default() }).unwrap();
+    assert!(renderer.set_group_transform(7, Mat4::IDENTITY).unwrap_err().to_string().contains("group 7"));
+    assert!(renderer.set_group_transform(0, Mat4::from_translation(Vec3::NAN)).is_err());
 }
 
 #[test]
@@ -276,8 +206,5 @@ fn exported_scene_renders_the_same_picture() {
     scene.export(&dir).unwrap();
     let reloaded = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
     let render = |s: &Scene| render_once(&ctx, s, 48, 48).pixels;
-    assert!(
-        render(&scene) == render(&reloaded),
-        "exported scene renders differently"
-    );
+    assert!(render(&scene) == render(&reloaded), "exported scene renders differently");
 }

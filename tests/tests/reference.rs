@@ -22,43 +22,19 @@ fn plane(size: f32) -> Mesh {
 }
 
 fn group(name: &str, mesh: Mesh, transform: Transform) -> Group {
-    Group {
-        name: name.into(),
-        meshes: vec![mesh],
-        transform,
-    }
+    Group { name: name.into(), meshes: vec![mesh], transform }
 }
 
 /// Low and to the side, aimed at the origin: the centre pixel of an odd-sized image looks
 /// straight at (0, 0, 0), under any blocker of half-size 1 at height 0.5 or more.
 fn side_camera() -> Camera {
-    Camera {
-        position: Vec3::new(3.0, 0.25, 0.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 20.0,
-    }
+    Camera { position: Vec3::new(3.0, 0.25, 0.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 20.0 }
 }
 
-fn render(
-    ctx: &Validated,
-    scene: &Scene,
-    size: u32,
-    light: LightMode,
-    seed: u32,
-    spp: u32,
-) -> Statistics {
-    let mut renderer = ReferenceRenderer::new(
-        ctx,
-        scene,
-        &ReferenceOptions {
-            width: size,
-            height: size,
-            light,
-            seed,
-        },
-    )
-    .unwrap();
+fn render(ctx: &Validated, scene: &Scene, size: u32, light: LightMode, seed: u32, spp: u32) -> Statistics {
+    let mut renderer =
+        ReferenceRenderer::new(ctx, scene, &ReferenceOptions { width: size, height: size, light, seed })
+            .unwrap();
     renderer.run_batch(spp).unwrap();
     renderer.statistics().unwrap()
 }
@@ -66,10 +42,7 @@ fn render(
 /// The centre pixel's red value and standard error.
 fn centre(stats: &Statistics, size: u32) -> (f64, f64) {
     let i = ((size / 2) * size + size / 2) as usize;
-    let se = stats
-        .standard_error
-        .as_ref()
-        .map_or(0.0, |e| f64::from(e[i][0]));
+    let se = stats.standard_error.as_ref().map_or(0.0, |e| f64::from(e[i][0]));
     (f64::from(stats.mean[i][0]), se)
 }
 
@@ -113,21 +86,14 @@ fn cpu_irradiance(map: &EnvMap, n: Vec3) -> [f64; 3] {
 #[test]
 fn plane_under_a_constant_sky_has_radiance_albedo() {
     let ctx = Validated::new();
-    let camera = Camera {
-        position: Vec3::new(0.0, 2.0, 0.5),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 30.0,
-    };
+    let camera =
+        Camera { position: Vec3::new(0.0, 2.0, 0.5), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 30.0 };
     let scene = single_mesh_scene(plane(20.0), EnvMap::constant([1.0; 3]), camera);
     let stats = render(&ctx, &scene, 16, LightMode::Environment, 1, 64);
     // Every pixel sees the plane: E = π, L = ρ/π · π = ρ.
     let (mean, se) = mean_over_pixels(&stats);
     // 4 σ of the mean of 256 pixels, plus f32 rounding of the sums.
-    assert!(
-        (mean - f64::from(RHO)).abs() <= 4.0 * se + 1e-5,
-        "{mean} ± {se} vs {RHO}"
-    );
+    assert!((mean - f64::from(RHO)).abs() <= 4.0 * se + 1e-5, "{mean} ± {se} vs {RHO}");
     // MIS of the map (uniform here) with cosine sampling is nearly exact on a plane.
     assert!(se < 2e-3, "standard error {se}");
 }
@@ -136,31 +102,18 @@ fn plane_under_a_constant_sky_has_radiance_albedo() {
 fn tilted_planes_under_a_real_map_match_cpu_integration() {
     let ctx = Validated::new();
     let map = Scene::builtin("teapot").unwrap().environment;
-    for (k, normal) in [
-        Vec3::Y,
-        Vec3::new(1.0, 0.3, -0.5),
-        Vec3::new(-0.2, -0.4, 1.0),
-    ]
-    .into_iter()
-    .enumerate()
+    for (k, normal) in
+        [Vec3::Y, Vec3::new(1.0, 0.3, -0.5), Vec3::new(-0.2, -0.4, 1.0)].into_iter().enumerate()
     {
         let n = normal.normalize();
-        let transform = Transform {
-            rotation: Quat::from_rotation_arc(Vec3::Y, n),
-            ..Transform::default()
-        };
+        let transform = Transform { rotation: Quat::from_rotation_arc(Vec3::Y, n), ..Transform::default() };
         let up = if n.y.abs() > 0.9 { Vec3::Z } else { Vec3::Y };
         let scene = Scene {
             name: "tilted".into(),
             groups: vec![group("plane", plane(4.0), transform)],
             environment: map.clone(),
             lights: vec![],
-            camera: Camera {
-                position: 2.0 * n,
-                target: Vec3::ZERO,
-                up,
-                fov_y_deg: 40.0,
-            },
+            camera: Camera { position: 2.0 * n, target: Vec3::ZERO, up, fov_y_deg: 40.0 },
         };
         let stats = render(&ctx, &scene, 16, LightMode::Environment, 10 + k as u32, 256);
         let expected = f64::from(RHO) / PI * cpu_irradiance(&map, n)[0];
@@ -180,20 +133,10 @@ fn irradiance_on_a_lone_sphere_matches_cpu_integration() {
     let map = Scene::builtin("teapot").unwrap().environment;
     let sphere = shapes::sphere("sphere", 1.0, 32, [RHO; 3]).unwrap();
     let scene = single_mesh_scene(sphere, map.clone(), side_camera());
-    let normals = [
-        Vec3::Y,
-        Vec3::NEG_Y,
-        Vec3::X,
-        Vec3::new(0.3, 0.5, -0.8).normalize(),
-    ];
+    let normals = [Vec3::Y, Vec3::NEG_Y, Vec3::X, Vec3::new(0.3, 0.5, -0.8).normalize()];
     // On the analytic sphere, which circumscribes the mesh: nothing above the tangent plane.
-    let points: Vec<Point> = normals
-        .iter()
-        .map(|n| Point {
-            position: n.to_array(),
-            normal: n.to_array(),
-        })
-        .collect();
+    let points: Vec<Point> =
+        normals.iter().map(|n| Point { position: n.to_array(), normal: n.to_array() }).collect();
     let mut reference = IrradianceReference::new(&ctx, &scene, &points, 3).unwrap();
     // Four points cost nothing: many samples, in several batches to exercise their merging.
     for _ in 0..8 {
@@ -228,10 +171,7 @@ fn square_blocked_fraction(s: f64, h: f64) -> f64 {
 fn a_blocker_darkens_the_floor_by_its_form_factor() {
     let ctx = Validated::new();
     let (s, h) = (0.5f32, 0.5f32);
-    let blocker = Transform {
-        translation: Vec3::new(0.0, h, 0.0),
-        ..Transform::default()
-    };
+    let blocker = Transform { translation: Vec3::new(0.0, h, 0.0), ..Transform::default() };
     let scene = Scene {
         name: "blocker".into(),
         groups: vec![
@@ -248,10 +188,7 @@ fn a_blocker_darkens_the_floor_by_its_form_factor() {
     let fraction = square_blocked_fraction(f64::from(s), f64::from(h));
     let expected = f64::from(RHO) * (1.0 - fraction);
     // 4 σ of one pixel, plus f32 rounding.
-    assert!(
-        (got - expected).abs() <= 4.0 * se + 1e-5,
-        "{got} ± {se} vs ρ(1 − {fraction}) = {expected}"
-    );
+    assert!((got - expected).abs() <= 4.0 * se + 1e-5, "{got} ± {se} vs ρ(1 − {fraction}) = {expected}");
     assert!(se < 0.01, "standard error {se}");
 }
 
@@ -259,10 +196,7 @@ fn a_blocker_darkens_the_floor_by_its_form_factor() {
 fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
     let ctx = Validated::new();
     let (height, intensity) = (2.0f32, [5.0f32, 2.0, 1.0]);
-    let lights = vec![Light::Point {
-        position: Vec3::new(0.0, height, 0.0),
-        intensity,
-    }];
+    let lights = vec![Light::Point { position: Vec3::new(0.0, height, 0.0), intensity }];
     let mut scene = Scene {
         name: "point light".into(),
         groups: vec![group("floor", plane(20.0), Transform::default())],
@@ -277,10 +211,7 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
     for (k, (got, i)) in centre_rgb(&lit).into_iter().zip(intensity).enumerate() {
         let expected = RHO / std::f32::consts::PI * i / (height * height);
         // Deterministic: only f32 rounding (a few ulps) separates it from the formula.
-        assert!(
-            (got - expected).abs() <= 1e-6 * expected,
-            "channel {k}: {got} vs {expected}"
-        );
+        assert!((got - expected).abs() <= 1e-6 * expected, "channel {k}: {got} vs {expected}");
     }
     // Background is black: the top-left pixel sees the sky above the horizon.
     assert_eq!(lit.mean[0], [0.0; 3]);
@@ -288,10 +219,7 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
     scene.groups.push(group(
         "blocker",
         plane(0.5),
-        Transform {
-            translation: Vec3::new(0.0, 0.5 * height, 0.0),
-            ..Transform::default()
-        },
+        Transform { translation: Vec3::new(0.0, 0.5 * height, 0.0), ..Transform::default() },
     ));
     let shadowed = render(&ctx, &scene, size, LightMode::Local, 0, 1);
     assert_eq!(centre_rgb(&shadowed), [0.0; 3]);
@@ -320,10 +248,7 @@ fn spot_light_lights_only_inside_its_cone() {
         values.push(centre(&stats, size).0);
     }
     let expected = f64::from(RHO) / PI * 4.0 / 4.0;
-    assert!(
-        (values[0] - expected).abs() <= 1e-6 * expected,
-        "{values:?}"
-    );
+    assert!((values[0] - expected).abs() <= 1e-6 * expected, "{values:?}");
     assert_eq!(values[1], 0.0);
 }
 
@@ -334,12 +259,7 @@ fn black_map_renders_black_without_nan() {
     scene.environment = EnvMap::constant([0.0; 3]);
     let stats = render(&ctx, &scene, 16, LightMode::Environment, 0, 4);
     assert!(stats.mean.iter().flatten().all(|&v| v == 0.0));
-    assert!(stats
-        .standard_error
-        .unwrap()
-        .iter()
-        .flatten()
-        .all(|&v| v == 0.0));
+    assert!(stats.standard_error.unwrap().iter().flatten().all(|&v| v == 0.0));
 }
 
 #[test]
@@ -353,20 +273,12 @@ fn default_scene_error_halves_when_samples_quadruple() {
     // RMSEs is 2 in expectation.
     let images: Vec<RgbaF32Image> = [(1, n), (2, 4 * n), (3, 16 * n)]
         .into_iter()
-        .map(|(seed, spp)| {
-            image(
-                &render(&ctx, &scene, size, LightMode::Environment, seed, spp),
-                size,
-            )
-        })
+        .map(|(seed, spp)| image(&render(&ctx, &scene, size, LightMode::Environment, seed, spp), size))
         .collect();
     let coarse = compare(&images[0], &images[1]).unwrap().relative_rmse;
     let fine = compare(&images[1], &images[2]).unwrap().relative_rmse;
     let ratio = coarse / fine;
     // Each RMSE is estimated from 32×32×3 values, but a few bright, noisy pixels (the sunlit
     // teapot rim) dominate, so the ratio scatters by roughly ±20 % around 2 from seed to seed.
-    assert!(
-        (1.5..2.7).contains(&ratio),
-        "relative RMSE {coarse} at N = {n}, {fine} at 4N: ratio {ratio}"
-    );
+    assert!((1.5..2.7).contains(&ratio), "relative RMSE {coarse} at N = {n}, {fine} at 4N: ratio {ratio}");
 }

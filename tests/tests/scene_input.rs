@@ -47,20 +47,11 @@ fn write_exr(dir: &Path, name: &str, width: usize, height: usize, value: [f32; 3
 #[track_caller]
 fn assert_rejected(scene: &Path, blamed: &str, problem: &str) {
     match Scene::load(scene) {
-        Ok(_) => panic!(
-            "{} loaded, but should fail with {problem:?}",
-            scene.display()
-        ),
+        Ok(_) => panic!("{} loaded, but should fail with {problem:?}", scene.display()),
         Err(e) => {
             let message = e.to_string();
-            assert!(
-                message.contains(blamed),
-                "{message:?} does not name {blamed:?}"
-            );
-            assert!(
-                message.contains(problem),
-                "{message:?} does not say {problem:?}"
-            );
+            assert!(message.contains(blamed), "{message:?} does not name {blamed:?}");
+            assert!(message.contains(problem), "{message:?} does not say {problem:?}");
         }
     }
 }
@@ -69,25 +60,14 @@ fn assert_rejected(scene: &Path, blamed: &str, problem: &str) {
 fn missing_files_are_named() {
     let dir = temp_dir("missing");
     assert_rejected(&dir.join("nowhere.json"), "nowhere.json", "cannot read");
-    let scene = write(
-        &dir,
-        "scene.json",
-        &scene_json(
-            "",
-            r#"{"obj": "absent.obj", "albedo": [0.5, 0.5, 0.5]}"#,
-            "",
-        ),
-    );
+    let scene =
+        write(&dir, "scene.json", &scene_json("", r#"{"obj": "absent.obj", "albedo": [0.5, 0.5, 0.5]}"#, ""));
     assert_rejected(&scene, "absent.obj", "cannot read");
     let scene = write(
         &dir,
         "env.json",
-        &scene_json(
-            "",
-            r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#,
-            "",
-        )
-        .replace(r#"{"constant": [1, 1, 1]}"#, r#"{"image": "absent.exr"}"#),
+        &scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#, "")
+            .replace(r#"{"constant": [1, 1, 1]}"#, r#"{"image": "absent.exr"}"#),
     );
     assert_rejected(&scene, "absent.exr", "cannot read");
 }
@@ -96,22 +76,10 @@ fn missing_files_are_named() {
 fn bad_obj_files_are_rejected() {
     let dir = temp_dir("obj");
     let cases = [
-        (
-            "malformed.obj",
-            "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n",
-            "malformed",
-        ),
+        ("malformed.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n", "malformed"),
         ("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "NaN"),
-        (
-            "infinite.obj",
-            "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n",
-            "infinite",
-        ),
-        (
-            "range.obj",
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-            "out of",
-        ),
+        ("infinite.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", "infinite"),
+        ("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of"),
         ("empty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no triangles"),
     ];
     for (file, contents, problem) in cases {
@@ -140,15 +108,9 @@ fn bad_environment_images_are_rejected() {
         ("garbage.exr", "OpenEXR"),
     ];
     for (file, problem) in cases {
-        let json = scene_json(
-            "",
-            r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#,
-            "",
-        )
-        .replace(
-            r#"{"constant": [1, 1, 1]}"#,
-            &format!(r#"{{"image": "{file}"}}"#),
-        );
+        let json =
+            scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#, "")
+                .replace(r#"{"constant": [1, 1, 1]}"#, &format!(r#"{{"image": "{file}"}}"#));
         let scene = write(&dir, &format!("{file}.json"), &json);
         assert_rejected(&scene, file, problem);
     }
@@ -180,18 +142,9 @@ fn radiance_hdr_files_load_and_are_checked() {
     std::fs::write(dir.join("square.hdr"), hdr(4, 4)).unwrap();
     let map = kage::scene::EnvMap::load(&dir.join("good.hdr")).unwrap();
     assert_eq!((map.width(), map.height()), (4, 2));
-    assert!(
-        map.pixels().iter().all(|p| *p == [1.0; 3]),
-        "{:?}",
-        map.pixels()[0]
-    );
-    let message = kage::scene::EnvMap::load(&dir.join("square.hdr"))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        message.contains("square.hdr") && message.contains("2:1"),
-        "{message}"
-    );
+    assert!(map.pixels().iter().all(|p| *p == [1.0; 3]), "{:?}", map.pixels()[0]);
+    let message = kage::scene::EnvMap::load(&dir.join("square.hdr")).unwrap_err().to_string();
+    assert!(message.contains("square.hdr") && message.contains("2:1"), "{message}");
 }
 
 #[test]
@@ -200,16 +153,8 @@ fn bad_scene_values_are_rejected() {
     let sphere = r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
     let cases = [
         ("syntax", "{\"camera\": ".to_string(), "line"),
-        (
-            "unknown-top",
-            scene_json("", sphere, r#", "fog": 1"#),
-            "unknown field `fog`",
-        ),
-        (
-            "unknown-group",
-            scene_json(r#", "colour": 1"#, sphere, ""),
-            "unknown field `colour`",
-        ),
+        ("unknown-top", scene_json("", sphere, r#", "fog": 1"#), "unknown field `fog`"),
+        ("unknown-group", scene_json(r#", "colour": 1"#, sphere, ""), "unknown field `colour`"),
         (
             "unknown-mesh",
             scene_json(
@@ -219,33 +164,13 @@ fn bad_scene_values_are_rejected() {
             ),
             "unknown field `rings`",
         ),
-        (
-            "zero-scale",
-            scene_json(r#", "scale": 0"#, sphere, ""),
-            "scale",
-        ),
-        (
-            "negative-scale",
-            scene_json(r#", "scale": -2"#, sphere, ""),
-            "scale",
-        ),
-        (
-            "infinite-translation",
-            scene_json(r#", "translation": [0, 1e39, 0]"#, sphere, ""),
-            "translation",
-        ),
-        (
-            "infinite-rotation",
-            scene_json(r#", "rotation_deg": [1e39, 0, 0]"#, sphere, ""),
-            "rotation",
-        ),
+        ("zero-scale", scene_json(r#", "scale": 0"#, sphere, ""), "scale"),
+        ("negative-scale", scene_json(r#", "scale": -2"#, sphere, ""), "scale"),
+        ("infinite-translation", scene_json(r#", "translation": [0, 1e39, 0]"#, sphere, ""), "translation"),
+        ("infinite-rotation", scene_json(r#", "rotation_deg": [1e39, 0, 0]"#, sphere, ""), "rotation"),
         (
             "albedo",
-            scene_json(
-                "",
-                r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 1.5, 0.5]}"#,
-                "",
-            ),
+            scene_json("", r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 1.5, 0.5]}"#, ""),
             "albedo",
         ),
         (
@@ -260,11 +185,7 @@ fn bad_scene_values_are_rejected() {
         ("no-meshes", scene_json("", "", ""), "no meshes"),
         (
             "plane",
-            scene_json(
-                "",
-                r#"{"plane": {"size": [1, 1], "vertices": [1, 5]}, "albedo": [1, 1, 1]}"#,
-                "",
-            ),
+            scene_json("", r#"{"plane": {"size": [1, 1], "vertices": [1, 5]}, "albedo": [1, 1, 1]}"#, ""),
             "plane vertices",
         ),
         (
@@ -285,17 +206,11 @@ fn bad_scene_values_are_rejected() {
             ),
             "direction",
         ),
-        (
-            "light-kind",
-            scene_json("", sphere, r#", "lights": [{"area": {}}]"#),
-            "unknown variant `area`",
-        ),
+        ("light-kind", scene_json("", sphere, r#", "lights": [{"area": {}}]"#), "unknown variant `area`"),
         (
             "env-intensity",
-            scene_json("", sphere, "").replace(
-                r#""constant": [1, 1, 1]"#,
-                r#""constant": [1, 1, 1], "intensity": -1"#,
-            ),
+            scene_json("", sphere, "")
+                .replace(r#""constant": [1, 1, 1]"#, r#""constant": [1, 1, 1], "intensity": -1"#),
             "intensity",
         ),
     ];
@@ -310,31 +225,11 @@ fn bad_cameras_are_rejected() {
     let dir = temp_dir("camera");
     let sphere = r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
     let cases = [
-        (
-            "same-point",
-            r#""position": [1, 2, 3], "target": [1, 2, 3], "fov_y_deg": 40"#,
-            "same point",
-        ),
-        (
-            "zero-up",
-            r#""position": [0, 2, 6], "target": [0, 0, 0], "up": [0, 0, 0], "fov_y_deg": 40"#,
-            "up",
-        ),
-        (
-            "fov-zero",
-            r#""position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 0"#,
-            "fov_y_deg",
-        ),
-        (
-            "fov-180",
-            r#""position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 180"#,
-            "fov_y_deg",
-        ),
-        (
-            "infinite",
-            r#""position": [0, 1e39, 6], "target": [0, 0, 0], "fov_y_deg": 40"#,
-            "not finite",
-        ),
+        ("same-point", r#""position": [1, 2, 3], "target": [1, 2, 3], "fov_y_deg": 40"#, "same point"),
+        ("zero-up", r#""position": [0, 2, 6], "target": [0, 0, 0], "up": [0, 0, 0], "fov_y_deg": 40"#, "up"),
+        ("fov-zero", r#""position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 0"#, "fov_y_deg"),
+        ("fov-180", r#""position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 180"#, "fov_y_deg"),
+        ("infinite", r#""position": [0, 1e39, 6], "target": [0, 0, 0], "fov_y_deg": 40"#, "not finite"),
     ];
     for (name, camera, problem) in cases {
         let json = scene_json("", sphere, "").replace(
@@ -355,15 +250,8 @@ fn a_full_scene_file_loads() {
                     {"name": "ball", "sphere": {"radius": 1, "segments": 16}, "albedo": [0.5, 0.5, 0.5]}"#;
     let lights = r#", "lights": [{"point": {"position": [0, 3, 0], "intensity": [5, 5, 5]}},
         {"spot": {"position": [2, 3, 0], "direction": [0, -2, 0], "fov_deg": 170, "intensity": [9, 9, 9]}}]"#;
-    let path = write(
-        &dir,
-        "full.json",
-        &scene_json(
-            r#", "rotation_deg": [0, 90, 0], "scale": 2"#,
-            meshes,
-            lights,
-        ),
-    );
+    let path =
+        write(&dir, "full.json", &scene_json(r#", "rotation_deg": [0, 90, 0], "scale": 2"#, meshes, lights));
     let scene = Scene::from_arg(path.to_str().unwrap()).unwrap();
     assert_eq!(scene.name, "full");
     let group = &scene.groups[0];
@@ -382,10 +270,7 @@ fn a_full_scene_file_loads() {
 fn built_in_scenes_are_listed_and_unknown_names_rejected() {
     assert_eq!(BUILTIN[0], "teapot");
     let message = Scene::from_arg("no-such-scene").unwrap_err().to_string();
-    assert!(
-        BUILTIN.iter().all(|name| message.contains(name)),
-        "{message}"
-    );
+    assert!(BUILTIN.iter().all(|name| message.contains(name)), "{message}");
     let hires = Scene::builtin("teapot-hires-floor").unwrap();
     let floor = hires.groups.iter().find(|g| g.name == "floor").unwrap();
     assert_eq!(floor.meshes[0].vertex_count(), 111 * 111);
@@ -413,9 +298,6 @@ fn exported_teapot_reads_back_identical() {
             assert!(m.indices == n.indices, "indices of {} differ", m.name);
         }
     }
-    assert!(
-        back.environment == scene.environment,
-        "environment pixels differ"
-    );
+    assert!(back.environment == scene.environment, "environment pixels differ");
     assert!(back == scene);
 }

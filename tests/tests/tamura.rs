@@ -16,7 +16,10 @@ fn transfer_of(ctx: &Validated, scene: &Scene) -> Arc<TransferSet> {
 }
 
 fn prt(transfer: &Arc<TransferSet>, regions: usize) -> TechniqueChoice {
-    TechniqueChoice::Prt { transfer: transfer.clone(), occlusion: OcclusionSettings { regions, ..Default::default() } }
+    TechniqueChoice::Prt {
+        transfer: transfer.clone(),
+        occlusion: OcclusionSettings { regions, ..Default::default() },
+    }
 }
 
 /// The two 1D passes of the box filter on one texel: the result is a w×w box of 1/w², exactly
@@ -26,15 +29,20 @@ fn box_filter_of_a_point_is_a_box() {
     let ctx = Validated::new();
     let (size, width) = (16u32, 5u32);
     let image = |name: &str| {
-        Image::new(&ctx, &ImageDesc {
-            name,
-            width: size,
-            height: size,
-            layers: 1,
-            array: true,
-            format: vk::Format::R32_SFLOAT,
-            usage: vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC,
-        })
+        Image::new(
+            &ctx,
+            &ImageDesc {
+                name,
+                width: size,
+                height: size,
+                layers: 1,
+                array: true,
+                format: vk::Format::R32_SFLOAT,
+                usage: vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::TRANSFER_DST
+                    | vk::ImageUsageFlags::TRANSFER_SRC,
+            },
+        )
         .unwrap()
     };
     let (mask, temp, filtered) = (image("mask"), image("temp"), image("filtered"));
@@ -42,7 +50,9 @@ fn box_filter_of_a_point_is_a_box() {
     texels[(7 * size + 9) as usize] = 1.0;
     mask.upload(&texels.iter().flat_map(|t| t.to_ne_bytes()).collect::<Vec<u8>>()).unwrap();
     let layer = OcclusionLayer { axis_u: [1.0, 0.0, 0.0, width as f32], ..Default::default() };
-    let layers = Buffer::with_data(&ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer])).unwrap();
+    let layers =
+        Buffer::with_data(&ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer]))
+            .unwrap();
     let blur = ComputePipeline::new(
         &ctx,
         "occlusion_blur",
@@ -58,18 +68,30 @@ fn box_filter_of_a_point_is_a_box() {
         blur.dispatch(cmd, &bindings, bytes_of(&push), [1, 1, 1])
     };
     executor
-        .run(&[], vec![
-            Pass::new("horizontal", &[], &["half"], |cmd| filter(cmd, 0, &mask, &temp)),
-            Pass::new("vertical", &["half"], &[], |cmd| filter(cmd, 1, &temp, &filtered)),
-        ])
+        .run(
+            &[],
+            vec![
+                Pass::new("horizontal", &[], &["half"], |cmd| filter(cmd, 0, &mask, &temp)),
+                Pass::new("vertical", &["half"], &[], |cmd| filter(cmd, 1, &temp, &filtered)),
+            ],
+        )
         .unwrap();
-    let out: Vec<f32> = filtered.read().unwrap().chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
+    let out: Vec<f32> = filtered
+        .read()
+        .unwrap()
+        .chunks_exact(4)
+        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
     let scale = 1.0f32 / width as f32;
     for y in 0..size {
         for x in 0..size {
             let inside = (x as i32 - 9).abs() <= 2 && (y as i32 - 7).abs() <= 2;
             let expected = if inside { scale * scale } else { 0.0 };
-            assert!((out[(y * size + x) as usize] - expected).abs() < 1e-7, "({x}, {y}): {}", out[(y * size + x) as usize]);
+            assert!(
+                (out[(y * size + x) as usize] - expected).abs() < 1e-7,
+                "({x}, {y}): {}",
+                out[(y * size + x) as usize]
+            );
         }
     }
 }
@@ -82,10 +104,14 @@ fn a_group_alone_runs_no_occlusion_pass() {
     let mut scene = Scene::builtin("teapot").unwrap();
     scene.groups.truncate(1);
     let transfer = transfer_of(&ctx, &scene);
-    let mut tamura = Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 32) }).unwrap();
+    let mut tamura =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 32) })
+            .unwrap();
     let names: Vec<&str> = tamura.render().unwrap().iter().map(|t| t.name).collect();
     assert!(!names.iter().any(|n| n.contains("mask") || n.contains("blur")), "{names:?}");
-    let mut sloan = Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 0) }).unwrap();
+    let mut sloan =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 0) })
+            .unwrap();
     sloan.render().unwrap();
     assert!(tamura.image().unwrap().pixels == sloan.image().unwrap().pixels);
 }

@@ -64,32 +64,20 @@ fn rays(args: &RaysArgs) -> Result<()> {
 
     let ctx = args.gpu.context()?;
     if ctx.info().timestamp_period_ns.is_none() {
-        bail!(
-            "{} has no GPU timestamps, so cast times cannot be measured",
-            ctx.info().name
-        );
+        bail!("{} has no GPU timestamps, so cast times cannot be measured", ctx.info().name);
     }
     let gpu = GpuBvh::new(&ctx, &bvh)?;
     let mut caster = RayCaster::new(&ctx)?;
     let sets = [
         ("coherent", GpuRays::new(&ctx, &camera_rays(&scene, side))?),
-        (
-            "incoherent",
-            GpuRays::new(&ctx, &surface_rays(&scene, side * side))?,
-        ),
+        ("incoherent", GpuRays::new(&ctx, &surface_rays(&scene, side * side))?),
     ];
-    let queries = [
-        ("closest hit", Query::ClosestHit),
-        ("any hit", Query::Occluded),
-    ];
+    let queries = [("closest hit", Query::ClosestHit), ("any hit", Query::Occluded)];
 
-    let bar = ProgressBar::new((sets.len() * queries.len()) as u64 * (args.runs as u64 + 1))
-        .with_style(
-            ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} casts, {elapsed} elapsed, {eta} left",
-            )
+    let bar = ProgressBar::new((sets.len() * queries.len()) as u64 * (args.runs as u64 + 1)).with_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} casts, {elapsed} elapsed, {eta} left")
             .expect("static template"),
-        );
+    );
     bar.set_draw_target(ProgressDrawTarget::hidden());
     bar.set_message("casting");
     let count = (side * side) as f64;
@@ -99,9 +87,7 @@ fn rays(args: &RaysArgs) -> Result<()> {
         for (set_name, rays) in &sets {
             let mut ms = Vec::new();
             for run in 0..=args.runs {
-                let gpu_ms = caster
-                    .cast(&gpu, rays, query)?
-                    .context("the cast pass returned no GPU time")?;
+                let gpu_ms = caster.cast(&gpu, rays, query)?.context("the cast pass returned no GPU time")?;
                 if run > 0 {
                     ms.push(gpu_ms);
                 }
@@ -176,9 +162,7 @@ fn surface_rays(scene: &Scene, count: u32) -> Vec<CastRay> {
     (0..count)
         .map(|_| {
             let pick = rng.next() as f64 * total;
-            let t = triangles[cumulative
-                .partition_point(|&c| c < pick)
-                .min(triangles.len() - 1)];
+            let t = triangles[cumulative.partition_point(|&c| c < pick).min(triangles.len() - 1)];
             let (mut a, mut b) = (rng.next(), rng.next());
             if a + b > 1.0 {
                 (a, b) = (1.0 - a, 1.0 - b);
@@ -189,21 +173,14 @@ fn surface_rays(scene: &Scene, count: u32) -> Vec<CastRay> {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
             let normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-            let side = if normal.dot(dir) >= 0.0 {
-                normal
-            } else {
-                -normal
-            };
+            let side = if normal.dot(dir) >= 0.0 { normal } else { -normal };
             ray(offset_ray_origin(p, side), dir)
         })
         .collect()
 }
 
 fn ray(origin: Vec3, dir: Vec3) -> CastRay {
-    CastRay {
-        origin: origin.extend(1e30).to_array(),
-        direction: dir.extend(0.0).to_array(),
-    }
+    CastRay { origin: origin.extend(1e30).to_array(), direction: dir.extend(0.0).to_array() }
 }
 
 /// PCG32 (O'Neill 2014): reproducible ray sets without a dependency.
@@ -212,10 +189,7 @@ struct Pcg32(u64);
 impl Pcg32 {
     /// Uniform in [0, 1).
     fn next(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
+        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
         let x = ((((self.0 >> 18) ^ self.0) >> 27) as u32).rotate_right((self.0 >> 59) as u32);
         (x >> 8) as f32 / (1 << 24) as f32
     }

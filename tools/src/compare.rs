@@ -29,10 +29,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         a.height
     );
     println!("rmse             {:.6e}", m.rmse);
-    println!(
-        "relative rmse    {:.6e}   (rmse / mean of B = {:.6e})",
-        m.relative_rmse, m.reference_mean
-    );
+    println!("relative rmse    {:.6e}   (rmse / mean of B = {:.6e})", m.relative_rmse, m.reference_mean);
     println!("mean abs error   {:.6e}", m.mean_abs_error);
     println!("p99 abs error    {:.6e}", m.p99_abs_error);
     println!("max abs error    {:.6e}", m.max_abs_error);

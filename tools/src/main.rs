@@ -15,11 +15,7 @@ use kage::backend::{Context, ContextDesc};
 use std::sync::Arc;
 
 #[derive(Parser)]
-#[command(
-    name = "kage",
-    version,
-    about = "Kage (影): real-time lighting on raw Vulkan"
-)]
+#[command(name = "kage", version, about = "Kage (影): real-time lighting on raw Vulkan")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -39,21 +35,14 @@ pub struct GpuArgs {
 
 impl GpuArgs {
     pub fn context(&self) -> Result<Arc<Context>> {
-        Ok(Context::new(&ContextDesc {
-            validation: self.validate,
-            device: self.device.clone(),
-        })?)
+        Ok(Context::new(&ContextDesc { validation: self.validate, device: self.device.clone() })?)
     }
 
     /// Fails when validation reported anything during the command.
     pub fn finish(&self, ctx: &Context) -> Result<()> {
         let messages = ctx.take_validation_messages();
         if !messages.is_empty() {
-            bail!(
-                "validation reported {} message(s); the first: {}",
-                messages.len(),
-                messages[0]
-            );
+            bail!("validation reported {} message(s); the first: {}", messages.len(), messages[0]);
         }
         Ok(())
     }

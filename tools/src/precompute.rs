@@ -1,11 +1,11 @@
 //! `kage precompute`: the PRT transfer of every vertex of a scene, from the cache when a valid
 //! file is there, else computed on the GPU and cached; prints the time and the bytes beside the
 //! paper's figures.
+use crate::transfer_source::{Origin, PrtArgs};
 use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use kage::scene::Scene;
-use crate::transfer_source::{Origin, PrtArgs};
 use kage::techniques::prt::TransferSet;
 
 #[derive(Args)]
@@ -49,9 +49,7 @@ pub fn run(args: &PrecomputeArgs) -> Result<()> {
 }
 
 fn file_len(path: &std::path::Path) -> Result<u64> {
-    Ok(std::fs::metadata(path)
-        .with_context(|| format!("reading the size of {}", path.display()))?
-        .len())
+    Ok(std::fs::metadata(path).with_context(|| format!("reading the size of {}", path.display()))?.len())
 }
 
 /// Time and bytes, and the paper's figures for the two scenes it measured.

@@ -6,8 +6,8 @@ use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use kage::reference::{
-    IrradianceFile, IrradianceReference, LightMode, PointsFile, ReferenceOptions,
-    ReferenceRenderer, Statistics,
+    IrradianceFile, IrradianceReference, LightMode, PointsFile, ReferenceOptions, ReferenceRenderer,
+    Statistics,
 };
 use kage::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -104,15 +104,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
             bail!("--time-budget must be a positive number of seconds, got {budget}");
         }
     }
-    let json_out = args
-        .out
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let json_out = args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
     if args.irradiance.is_some() && !json_out {
-        bail!(
-            "--out {}: irradiance results are written as .json",
-            args.out.display()
-        );
+        bail!("--out {}: irradiance results are written as .json", args.out.display());
     }
     // Bad input files fail before the GPU is set up.
     let points = args.irradiance.as_deref().map(read_points).transpose()?;
@@ -136,20 +130,12 @@ fn run_image(
         LightArg::Local => LightMode::Local,
     };
     if light == LightMode::Local && scene.lights.is_empty() {
-        eprintln!(
-            "kage: note: scene {} has no local lights: the image is black",
-            scene.name
-        );
+        eprintln!("kage: note: scene {} has no local lights: the image is black", scene.name);
     }
     let mut renderer = ReferenceRenderer::new(
         ctx,
         scene,
-        &ReferenceOptions {
-            width: args.width,
-            height: args.height,
-            light,
-            seed: args.seed,
-        },
+        &ReferenceOptions { width: args.width, height: args.height, light, seed: args.seed },
     )
     .context("setting up the reference renderer")?;
     let start = Instant::now();
@@ -187,8 +173,7 @@ fn run_image(
 }
 
 fn read_points(path: &Path) -> Result<PointsFile> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     PointsFile::parse(&text).with_context(|| format!("in {}", path.display()))
 }
 

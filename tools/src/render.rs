@@ -1,13 +1,13 @@
 //! `kage render`: renders frames offscreen, writes the last one, and reports pass timings.
+use crate::transfer_source::{Origin, PrtArgs};
 use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
-use crate::transfer_source::{Origin, PrtArgs};
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
-use kage::techniques::tamura::technique::OcclusionSettings;
 use kage::scene::Scene;
+use kage::techniques::tamura::technique::OcclusionSettings;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -97,7 +97,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
             TechniqueChoice::Prt {
                 transfer: std::sync::Arc::new(transfer),
-                occlusion: OcclusionSettings { regions, mask_size: args.mask_size, ..OcclusionSettings::default() },
+                occlusion: OcclusionSettings {
+                    regions,
+                    mask_size: args.mask_size,
+                    ..OcclusionSettings::default()
+                },
             }
         }
     };
@@ -107,10 +111,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
     let animated = scene.groups.first().map(|g| (g.transform, group_height(g)));
     let bar = ProgressBar::new(args.frames as u64).with_style(
-        ProgressStyle::with_template(
-            "{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left",
-        )
-        .expect("static template"),
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
+            .expect("static template"),
     );
     bar.set_message("rendering");
     let start = Instant::now();
@@ -131,19 +133,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.finish_and_clear();
     let image = renderer.image()?;
     kage::imageio::write(&args.out, &image, args.exposure)?;
-    println!(
-        "wrote {} ({}x{}, scene {})",
-        args.out.display(),
-        args.width,
-        args.height,
-        scene.name
-    );
+    println!("wrote {} ({}x{}, scene {})", args.out.display(), args.width, args.height, scene.name);
 
     let rows = table.rows();
-    println!(
-        "{:<16} {:>10} {:>10} {:>10} {:>7}",
-        "pass", "median ms", "min ms", "max ms", "frames"
-    );
+    println!("{:<16} {:>10} {:>10} {:>10} {:>7}", "pass", "median ms", "min ms", "max ms", "frames");
     for row in &rows {
         println!(
             "{:<16} {:>10.3} {:>10.3} {:>10.3} {:>7}",

@@ -21,9 +21,7 @@ pub fn run(command: &SceneCommand) -> Result<()> {
     match command {
         SceneCommand::Export { scene, out } => {
             let loaded = Scene::from_arg(scene)?;
-            loaded
-                .export(out)
-                .with_context(|| format!("exporting scene {scene}"))?;
+            loaded.export(out).with_context(|| format!("exporting scene {scene}"))?;
             println!("wrote {}", out.join(kage::scene::SCENE_FILE).display());
             Ok(())
         }

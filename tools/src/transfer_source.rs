@@ -45,8 +45,9 @@ impl PrtArgs {
         let params = self.params()?;
         let dir = match &self.cache {
             Some(dir) => dir.clone(),
-            None => cache::default_dir()
-                .context("no cache folder: pass --cache DIR, or set KAGE_CACHE_DIR, XDG_CACHE_HOME or HOME")?,
+            None => cache::default_dir().context(
+                "no cache folder: pass --cache DIR, or set KAGE_CACHE_DIR, XDG_CACHE_HOME or HOME",
+            )?,
         };
         let key = cache::CacheKey::new(scene, params);
         let path = dir.join(key.file_name(&scene.name));
@@ -60,8 +61,10 @@ impl PrtArgs {
             }
         }
         let bar = ProgressBar::hidden().with_style(
-            ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} vertices, {elapsed} elapsed, {eta} left")
-                .expect("static template"),
+            ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} vertices, {elapsed} elapsed, {eta} left",
+            )
+            .expect("static template"),
         );
         bar.set_message("precomputing transfer");
         let start = Instant::now();

@@ -3,18 +3,11 @@ use kage_tests::scratch_dir;
 use std::process::{Command, Output};
 
 fn kage(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kage"))
-        .args(args)
-        .output()
-        .expect("run kage")
+    Command::new(env!("CARGO_BIN_EXE_kage")).args(args).output().expect("run kage")
 }
 
 fn text(output: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    )
+    format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr))
 }
 
 #[test]
@@ -55,16 +48,12 @@ fn render_writes_png_exr_and_timings() {
     let png_bytes = std::fs::read(&png).unwrap();
     assert_eq!(&png_bytes[1..4], b"PNG");
 
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&timings).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&timings).unwrap()).unwrap();
     assert_eq!(json["frames"], 1);
     assert!(json["device"].as_str().is_some_and(|d| !d.is_empty()));
     let passes = json["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    assert_eq!(
-        names,
-        ["sh_project", "sh_reduce", "background", "scene", "readback"]
-    );
+    assert_eq!(names, ["sh_project", "sh_reduce", "background", "scene", "readback"]);
     for pass in passes {
         for key in ["median_ms", "min_ms", "max_ms"] {
             assert!(pass[key].as_f64().is_some_and(|ms| ms > 0.0), "{pass}");
@@ -77,24 +66,12 @@ fn render_writes_png_exr_and_timings() {
 fn sh_prints_coefficients_and_irradiance() {
     let dir = scratch_dir("cli-sh");
     let map = dir.join("constant.exr");
-    kage::scene::EnvMap::from_pixels(256, 128, vec![[1.0; 3]; 256 * 128])
-        .unwrap()
-        .write_exr(&map)
-        .unwrap();
-    let out = kage(&[
-        "sh",
-        map.to_str().unwrap(),
-        "--irradiance",
-        "0,1,0",
-        "--validate",
-    ]);
+    kage::scene::EnvMap::from_pixels(256, 128, vec![[1.0; 3]; 256 * 128]).unwrap().write_exr(&map).unwrap();
+    let out = kage(&["sh", map.to_str().unwrap(), "--irradiance", "0,1,0", "--validate"]);
     assert!(out.status.success(), "{}", text(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(
-        stdout
-            .lines()
-            .filter(|l| !l.starts_with('#') && !l.starts_with("irradiance"))
-            .count(),
+        stdout.lines().filter(|l| !l.starts_with('#') && !l.starts_with("irradiance")).count(),
         9,
         "{stdout}"
     );
@@ -118,37 +95,17 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
     let cases: [(&[&str], &str); 5] = [
-        (
-            &["render", "--scene", "no-such-scene"],
-            "built-in scenes are",
-        ),
-        (
-            &["render", "--scene", bad_scene.to_str().unwrap()],
-            "colour",
-        ),
+        (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
+        (&["render", "--scene", bad_scene.to_str().unwrap()], "colour"),
         (&["render", "--width", "0"], "image size"),
-        (
-            &[
-                "render",
-                "--out",
-                "picture.jpg",
-                "--width",
-                "8",
-                "--height",
-                "8",
-            ],
-            "picture.jpg",
-        ),
+        (&["render", "--out", "picture.jpg", "--width", "8", "--height", "8"], "picture.jpg"),
         (&["sh", "/nonexistent/map.exr"], "/nonexistent/map.exr"),
     ];
     for (args, expected) in cases {
         let out = kage(args);
         let all = text(&out);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {all}");
-        assert!(
-            all.contains("kage: error:") && all.contains(expected),
-            "{args:?}: {all}"
-        );
+        assert!(all.contains("kage: error:") && all.contains(expected), "{args:?}: {all}");
         assert!(!all.contains("panicked"), "{args:?}: {all}");
     }
 }
@@ -158,8 +115,47 @@ fn info_lists_features() {
     let out = kage(&["info"]);
     assert!(out.status.success(), "{}", text(&out));
     let all = text(&out);
-    assert!(
-        all.contains("VK_KHR_dynamic_rendering") && all.contains("timestamps"),
-        "{all}"
-    );
+    assert!(all.contains("VK_KHR_dynamic_rendering") && all.contains("timestamps"), "{all}");
+}
+
+#[test]
+fn precompute_caches_and_tamura_renders_from_the_cache() {
+    let dir = scratch_dir("cli-prt");
+    let cache = dir.join("cache");
+    let cache = cache.to_str().unwrap();
+    let first = kage(&["precompute", "--rays", "64", "--cache", cache, "--validate"]);
+    assert!(first.status.success(), "{}", text(&first));
+    assert!(text(&first).contains("computing") && text(&first).contains("cache: wrote"), "{}", text(&first));
+    let second = kage(&["precompute", "--rays", "64", "--cache", cache]);
+    assert!(text(&second).contains("is valid, nothing to compute"), "{}", text(&second));
+    let forced = kage(&["precompute", "--rays", "64", "--cache", cache, "--force"]);
+    assert!(text(&forced).contains("(--force)"), "{}", text(&forced));
+
+    let out = dir.join("tamura.png");
+    let render = kage(&[
+        "render",
+        "--technique",
+        "tamura",
+        "--rays",
+        "64",
+        "--cache",
+        cache,
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--animate",
+        "--frames",
+        "2",
+        "--env-rotation",
+        "30",
+        "--validate",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(render.status.success(), "{}", text(&render));
+    assert!(text(&render).contains("transfer: from"), "the cached transfer is used: {}", text(&render));
+    for pass in ["self_shadow", "occluder_masks", "blur_horizontal", "blur_vertical", "scene"] {
+        assert!(text(&render).contains(pass), "{pass} missing: {}", text(&render));
+    }
 }

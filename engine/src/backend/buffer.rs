@@ -26,18 +26,14 @@ pub struct Buffer {
 impl Buffer {
     pub fn new(ctx: &Arc<Context>, desc: &BufferDesc) -> Result<Buffer> {
         if desc.size == 0 {
-            return Err(Error::InvalidArgument(format!(
-                "buffer {} has size 0",
-                desc.name
-            )));
+            return Err(Error::InvalidArgument(format!("buffer {} has size 0", desc.name)));
         }
         let info = vk::BufferCreateInfo::default()
             .size(desc.size)
             .usage(desc.usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_buffer(&info, None) }
-            .map_err(Error::vk("vkCreateBuffer"))?;
+        let raw = unsafe { ctx.device.create_buffer(&info, None) }.map_err(Error::vk("vkCreateBuffer"))?;
         // SAFETY: raw was just created on this device.
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
         let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
@@ -56,10 +52,7 @@ impl Buffer {
             }
         };
         // SAFETY: the allocation satisfies the buffer's requirements and is not bound elsewhere.
-        let bound = unsafe {
-            ctx.device
-                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        };
+        let bound = unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) };
         let buffer = Buffer {
             ctx: ctx.clone(),
             raw,
@@ -105,25 +98,19 @@ impl Buffer {
     }
 
     fn mapped(&self) -> Option<&[u8]> {
-        self.allocation
-            .as_ref()?
-            .mapped_slice()
-            .map(|s| &s[..self.size as usize])
+        self.allocation.as_ref()?.mapped_slice().map(|s| &s[..self.size as usize])
     }
 
     /// Writes into a host-visible buffer at `offset`.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
-        let end = offset
-            .checked_add(data.len() as u64)
-            .filter(|&e| e <= self.size)
-            .ok_or_else(|| {
-                Error::InvalidArgument(format!(
-                    "write of {} bytes at {offset} past the end of buffer {} ({} bytes)",
-                    data.len(),
-                    self.name,
-                    self.size
-                ))
-            })?;
+        let end = offset.checked_add(data.len() as u64).filter(|&e| e <= self.size).ok_or_else(|| {
+            Error::InvalidArgument(format!(
+                "write of {} bytes at {offset} past the end of buffer {} ({} bytes)",
+                data.len(),
+                self.name,
+                self.size
+            ))
+        })?;
         let name = &self.name;
         let slice = self
             .allocation
@@ -157,11 +144,7 @@ impl Buffer {
         let region = vk::BufferCopy::default().size(data.len() as u64);
         self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
             // SAFETY: both buffers are alive until the one-shot submission has completed.
-            unsafe {
-                self.ctx
-                    .device
-                    .cmd_copy_buffer(cmd, staging.raw, self.raw, &[region])
-            }
+            unsafe { self.ctx.device.cmd_copy_buffer(cmd, staging.raw, self.raw, &[region]) }
         })
     }
 
@@ -180,30 +163,23 @@ impl Buffer {
             },
         )?;
         let region = vk::BufferCopy::default().size(self.size);
-        self.ctx
-            .one_shot(&format!("{}.readback", self.name), |cmd| {
-                // SAFETY: both buffers are alive until the submission has completed.
-                unsafe {
-                    self.ctx
-                        .device
-                        .cmd_copy_buffer(cmd, self.raw, staging.raw, &[region])
-                }
-            })?;
-        staging.mapped().map(<[u8]>::to_vec).ok_or_else(|| {
-            Error::InvalidArgument(format!("{} readback memory is not mapped", self.name))
-        })
+        self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| {
+            // SAFETY: both buffers are alive until the submission has completed.
+            unsafe { self.ctx.device.cmd_copy_buffer(cmd, self.raw, staging.raw, &[region]) }
+        })?;
+        staging
+            .mapped()
+            .map(<[u8]>::to_vec)
+            .ok_or_else(|| Error::InvalidArgument(format!("{} readback memory is not mapped", self.name)))
     }
 }
 
 pub(crate) fn allocation_error(name: &str, e: gpu_allocator::AllocationError) -> Error {
     match e {
-        gpu_allocator::AllocationError::OutOfMemory => Error::OutOfDeviceMemory {
-            call: "gpu-allocator allocate",
-        },
-        e => Error::Allocation {
-            name: name.to_owned(),
-            message: e.to_string(),
-        },
+        gpu_allocator::AllocationError::OutOfMemory => {
+            Error::OutOfDeviceMemory { call: "gpu-allocator allocate" }
+        }
+        e => Error::Allocation { name: name.to_owned(), message: e.to_string() },
     }
 }
 

@@ -27,10 +27,7 @@ impl Context {
                 .map_err(Error::vk("vkAllocateCommandBuffers"))?[0]
         };
         // SAFETY: valid device, default create info.
-        let fence = match unsafe {
-            self.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-        } {
+        let fence = match unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) } {
             Ok(f) => f,
             Err(e) => {
                 self.free_command_buffer(cmd);
@@ -55,8 +52,7 @@ impl Context {
     }
 
     pub(crate) fn begin(&self, recorder: &CommandRecorder) -> Result<()> {
-        let begin = vk::CommandBufferBeginInfo::default()
-            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: the buffer is not pending: every submit is waited for before the next begin.
         unsafe { self.device.begin_command_buffer(recorder.cmd, &begin) }
             .map_err(Error::vk("vkBeginCommandBuffer"))
@@ -65,8 +61,7 @@ impl Context {
     /// Ends, submits and waits for the recorder's command buffer.
     pub(crate) fn submit_and_wait(&self, recorder: &CommandRecorder) -> Result<()> {
         // SAFETY: recording was begun by `begin`.
-        unsafe { self.device.end_command_buffer(recorder.cmd) }
-            .map_err(Error::vk("vkEndCommandBuffer"))?;
+        unsafe { self.device.end_command_buffer(recorder.cmd) }.map_err(Error::vk("vkEndCommandBuffer"))?;
         let cmds = [recorder.cmd];
         let submit = vk::SubmitInfo::default().command_buffers(&cmds);
         {
@@ -76,11 +71,8 @@ impl Context {
                 .map_err(Error::vk("vkQueueSubmit"))?;
         }
         // SAFETY: the fence was just submitted.
-        unsafe {
-            self.device
-                .wait_for_fences(&[recorder.fence], true, FENCE_TIMEOUT_NS)
-        }
-        .map_err(Error::vk("vkWaitForFences"))?;
+        unsafe { self.device.wait_for_fences(&[recorder.fence], true, FENCE_TIMEOUT_NS) }
+            .map_err(Error::vk("vkWaitForFences"))?;
         // SAFETY: the fence is signalled and no longer in use.
         unsafe { self.device.reset_fences(&[recorder.fence]) }.map_err(Error::vk("vkResetFences"))
     }

@@ -55,12 +55,7 @@ fn has_extension(list: &[vk::ExtensionProperties], name: &CStr) -> bool {
 }
 
 fn version_string(v: u32) -> String {
-    format!(
-        "{}.{}.{}",
-        vk::api_version_major(v),
-        vk::api_version_minor(v),
-        vk::api_version_patch(v)
-    )
+    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
 }
 
 impl Context {
@@ -71,14 +66,9 @@ impl Context {
         // SAFETY: plain enumeration calls on a loaded entry.
         let layers = unsafe { entry.enumerate_instance_layer_properties() }
             .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
-        if desc.validation
-            && !layers
-                .iter()
-                .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
-        {
+        if desc.validation && !layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)) {
             return Err(Error::Unsupported(
-                "the validation layer VK_LAYER_KHRONOS_validation (Debian: vulkan-validationlayers)"
-                    .into(),
+                "the validation layer VK_LAYER_KHRONOS_validation (Debian: vulkan-validationlayers)".into(),
             ));
         }
         // SAFETY: as above.
@@ -86,9 +76,8 @@ impl Context {
             .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
         if desc.validation {
             // SAFETY: as above; the layer name is a valid C string.
-            let from_layer =
-                unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
-                    .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
+            let from_layer = unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                .map_err(Error::vk("vkEnumerateInstanceExtensionProperties"))?;
             instance_exts.extend(from_layer);
         }
         let debug_utils = has_extension(&instance_exts, ash::ext::debug_utils::NAME);
@@ -98,32 +87,22 @@ impl Context {
             .application_name(app_name)
             .engine_name(app_name)
             .api_version(vk::API_VERSION_1_3);
-        let layer_ptrs: Vec<*const c_char> = if desc.validation {
-            vec![VALIDATION_LAYER.as_ptr()]
-        } else {
-            vec![]
-        };
-        let ext_ptrs: Vec<*const c_char> = if debug_utils {
-            vec![ash::ext::debug_utils::NAME.as_ptr()]
-        } else {
-            vec![]
-        };
+        let layer_ptrs: Vec<*const c_char> =
+            if desc.validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
+        let ext_ptrs: Vec<*const c_char> =
+            if debug_utils { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
         let instance_info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layer_ptrs)
             .enabled_extension_names(&ext_ptrs);
         // SAFETY: the create info points at locals that outlive the call.
-        let instance = unsafe { entry.create_instance(&instance_info, None) }
-            .map_err(Error::vk("vkCreateInstance"))?;
+        let instance =
+            unsafe { entry.create_instance(&instance_info, None) }.map_err(Error::vk("vkCreateInstance"))?;
 
         // Declared before the guard so that it outlives the messenger the guard destroys.
         let validation = desc.validation.then(|| Box::new(ValidationLog::default()));
         // From here on a failure must undo what was created: the guard does it on drop.
-        let mut guard = Guard {
-            instance: instance.clone(),
-            messenger: None,
-            device: None,
-        };
+        let mut guard = Guard { instance: instance.clone(), messenger: None, device: None };
         let (debug_instance, messenger) = match (&validation, debug_utils) {
             (Some(log), true) => {
                 let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
@@ -151,10 +130,7 @@ impl Context {
             (None, _) => (None, vk::DebugUtilsMessengerEXT::null()),
         };
 
-        let wanted = desc
-            .device
-            .clone()
-            .or_else(|| std::env::var("KAGE_DEVICE").ok());
+        let wanted = desc.device.clone().or_else(|| std::env::var("KAGE_DEVICE").ok());
         let (physical, queue_family) = pick_device(&instance, wanted.as_deref())?;
 
         // SAFETY: valid physical device from this instance.
@@ -170,12 +146,10 @@ impl Context {
             && families[queue_family as usize].timestamp_valid_bits > 0;
         // SAFETY: as above.
         let rgba32f = unsafe {
-            instance
-                .get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
+            instance.get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
         };
-        let rgba32f_linear = rgba32f
-            .optimal_tiling_features
-            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
+        let rgba32f_linear =
+            rgba32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
 
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
@@ -183,22 +157,12 @@ impl Context {
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
         let driver_text = format!(
             "{} ({})",
-            driver
-                .driver_name_as_c_str()
-                .unwrap_or(c"?")
-                .to_string_lossy(),
-            driver
-                .driver_info_as_c_str()
-                .unwrap_or(c"?")
-                .to_string_lossy()
+            driver.driver_name_as_c_str().unwrap_or(c"?").to_string_lossy(),
+            driver.driver_info_as_c_str().unwrap_or(c"?").to_string_lossy()
         );
 
         let info = DeviceInfo {
-            name: props
-                .device_name_as_c_str()
-                .unwrap_or(c"?")
-                .to_string_lossy()
-                .into_owned(),
+            name: props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned(),
             device_type: format!("{:?}", props.device_type),
             driver: driver_text,
             api_version: version_string(props.api_version),
@@ -213,16 +177,11 @@ impl Context {
                     has_extension(&device_exts, ash::khr::push_descriptor::NAME),
                 ),
                 ("RGBA32F linear filtering (required)", rgba32f_linear),
-                (
-                    "timestamps on the graphics/compute queue (pass timings)",
-                    timestamps,
-                ),
+                ("timestamps on the graphics/compute queue (pass timings)", timestamps),
                 ("VK_EXT_debug_utils (object names, labels)", debug_utils),
                 (
                     "VK_LAYER_KHRONOS_validation (installed)",
-                    layers
-                        .iter()
-                        .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
+                    layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
                 ),
                 ("shaderClipDistance (required)", features.shader_clip_distance == vk::TRUE),
                 ("shaderFloat64", features.shader_float64 == vk::TRUE),
@@ -242,10 +201,8 @@ impl Context {
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let device_ext_ptrs = [
-            ash::khr::dynamic_rendering::NAME.as_ptr(),
-            ash::khr::push_descriptor::NAME.as_ptr(),
-        ];
+        let device_ext_ptrs =
+            [ash::khr::dynamic_rendering::NAME.as_ptr(), ash::khr::push_descriptor::NAME.as_ptr()];
         let mut dynamic_rendering_features =
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
         let enabled = vk::PhysicalDeviceFeatures::default().shader_clip_distance(true);
@@ -269,10 +226,7 @@ impl Context {
             buffer_device_address: false,
             allocation_sizes: Default::default(),
         })
-        .map_err(|e| Error::Allocation {
-            name: "allocator".into(),
-            message: e.to_string(),
-        })?;
+        .map_err(|e| Error::Allocation { name: "allocator".into(), message: e.to_string() })?;
 
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
@@ -318,10 +272,7 @@ impl Context {
 
     /// Every validation message of warning or error severity since the last call.
     pub fn take_validation_messages(&self) -> Vec<String> {
-        self.validation
-            .as_ref()
-            .map(|log| log.take())
-            .unwrap_or_default()
+        self.validation.as_ref().map(|log| log.take()).unwrap_or_default()
     }
 
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
@@ -338,9 +289,7 @@ impl Context {
         let Ok(name) = CString::new(name.replace('\0', " ")) else {
             return;
         };
-        let info = vk::DebugUtilsObjectNameInfoEXT::default()
-            .object_handle(handle)
-            .object_name(&name);
+        let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
         // SAFETY: the handle belongs to this device; naming has no other effect.
         // A failure to name is not worth failing the caller for.
         let _ = unsafe { debug.set_debug_utils_object_name(&info) };
@@ -360,13 +309,8 @@ impl Drop for Context {
         // makes sure no submitted work still uses the pool.
         unsafe {
             let _ = self.device.device_wait_idle();
-            self.device.destroy_command_pool(
-                *self
-                    .command_pool
-                    .get_mut()
-                    .unwrap_or_else(|e| e.into_inner()),
-                None,
-            );
+            self.device
+                .destroy_command_pool(*self.command_pool.get_mut().unwrap_or_else(|e| e.into_inner()), None);
         }
         // The allocator frees its memory blocks through the device: drop it before the device.
         // SAFETY: dropped exactly once, here.
@@ -407,33 +351,26 @@ impl Drop for Guard {
 
 /// Chooses a Vulkan 1.2+ device with a graphics+compute queue: by name when asked, otherwise
 /// discrete GPU first, then integrated, virtual, CPU.
-fn pick_device(
-    instance: &ash::Instance,
-    wanted: Option<&str>,
-) -> Result<(vk::PhysicalDevice, u32)> {
+fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::PhysicalDevice, u32)> {
     // SAFETY: plain enumeration on a valid instance.
-    let devices = unsafe { instance.enumerate_physical_devices() }
-        .map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
+    let devices =
+        unsafe { instance.enumerate_physical_devices() }.map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
     let mut candidates = Vec::new();
     let mut names = Vec::new();
     for physical in devices {
         // SAFETY: physical device from this instance.
         let props = unsafe { instance.get_physical_device_properties(physical) };
-        let name = props
-            .device_name_as_c_str()
-            .unwrap_or(c"?")
-            .to_string_lossy()
-            .into_owned();
+        let name = props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
         names.push(name.clone());
         if props.api_version < vk::API_VERSION_1_2 {
             continue;
         }
         // SAFETY: as above.
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-        let Some(family) = families.iter().position(|f| {
-            f.queue_flags
-                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-        }) else {
+        let Some(family) = families
+            .iter()
+            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
+        else {
             continue;
         };
         let rank = match props.device_type {
@@ -454,28 +391,16 @@ fn pick_device(
             .ok_or_else(|| {
                 Error::NoDevice(format!(
                     "no Vulkan 1.2 device named like {wanted:?}; devices: {}",
-                    if names.is_empty() {
-                        "none".into()
-                    } else {
-                        names.join(", ")
-                    }
+                    if names.is_empty() { "none".into() } else { names.join(", ") }
                 ))
             });
     }
     candidates.sort_by_key(|c| c.0);
-    candidates
-        .into_iter()
-        .next()
-        .map(|c| (c.2, c.3))
-        .ok_or_else(|| {
-            Error::NoDevice(if names.is_empty() {
-                "the loader found no device (Debian: install mesa-vulkan-drivers for lavapipe)"
-                    .into()
-            } else {
-                format!(
-                    "none of {} has Vulkan 1.2 and a graphics+compute queue",
-                    names.join(", ")
-                )
-            })
+    candidates.into_iter().next().map(|c| (c.2, c.3)).ok_or_else(|| {
+        Error::NoDevice(if names.is_empty() {
+            "the loader found no device (Debian: install mesa-vulkan-drivers for lavapipe)".into()
+        } else {
+            format!("none of {} has Vulkan 1.2 and a graphics+compute queue", names.join(", "))
         })
+    })
 }

@@ -42,9 +42,7 @@ impl Binding<'_> {
     }
 }
 
-pub(crate) fn set_layout_bindings(
-    kinds: &[BindingKind],
-) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+pub(crate) fn set_layout_bindings(kinds: &[BindingKind]) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
     kinds
         .iter()
         .enumerate()
@@ -68,22 +66,13 @@ pub fn push_descriptors(
     expected: &[BindingKind],
     bindings: &[Binding],
 ) {
-    debug_assert_eq!(
-        expected,
-        bindings
-            .iter()
-            .map(Binding::kind)
-            .collect::<Vec<_>>()
-            .as_slice()
-    );
+    debug_assert_eq!(expected, bindings.iter().map(Binding::kind).collect::<Vec<_>>().as_slice());
     let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
         .iter()
         .map(|b| match b {
-            Binding::Uniform(buf) | Binding::Storage(buf) => [vk::DescriptorBufferInfo {
-                buffer: buf.raw,
-                offset: 0,
-                range: vk::WHOLE_SIZE,
-            }],
+            Binding::Uniform(buf) | Binding::Storage(buf) => {
+                [vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }]
+            }
             _ => [vk::DescriptorBufferInfo::default()],
         })
         .collect();
@@ -118,8 +107,5 @@ pub fn push_descriptors(
         .collect();
     // SAFETY: recording command buffer; the writes point at locals alive for the call, and the
     // set layout was created with the push-descriptor flag.
-    unsafe {
-        ctx.push_descriptor
-            .cmd_push_descriptor_set(cmd, bind_point, layout, 0, &writes)
-    };
+    unsafe { ctx.push_descriptor.cmd_push_descriptor_set(cmd, bind_point, layout, 0, &writes) };
 }

@@ -79,11 +79,7 @@ impl Image {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
-            .extent(vk::Extent3D {
-                width: desc.width,
-                height: desc.height,
-                depth: 1,
-            })
+            .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
             .mip_levels(1)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -92,8 +88,7 @@ impl Image {
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid device and create info.
-        let raw =
-            unsafe { ctx.device.create_image(&info, None) }.map_err(Error::vk("vkCreateImage"))?;
+        let raw = unsafe { ctx.device.create_image(&info, None) }.map_err(Error::vk("vkCreateImage"))?;
         // SAFETY: raw was just created on this device.
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
         let allocation = match ctx.allocator().allocate(&AllocationCreateDesc {
@@ -123,10 +118,7 @@ impl Image {
             name: desc.name.to_owned(),
         };
         // SAFETY: the allocation satisfies the image's requirements.
-        let bound = unsafe {
-            ctx.device
-                .bind_image_memory(raw, allocation.memory(), allocation.offset())
-        };
+        let bound = unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
         image.allocation = Some(allocation);
         bound.map_err(Error::vk("vkBindImageMemory"))?;
         ctx.set_name(raw, desc.name);
@@ -150,11 +142,8 @@ impl Image {
             vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
         if desc.layers > 1 && desc.usage.intersects(attachment) {
             for layer in 0..desc.layers {
-                let range = vk::ImageSubresourceRange {
-                    base_array_layer: layer,
-                    layer_count: 1,
-                    ..image.range()
-                };
+                let range =
+                    vk::ImageSubresourceRange { base_array_layer: layer, layer_count: 1, ..image.range() };
                 let info = vk::ImageViewCreateInfo::default()
                     .image(raw)
                     .view_type(vk::ImageViewType::TYPE_2D)
@@ -218,19 +207,13 @@ impl Image {
 
     /// The view to render into `layer` (the whole image when it has one layer).
     pub(crate) fn attachment_view(&self, layer: u32) -> vk::ImageView {
-        self.layer_views
-            .get(layer as usize)
-            .copied()
-            .unwrap_or(self.view)
+        self.layer_views.get(layer as usize).copied().unwrap_or(self.view)
     }
 
     /// Bytes of the whole image in a tightly packed buffer.
     pub fn byte_size(&self) -> Result<u64> {
         let texel = texel_bytes(self.format).ok_or_else(|| {
-            Error::InvalidArgument(format!(
-                "no host copies of {:?} ({})",
-                self.format, self.name
-            ))
+            Error::InvalidArgument(format!("no host copies of {:?} ({})", self.format, self.name))
         })?;
         Ok(texel * self.width as u64 * self.height as u64 * self.layers as u64)
     }
@@ -243,11 +226,7 @@ impl Image {
                 base_array_layer: 0,
                 layer_count: self.layers,
             })
-            .image_extent(vk::Extent3D {
-                width: self.width,
-                height: self.height,
-                depth: 1,
-            })
+            .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 })
     }
 
     /// Records a copy of the whole image into `buffer` (tightly packed, layer after layer).
@@ -256,13 +235,7 @@ impl Image {
         self.transition(cmd, vk::ImageLayout::GENERAL, src);
         // SAFETY: recording command buffer; the image was just moved to `src`.
         unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(
-                cmd,
-                self.raw,
-                src,
-                buffer.raw,
-                &[self.copy_region()],
-            )
+            self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, src, buffer.raw, &[self.copy_region()])
         }
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
@@ -292,11 +265,7 @@ impl Image {
             let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
             self.transition(cmd, vk::ImageLayout::GENERAL, dst);
             // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
-            unsafe {
-                self.ctx
-                    .device
-                    .cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region])
-            }
+            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region]) }
             self.transition(cmd, dst, vk::ImageLayout::GENERAL);
         })
     }
@@ -312,10 +281,7 @@ impl Image {
                 location: MemoryLocation::GpuToCpu,
             },
         )?;
-        self.ctx
-            .one_shot(&format!("{}.readback", self.name), |cmd| {
-                self.record_copy_to(cmd, &staging)
-            })?;
+        self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| self.record_copy_to(cmd, &staging))?;
         staging.read()
     }
 }
@@ -346,16 +312,8 @@ pub struct Sampler {
 impl Sampler {
     /// Linear filtering; `u` repeats (longitude wraps around), `v` clamps (poles).
     pub fn new(ctx: &Arc<Context>, name: &str, linear: bool, repeat_u: bool) -> Result<Sampler> {
-        let filter = if linear {
-            vk::Filter::LINEAR
-        } else {
-            vk::Filter::NEAREST
-        };
-        let u = if repeat_u {
-            vk::SamplerAddressMode::REPEAT
-        } else {
-            vk::SamplerAddressMode::CLAMP_TO_EDGE
-        };
+        let filter = if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
+        let u = if repeat_u { vk::SamplerAddressMode::REPEAT } else { vk::SamplerAddressMode::CLAMP_TO_EDGE };
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(filter)
             .min_filter(filter)
@@ -365,13 +323,9 @@ impl Sampler {
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .max_lod(0.0);
         // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_sampler(&info, None) }
-            .map_err(Error::vk("vkCreateSampler"))?;
+        let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
         ctx.set_name(raw, name);
-        Ok(Sampler {
-            ctx: ctx.clone(),
-            raw,
-        })
+        Ok(Sampler { ctx: ctx.clone(), raw })
     }
 }
 

@@ -13,12 +13,7 @@ struct Layout {
     push_size: u32,
 }
 
-fn create_layout(
-    ctx: &Context,
-    name: &str,
-    bindings: &[BindingKind],
-    push_size: u32,
-) -> Result<Layout> {
+fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size: u32) -> Result<Layout> {
     let set_bindings = set_layout_bindings(bindings);
     let set_info = vk::DescriptorSetLayoutCreateInfo::default()
         .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
@@ -27,11 +22,8 @@ fn create_layout(
     let set = unsafe { ctx.device.create_descriptor_set_layout(&set_info, None) }
         .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
     ctx.set_name(set, &format!("{name}.set_layout"));
-    let ranges = [vk::PushConstantRange {
-        stage_flags: vk::ShaderStageFlags::ALL,
-        offset: 0,
-        size: push_size,
-    }];
+    let ranges =
+        [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::ALL, offset: 0, size: push_size }];
     let sets = [set];
     let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(&sets);
     if push_size > 0 {
@@ -47,12 +39,7 @@ fn create_layout(
         }
     };
     ctx.set_name(pipeline, &format!("{name}.layout"));
-    Ok(Layout {
-        set,
-        pipeline,
-        bindings: bindings.to_vec(),
-        push_size,
-    })
+    Ok(Layout { set, pipeline, bindings: bindings.to_vec(), push_size })
 }
 
 fn destroy_layout(ctx: &Context, layout: &Layout) {
@@ -90,17 +77,10 @@ impl Drop for Module<'_> {
 }
 
 fn push_bytes(ctx: &Context, cmd: vk::CommandBuffer, layout: &Layout, bytes: &[u8]) {
-    debug_assert_eq!(
-        bytes.len() as u32,
-        layout.push_size,
-        "push constant size mismatch"
-    );
+    debug_assert_eq!(bytes.len() as u32, layout.push_size, "push constant size mismatch");
     if !bytes.is_empty() {
         // SAFETY: recording command buffer; the range was declared in the layout.
-        unsafe {
-            ctx.device
-                .cmd_push_constants(cmd, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes)
-        };
+        unsafe { ctx.device.cmd_push_constants(cmd, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes) };
     }
 }
 
@@ -124,42 +104,24 @@ impl ComputePipeline {
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
             .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout.pipeline);
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline);
         // SAFETY: valid device, module and layout.
-        let raw = match unsafe {
-            ctx.device
-                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
-        } {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                destroy_layout(ctx, &layout);
-                return Err(Error::vk("vkCreateComputePipelines")(e));
-            }
-        };
+        let raw =
+            match unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) } {
+                Ok(p) => p[0],
+                Err((_, e)) => {
+                    destroy_layout(ctx, &layout);
+                    return Err(Error::vk("vkCreateComputePipelines")(e));
+                }
+            };
         ctx.set_name(raw, name);
-        Ok(ComputePipeline {
-            ctx: ctx.clone(),
-            raw,
-            layout,
-        })
+        Ok(ComputePipeline { ctx: ctx.clone(), raw, layout })
     }
 
     /// Binds the pipeline, its resources and push constants, then dispatches.
-    pub fn dispatch(
-        &self,
-        cmd: vk::CommandBuffer,
-        bindings: &[Binding],
-        push: &[u8],
-        groups: [u32; 3],
-    ) {
+    pub fn dispatch(&self, cmd: vk::CommandBuffer, bindings: &[Binding], push: &[u8], groups: [u32; 3]) {
         // SAFETY: recording command buffer of this device.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw)
-        };
+        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
         push_descriptors(
             &self.ctx,
             cmd,
@@ -170,11 +132,7 @@ impl ComputePipeline {
         );
         push_bytes(&self.ctx, cmd, &self.layout, push);
         // SAFETY: pipeline and descriptors bound above.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
-        };
+        unsafe { self.ctx.device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 }
 
@@ -254,24 +212,19 @@ impl GraphicsPipeline {
             .iter()
             .enumerate()
             .flat_map(|(b, buffer)| {
-                buffer
-                    .attributes
-                    .iter()
-                    .map(move |a| vk::VertexInputAttributeDescription {
-                        location: a.location,
-                        binding: b as u32,
-                        format: a.format,
-                        offset: a.offset,
-                    })
+                buffer.attributes.iter().map(move |a| vk::VertexInputAttributeDescription {
+                    location: a.location,
+                    binding: b as u32,
+                    format: a.format,
+                    offset: a.offset,
+                })
             })
             .collect();
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)
             .vertex_attribute_descriptions(&attributes);
         let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         // Kage's surfaces are two-sided (open meshes such as the teapot show their inside), so
         // nothing is culled; shaders flip normals on back faces.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
@@ -295,8 +248,7 @@ impl GraphicsPipeline {
             .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
             .alpha_blend_op(vk::BlendOp::ADD);
         let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
-        let blend =
-            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
@@ -315,32 +267,22 @@ impl GraphicsPipeline {
             .layout(layout.pipeline)
             .push_next(&mut rendering);
         // SAFETY: every pointer in the create info refers to locals alive for the call.
-        let raw = match unsafe {
-            ctx.device
-                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-        } {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                destroy_layout(ctx, &layout);
-                return Err(Error::vk("vkCreateGraphicsPipelines")(e));
-            }
-        };
+        let raw =
+            match unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) } {
+                Ok(p) => p[0],
+                Err((_, e)) => {
+                    destroy_layout(ctx, &layout);
+                    return Err(Error::vk("vkCreateGraphicsPipelines")(e));
+                }
+            };
         ctx.set_name(raw, desc.name);
-        Ok(GraphicsPipeline {
-            ctx: ctx.clone(),
-            raw,
-            layout,
-        })
+        Ok(GraphicsPipeline { ctx: ctx.clone(), raw, layout })
     }
 
     /// Binds the pipeline and its resources (call inside a rendering scope).
     pub fn bind(&self, cmd: vk::CommandBuffer, bindings: &[Binding]) {
         // SAFETY: recording command buffer of this device.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw)
-        };
+        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw) };
         push_descriptors(
             &self.ctx,
             cmd,

@@ -39,9 +39,7 @@ impl Context {
                     })
                     .store_op(vk::AttachmentStoreOp::STORE)
                     .clear_value(vk::ClearValue {
-                        color: vk::ClearColorValue {
-                            float32: clear.unwrap_or_default(),
-                        },
+                        color: vk::ClearColorValue { float32: clear.unwrap_or_default() },
                     })
             })
             .collect();
@@ -52,22 +50,13 @@ impl Context {
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: 1.0,
-                        stencil: 0,
-                    },
+                    depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 },
                 })
         });
-        let size = color
-            .or(depth)
-            .map(|t| (t.image.width, t.image.height))
-            .unwrap_or((1, 1));
+        let size = color.or(depth).map(|t| (t.image.width, t.image.height)).unwrap_or((1, 1));
         let area = vk::Rect2D {
             offset: vk::Offset2D::default(),
-            extent: vk::Extent2D {
-                width: size.0,
-                height: size.1,
-            },
+            extent: vk::Extent2D { width: size.0, height: size.1 },
         };
         let mut info = vk::RenderingInfo::default()
             .render_area(area)
@@ -111,8 +100,7 @@ impl Context {
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {
             self.device.cmd_bind_vertex_buffers(cmd, 0, &raw, &offsets);
-            self.device
-                .cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
+            self.device.cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
             self.device.cmd_draw_indexed(cmd, count, 1, 0, 0, 0);
         }
     }

@@ -12,18 +12,13 @@ pub struct TimestampPool {
 
 impl TimestampPool {
     pub fn new(ctx: &Arc<Context>, name: &str, capacity: u32) -> Result<TimestampPool> {
-        let info = vk::QueryPoolCreateInfo::default()
-            .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(capacity);
+        let info =
+            vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(capacity);
         // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_query_pool(&info, None) }
-            .map_err(Error::vk("vkCreateQueryPool"))?;
+        let raw =
+            unsafe { ctx.device.create_query_pool(&info, None) }.map_err(Error::vk("vkCreateQueryPool"))?;
         ctx.set_name(raw, name);
-        Ok(TimestampPool {
-            ctx: ctx.clone(),
-            raw,
-            capacity,
-        })
+        Ok(TimestampPool { ctx: ctx.clone(), raw, capacity })
     }
 
     pub fn capacity(&self) -> u32 {
@@ -32,20 +27,12 @@ impl TimestampPool {
 
     pub fn reset(&self, cmd: vk::CommandBuffer, count: u32) {
         // SAFETY: recording command buffer; count <= capacity (checked by the caller).
-        unsafe {
-            self.ctx
-                .device
-                .cmd_reset_query_pool(cmd, self.raw, 0, count)
-        };
+        unsafe { self.ctx.device.cmd_reset_query_pool(cmd, self.raw, 0, count) };
     }
 
     pub fn write(&self, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags, index: u32) {
         // SAFETY: recording command buffer; the query was reset earlier in the same buffer.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_write_timestamp(cmd, stage, self.raw, index)
-        };
+        unsafe { self.ctx.device.cmd_write_timestamp(cmd, stage, self.raw, index) };
     }
 
     /// Reads `count` timestamps (ticks) once the submission that wrote them has completed.

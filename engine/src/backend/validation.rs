@@ -11,10 +11,7 @@ pub struct ValidationLog {
 
 impl ValidationLog {
     pub fn push(&self, message: String) {
-        self.messages
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(message);
+        self.messages.lock().unwrap_or_else(|e| e.into_inner()).push(message);
     }
 
     /// Returns and clears every message collected so far.
@@ -46,9 +43,7 @@ pub(crate) unsafe extern "system" fn callback(
         String::from("(no message)")
     } else {
         // SAFETY: p_message is a NUL-terminated string owned by the layer.
-        unsafe { CStr::from_ptr(data.p_message) }
-            .to_string_lossy()
-            .into_owned()
+        unsafe { CStr::from_ptr(data.p_message) }.to_string_lossy().into_owned()
     };
     let message = format!("[{severity:?} {kind:?}] {text}");
     eprintln!("kage validation: {message}");

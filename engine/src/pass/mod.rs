@@ -40,12 +40,7 @@ impl<'a> Pass<'a> {
         outputs: &'a [&'static str],
         record: impl FnOnce(vk::CommandBuffer) + 'a,
     ) -> Pass<'a> {
-        Pass {
-            name,
-            inputs,
-            outputs,
-            record: Box::new(record),
-        }
+        Pass { name, inputs, outputs, record: Box::new(record) }
     }
 }
 
@@ -76,29 +71,18 @@ impl FrameExecutor {
     }
 
     /// Runs `passes` in order as one submission and returns each pass's GPU time.
-    pub fn run(
-        &mut self,
-        imports: &[&'static str],
-        passes: Vec<Pass<'_>>,
-    ) -> Result<Vec<PassTiming>> {
+    pub fn run(&mut self, imports: &[&'static str], passes: Vec<Pass<'_>>) -> Result<Vec<PassTiming>> {
         check_data_flow(imports, &passes)?;
         let count = 2 * passes.len() as u32;
         let period_ns = self.ctx.info().timestamp_period_ns;
-        if period_ns.is_some()
-            && self
-                .timestamps
-                .as_ref()
-                .is_none_or(|t| t.capacity() < count)
-        {
-            self.timestamps = Some(TimestampPool::new(
-                &self.ctx,
-                &format!("{}.timestamps", self.name),
-                count.max(16),
-            )?);
+        if period_ns.is_some() && self.timestamps.as_ref().is_none_or(|t| t.capacity() < count) {
+            self.timestamps =
+                Some(TimestampPool::new(&self.ctx, &format!("{}.timestamps", self.name), count.max(16))?);
         }
-        let recorder = self.recorder.as_ref().ok_or(Error::InvalidArgument(
-            "frame executor was poisoned by an earlier failure".into(),
-        ))?;
+        let recorder = self
+            .recorder
+            .as_ref()
+            .ok_or(Error::InvalidArgument("frame executor was poisoned by an earlier failure".into()))?;
         let cmd = recorder.cmd;
         let timestamps = self.timestamps.as_ref().filter(|_| period_ns.is_some());
         self.ctx.begin(recorder)?;
@@ -116,11 +100,7 @@ impl FrameExecutor {
             }
             (pass.record)(cmd);
             if let Some(t) = timestamps {
-                t.write(
-                    cmd,
-                    vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                    2 * i as u32 + 1,
-                );
+                t.write(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * i as u32 + 1);
             }
             self.end_label(cmd);
         }
@@ -139,9 +119,10 @@ impl FrameExecutor {
             .enumerate()
             .map(|(i, name)| PassTiming {
                 name,
-                gpu_ms: ticks.as_ref().zip(period_ns).map(|(t, period)| {
-                    t[2 * i + 1].saturating_sub(t[2 * i]) as f64 * period * 1e-6
-                }),
+                gpu_ms: ticks
+                    .as_ref()
+                    .zip(period_ns)
+                    .map(|(t, period)| t[2 * i + 1].saturating_sub(t[2 * i]) as f64 * period * 1e-6),
             })
             .collect())
     }

@@ -81,22 +81,13 @@ mod tests {
         let mut table = TimingTable::default();
         for ms in [3.0, 1.0, 2.0, 10.0] {
             table.add_frame(&[
-                PassTiming {
-                    name: "a",
-                    gpu_ms: Some(ms),
-                },
-                PassTiming {
-                    name: "b",
-                    gpu_ms: Some(1.0),
-                },
+                PassTiming { name: "a", gpu_ms: Some(ms) },
+                PassTiming { name: "b", gpu_ms: Some(1.0) },
             ]);
         }
         let rows = table.rows();
         assert_eq!(rows[0].name, "a");
-        assert_eq!(
-            (rows[0].median_ms, rows[0].min_ms, rows[0].max_ms),
-            (2.5, 1.0, 10.0)
-        );
+        assert_eq!((rows[0].median_ms, rows[0].min_ms, rows[0].max_ms), (2.5, 1.0, 10.0));
         assert_eq!(rows[1].frames, 4);
         assert_eq!(table.frame_median_ms(), 3.5);
     }

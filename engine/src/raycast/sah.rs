@@ -137,7 +137,7 @@ impl Builder<'_> {
         let mut best: Option<Split> = None;
         for axis in 0..3 {
             let (lo, extent) = (centroids.lo[axis], centroids.hi[axis] - centroids.lo[axis]);
-            if !(extent > 0.0) {
+            if extent <= 0.0 || !extent.is_finite() {
                 continue;
             }
             let mut bins = [Bin { bounds: Aabb::EMPTY, count: 0 }; BINS];

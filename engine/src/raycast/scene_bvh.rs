@@ -192,7 +192,7 @@ fn check_rigid(m: &Mat4) -> std::result::Result<(), String> {
     }
     let axes = [m.x_axis.truncate(), m.y_axis.truncate(), m.z_axis.truncate()];
     let scale = axes[0].length();
-    if !(scale > 0.0) {
+    if scale == 0.0 {
         return Err("the scale is zero".into());
     }
     let tolerance = 1e-3 * scale;

@@ -54,14 +54,7 @@ impl EnvDistribution {
         }
         let total: f64 = row_weights.iter().sum();
         let marginal_cdf = cdf(row_weights.iter().copied(), height as usize);
-        EnvDistribution {
-            width,
-            height,
-            luminance,
-            marginal_cdf,
-            conditional_cdf,
-            total: total as f32,
-        }
+        EnvDistribution { width, height, luminance, marginal_cdf, conditional_cdf, total: total as f32 }
     }
 
     /// False for a map that is black everywhere: there is nothing to importance-sample, and the
@@ -152,11 +145,7 @@ fn pick(cdf: &[f32], u: f32) -> (usize, f32) {
     // The first entry greater than u, minus one: skips zero-width intervals.
     let k = cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
     let width = cdf[k + 1] - cdf[k];
-    let within = if width > 0.0 {
-        ((u - cdf[k]) / width).clamp(0.0, 1.0)
-    } else {
-        0.5
-    };
+    let within = if width > 0.0 { ((u - cdf[k]) / width).clamp(0.0, 1.0) } else { 0.5 };
     (k, within)
 }
 
@@ -222,8 +211,7 @@ mod tests {
                     (j as f32 + 0.5) / map.height() as f32,
                 );
                 let pdf = dist.pdf(crate::scene::uv_to_direction(uv));
-                integral +=
-                    f64::from(pdf) * equirect_texel_solid_angle(map.width(), map.height(), j);
+                integral += f64::from(pdf) * equirect_texel_solid_angle(map.width(), map.height(), j);
             }
         }
         assert!((integral - 1.0).abs() < 1e-5, "{integral}");
@@ -264,9 +252,7 @@ mod tests {
             }
         }
         // Black texels are never drawn.
-        assert!(counts[(12 * map.width()) as usize..]
-            .iter()
-            .all(|&c| c == 0));
+        assert!(counts[(12 * map.width()) as usize..].iter().all(|&c| c == 0));
     }
 
     #[test]
@@ -274,10 +260,7 @@ mod tests {
         let dist = EnvDistribution::new(&EnvMap::constant([0.5, 1.0, 2.0]));
         for d in [Vec3::Y, Vec3::NEG_Y, Vec3::X, Vec3::new(0.3, -0.4, 0.5)] {
             let pdf = dist.pdf(d);
-            assert!(
-                (pdf - 1.0 / (4.0 * PI)).abs() < 1e-5 / (4.0 * PI),
-                "{d}: {pdf}"
-            );
+            assert!((pdf - 1.0 / (4.0 * PI)).abs() < 1e-5 / (4.0 * PI), "{d}: {pdf}");
         }
     }
 

@@ -33,8 +33,8 @@ pub struct Point {
 impl PointsFile {
     /// Parses and checks a points file's text (see `check_points`).
     pub fn parse(text: &str) -> Result<PointsFile> {
-        let file: PointsFile = serde_json::from_str(text)
-            .map_err(|e| Error::InvalidArgument(format!("points file: {e}")))?;
+        let file: PointsFile =
+            serde_json::from_str(text).map_err(|e| Error::InvalidArgument(format!("points file: {e}")))?;
         check_points(&file.points).map_err(|e| match e {
             Error::InvalidArgument(m) => Error::InvalidArgument(format!("points file: {m}")),
             e => e,
@@ -46,20 +46,14 @@ impl PointsFile {
 /// At least one point, finite values, non-zero normals; errors name the point.
 fn check_points(points: &[Point]) -> Result<()> {
     if points.is_empty() {
-        return Err(Error::InvalidArgument(
-            "\"points\" is empty; list at least one point".into(),
-        ));
+        return Err(Error::InvalidArgument("\"points\" is empty; list at least one point".into()));
     }
     for (i, p) in points.iter().enumerate() {
         if !p.position.iter().chain(&p.normal).all(|v| v.is_finite()) {
-            return Err(Error::InvalidArgument(format!(
-                "point {i} has a NaN or infinite coordinate"
-            )));
+            return Err(Error::InvalidArgument(format!("point {i} has a NaN or infinite coordinate")));
         }
         if Vec3::from(p.normal).length_squared() == 0.0 {
-            return Err(Error::InvalidArgument(format!(
-                "point {i} has a zero normal"
-            )));
+            return Err(Error::InvalidArgument(format!("point {i} has a zero normal")));
         }
     }
     Ok(())
@@ -121,10 +115,7 @@ impl IrradianceReference {
                 ctx,
                 "reference_irradiance",
                 spirv::REFERENCE_IRRADIANCE_COMP,
-                &ReferenceLighting::binding_kinds(&[
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                ]),
+                &ReferenceLighting::binding_kinds(&[BindingKind::StorageBuffer, BindingKind::StorageBuffer]),
                 size_of::<IrradiancePush>() as u32,
             )?,
             points: Buffer::with_data(
@@ -156,21 +147,18 @@ impl IrradianceReference {
         })?;
         let groups = [self.count.div_ceil(constants::IRRADIANCE_GROUP), 1, 1];
         let pipeline = &self.pipeline;
-        // One dispatch per KAGE_SAMPLES_PER_DISPATCH samples (see constants.glsl), one submission.
-        let mut passes = Vec::new();
-        let mut done = 0;
-        while done < spp {
-            let count = (spp - done).min(constants::SAMPLES_PER_DISPATCH);
+        let (lighting, accum, points) = (&self.lighting, &self.accum, &self.points);
+        let (count_points, seed, env_total) = (self.count, self.seed, self.lighting.env_total);
+        let passes = super::sample_passes(spp, self.samples, |first, count| {
             let push = IrradiancePush {
-                params: [self.count, self.samples + done, count, self.seed],
-                env: [self.lighting.env_total, 0.0, 0.0, 0.0],
+                params: [count_points, first, count, seed],
+                env: [env_total, 0.0, 0.0, 0.0],
             };
-            let bindings = self.lighting.bindings(&[&self.accum, &self.points]);
-            passes.push(Pass::new("reference_irradiance", &IMPORTS, &["irradiance_accum"], move |cmd| {
+            let bindings = lighting.bindings(&[accum, points]);
+            Pass::new("reference_irradiance", &IMPORTS, &["irradiance_accum"], move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
-            }));
-            done += count;
-        }
+            })
+        });
         self.executor.run(&IMPORTS, passes)?;
         self.samples = after;
         Ok(())
@@ -192,19 +180,12 @@ mod tests {
     #[test]
     fn points_parse_and_bad_input_is_named() {
         let file =
-            PointsFile::parse(r#"{"points": [{"position": [0, 1, 2], "normal": [0, 2, 0]}]}"#)
-                .unwrap();
+            PointsFile::parse(r#"{"points": [{"position": [0, 1, 2], "normal": [0, 2, 0]}]}"#).unwrap();
         assert_eq!(file.points[0].normal, [0.0, 2.0, 0.0]);
         for (text, expected) in [
             (r#"{"points": []}"#, "empty"),
-            (
-                r#"{"points": [{"position": [0, 0, 0], "normal": [0, 0, 0]}]}"#,
-                "point 0 has a zero normal",
-            ),
-            (
-                r#"{"points": [{"position": [0, 0], "normal": [0, 1, 0]}]}"#,
-                "points file",
-            ),
+            (r#"{"points": [{"position": [0, 0, 0], "normal": [0, 0, 0]}]}"#, "point 0 has a zero normal"),
+            (r#"{"points": [{"position": [0, 0], "normal": [0, 1, 0]}]}"#, "points file"),
             (
                 r#"{"points": [{"position": [0, 0, 0], "normal": [0, 1, 0], "radius": 1}]}"#,
                 "unknown field `radius`",

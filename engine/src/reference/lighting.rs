@@ -40,11 +40,7 @@ impl ReferenceLighting {
     /// The binding kinds of a reference shader: these, then the shader's own `extra`.
     pub fn binding_kinds(extra: &[BindingKind]) -> Vec<BindingKind> {
         let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
-        kinds.extend([
-            BindingKind::SampledImage,
-            BindingKind::StorageBuffer,
-            BindingKind::StorageBuffer,
-        ]);
+        kinds.extend([BindingKind::SampledImage, BindingKind::StorageBuffer, BindingKind::StorageBuffer]);
         kinds.extend_from_slice(extra);
         kinds
     }

@@ -57,11 +57,7 @@ pub fn compare(a: &RgbaF32Image, b: &RgbaF32Image) -> Result<ImageMetrics> {
     errors.sort_by(f64::total_cmp);
     Ok(ImageMetrics {
         rmse,
-        relative_rmse: if rmse == 0.0 {
-            0.0
-        } else {
-            rmse / reference_mean
-        },
+        relative_rmse: if rmse == 0.0 { 0.0 } else { rmse / reference_mean },
         mean_abs_error: abs / n,
         p99_abs_error: percentile(&errors, 0.99),
         max_abs_error: errors.last().copied().unwrap_or(0.0),
@@ -101,21 +97,9 @@ pub fn diff_image(a: &RgbaF32Image, b: &RgbaF32Image) -> Result<DiffImage> {
     let mut sorted = errors.clone();
     sorted.sort_by(f64::total_cmp);
     let p99 = percentile(&sorted, 0.99);
-    let scale = if p99 > 0.0 {
-        p99
-    } else {
-        sorted.last().copied().unwrap_or(0.0)
-    };
-    let rgb = errors
-        .iter()
-        .flat_map(|&e| viridis(if scale > 0.0 { e / scale } else { 0.0 }))
-        .collect();
-    Ok(DiffImage {
-        width: a.width,
-        height: a.height,
-        rgb,
-        scale,
-    })
+    let scale = if p99 > 0.0 { p99 } else { sorted.last().copied().unwrap_or(0.0) };
+    let rgb = errors.iter().flat_map(|&e| viridis(if scale > 0.0 { e / scale } else { 0.0 })).collect();
+    Ok(DiffImage { width: a.width, height: a.height, rgb, scale })
 }
 
 impl DiffImage {
@@ -157,11 +141,7 @@ mod tests {
     use super::*;
 
     fn image(width: u32, height: u32, values: &[f32]) -> RgbaF32Image {
-        RgbaF32Image {
-            width,
-            height,
-            pixels: values.iter().map(|&v| [v, v, v, 1.0]).collect(),
-        }
+        RgbaF32Image { width, height, pixels: values.iter().map(|&v| [v, v, v, 1.0]).collect() }
     }
 
     #[test]
@@ -178,10 +158,7 @@ mod tests {
         assert_eq!(m.p99_abs_error, 3.0);
         assert_eq!(m.max_abs_error, 3.0);
         let same = compare(&b, &b).unwrap();
-        assert_eq!(
-            (same.rmse, same.relative_rmse, same.max_abs_error),
-            (0.0, 0.0, 0.0)
-        );
+        assert_eq!((same.rmse, same.relative_rmse, same.max_abs_error), (0.0, 0.0, 0.0));
     }
 
     #[test]

@@ -23,3 +23,16 @@ pub use irradiance::{IrradianceFile, IrradianceReference, PointsFile};
 pub use metrics::{compare, diff_image, ImageMetrics};
 pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
 pub use statistics::Statistics;
+
+use crate::layouts::constants;
+use crate::pass::Pass;
+
+/// Splits a batch of `spp` samples, the first numbered `first`, into passes of at most
+/// `KAGE_SAMPLES_PER_DISPATCH` samples each (see constants.glsl: llvmpipe cuts long loops),
+/// made by `pass(first sample, count)`.
+fn sample_passes<'a>(spp: u32, first: u32, mut pass: impl FnMut(u32, u32) -> Pass<'a>) -> Vec<Pass<'a>> {
+    (0..spp)
+        .step_by(constants::SAMPLES_PER_DISPATCH as usize)
+        .map(|done| pass(first + done, (spp - done).min(constants::SAMPLES_PER_DISPATCH)))
+        .collect()
+}

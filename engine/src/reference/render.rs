@@ -47,11 +47,7 @@ pub struct ReferenceRenderer {
 }
 
 impl ReferenceRenderer {
-    pub fn new(
-        ctx: &Arc<Context>,
-        scene: &Scene,
-        options: &ReferenceOptions,
-    ) -> Result<ReferenceRenderer> {
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, options: &ReferenceOptions) -> Result<ReferenceRenderer> {
         let (width, height) = (options.width, options.height);
         if !(1..=MAX_SIZE).contains(&width) || !(1..=MAX_SIZE).contains(&height) {
             return Err(Error::InvalidArgument(format!(
@@ -70,10 +66,7 @@ impl ReferenceRenderer {
                 ctx,
                 "reference_render",
                 spirv::REFERENCE_RENDER_COMP,
-                &ReferenceLighting::binding_kinds(&[
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                ]),
+                &ReferenceLighting::binding_kinds(&[BindingKind::StorageBuffer, BindingKind::StorageBuffer]),
                 size_of::<ReferencePush>() as u32,
             )?,
             accum: accum_buffer(ctx, "reference_accum", width as usize * height as usize)?,
@@ -110,23 +103,19 @@ impl ReferenceRenderer {
         let group = constants::REFERENCE_GROUP;
         let groups = [width.div_ceil(group), height.div_ceil(group), 1];
         let pipeline = &self.pipeline;
-        // One dispatch per KAGE_SAMPLES_PER_DISPATCH samples (see constants.glsl), one submission.
-        let mut passes = Vec::new();
-        let mut done = 0;
-        while done < spp {
-            let count = (spp - done).min(constants::SAMPLES_PER_DISPATCH);
-            let push = ReferencePush {
-                inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-                camera_pos: self.camera.position.extend(self.lighting.env_total).to_array(),
-                frame: [width, height, self.samples + done, count],
-                params: [(self.options.light == LightMode::Local) as u32, self.light_count, self.options.seed, 0],
-            };
-            let bindings = self.lighting.bindings(&[&self.accum, &self.lights]);
-            passes.push(Pass::new("reference_render", &IMPORTS, &["reference_accum"], move |cmd| {
+        let (lighting, accum, lights) = (&self.lighting, &self.accum, &self.lights);
+        let inv_view_proj = view_proj.inverse().to_cols_array_2d();
+        let camera_pos = self.camera.position.extend(self.lighting.env_total).to_array();
+        let params =
+            [(self.options.light == LightMode::Local) as u32, self.light_count, self.options.seed, 0];
+        let passes = super::sample_passes(spp, self.samples, |first, count| {
+            let push =
+                ReferencePush { inv_view_proj, camera_pos, frame: [width, height, first, count], params };
+            let bindings = lighting.bindings(&[accum, lights]);
+            Pass::new("reference_render", &IMPORTS, &["reference_accum"], move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
-            }));
-            done += count;
-        }
+            })
+        });
         self.executor.run(&IMPORTS, passes)?;
         self.samples = after;
         Ok(())
@@ -151,11 +140,7 @@ impl ReferenceRenderer {
         RgbaF32Image {
             width: self.options.width,
             height: self.options.height,
-            pixels: statistics
-                .mean
-                .iter()
-                .map(|&[r, g, b]| [r, g, b, 1.0])
-                .collect(),
+            pixels: statistics.mean.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect(),
         }
     }
 }
@@ -165,25 +150,14 @@ impl ReferenceRenderer {
 /// angle `fov_deg`.
 fn reference_light(light: &Light) -> ReferenceLight {
     match *light {
-        Light::Point {
-            position,
-            intensity,
-        } => ReferenceLight {
+        Light::Point { position, intensity } => ReferenceLight {
             position: position.extend(0.0).to_array(),
             direction: [0.0, -1.0, 0.0, -1.0],
             intensity: [intensity[0], intensity[1], intensity[2], 0.0],
         },
-        Light::Spot {
-            position,
-            direction,
-            fov_deg,
-            intensity,
-        } => ReferenceLight {
+        Light::Spot { position, direction, fov_deg, intensity } => ReferenceLight {
             position: position.extend(1.0).to_array(),
-            direction: direction
-                .normalize()
-                .extend((0.5 * fov_deg).to_radians().cos())
-                .to_array(),
+            direction: direction.normalize().extend((0.5 * fov_deg).to_radians().cos()).to_array(),
             intensity: [intensity[0], intensity[1], intensity[2], 0.0],
         },
     }

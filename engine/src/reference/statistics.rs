@@ -31,26 +31,17 @@ impl Statistics {
     /// Reads `buffer` (after the batches that filled it) holding `samples` samples per item.
     pub fn read(buffer: &Buffer, samples: u32) -> Result<Statistics> {
         let bytes = buffer.read()?;
-        let floats: Vec<f32> = bytes
-            .chunks_exact(4)
-            .map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
+        let floats: Vec<f32> =
+            bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
         let items = floats.chunks_exact(8);
         let mean = items.clone().map(|a| [a[0], a[1], a[2]]).collect();
         let standard_error = (samples >= 2).then(|| {
             let n = f64::from(samples);
             items
-                .map(|a| {
-                    [a[4], a[5], a[6]]
-                        .map(|m2| (f64::from(m2.max(0.0)) / (n - 1.0) / n).sqrt() as f32)
-                })
+                .map(|a| [a[4], a[5], a[6]].map(|m2| (f64::from(m2.max(0.0)) / (n - 1.0) / n).sqrt() as f32))
                 .collect()
         });
-        Ok(Statistics {
-            samples,
-            mean,
-            standard_error,
-        })
+        Ok(Statistics { samples, mean, standard_error })
     }
 
     /// The noise left in the estimate, relative: the RMS over items and channels of the standard
@@ -60,19 +51,8 @@ impl Statistics {
     pub fn relative_standard_error(&self) -> Option<f64> {
         let errors = self.standard_error.as_ref()?;
         let n = (self.mean.len() * 3) as f64;
-        let mean: f64 = self
-            .mean
-            .iter()
-            .flatten()
-            .map(|&v| f64::from(v))
-            .sum::<f64>()
-            / n;
-        let square: f64 = errors
-            .iter()
-            .flatten()
-            .map(|&e| f64::from(e) * f64::from(e))
-            .sum::<f64>()
-            / n;
+        let mean: f64 = self.mean.iter().flatten().map(|&v| f64::from(v)).sum::<f64>() / n;
+        let square: f64 = errors.iter().flatten().map(|&e| f64::from(e) * f64::from(e)).sum::<f64>() / n;
         (mean > 0.0).then(|| square.sqrt() / mean)
     }
 }

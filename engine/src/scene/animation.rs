@@ -19,7 +19,8 @@ pub fn pose(base: &Transform, height: f32, t: f32) -> Mat4 {
     let phase = TAU * t;
     let offset = Vec3::new(SLIDE * height * phase.sin(), HOP * height * (2.0 * phase).sin().abs(), 0.0);
     let spin = Quat::from_rotation_y(TURNS * phase);
-    Transform { translation: base.translation + offset, rotation: spin * base.rotation, scale: base.scale }.matrix()
+    Transform { translation: base.translation + offset, rotation: spin * base.rotation, scale: base.scale }
+        .matrix()
 }
 
 #[cfg(test)]

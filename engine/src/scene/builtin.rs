@@ -29,8 +29,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     // The embedded assets are known good, but a failure still reports rather than panics.
     let context = |e: SceneError| e.within(&format!("built-in scene \"{name}\""));
     let teapot = obj::parse_obj(TEAPOT_OBJ, "teapot", [0.75; 3]).map_err(context)?;
-    let floor =
-        shapes::plane("floor", [6.0, 6.0], [floor_vertices; 2], [0.6; 3]).map_err(context)?;
+    let floor = shapes::plane("floor", [6.0, 6.0], [floor_vertices; 2], [0.6; 3]).map_err(context)?;
     let environment = EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?;
 
     // One unit tall, standing on the floor.
@@ -42,16 +41,8 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     Ok(Scene {
         name: name.to_string(),
         groups: vec![
-            Group {
-                name: "teapot".into(),
-                meshes: vec![teapot],
-                transform: teapot_transform,
-            },
-            Group {
-                name: "floor".into(),
-                meshes: vec![floor],
-                transform: Transform::default(),
-            },
+            Group { name: "teapot".into(), meshes: vec![teapot], transform: teapot_transform },
+            Group { name: "floor".into(), meshes: vec![floor], transform: Transform::default() },
         ],
         environment,
         lights: Vec::new(),

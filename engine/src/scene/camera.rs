@@ -32,35 +32,20 @@ impl Camera {
 
     /// Checks that the view and projection matrices will be well defined.
     pub fn validated(self) -> Result<Camera, SceneError> {
-        for (name, v) in [
-            ("position", self.position),
-            ("target", self.target),
-            ("up", self.up),
-        ] {
+        for (name, v) in [("position", self.position), ("target", self.target), ("up", self.up)] {
             if !v.is_finite() {
-                return Err(SceneError::invalid(format!(
-                    "camera {name} {v} is not finite"
-                )));
+                return Err(SceneError::invalid(format!("camera {name} {v} is not finite")));
             }
         }
         let forward = self.target - self.position;
         if forward.length_squared() == 0.0 {
-            return Err(SceneError::invalid(
-                "camera position and target are the same point",
-            ));
+            return Err(SceneError::invalid("camera position and target are the same point"));
         }
         if self.up.length_squared() == 0.0 {
             return Err(SceneError::invalid("camera up vector has zero length"));
         }
-        if forward
-            .normalize()
-            .cross(self.up.normalize())
-            .length_squared()
-            < 1e-12
-        {
-            return Err(SceneError::invalid(
-                "camera up vector is parallel to the viewing direction",
-            ));
+        if forward.normalize().cross(self.up.normalize()).length_squared() < 1e-12 {
+            return Err(SceneError::invalid("camera up vector is parallel to the viewing direction"));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
             return Err(SceneError::invalid(format!(
@@ -77,12 +62,7 @@ mod tests {
     use super::*;
 
     fn camera() -> Camera {
-        Camera {
-            position: Vec3::new(0.0, 0.0, 5.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 60.0,
-        }
+        Camera { position: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 }
     }
 
     #[test]
@@ -101,34 +81,13 @@ mod tests {
     fn bad_cameras_are_rejected() {
         assert!(camera().validated().is_ok());
         let bad = [
-            Camera {
-                target: camera().position,
-                ..camera()
-            },
-            Camera {
-                up: Vec3::ZERO,
-                ..camera()
-            },
-            Camera {
-                up: Vec3::Z,
-                ..camera()
-            },
-            Camera {
-                fov_y_deg: 0.0,
-                ..camera()
-            },
-            Camera {
-                fov_y_deg: 180.0,
-                ..camera()
-            },
-            Camera {
-                fov_y_deg: f32::NAN,
-                ..camera()
-            },
-            Camera {
-                position: Vec3::new(f32::NAN, 0.0, 0.0),
-                ..camera()
-            },
+            Camera { target: camera().position, ..camera() },
+            Camera { up: Vec3::ZERO, ..camera() },
+            Camera { up: Vec3::Z, ..camera() },
+            Camera { fov_y_deg: 0.0, ..camera() },
+            Camera { fov_y_deg: 180.0, ..camera() },
+            Camera { fov_y_deg: f32::NAN, ..camera() },
+            Camera { position: Vec3::new(f32::NAN, 0.0, 0.0), ..camera() },
         ];
         for c in bad {
             assert!(c.validated().is_err(), "{c:?}");

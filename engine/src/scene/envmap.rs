@@ -37,15 +37,9 @@ const CONSTANT_WIDTH: u32 = 64;
 impl EnvMap {
     /// Checks the shape (2:1, not empty) and that every value is finite; negative values are
     /// clamped to 0 and counted (see [`EnvMap::clamped_negative`]).
-    pub fn from_pixels(
-        width: u32,
-        height: u32,
-        pixels: Vec<[f32; 3]>,
-    ) -> Result<EnvMap, SceneError> {
+    pub fn from_pixels(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Result<EnvMap, SceneError> {
         if width == 0 || height == 0 {
-            return Err(SceneError::invalid(format!(
-                "environment map is empty ({width}x{height})"
-            )));
+            return Err(SceneError::invalid(format!("environment map is empty ({width}x{height})")));
         }
         if u64::from(width) != 2 * u64::from(height) {
             return Err(SceneError::invalid(format!(
@@ -74,43 +68,31 @@ impl EnvMap {
             *c = 0.0;
             clamped_negative += 1;
         }
-        Ok(EnvMap {
-            width,
-            height,
-            pixels,
-            clamped_negative,
-        })
+        Ok(EnvMap { width, height, pixels, clamped_negative })
     }
 
     /// A small map of one radiance in every direction.
     pub fn constant(rgb: [f32; 3]) -> EnvMap {
         let (width, height) = (CONSTANT_WIDTH, CONSTANT_WIDTH / 2);
-        EnvMap {
-            width,
-            height,
-            pixels: vec![rgb; (width * height) as usize],
-            clamped_negative: 0,
-        }
+        EnvMap { width, height, pixels: vec![rgb; (width * height) as usize], clamped_negative: 0 }
     }
 
     /// Reads `.exr` (RGB or RGBA, any sample type and compression `exr` supports) or Radiance
     /// `.hdr`, chosen by extension.
     pub fn load(path: &Path) -> Result<EnvMap, SceneError> {
-        let extension = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let decode =
-            match extension.as_deref() {
-                Some("exr") => EnvMap::from_exr_bytes,
-                Some("hdr") => EnvMap::from_hdr_bytes,
-                _ => return Err(SceneError::in_file(
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let decode = match extension.as_deref() {
+            Some("exr") => EnvMap::from_exr_bytes,
+            Some("hdr") => EnvMap::from_hdr_bytes,
+            _ => {
+                return Err(SceneError::in_file(
                     path,
                     "unsupported environment map format; use OpenEXR (.exr) or Radiance HDR (.hdr)",
-                )),
-            };
-        let bytes = std::fs::read(path)
-            .map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
+                ))
+            }
+        };
+        let bytes =
+            std::fs::read(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
         decode(&bytes).map_err(|e| SceneError::in_file(path, e.problem()))
     }
 
@@ -121,9 +103,7 @@ impl EnvMap {
             .largest_resolution_level()
             .rgba_channels(
                 |size, _| (size.width(), vec![[0.0f32; 3]; size.area()]),
-                |(width, pixels): &mut (usize, Vec<[f32; 3]>),
-                 at,
-                 (r, g, b, _a): (f32, f32, f32, f32)| {
+                |(width, pixels): &mut (usize, Vec<[f32; 3]>), at, (r, g, b, _a): (f32, f32, f32, f32)| {
                     pixels[at.y() * *width + at.x()] = [r, g, b];
                 },
             )
@@ -133,11 +113,7 @@ impl EnvMap {
             .map_err(|e| SceneError::invalid(format!("not a readable OpenEXR RGB image: {e}")))?;
         let layer = image.layer_data;
         let (width, height) = (layer.size.width(), layer.size.height());
-        EnvMap::from_pixels(
-            dimension(width)?,
-            dimension(height)?,
-            layer.channel_data.pixels.1,
-        )
+        EnvMap::from_pixels(dimension(width)?, dimension(height)?, layer.channel_data.pixels.1)
     }
 
     /// Decodes a Radiance RGBE (.hdr) file held in memory.
@@ -248,11 +224,7 @@ mod tests {
 
     #[test]
     fn u_stays_in_the_half_open_unit_interval() {
-        for d in [
-            Vec3::new(-1e-30, 0.0, -1.0),
-            Vec3::new(-1e-7, 0.3, -1.0),
-            Vec3::new(0.0, 1.0, 0.0),
-        ] {
+        for d in [Vec3::new(-1e-30, 0.0, -1.0), Vec3::new(-1e-7, 0.3, -1.0), Vec3::new(0.0, 1.0, 0.0)] {
             let u = direction_to_uv(d).x;
             assert!((0.0..1.0).contains(&u), "{d} -> u = {u}");
         }
@@ -263,10 +235,7 @@ mod tests {
         let (width, height) = (16, 8);
         for j in 0..height {
             for i in 0..width {
-                let uv = Vec2::new(
-                    (i as f32 + 0.5) / width as f32,
-                    (j as f32 + 0.5) / height as f32,
-                );
+                let uv = Vec2::new((i as f32 + 0.5) / width as f32, (j as f32 + 0.5) / height as f32);
                 let d = uv_to_direction(uv);
                 assert!((d.length() - 1.0).abs() < 1e-6);
                 assert!(close(direction_to_uv(d), uv), "pixel ({i}, {j})");
@@ -278,26 +247,15 @@ mod tests {
     fn from_pixels_checks_shape_and_values() {
         assert!(EnvMap::from_pixels(4, 2, vec![[1.0; 3]; 8]).is_ok());
         assert!(EnvMap::from_pixels(0, 0, vec![]).is_err());
-        assert!(EnvMap::from_pixels(4, 4, vec![[1.0; 3]; 16])
-            .unwrap_err()
-            .to_string()
-            .contains("2:1"));
+        assert!(EnvMap::from_pixels(4, 4, vec![[1.0; 3]; 16]).unwrap_err().to_string().contains("2:1"));
         assert!(EnvMap::from_pixels(4, 2, vec![[1.0; 3]; 7]).is_err());
         let mut pixels = vec![[1.0; 3]; 8];
         pixels[6] = [1.0, f32::NAN, 1.0];
-        let message = EnvMap::from_pixels(4, 2, pixels.clone())
-            .unwrap_err()
-            .to_string();
-        assert!(
-            message.contains("(2, 1)") && message.contains("NaN"),
-            "{message}"
-        );
+        let message = EnvMap::from_pixels(4, 2, pixels.clone()).unwrap_err().to_string();
+        assert!(message.contains("(2, 1)") && message.contains("NaN"), "{message}");
         pixels[6] = [1.0, -0.5, -0.25];
         let clamped = EnvMap::from_pixels(4, 2, pixels).unwrap();
-        assert_eq!(
-            (clamped.pixels()[6], clamped.clamped_negative()),
-            ([1.0, 0.0, 0.0], 2)
-        );
+        assert_eq!((clamped.pixels()[6], clamped.clamped_negative()), ([1.0, 0.0, 0.0], 2));
     }
 
     #[test]

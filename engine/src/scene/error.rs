@@ -12,28 +12,19 @@ pub struct SceneError {
 impl SceneError {
     /// A problem with the named file.
     pub fn in_file(file: impl Into<PathBuf>, problem: impl Into<String>) -> SceneError {
-        SceneError {
-            file: Some(file.into()),
-            problem: problem.into(),
-        }
+        SceneError { file: Some(file.into()), problem: problem.into() }
     }
 
     /// A problem with data that came from no file (a built-in scene, an API call).
     pub fn invalid(problem: impl Into<String>) -> SceneError {
-        SceneError {
-            file: None,
-            problem: problem.into(),
-        }
+        SceneError { file: None, problem: problem.into() }
     }
 
     /// Prefixes the place the problem is at, e.g. `group 0 ("floor")`. A file this error already
     /// names moves into the message, so nested errors read
     /// `scene.json: group 0 ("teapot"): mesh 0: teapot.obj: ...` once attributed.
     pub(crate) fn within(self, place: &str) -> SceneError {
-        SceneError {
-            file: None,
-            problem: format!("{place}: {self}"),
-        }
+        SceneError { file: None, problem: format!("{place}: {self}") }
     }
 
     /// Names `file` as the file at fault, keeping any file already named in the message.
@@ -42,10 +33,7 @@ impl SceneError {
             Some(_) => self.to_string(),
             None => self.problem,
         };
-        SceneError {
-            file: Some(file.to_path_buf()),
-            problem,
-        }
+        SceneError { file: Some(file.to_path_buf()), problem }
     }
 
     pub fn file(&self) -> Option<&Path> {

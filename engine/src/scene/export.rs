@@ -52,36 +52,22 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
             up: c.up.to_array(),
             fov_y_deg: c.fov_y_deg,
         },
-        environment: EnvironmentDesc {
-            image: Some(ENVIRONMENT_FILE.into()),
-            constant: None,
-            intensity: 1.0,
-        },
+        environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
         groups,
         lights: scene.lights.iter().map(light).collect(),
     };
     let path = dir.join(SCENE_FILE);
     let json = serde_json::to_string_pretty(&file)
         .map_err(|e| SceneError::in_file(&path, format!("cannot encode scene: {e}")))?;
-    std::fs::write(&path, json + "\n")
-        .map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))
+    std::fs::write(&path, json + "\n").map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))
 }
 
 fn light(light: &Light) -> LightDesc {
     match *light {
-        Light::Point {
-            position,
-            intensity,
-        } => LightDesc::Point(PointDesc {
-            position: position.to_array(),
-            intensity,
-        }),
-        Light::Spot {
-            position,
-            direction,
-            fov_deg,
-            intensity,
-        } => LightDesc::Spot(SpotDesc {
+        Light::Point { position, intensity } => {
+            LightDesc::Point(PointDesc { position: position.to_array(), intensity })
+        }
+        Light::Spot { position, direction, fov_deg, intensity } => LightDesc::Spot(SpotDesc {
             position: position.to_array(),
             direction: direction.to_array(),
             fov_deg,
@@ -94,19 +80,9 @@ fn light(light: &Light) -> LightDesc {
 fn unique_file_name(mesh_name: &str, used: &mut HashSet<String>) -> String {
     let stem: String = mesh_name
         .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
         .collect();
-    let stem = if stem.is_empty() {
-        "mesh".to_string()
-    } else {
-        stem
-    };
+    let stem = if stem.is_empty() { "mesh".to_string() } else { stem };
     let mut file = format!("{stem}.obj");
     let mut n = 2;
     while !used.insert(file.clone()) {

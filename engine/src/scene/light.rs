@@ -12,32 +12,19 @@ pub enum Light {
     /// Radiant intensity (W/sr per channel) in every direction.
     Point { position: Vec3, intensity: [f32; 3] },
     /// Radiant intensity inside a cone of full angle `fov_deg` about the unit `direction`.
-    Spot {
-        position: Vec3,
-        direction: Vec3,
-        fov_deg: f32,
-        intensity: [f32; 3],
-    },
+    Spot { position: Vec3, direction: Vec3, fov_deg: f32, intensity: [f32; 3] },
 }
 
 impl Light {
     /// Checks finiteness and ranges; a spot light's direction comes back normalized.
     pub fn validated(self) -> Result<Light, SceneError> {
         let (position, intensity) = match self {
-            Light::Point {
-                position,
-                intensity,
+            Light::Point { position, intensity } | Light::Spot { position, intensity, .. } => {
+                (position, intensity)
             }
-            | Light::Spot {
-                position,
-                intensity,
-                ..
-            } => (position, intensity),
         };
         if !position.is_finite() {
-            return Err(SceneError::invalid(format!(
-                "light position {position} is not finite"
-            )));
+            return Err(SceneError::invalid(format!("light position {position} is not finite")));
         }
         if intensity.iter().any(|c| !(c.is_finite() && *c >= 0.0)) {
             return Err(SceneError::invalid(format!(
@@ -46,9 +33,7 @@ impl Light {
         }
         match self {
             Light::Point { .. } => Ok(self),
-            Light::Spot {
-                direction, fov_deg, ..
-            } => {
+            Light::Spot { direction, fov_deg, .. } => {
                 if !direction.is_finite() || direction.length_squared() == 0.0 {
                     return Err(SceneError::invalid(format!(
                         "spot light direction {direction} is not a direction"
@@ -60,17 +45,8 @@ impl Light {
                     )));
                 }
                 // Leave unit directions untouched so that a written and re-read scene is bit-identical.
-                let direction = if direction.is_normalized() {
-                    direction
-                } else {
-                    direction.normalize()
-                };
-                Ok(Light::Spot {
-                    position,
-                    direction,
-                    fov_deg,
-                    intensity,
-                })
+                let direction = if direction.is_normalized() { direction } else { direction.normalize() };
+                Ok(Light::Spot { position, direction, fov_deg, intensity })
             }
         }
     }

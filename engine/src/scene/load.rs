@@ -8,8 +8,8 @@ use super::file::{EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, SceneFile};
 use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
 
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
     let file: SceneFile = serde_json::from_str(&text)
         .map_err(|e| SceneError::in_file(path, format!("invalid scene JSON: {e}")))?;
     let folder = path.parent().unwrap_or(Path::new(""));
@@ -47,13 +47,7 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .enumerate()
         .map(|(at, l)| light(l).map_err(|e| e.within(&format!("light {at}"))))
         .collect::<Result<_, _>>()?;
-    Ok(Scene {
-        name,
-        groups,
-        environment,
-        lights,
-        camera,
-    })
+    Ok(Scene { name, groups, environment, lights, camera })
 }
 
 fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneError> {
@@ -67,11 +61,7 @@ fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneErr
             }
             EnvMap::constant(rgb)
         }
-        _ => {
-            return Err(SceneError::invalid(
-                "environment needs exactly one of \"image\" or \"constant\"",
-            ))
-        }
+        _ => return Err(SceneError::invalid("environment needs exactly one of \"image\" or \"constant\"")),
     };
     map.scaled(desc.intensity)
 }
@@ -82,17 +72,11 @@ fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
         (Some(degrees), None) => Transform::rotation_from_euler_deg(degrees),
         (None, Some(q)) => Quat::from_array(q),
         (Some(_), Some(_)) => {
-            return Err(SceneError::invalid(
-                "give either \"rotation_deg\" or \"rotation_quat\", not both",
-            ))
+            return Err(SceneError::invalid("give either \"rotation_deg\" or \"rotation_quat\", not both"))
         }
     };
-    let transform = Transform {
-        translation: Vec3::from(desc.translation),
-        rotation,
-        scale: desc.scale,
-    }
-    .validated()?;
+    let transform =
+        Transform { translation: Vec3::from(desc.translation), rotation, scale: desc.scale }.validated()?;
     if desc.meshes.is_empty() {
         return Err(SceneError::invalid("it has no meshes"));
     }
@@ -102,11 +86,7 @@ fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
         .enumerate()
         .map(|(at, m)| mesh(m, folder).map_err(|e| e.within(&format!("mesh {at}"))))
         .collect::<Result<_, _>>()?;
-    Ok(Group {
-        name: desc.name,
-        meshes,
-        transform,
-    })
+    Ok(Group { name: desc.name, meshes, transform })
 }
 
 fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
@@ -117,11 +97,7 @@ fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
         }
         (None, Some(p), None) => shapes::plane("plane", p.size, p.vertices, desc.albedo)?,
         (None, None, Some(s)) => shapes::sphere("sphere", s.radius, s.segments, desc.albedo)?,
-        _ => {
-            return Err(SceneError::invalid(
-                "a mesh needs exactly one of \"obj\", \"plane\" or \"sphere\"",
-            ))
-        }
+        _ => return Err(SceneError::invalid("a mesh needs exactly one of \"obj\", \"plane\" or \"sphere\"")),
     };
     if let Some(name) = desc.name {
         mesh.name = name;
@@ -131,10 +107,7 @@ fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
 
 fn light(desc: LightDesc) -> Result<Light, SceneError> {
     let light = match desc {
-        LightDesc::Point(p) => Light::Point {
-            position: Vec3::from(p.position),
-            intensity: p.intensity,
-        },
+        LightDesc::Point(p) => Light::Point { position: Vec3::from(p.position), intensity: p.intensity },
         LightDesc::Spot(s) => Light::Spot {
             position: Vec3::from(s.position),
             direction: Vec3::from(s.direction),

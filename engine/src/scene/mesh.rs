@@ -33,9 +33,7 @@ impl Mesh {
     ) -> Result<Mesh, SceneError> {
         let name = name.into();
         if indices.is_empty() {
-            return Err(SceneError::invalid(format!(
-                "mesh \"{name}\" is empty: it has no triangles"
-            )));
+            return Err(SceneError::invalid(format!("mesh \"{name}\" is empty: it has no triangles")));
         }
         if indices.len() % 3 != 0 {
             return Err(SceneError::invalid(format!(
@@ -43,43 +41,27 @@ impl Mesh {
                 indices.len()
             )));
         }
-        if let Some((at, index)) = indices
-            .iter()
-            .enumerate()
-            .find(|(_, i)| **i as usize >= positions.len())
-        {
+        if let Some((at, index)) = indices.iter().enumerate().find(|(_, i)| **i as usize >= positions.len()) {
             return Err(SceneError::invalid(format!(
                 "mesh \"{name}\": triangle {} uses vertex index {index}, out of range for {} vertices",
                 at / 3,
                 positions.len()
             )));
         }
-        if let Some((at, p)) = positions
-            .iter()
-            .enumerate()
-            .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
-        {
+        if let Some((at, p)) = positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite())) {
             return Err(SceneError::invalid(format!(
                 "mesh \"{name}\": vertex {at} is NaN or infinite: {p:?}"
             )));
         }
         if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
-            return Err(SceneError::invalid(format!(
-                "mesh \"{name}\": albedo {albedo:?} is outside [0, 1]"
-            )));
+            return Err(SceneError::invalid(format!("mesh \"{name}\": albedo {albedo:?} is outside [0, 1]")));
         }
         let normals = match normals {
             Some(normals) if normals.len() == positions.len() => unit_normals(&name, normals)?,
             _ => area_weighted_normals(&positions, &indices),
         };
         let (positions, normals, indices) = in_first_use_order(positions, normals, indices);
-        Ok(Mesh {
-            name,
-            positions,
-            normals,
-            indices,
-            albedo,
-        })
+        Ok(Mesh { name, positions, normals, indices, albedo })
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -103,11 +85,7 @@ fn unit_normals(name: &str, normals: Vec<[f32; 3]>) -> Result<Vec<[f32; 3]>, Sce
                 )));
             }
             // Already-unit normals stay bit-identical (see `Mesh`'s round-trip promise).
-            Ok(if v.is_normalized() {
-                n
-            } else {
-                v.normalize().to_array()
-            })
+            Ok(if v.is_normalized() { n } else { v.normalize().to_array() })
         })
         .collect()
 }
@@ -124,9 +102,7 @@ pub(crate) fn area_weighted_normals(positions: &[[f32; 3]], indices: &[u32]) -> 
             sums[i as usize] += face;
         }
     }
-    sums.into_iter()
-        .map(|n| n.try_normalize().unwrap_or(Vec3::Y).to_array())
-        .collect()
+    sums.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y).to_array()).collect()
 }
 
 fn in_first_use_order(
@@ -158,17 +134,9 @@ mod tests {
 
     #[test]
     fn vertices_are_reordered_by_first_use_and_unused_ones_dropped() {
-        let positions = vec![
-            [9.0, 9.0, 9.0],
-            [0.0, 0.0, 1.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 0.0, 0.0],
-        ];
+        let positions = vec![[9.0, 9.0, 9.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
         let mesh = Mesh::new("t", positions, None, vec![3, 1, 2], [0.5; 3]).unwrap();
-        assert_eq!(
-            mesh.positions,
-            vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]
-        );
+        assert_eq!(mesh.positions, vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]);
         assert_eq!(mesh.indices, vec![0, 1, 2]);
         assert_eq!(mesh.normals, vec![[0.0, 1.0, 0.0]; 3]);
     }
@@ -185,9 +153,7 @@ mod tests {
     fn bad_meshes_are_rejected() {
         let tri = || vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let err = |positions, indices, albedo| {
-            Mesh::new("m", positions, None, indices, albedo)
-                .unwrap_err()
-                .to_string()
+            Mesh::new("m", positions, None, indices, albedo).unwrap_err().to_string()
         };
         assert!(err(tri(), vec![], [0.5; 3]).contains("empty"));
         assert!(err(tri(), vec![0, 1], [0.5; 3]).contains("whole number"));

@@ -18,9 +18,9 @@
 //! problem.
 use std::path::Path;
 
+pub mod animation;
 mod builtin;
 mod camera;
-pub mod animation;
 pub mod envmap;
 mod error;
 mod export;
@@ -89,9 +89,7 @@ impl Scene {
     }
 
     pub fn meshes(&self) -> impl Iterator<Item = (&Group, &Mesh)> {
-        self.groups
-            .iter()
-            .flat_map(|g| g.meshes.iter().map(move |m| (g, m)))
+        self.groups.iter().flat_map(|g| g.meshes.iter().map(move |m| (g, m)))
     }
 
     pub fn triangle_count(&self) -> usize {

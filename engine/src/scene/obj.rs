@@ -10,12 +10,8 @@ use super::{Mesh, SceneError};
 pub fn parse_obj(bytes: &[u8], name: &str, albedo: [f32; 3]) -> Result<Mesh, SceneError> {
     // Materials are not part of a Kage scene; `mtllib` lines are accepted and ignored.
     let ignore_materials = |_: &Path| Ok(Default::default());
-    let (models, _) = tobj::load_obj_buf(
-        &mut Cursor::new(bytes),
-        &tobj::GPU_LOAD_OPTIONS,
-        ignore_materials,
-    )
-    .map_err(|e| SceneError::invalid(format!("malformed OBJ: {e}")))?;
+    let (models, _) = tobj::load_obj_buf(&mut Cursor::new(bytes), &tobj::GPU_LOAD_OPTIONS, ignore_materials)
+        .map_err(|e| SceneError::invalid(format!("malformed OBJ: {e}")))?;
 
     let mut positions = Vec::new();
     let mut normals = Vec::new();
@@ -24,8 +20,8 @@ pub fn parse_obj(bytes: &[u8], name: &str, albedo: [f32; 3]) -> Result<Mesh, Sce
     let mut every_vertex_has_a_normal = true;
     for model in models {
         let mesh = model.mesh;
-        let base = u32::try_from(positions.len())
-            .map_err(|_| SceneError::invalid("OBJ has too many vertices"))?;
+        let base =
+            u32::try_from(positions.len()).map_err(|_| SceneError::invalid("OBJ has too many vertices"))?;
         every_vertex_has_a_normal &= mesh.normals.len() == mesh.positions.len();
         positions.extend(mesh.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
         normals.extend(mesh.normals.chunks_exact(3).map(|n| [n[0], n[1], n[2]]));
@@ -37,12 +33,8 @@ pub fn parse_obj(bytes: &[u8], name: &str, albedo: [f32; 3]) -> Result<Mesh, Sce
 
 /// Reads an OBJ file; every error names `path`.
 pub fn load_obj(path: &Path, albedo: [f32; 3]) -> Result<Mesh, SceneError> {
-    let bytes =
-        std::fs::read(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let bytes = std::fs::read(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     parse_obj(&bytes, &name, albedo).map_err(|e| SceneError::in_file(path, e.problem()))
 }
 

@@ -11,16 +11,9 @@ pub const MAX_RESOLUTION: u32 = 4096;
 
 /// A grid in the XZ plane centred at the origin, normal +Y. `size` is the extent along X and Z,
 /// `vertices` the number of grid vertices along X and Z (at least 2 each).
-pub fn plane(
-    name: &str,
-    size: [f32; 2],
-    vertices: [u32; 2],
-    albedo: [f32; 3],
-) -> Result<Mesh, SceneError> {
+pub fn plane(name: &str, size: [f32; 2], vertices: [u32; 2], albedo: [f32; 3]) -> Result<Mesh, SceneError> {
     if size.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(SceneError::invalid(format!(
-            "plane size {size:?} must be finite and greater than zero"
-        )));
+        return Err(SceneError::invalid(format!("plane size {size:?} must be finite and greater than zero")));
     }
     if vertices.iter().any(|n| !(2..=MAX_RESOLUTION).contains(n)) {
         return Err(SceneError::invalid(format!(
@@ -50,12 +43,7 @@ pub fn plane(
 
 /// A UV sphere centred at the origin: `segments` vertices around each ring, `segments / 2`
 /// bands from pole to pole, one vertex at each pole so that no triangle is degenerate.
-pub fn sphere(
-    name: &str,
-    radius: f32,
-    segments: u32,
-    albedo: [f32; 3],
-) -> Result<Mesh, SceneError> {
+pub fn sphere(name: &str, radius: f32, segments: u32, albedo: [f32; 3]) -> Result<Mesh, SceneError> {
     if !(radius.is_finite() && radius > 0.0) {
         return Err(SceneError::invalid(format!(
             "sphere radius {radius} must be finite and greater than zero"
@@ -108,8 +96,7 @@ mod tests {
     /// Every triangle's winding normal must agree with its vertex normals and be non-degenerate.
     fn assert_ccw_along_normals(mesh: &Mesh) {
         for tri in mesh.indices.chunks_exact(3) {
-            let [a, b, c] =
-                [tri[0], tri[1], tri[2]].map(|i| Vec3::from(mesh.positions[i as usize]));
+            let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| Vec3::from(mesh.positions[i as usize]));
             let face = (b - a).cross(c - a);
             assert!(face.length() > 0.0, "degenerate triangle {tri:?}");
             for &i in tri {

@@ -13,22 +13,14 @@ pub struct Transform {
 
 impl Default for Transform {
     fn default() -> Self {
-        Transform {
-            translation: Vec3::ZERO,
-            rotation: Quat::IDENTITY,
-            scale: 1.0,
-        }
+        Transform { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: 1.0 }
     }
 }
 
 impl Transform {
     /// Object space to world space.
     pub fn matrix(&self) -> Mat4 {
-        Mat4::from_scale_rotation_translation(
-            Vec3::splat(self.scale),
-            self.rotation,
-            self.translation,
-        )
+        Mat4::from_scale_rotation_translation(Vec3::splat(self.scale), self.rotation, self.translation)
     }
 
     /// Euler angles in degrees as the scene file gives them: R = Rz · Ry · Rx, so X is applied
@@ -42,10 +34,7 @@ impl Transform {
     /// rotation. A quaternion that is only slightly off unit length is renormalized.
     pub fn validated(mut self) -> Result<Transform, SceneError> {
         if !self.translation.is_finite() {
-            return Err(SceneError::invalid(format!(
-                "translation {} is not finite",
-                self.translation
-            )));
+            return Err(SceneError::invalid(format!("translation {} is not finite", self.translation)));
         }
         if !(self.scale.is_finite() && self.scale > 0.0) {
             return Err(SceneError::invalid(format!(
@@ -54,10 +43,7 @@ impl Transform {
             )));
         }
         if !self.rotation.is_finite() || self.rotation.length_squared() == 0.0 {
-            return Err(SceneError::invalid(format!(
-                "rotation {} is not a rotation",
-                self.rotation
-            )));
+            return Err(SceneError::invalid(format!("rotation {} is not a rotation", self.rotation)));
         }
         // Leave unit quaternions untouched so that a written and re-read scene is bit-identical.
         if !self.rotation.is_normalized() {
@@ -99,23 +85,9 @@ mod tests {
         let ok = Transform::default();
         assert!(ok.validated().is_ok());
         for scale in [0.0, -1.0, f32::NAN, f32::INFINITY] {
-            assert!(Transform { scale, ..ok }
-                .validated()
-                .unwrap_err()
-                .to_string()
-                .contains("scale"));
+            assert!(Transform { scale, ..ok }.validated().unwrap_err().to_string().contains("scale"));
         }
-        assert!(Transform {
-            translation: Vec3::new(0.0, f32::NAN, 0.0),
-            ..ok
-        }
-        .validated()
-        .is_err());
-        assert!(Transform {
-            rotation: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
-            ..ok
-        }
-        .validated()
-        .is_err());
+        assert!(Transform { translation: Vec3::new(0.0, f32::NAN, 0.0), ..ok }.validated().is_err());
+        assert!(Transform { rotation: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0), ..ok }.validated().is_err());
     }
 }

@@ -167,9 +167,7 @@ impl ShRgb9 {
     /// when it has fewer than 3 bands.
     pub fn from_f64(coeffs: &[[f64; 3]]) -> Option<Self> {
         let coeffs = coeffs.get(..9)?;
-        Some(Self {
-            c: std::array::from_fn(|i| coeffs[i].map(|v| v as f32)),
-        })
+        Some(Self { c: std::array::from_fn(|i| coeffs[i].map(|v| v as f32)) })
     }
 
     /// Irradiance at a surface with unit normal `n` (Ramamoorthi & Hanrahan 2001, eq. 7):
@@ -209,13 +207,7 @@ impl ShRgb9 {
 /// c1..c5 of Ramamoorthi & Hanrahan eq. 12. The off-diagonal entries appear twice in `nᵀMn`,
 /// hence the halves: e.g. `2·c1·xy` must give `Â2·K_2^-2·xy` with `K_2^-2 = 2·K_2^2`.
 fn irradiance_matrix_constants() -> [f64; 5] {
-    [
-        A_HAT[2] * K[8],
-        A_HAT[1] * K[3] / 2.0,
-        3.0 * A_HAT[2] * K[6],
-        A_HAT[0] * K[0],
-        A_HAT[2] * K[6],
-    ]
+    [A_HAT[2] * K[8], A_HAT[1] * K[3] / 2.0, 3.0 * A_HAT[2] * K[6], A_HAT[0] * K[0], A_HAT[2] * K[6]]
 }
 
 /// Exact solid angle of one texel in row `row` of a `width`×`height` equirectangular map:
@@ -245,12 +237,7 @@ pub fn equirect_direction(u: f64, v: f64) -> DVec3 {
 ///
 /// Errors (as [`Error::InvalidArgument`]) on `bands` outside `1..=MAX_BANDS`, a zero size, a
 /// pixel count other than `width·height`, or a NaN or infinite pixel.
-pub fn project_equirect(
-    width: u32,
-    height: u32,
-    pixels: &[[f32; 3]],
-    bands: usize,
-) -> Result<Vec<[f64; 3]>> {
+pub fn project_equirect(width: u32, height: u32, pixels: &[[f32; 3]], bands: usize) -> Result<Vec<[f64; 3]>> {
     if !(1..=MAX_BANDS).contains(&bands) {
         return Err(Error::InvalidArgument(format!(
             "SH projection onto {bands} bands: Kage supports 1 to {MAX_BANDS}"
@@ -313,8 +300,7 @@ mod tests {
             let mut prev = pmm;
             p = ct * (2 * am + 1) as f64 * pmm;
             for ll in (am + 2)..=l {
-                let next =
-                    ((2 * ll - 1) as f64 * ct * p - (ll + am - 1) as f64 * prev) / (ll - am) as f64;
+                let next = ((2 * ll - 1) as f64 * ct * p - (ll + am - 1) as f64 * prev) / (ll - am) as f64;
                 prev = p;
                 p = next;
             }
@@ -333,12 +319,7 @@ mod tests {
             .map(|i| {
                 // A spread of directions that avoids the axes.
                 let t = i as f64;
-                DVec3::new(
-                    (t * 1.7).sin(),
-                    (t * 0.37 + 0.2).cos(),
-                    (t * 2.9).sin() + 0.1,
-                )
-                .normalize()
+                DVec3::new((t * 1.7).sin(), (t * 0.37 + 0.2).cos(), (t * 2.9).sin() + 0.1).normalize()
             })
             .collect()
     }
@@ -364,10 +345,8 @@ mod tests {
 
     #[test]
     fn low_order_constants_match_the_published_values() {
-        let published = [
-            0.282095, 0.488603, 0.488603, 0.488603, 1.092548, 1.092548, 0.315392, 1.092548,
-            0.546274,
-        ];
+        let published =
+            [0.282095, 0.488603, 0.488603, 0.488603, 1.092548, 1.092548, 0.315392, 1.092548, 0.546274];
         for (k, p) in K.iter().zip(published) {
             assert!((k - p).abs() < 5e-7, "{k} vs {p}");
         }
@@ -382,11 +361,7 @@ mod tests {
                 for m in -(l as i64)..=(l as i64) {
                     let i = (l * (l + 1)) as i64 + m;
                     let r = reference_basis(l, m, d);
-                    assert!(
-                        (out[i as usize] - r).abs() < 1e-12,
-                        "l={l} m={m}: {} vs {r}",
-                        out[i as usize]
-                    );
+                    assert!((out[i as usize] - r).abs() < 1e-12, "l={l} m={m}: {} vs {r}", out[i as usize]);
                 }
             }
         }
@@ -416,11 +391,7 @@ mod tests {
         for (i, row) in gram.iter().enumerate() {
             for (j, g) in row.iter().enumerate() {
                 let expected = if i == j { 1.0 } else { 0.0 };
-                assert!(
-                    (g * d_omega - expected).abs() < 1e-5,
-                    "<y{i}, y{j}> = {}",
-                    g * d_omega
-                );
+                assert!((g * d_omega - expected).abs() < 1e-5, "<y{i}, y{j}> = {}", g * d_omega);
             }
         }
     }
@@ -439,9 +410,7 @@ mod tests {
     #[test]
     fn solid_angles_sum_to_the_sphere() {
         for (w, h) in [(1, 1), (8, 4), (512, 256), (7, 3)] {
-            let total: f64 = (0..h)
-                .map(|r| w as f64 * equirect_texel_solid_angle(w, h, r))
-                .sum();
+            let total: f64 = (0..h).map(|r| w as f64 * equirect_texel_solid_angle(w, h, r)).sum();
             assert!((total - 4.0 * PI).abs() < 1e-9, "{w}×{h}: {total}");
         }
         assert_eq!(equirect_texel_solid_angle(8, 4, 4), 0.0);
@@ -509,11 +478,7 @@ mod tests {
             let expected = [a.y * s * scale, a.z * s * scale, a.x * s * scale];
             for (i, e) in expected.iter().enumerate() {
                 let got = coeffs[1 + i][ch];
-                assert!(
-                    (got - e).abs() < 1e-4 * s,
-                    "ch {ch} coefficient {}: {got} vs {e}",
-                    1 + i
-                );
+                assert!((got - e).abs() < 1e-4 * s, "ch {ch} coefficient {}: {got} vs {e}", 1 + i);
             }
             for (i, c) in coeffs.iter().enumerate().skip(4) {
                 assert!(c[ch].abs() < 1e-4, "ch {ch} coefficient {i}: {}", c[ch]);
@@ -554,11 +519,7 @@ mod tests {
             let n4 = n.extend(1.0);
             for ch in 0..3 {
                 let quad = n4.dot(m[ch] * n4);
-                assert!(
-                    (quad - direct[ch]).abs() < 1e-5,
-                    "{n} ch {ch}: {quad} vs {}",
-                    direct[ch]
-                );
+                assert!((quad - direct[ch]).abs() < 1e-5, "{n} ch {ch}: {quad} vs {}", direct[ch]);
             }
         }
     }

@@ -63,13 +63,10 @@ fn pseudo_inverses() -> &'static [Vec<f64>] {
 /// Inverse of an n×n well-conditioned matrix (Gauss–Jordan with partial pivoting).
 fn invert(m: &[f64], n: usize) -> Vec<f64> {
     let mut a = m.to_vec();
-    let mut inv: Vec<f64> = (0..n * n)
-        .map(|i| if i / n == i % n { 1.0 } else { 0.0 })
-        .collect();
+    let mut inv: Vec<f64> = (0..n * n).map(|i| if i / n == i % n { 1.0 } else { 0.0 }).collect();
     for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&x, &y| a[x * n + col].abs().total_cmp(&a[y * n + col].abs()))
-            .unwrap_or(col);
+        let pivot =
+            (col..n).max_by(|&x, &y| a[x * n + col].abs().total_cmp(&a[y * n + col].abs())).unwrap_or(col);
         for k in 0..n {
             a.swap(col * n + k, pivot * n + k);
             inv.swap(col * n + k, pivot * n + k);
@@ -110,9 +107,7 @@ pub fn rotate(coeffs: &[[f64; 3]], bands: usize, rotation: DMat3) -> Vec<[f64; 3
         // D = B P with B[m][k] = y_lm(R ω_k); g = Dᵀ c.
         for m in 0..n {
             for j in 0..n {
-                let d: f64 = (0..dirs.len())
-                    .map(|k| rotated[k][first + m] * p[k * n + j])
-                    .sum();
+                let d: f64 = (0..dirs.len()).map(|k| rotated[k][first + m] * p[k * n + j]).sum();
                 for ch in 0..3 {
                     out[first + j][ch] += d * coeffs.get(first + m).map_or(0.0, |c| c[ch]);
                 }
@@ -161,42 +156,28 @@ mod tests {
     #[test]
     fn rotated_coefficients_are_those_of_the_rotated_function() {
         let r = DMat3::from_euler(glam::EulerRot::ZYX, 0.7, -1.1, 0.4);
-        let c: Vec<[f64; 3]> = project(f, 5)
-            .into_iter()
-            .map(|v| [v, 2.0 * v, -v])
-            .collect();
+        let c: Vec<[f64; 3]> = project(f, 5).into_iter().map(|v| [v, 2.0 * v, -v]).collect();
         let rotated = rotate(&c, 5, r);
         let expected = project(|w| f(r * w), 5);
         // The midpoint quadrature of `project` is good to a few 1e-5 of the largest coefficient;
         // the rotation itself is exact to rounding (next test).
         let scale = expected.iter().fold(0.0f64, |m, e| m.max(e.abs()));
         for (i, e) in expected.iter().enumerate() {
-            assert!(
-                (rotated[i][0] - e).abs() < 1e-4 * scale,
-                "coefficient {i}: {} vs {e}",
-                rotated[i][0]
-            );
+            assert!((rotated[i][0] - e).abs() < 1e-4 * scale, "coefficient {i}: {} vs {e}", rotated[i][0]);
             assert!((rotated[i][1] - 2.0 * e).abs() < 2e-4 * scale);
         }
     }
 
     #[test]
     fn identity_and_inverse_round_trip_exactly() {
-        let c: Vec<[f64; 3]> = (0..25)
-            .map(|i| [i as f64 * 0.1 - 1.0, (i * i) as f64 * 0.01, 1.0])
-            .collect();
+        let c: Vec<[f64; 3]> = (0..25).map(|i| [i as f64 * 0.1 - 1.0, (i * i) as f64 * 0.01, 1.0]).collect();
         let same = rotate(&c, 5, DMat3::IDENTITY);
         let r = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 2.3);
         let back = rotate(&rotate(&c, 5, r), 5, r.transpose());
         for i in 0..25 {
             for ch in 0..3 {
                 assert!((same[i][ch] - c[i][ch]).abs() < 1e-12);
-                assert!(
-                    (back[i][ch] - c[i][ch]).abs() < 1e-10,
-                    "{i}: {} vs {}",
-                    back[i][ch],
-                    c[i][ch]
-                );
+                assert!((back[i][ch] - c[i][ch]).abs() < 1e-10, "{i}: {} vs {}", back[i][ch], c[i][ch]);
             }
         }
     }

@@ -14,19 +14,22 @@ pub struct Background {
 
 impl Background {
     pub fn new(ctx: &Arc<Context>) -> Result<Background> {
-        let pipeline = GraphicsPipeline::new(ctx, &GraphicsDesc {
-            name: "background",
-            vertex_spirv: spirv::BACKGROUND_VERT,
-            fragment_spirv: spirv::BACKGROUND_FRAG,
-            bindings: &[BindingKind::UniformBuffer, BindingKind::SampledImage],
-            push_size: 0,
-            vertex_buffers: &[],
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            color_formats: &[COLOR_FORMAT],
-            depth_format: None,
-            depth_test: false,
-            additive: false,
-        })?;
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "background",
+                vertex_spirv: spirv::BACKGROUND_VERT,
+                fragment_spirv: spirv::BACKGROUND_FRAG,
+                bindings: &[BindingKind::UniformBuffer, BindingKind::SampledImage],
+                push_size: 0,
+                vertex_buffers: &[],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[COLOR_FORMAT],
+                depth_format: None,
+                depth_test: false,
+                additive: false,
+            },
+        )?;
         Ok(Background { pipeline })
     }
 
@@ -35,7 +38,8 @@ impl Background {
             (inputs.ctx, inputs.uniforms, inputs.environment, &inputs.targets.color);
         Pass::new("background", &["frame_uniforms", "environment"], &["color"], move |cmd| {
             ctx.begin_rendering(cmd, Some(color.into()), Some([0.0; 4]), None);
-            self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Sampled(&env.image, &env.sampler)]);
+            self.pipeline
+                .bind(cmd, &[Binding::Uniform(uniforms), Binding::Sampled(&env.image, &env.sampler)]);
             ctx.draw(cmd, &[], 3);
             ctx.end_rendering(cmd);
         })

@@ -67,41 +67,22 @@ impl EnvSh {
 
     /// The two passes; they read "environment" and write "env_sh".
     pub fn passes<'a>(&'a self, env: &'a GpuEnvironment) -> [Pass<'a>; 2] {
-        let project_push = ShProjectPush {
-            size: [
-                self.size[0],
-                self.size[1],
-                constants::SH_TEXELS_PER_INVOCATION,
-                0,
-            ],
-        };
-        let reduce_push = ShProjectPush {
-            size: [self.groups, 0, 0, 0],
-        };
+        let project_push =
+            ShProjectPush { size: [self.size[0], self.size[1], constants::SH_TEXELS_PER_INVOCATION, 0] };
+        let reduce_push = ShProjectPush { size: [self.groups, 0, 0, 0] };
         [
-            Pass::new(
-                "sh_project",
-                &["environment"],
-                &["sh_partials"],
-                move |cmd| {
-                    self.project.dispatch(
-                        cmd,
-                        &[
-                            Binding::Sampled(&env.image, &env.sampler),
-                            Binding::Storage(&self.partials),
-                        ],
-                        bytes_of(&project_push),
-                        [self.groups, 1, 1],
-                    )
-                },
-            ),
+            Pass::new("sh_project", &["environment"], &["sh_partials"], move |cmd| {
+                self.project.dispatch(
+                    cmd,
+                    &[Binding::Sampled(&env.image, &env.sampler), Binding::Storage(&self.partials)],
+                    bytes_of(&project_push),
+                    [self.groups, 1, 1],
+                )
+            }),
             Pass::new("sh_reduce", &["sh_partials"], &["env_sh"], move |cmd| {
                 self.reduce.dispatch(
                     cmd,
-                    &[
-                        Binding::Storage(&self.partials),
-                        Binding::Storage(&self.coefficients),
-                    ],
+                    &[Binding::Storage(&self.partials), Binding::Storage(&self.coefficients)],
                     bytes_of(&reduce_push),
                     [1, 1, 1],
                 )

@@ -24,12 +24,8 @@ impl GpuEnvironment {
                 usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
             },
         )?;
-        let texels: Vec<u8> = map
-            .pixels()
-            .iter()
-            .flat_map(|p| [p[0], p[1], p[2], 0.0])
-            .flat_map(f32::to_ne_bytes)
-            .collect();
+        let texels: Vec<u8> =
+            map.pixels().iter().flat_map(|p| [p[0], p[1], p[2], 0.0]).flat_map(f32::to_ne_bytes).collect();
         image.upload(&texels)?;
         let sampler = Sampler::new(ctx, "environment.sampler", true, true)?;
         Ok(GpuEnvironment { image, sampler })

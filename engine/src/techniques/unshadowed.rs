@@ -27,19 +27,22 @@ pub struct Unshadowed {
 
 impl Unshadowed {
     pub fn new(ctx: &Arc<Context>) -> Result<Unshadowed> {
-        let scene = GraphicsPipeline::new(ctx, &GraphicsDesc {
-            name: "scene_unshadowed",
-            vertex_spirv: spirv::SCENE_VERT,
-            fragment_spirv: spirv::SCENE_FRAG,
-            bindings: &[BindingKind::UniformBuffer, BindingKind::StorageBuffer],
-            push_size: size_of::<DrawPush>() as u32,
-            vertex_buffers: &[MESH_VERTICES],
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            color_formats: &[COLOR_FORMAT],
-            depth_format: Some(DEPTH_FORMAT),
-            depth_test: true,
-            additive: false,
-        })?;
+        let scene = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "scene_unshadowed",
+                vertex_spirv: spirv::SCENE_VERT,
+                fragment_spirv: spirv::SCENE_FRAG,
+                bindings: &[BindingKind::UniformBuffer, BindingKind::StorageBuffer],
+                push_size: size_of::<DrawPush>() as u32,
+                vertex_buffers: &[MESH_VERTICES],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[COLOR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                additive: false,
+            },
+        )?;
         Ok(Unshadowed { scene })
     }
 }

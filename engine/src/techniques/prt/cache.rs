@@ -59,25 +59,20 @@ impl fmt::Display for Stale {
             Stale::Missing => write!(f, "no cache file yet"),
             Stale::Unreadable(e) => write!(f, "the cache file cannot be read: {e}"),
             Stale::NotACacheFile => write!(f, "the file is not a Kage PRT cache (wrong magic)"),
-            Stale::Version { found } => write!(
-                f,
-                "it has format version {found}; this Kage writes version {FORMAT_VERSION}"
-            ),
+            Stale::Version { found } => {
+                write!(f, "it has format version {found}; this Kage writes version {FORMAT_VERSION}")
+            }
             Stale::Truncated { bytes, expected } => {
                 write!(f, "it is truncated: {bytes} bytes of {expected}")
             }
-            Stale::TrailingBytes { bytes, expected } => write!(
-                f,
-                "it has {bytes} bytes where its header says {expected}: extra data at the end"
-            ),
+            Stale::TrailingBytes { bytes, expected } => {
+                write!(f, "it has {bytes} bytes where its header says {expected}: extra data at the end")
+            }
             Stale::Bands { found, wanted } => {
                 write!(f, "it holds {found} SH bands; {wanted} were asked for")
             }
             Stale::Rays { found, wanted } => {
-                write!(
-                    f,
-                    "it was made with {found} rays per vertex; {wanted} were asked for"
-                )
+                write!(f, "it was made with {found} rays per vertex; {wanted} were asked for")
             }
             Stale::Geometry => write!(f, "the scene's geometry changed since it was made"),
             Stale::Meshes(what) => write!(f, "its meshes do not match the scene: {what}"),
@@ -106,11 +101,7 @@ pub struct CacheKey {
 
 impl CacheKey {
     pub fn new(scene: &Scene, params: PrtParams) -> CacheKey {
-        CacheKey {
-            params,
-            geometry: geometry_hash(scene),
-            layout: mesh_layout(scene),
-        }
+        CacheKey { params, geometry: geometry_hash(scene), layout: mesh_layout(scene) }
     }
 
     /// `<scene name>-<16 hex digits>.kageprt`: the digits hash the geometry, the parameters and
@@ -124,13 +115,7 @@ impl CacheKey {
         h.write(&FORMAT_VERSION.to_le_bytes());
         let name: String = scene_name
             .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                    c
-                } else {
-                    '_'
-                }
-            })
+            .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
             .collect();
         let name = if name.is_empty() { "scene" } else { &name };
         format!("{name}-{:016x}.{EXTENSION}", h.finish())
@@ -185,10 +170,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(Stale::NotACacheFile);
     }
-    let truncated = |expected| Stale::Truncated {
-        bytes: bytes.len(),
-        expected,
-    };
+    let truncated = |expected| Stale::Truncated { bytes: bytes.len(), expected };
     let mut r = Reader { bytes, at: 8 };
     let version = r.u32().ok_or(truncated(HEADER_BYTES))?;
     if version != FORMAT_VERSION {
@@ -205,16 +187,10 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
     let checksum = r.u64().unwrap_or_default();
 
     if bands != key.params.bands {
-        return Err(Stale::Bands {
-            found: bands,
-            wanted: key.params.bands,
-        });
+        return Err(Stale::Bands { found: bands, wanted: key.params.bands });
     }
     if rays != key.params.rays {
-        return Err(Stale::Rays {
-            found: rays,
-            wanted: key.params.rays,
-        });
+        return Err(Stale::Rays { found: rays, wanted: key.params.rays });
     }
     if geometry != key.geometry {
         return Err(Stale::Geometry);
@@ -238,10 +214,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
         return Err(truncated(expected));
     }
     if bytes.len() > expected {
-        return Err(Stale::TrailingBytes {
-            bytes: bytes.len(),
-            expected,
-        });
+        return Err(Stale::TrailingBytes { bytes: bytes.len(), expected });
     }
     for (at, &(group, mesh, vertices)) in key.layout.iter().enumerate() {
         let entry = [r.u32(), r.u32(), r.u32()].map(|v| v.unwrap_or_default() as usize);
@@ -259,9 +232,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
     if h.finish() != checksum {
         return Err(Stale::Checksum);
     }
-    let mut floats = data
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]));
+    let mut floats = data.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]));
     let meshes = key
         .layout
         .iter()
@@ -271,11 +242,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
             coefficients: floats.by_ref().take(vertices * coeffs).collect(),
         })
         .collect();
-    Ok(TransferSet {
-        params: key.params,
-        seconds,
-        meshes,
-    })
+    Ok(TransferSet { params: key.params, seconds, meshes })
 }
 
 /// Writes `set` to `path` atomically (a temporary file in the same folder, then a rename), so a
@@ -302,11 +269,7 @@ pub fn save(path: &Path, set: &TransferSet, key: &CacheKey) -> Result<u64, Cache
 
 fn fail(action: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> CacheWriteError {
     let path = path.to_path_buf();
-    move |source| CacheWriteError {
-        action,
-        path,
-        source,
-    }
+    move |source| CacheWriteError { action, path, source }
 }
 
 fn encode(set: &TransferSet, key: &CacheKey) -> Vec<u8> {
@@ -318,12 +281,7 @@ fn encode(set: &TransferSet, key: &CacheKey) -> Vec<u8> {
     checksum.write(&data);
     let mut out = Vec::with_capacity(HEADER_BYTES + 12 * set.meshes.len() + data.len());
     out.extend_from_slice(&MAGIC);
-    for v in [
-        FORMAT_VERSION,
-        set.params.bands,
-        set.params.rays,
-        set.meshes.len() as u32,
-    ] {
+    for v in [FORMAT_VERSION, set.params.bands, set.params.rays, set.meshes.len() as u32] {
         out.extend_from_slice(&v.to_le_bytes());
     }
     out.extend_from_slice(&(set.vertex_count() as u64).to_le_bytes());
@@ -413,16 +371,9 @@ mod tests {
 
     #[test]
     fn file_names_are_safe_and_keyed() {
-        let key = |bands| CacheKey {
-            params: PrtParams { bands, rays: 64 },
-            geometry: 7,
-            layout: Vec::new(),
-        };
+        let key = |bands| CacheKey { params: PrtParams { bands, rays: 64 }, geometry: 7, layout: Vec::new() };
         let name = key(3).file_name("../my scene");
-        assert!(
-            name.starts_with("___my_scene-") && name.ends_with(".kageprt"),
-            "{name}"
-        );
+        assert!(name.starts_with("___my_scene-") && name.ends_with(".kageprt"), "{name}");
         assert_ne!(name, key(4).file_name("../my scene"));
         assert!(key(3).file_name("").starts_with("scene-"));
     }

@@ -77,11 +77,7 @@ mod tests {
             let expected = clamped_cosine(5, n);
             for (i, (s, e)) in sum.iter().zip(&expected).enumerate() {
                 // The kink of max(·, 0) limits the midpoint rule: 4.5e-6 at worst at this resolution.
-                assert!(
-                    (s * d_omega - e).abs() < 2e-5,
-                    "n={n} i={i}: {} vs {e}",
-                    s * d_omega
-                );
+                assert!((s * d_omega - e).abs() < 2e-5, "n={n} i={i}: {} vs {e}", s * d_omega);
             }
         }
     }

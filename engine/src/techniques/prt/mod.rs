@@ -40,10 +40,7 @@ pub struct PrtParams {
 impl PrtParams {
     /// 3 bands as in the paper; 2048 rays keep the unshadowed error of every coefficient below
     /// 1e-3 (the quasi-Monte Carlo error falls about as 1/N: ~5e-4 at 1024, ~1e-4 at 4096).
-    pub const DEFAULT: PrtParams = PrtParams {
-        bands: 3,
-        rays: 2048,
-    };
+    pub const DEFAULT: PrtParams = PrtParams { bands: 3, rays: 2048 };
 
     pub fn validated(self) -> Result<PrtParams> {
         if !(MIN_BANDS..=MAX_BANDS).contains(&self.bands) {
@@ -96,10 +93,7 @@ pub struct TransferSet {
 
 impl TransferSet {
     pub fn vertex_count(&self) -> usize {
-        self.meshes
-            .iter()
-            .map(|m| m.coefficients.len() / self.params.coeffs())
-            .sum()
+        self.meshes.iter().map(|m| m.coefficients.len() / self.params.coeffs()).sum()
     }
 
     /// Bytes of coefficient data (f32), what the GPU would hold.
@@ -110,10 +104,7 @@ impl TransferSet {
     /// The coefficients of one vertex; `None` out of range.
     pub fn vertex(&self, group: usize, mesh: usize, vertex: usize) -> Option<&[f32]> {
         let n = self.params.coeffs();
-        let m = self
-            .meshes
-            .iter()
-            .find(|m| m.group == group && m.mesh == mesh)?;
+        let m = self.meshes.iter().find(|m| m.group == group && m.mesh == mesh)?;
         m.coefficients.get(vertex * n..(vertex + 1) * n)
     }
 }
@@ -126,11 +117,7 @@ pub(crate) fn mesh_layout(scene: &Scene) -> Vec<(usize, usize, usize)> {
         .iter()
         .enumerate()
         .flat_map(|(g, group)| {
-            group
-                .meshes
-                .iter()
-                .enumerate()
-                .map(move |(m, mesh)| (g, m, mesh.vertex_count()))
+            group.meshes.iter().enumerate().map(move |(m, mesh)| (g, m, mesh.vertex_count()))
         })
         .collect()
 }

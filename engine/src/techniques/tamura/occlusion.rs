@@ -25,7 +25,9 @@ use crate::backend::{
     Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
 use crate::error::Result;
-use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis};
+use crate::layouts::{
+    bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
+};
 use crate::pass::Pass;
 use crate::renderer::GpuScene;
 use crate::sh;
@@ -108,25 +110,37 @@ pub struct Occlusion {
 
 const MASK_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
-fn layered(ctx: &Arc<Context>, name: &str, size: u32, layers: u32, usage: vk::ImageUsageFlags) -> Result<Image> {
-    Image::new(ctx, &ImageDesc {
-        name,
-        width: size,
-        height: size,
-        layers,
-        array: true,
-        format: MASK_FORMAT,
-        usage: usage | vk::ImageUsageFlags::STORAGE,
-    })
+fn layered(
+    ctx: &Arc<Context>,
+    name: &str,
+    size: u32,
+    layers: u32,
+    usage: vk::ImageUsageFlags,
+) -> Result<Image> {
+    Image::new(
+        ctx,
+        &ImageDesc {
+            name,
+            width: size,
+            height: size,
+            layers,
+            array: true,
+            format: MASK_FORMAT,
+            usage: usage | vk::ImageUsageFlags::STORAGE,
+        },
+    )
 }
 
 fn host_buffer(ctx: &Arc<Context>, name: &str, size: usize) -> Result<Buffer> {
-    Buffer::new(ctx, &BufferDesc {
-        name,
-        size: size.max(16) as u64,
-        usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::UNIFORM_BUFFER,
-        location: MemoryLocation::CpuToGpu,
-    })
+    Buffer::new(
+        ctx,
+        &BufferDesc {
+            name,
+            size: size.max(16) as u64,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::UNIFORM_BUFFER,
+            location: MemoryLocation::CpuToGpu,
+        },
+    )
 }
 
 /// Two unit vectors completing `w` to an orthonormal basis.
@@ -159,19 +173,22 @@ impl Occlusion {
             .collect();
         energy.write(0, &rgb)?;
         Ok(Occlusion {
-            mask_pipeline: GraphicsPipeline::new(ctx, &GraphicsDesc {
-                name: "occluder_mask",
-                vertex_spirv: spirv::OCCLUDER_MASK_VERT,
-                fragment_spirv: spirv::OCCLUDER_MASK_FRAG,
-                bindings: &[BindingKind::StorageBuffer],
-                push_size: size_of::<MaskPush>() as u32,
-                vertex_buffers: &[MESH_POSITIONS],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[MASK_FORMAT],
-                depth_format: None,
-                depth_test: false,
-                additive: false,
-            })?,
+            mask_pipeline: GraphicsPipeline::new(
+                ctx,
+                &GraphicsDesc {
+                    name: "occluder_mask",
+                    vertex_spirv: spirv::OCCLUDER_MASK_VERT,
+                    fragment_spirv: spirv::OCCLUDER_MASK_FRAG,
+                    bindings: &[BindingKind::StorageBuffer],
+                    push_size: size_of::<MaskPush>() as u32,
+                    vertex_buffers: &[MESH_POSITIONS],
+                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                    color_formats: &[MASK_FORMAT],
+                    depth_format: None,
+                    depth_test: false,
+                    additive: false,
+                },
+            )?,
             blur: ComputePipeline::new(
                 ctx,
                 "occlusion_blur",
@@ -179,9 +196,21 @@ impl Occlusion {
                 &[BindingKind::StorageBuffer, BindingKind::StorageImage, BindingKind::StorageImage],
                 size_of::<BlurPush>() as u32,
             )?,
-            mask: layered(ctx, "occlusion.mask", resolution, layer_count, vk::ImageUsageFlags::COLOR_ATTACHMENT)?,
+            mask: layered(
+                ctx,
+                "occlusion.mask",
+                resolution,
+                layer_count,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT,
+            )?,
             temp: layered(ctx, "occlusion.temp", resolution, layer_count, vk::ImageUsageFlags::empty())?,
-            filtered: layered(ctx, "occlusion.filtered", resolution, layer_count, vk::ImageUsageFlags::SAMPLED)?,
+            filtered: layered(
+                ctx,
+                "occlusion.filtered",
+                resolution,
+                layer_count,
+                vk::ImageUsageFlags::SAMPLED,
+            )?,
             sampler: Sampler::new(ctx, "occlusion.sampler", true, false)?,
             layers: host_buffer(ctx, "occlusion.layers", layer_count as usize * size_of::<OcclusionLayer>())?,
             energy,
@@ -210,7 +239,8 @@ impl Occlusion {
             .zip(transforms)
             .map(|(b, t)| (t.transform_point3(b.centre), b.radius * t.x_axis.truncate().length()))
             .collect();
-        let directions: Vec<Vec3> = self.regions.regions.iter().map(|r| env * r.direction.as_vec3()).collect();
+        let directions: Vec<Vec3> =
+            self.regions.regions.iter().map(|r| env * r.direction.as_vec3()).collect();
 
         let mut jobs = Vec::new();
         for (r, &(receiver_centre, receiver_radius)) in world.iter().enumerate() {
@@ -221,7 +251,9 @@ impl Occlusion {
                 if energy <= 0.0 || self.bounds[r].faces_away_from(to_object * w) {
                     continue;
                 }
-                for (o, &(occluder_centre, occluder_radius)) in world.iter().enumerate().filter(|&(o, _)| o != r) {
+                for (o, &(occluder_centre, occluder_radius)) in
+                    world.iter().enumerate().filter(|&(o, _)| o != r)
+                {
                     if self.bounds[o].reach_along(&transforms[o], receiver_centre, w) <= 0.0 {
                         continue;
                     }
@@ -304,7 +336,11 @@ impl Occlusion {
             let push = BlurPush { params: [u32::from(!horizontal), self.resolution, count, 0] };
             self.blur.dispatch(
                 cmd,
-                &[Binding::Storage(&self.layers), Binding::StorageImage(source), Binding::StorageImage(target)],
+                &[
+                    Binding::Storage(&self.layers),
+                    Binding::StorageImage(source),
+                    Binding::StorageImage(target),
+                ],
                 bytes_of(&push),
                 groups,
             );

@@ -68,8 +68,7 @@ fn relaxation_samples(map: &EnvMap) -> Vec<Sample> {
             let mut sum = [0.0f64; 3];
             for dy in 0..factor {
                 for dx in 0..factor {
-                    let p =
-                        map.pixels()[((y * factor + dy) * map.width() + x * factor + dx) as usize];
+                    let p = map.pixels()[((y * factor + dy) * map.width() + x * factor + dx) as usize];
                     for k in 0..3 {
                         sum[k] += p[k] as f64;
                     }
@@ -84,10 +83,7 @@ fn relaxation_samples(map: &EnvMap) -> Vec<Sample> {
     }
     let total: f64 = samples.iter().map(|s| s.energy).sum();
     let area = 4.0 * std::f64::consts::PI;
-    for (s, y) in samples
-        .iter_mut()
-        .zip((0..h).flat_map(|y| (0..w).map(move |_| y)))
-    {
+    for (s, y) in samples.iter_mut().zip((0..h).flat_map(|y| (0..w).map(move |_| y))) {
         let share = if total > 0.0 { s.energy / total } else { 0.0 };
         s.energy = 0.5 * share + 0.5 * equirect_texel_solid_angle(w, h, y) / area;
     }
@@ -142,9 +138,7 @@ fn relax(samples: &[Sample], mut sites: Vec<DVec3>) -> Vec<DVec3> {
             if centroid[i].length_squared() > 0.0 {
                 sites[i] = centroid[i].normalize();
             } else {
-                let busiest = (0..q)
-                    .max_by(|&a, &b| energy[a].total_cmp(&energy[b]))
-                    .unwrap_or(0);
+                let busiest = (0..q).max_by(|&a, &b| energy[a].total_cmp(&energy[b])).unwrap_or(0);
                 let brightest = samples
                     .iter()
                     .zip(&owner)
@@ -192,9 +186,7 @@ impl Regions {
     /// Splits `map` into `q` regions (1 ≤ q ≤ [`MAX_REGIONS`]).
     pub fn new(map: &EnvMap, q: usize) -> Result<Regions> {
         if !(1..=MAX_REGIONS).contains(&q) {
-            return Err(Error::InvalidArgument(format!(
-                "regions: q = {q}, must be 1 to {MAX_REGIONS}"
-            )));
+            return Err(Error::InvalidArgument(format!("regions: q = {q}, must be 1 to {MAX_REGIONS}")));
         }
         let samples = relaxation_samples(map);
         let sites = relax(&samples, initial_sites(&samples, q));
@@ -203,13 +195,8 @@ impl Regions {
         let texels: Vec<(DVec3, f64, [f64; 3])> = (0..w * h)
             .map(|t| {
                 let (x, y) = (t % w, t / w);
-                let dir =
-                    equirect_direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-                (
-                    dir,
-                    equirect_texel_solid_angle(w, h, y),
-                    map.pixels()[t as usize].map(f64::from),
-                )
+                let dir = equirect_direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                (dir, equirect_texel_solid_angle(w, h, y), map.pixels()[t as usize].map(f64::from))
             })
             .collect();
         let (sites, texel_region) = assign_without_empty_regions(&texels, sites);
@@ -236,21 +223,12 @@ impl Regions {
                 solid_angle: solid_angle[i],
             })
             .collect();
-        Ok(Regions {
-            regions,
-            texel_region,
-        })
+        Ok(Regions { regions, texel_region })
     }
 
     /// Σ B_i: the map's total energy per channel.
     pub fn total_energy(&self) -> [f64; 3] {
-        let mut total = [0.0; 3];
-        for r in &self.regions {
-            for k in 0..3 {
-                total[k] += r.energy[k];
-            }
-        }
-        total
+        std::array::from_fn(|k| self.regions.iter().map(|r| r.energy[k]).sum())
     }
 }
 
@@ -262,8 +240,7 @@ mod tests {
     fn map_energy(map: &EnvMap) -> [f64; 3] {
         let mut total = [0.0; 3];
         for (t, p) in map.pixels().iter().enumerate() {
-            let d_omega =
-                equirect_texel_solid_angle(map.width(), map.height(), t as u32 / map.width());
+            let d_omega = equirect_texel_solid_angle(map.width(), map.height(), t as u32 / map.width());
             for k in 0..3 {
                 total[k] += p[k] as f64 * d_omega;
             }
@@ -305,10 +282,7 @@ mod tests {
             }
             let omega: f64 = regions.regions.iter().map(|r| r.solid_angle).sum();
             assert!((omega - 4.0 * PI).abs() < 1e-9, "q = {q}: {omega}");
-            assert!(
-                regions.regions.iter().all(|r| r.solid_angle > 0.0),
-                "q = {q}: an empty region"
-            );
+            assert!(regions.regions.iter().all(|r| r.solid_angle > 0.0), "q = {q}: an empty region");
         }
     }
 
@@ -317,16 +291,8 @@ mod tests {
         let map = sun_map();
         let regions = Regions::new(&map, 32).unwrap();
         let sun = equirect_direction(61.5 / 256.0, 31.5 / 128.0);
-        let brightest = regions
-            .regions
-            .iter()
-            .max_by(|a, b| a.energy[0].total_cmp(&b.energy[0]))
-            .unwrap();
-        assert!(
-            brightest.direction.dot(sun) > 0.999,
-            "{:?}",
-            brightest.direction
-        );
+        let brightest = regions.regions.iter().max_by(|a, b| a.energy[0].total_cmp(&b.energy[0])).unwrap();
+        assert!(brightest.direction.dot(sun) > 0.999, "{:?}", brightest.direction);
         let mean_solid_angle = 4.0 * PI / 32.0;
         assert!(
             brightest.solid_angle < 0.25 * mean_solid_angle,
@@ -340,10 +306,7 @@ mod tests {
         let regions = Regions::new(&EnvMap::constant([1.0; 3]), 8).unwrap();
         // A constant map: the regions share the sphere roughly evenly.
         for r in &regions.regions {
-            assert!(
-                r.solid_angle > 0.5 * 4.0 * PI / 8.0 && r.solid_angle < 2.0 * 4.0 * PI / 8.0,
-                "{r:?}"
-            );
+            assert!(r.solid_angle > 0.5 * 4.0 * PI / 8.0 && r.solid_angle < 2.0 * 4.0 * PI / 8.0, "{r:?}");
         }
         assert_eq!(regions.texel_region.len(), 64 * 32);
         assert!(Regions::new(&EnvMap::constant([1.0; 3]), 0).is_err());
@@ -355,9 +318,6 @@ mod tests {
         let regions = Regions::new(&EnvMap::constant([0.0; 3]), 4).unwrap();
         let omega: f64 = regions.regions.iter().map(|r| r.solid_angle).sum();
         assert!((omega - 4.0 * PI).abs() < 1e-9);
-        assert!(regions
-            .regions
-            .iter()
-            .all(|r| r.direction.is_finite() && r.energy == [0.0; 3]));
+        assert!(regions.regions.iter().all(|r| r.direction.is_finite() && r.energy == [0.0; 3]));
     }
 }

@@ -19,7 +19,8 @@ const WIDTH: u32 = constants::SELF_SHADOW_WIDTH;
 
 /// The transfer vectors as vertex attributes: `TRANSFER_VEC4` vec4s per vertex, zero-padded.
 const TRANSFER_ATTRIBUTES: [VertexAttribute; TRANSFER_VEC4] = {
-    let mut a = [VertexAttribute { location: 0, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }; TRANSFER_VEC4];
+    let mut a =
+        [VertexAttribute { location: 0, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }; TRANSFER_VEC4];
     let mut i = 0;
     while i < TRANSFER_VEC4 {
         a[i].location = i as u32;
@@ -63,7 +64,12 @@ pub struct SelfShadow {
 }
 
 impl SelfShadow {
-    pub fn new(ctx: &Arc<Context>, scene: &GpuScene, transfer: &TransferSet, env: Vec<[f64; 3]>) -> Result<SelfShadow> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &GpuScene,
+        transfer: &TransferSet,
+        env: Vec<[f64; 3]>,
+    ) -> Result<SelfShadow> {
         let coeffs = transfer.params.coeffs();
         let mut buffers = Vec::new();
         let mut first_texel = Vec::new();
@@ -85,39 +91,53 @@ impl SelfShadow {
                 padded[v * 4 * TRANSFER_VEC4..][..coeffs].copy_from_slice(c);
             }
             let bytes: Vec<u8> = padded.iter().flat_map(|f| f.to_ne_bytes()).collect();
-            buffers.push(Buffer::with_data(ctx, &format!("{}.transfer", mesh.name), vk::BufferUsageFlags::VERTEX_BUFFER, &bytes)?);
+            buffers.push(Buffer::with_data(
+                ctx,
+                &format!("{}.transfer", mesh.name),
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+                &bytes,
+            )?);
             first_texel.push(next);
             next += mesh.vertex_count;
         }
-        let texture = Image::new(ctx, &ImageDesc {
-            name: "self_shadow",
-            width: WIDTH,
-            height: next.div_ceil(WIDTH).max(1),
-            layers: 1,
-            array: false,
-            format: vk::Format::R32G32B32A32_SFLOAT,
-            usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
-        })?;
+        let texture = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "self_shadow",
+                width: WIDTH,
+                height: next.div_ceil(WIDTH).max(1),
+                layers: 1,
+                array: false,
+                format: vk::Format::R32G32B32A32_SFLOAT,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            },
+        )?;
         let groups = scene.transforms.len();
-        let lights = Buffer::new(ctx, &BufferDesc {
-            name: "self_shadow.group_lights",
-            size: (groups.max(1) * size_of::<GroupLight>()) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::CpuToGpu,
-        })?;
-        let pipeline = GraphicsPipeline::new(ctx, &GraphicsDesc {
-            name: "self_shadow",
-            vertex_spirv: spirv::SELF_SHADOW_VERT,
-            fragment_spirv: spirv::SELF_SHADOW_FRAG,
-            bindings: &[BindingKind::StorageBuffer],
-            push_size: size_of::<SelfShadowPush>() as u32,
-            vertex_buffers: &[VertexBuffer { stride: TRANSFER_STRIDE, attributes: &TRANSFER_ATTRIBUTES }],
-            topology: vk::PrimitiveTopology::POINT_LIST,
-            color_formats: &[vk::Format::R32G32B32A32_SFLOAT],
-            depth_format: None,
-            depth_test: false,
-            additive: false,
-        })?;
+        let lights = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "self_shadow.group_lights",
+                size: (groups.max(1) * size_of::<GroupLight>()) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "self_shadow",
+                vertex_spirv: spirv::SELF_SHADOW_VERT,
+                fragment_spirv: spirv::SELF_SHADOW_FRAG,
+                bindings: &[BindingKind::StorageBuffer],
+                push_size: size_of::<SelfShadowPush>() as u32,
+                vertex_buffers: &[VertexBuffer { stride: TRANSFER_STRIDE, attributes: &TRANSFER_ATTRIBUTES }],
+                topology: vk::PrimitiveTopology::POINT_LIST,
+                color_formats: &[vk::Format::R32G32B32A32_SFLOAT],
+                depth_format: None,
+                depth_test: false,
+                additive: false,
+            },
+        )?;
         Ok(SelfShadow {
             pipeline,
             transfer: buffers,

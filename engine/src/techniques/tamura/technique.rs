@@ -3,7 +3,9 @@
 use super::occlusion::{group_bounds, Occlusion};
 use super::regions::Regions;
 use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
-use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer};
+use crate::backend::{
+    vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer,
+};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush};
 use crate::pass::Pass;
@@ -61,7 +63,10 @@ impl PrtTechnique {
             )));
         }
         if !(8..=2048).contains(&settings.mask_size) {
-            return Err(Error::InvalidArgument(format!("mask size {} must be 8 to 2048 texels", settings.mask_size)));
+            return Err(Error::InvalidArgument(format!(
+                "mask size {} must be 8 to 2048 texels",
+                settings.mask_size
+            )));
         }
         let bands = transfer.params.bands as usize;
         let env = crate::sh::project_equirect(
@@ -79,30 +84,40 @@ impl PrtTechnique {
         let transfer_attributes = transfer_vertex_buffer(2);
         Ok(PrtTechnique {
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
-            occlusion: Occlusion::new(ctx, regions, bands, group_bounds(scene), settings.mask_size, capacity)?,
-            scene_pipeline: GraphicsPipeline::new(ctx, &GraphicsDesc {
-                name: "scene_prt",
-                vertex_spirv: spirv::PRT_SCENE_VERT,
-                fragment_spirv: spirv::PRT_SCENE_FRAG,
-                bindings: &[
-                    BindingKind::UniformBuffer,
-                    BindingKind::SampledImage,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::SampledImage,
-                    BindingKind::UniformBuffer,
-                ],
-                push_size: size_of::<PrtDrawPush>() as u32,
-                vertex_buffers: &[
-                    MESH_POSITIONS,
-                    VertexBuffer { stride: TRANSFER_STRIDE, attributes: &transfer_attributes },
-                ],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                additive: false,
-            })?,
+            occlusion: Occlusion::new(
+                ctx,
+                regions,
+                bands,
+                group_bounds(scene),
+                settings.mask_size,
+                capacity,
+            )?,
+            scene_pipeline: GraphicsPipeline::new(
+                ctx,
+                &GraphicsDesc {
+                    name: "scene_prt",
+                    vertex_spirv: spirv::PRT_SCENE_VERT,
+                    fragment_spirv: spirv::PRT_SCENE_FRAG,
+                    bindings: &[
+                        BindingKind::UniformBuffer,
+                        BindingKind::SampledImage,
+                        BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
+                        BindingKind::SampledImage,
+                        BindingKind::UniformBuffer,
+                    ],
+                    push_size: size_of::<PrtDrawPush>() as u32,
+                    vertex_buffers: &[
+                        MESH_POSITIONS,
+                        VertexBuffer { stride: TRANSFER_STRIDE, attributes: &transfer_attributes },
+                    ],
+                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                    color_formats: &[COLOR_FORMAT],
+                    depth_format: Some(DEPTH_FORMAT),
+                    depth_test: true,
+                    additive: false,
+                },
+            )?,
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, false)?,
         })
     }
@@ -138,14 +153,17 @@ impl Technique for PrtTechnique {
         };
         passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.scene_pipeline.bind(cmd, &[
-                Binding::Uniform(uniforms),
-                Binding::Sampled(&self_shadow.texture, &self.nearest),
-                Binding::Storage(&occlusion.region_basis),
-                Binding::Storage(&occlusion.energy),
-                Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
-                Binding::Uniform(&occlusion.layers),
-            ]);
+            self.scene_pipeline.bind(
+                cmd,
+                &[
+                    Binding::Uniform(uniforms),
+                    Binding::Sampled(&self_shadow.texture, &self.nearest),
+                    Binding::Storage(&occlusion.region_basis),
+                    Binding::Storage(&occlusion.energy),
+                    Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
+                    Binding::Uniform(&occlusion.layers),
+                ],
+            );
             for (i, mesh) in scene.meshes.iter().enumerate() {
                 let (first_layer, layer_count) = occlusion.ranges[mesh.group];
                 let push = PrtDrawPush {
@@ -155,7 +173,12 @@ impl Technique for PrtTechnique {
                     layers: [first_layer, layer_count, 0, 0],
                 };
                 self.scene_pipeline.push(cmd, bytes_of(&push));
-                ctx.draw_indexed(cmd, &[&mesh.vertices, &self_shadow.transfer[i]], &mesh.indices, mesh.index_count);
+                ctx.draw_indexed(
+                    cmd,
+                    &[&mesh.vertices, &self_shadow.transfer[i]],
+                    &mesh.indices,
+                    mesh.index_count,
+                );
             }
             ctx.end_rendering(cmd);
         }));
