@@ -15,6 +15,33 @@ layout(location = 1) in vec3 world_position;
 layout(location = 2) in vec4 region_transfer[KAGE_MAX_REGIONS / 4];
 layout(location = 0) out vec4 color;
 
+// Sums of both channels of a summed-area table layer over the square of half-width `half_width`
+// (uv units) around `uv`. An integral up to edge X (in texels) is the table's value at texel
+// X - 1, so the table is sampled half a texel before each edge; bilinear filtering gives exact
+// integrals between texel edges, and the sampler's black border the zero before the first one.
+vec2 table_box(uint l, vec2 uv, float half_width, float size) {
+    vec2 lo = clamp(uv - half_width, 0.0, 1.0) - 0.5 / size;
+    vec2 hi = clamp(uv + half_width, 0.0, 1.0) - 0.5 / size;
+    float layer = float(l);
+    return textureLod(occlusion, vec3(hi, layer), 0.0).rg - textureLod(occlusion, vec3(lo.x, hi.y, layer), 0.0).rg
+        - textureLod(occlusion, vec3(hi.x, lo.y, layer), 0.0).rg + textureLod(occlusion, vec3(lo, layer), 0.0).rg;
+}
+
+// The adaptive penumbra (beyond the paper): the box width follows this pixel's distance to the
+// occluder along the region's direction, s = sqrt(Omega_i) * distance, as the paper's R does for
+// the group centres. The distance comes from the mean occluder height found in a search box
+// (as in percentage-closer soft shadows); an occluder below the pixel casts nothing on it.
+float adaptive_occlusion(OcclusionLayer layer, uint l, vec2 uv, vec3 offset, float size) {
+    vec2 found = table_box(l, uv, 0.5 * layer.axis_u.w / size, size);
+    if (found.x < 0.5) return 0.0;  // less than half a texel of occluder within reach
+    float height = dot(offset, cross(layer.axis_u.xyz, layer.axis_v.xyz));
+    float distance = found.y / found.x - height;
+    if (distance <= 0.0) return 0.0;
+    float half_width = max(0.5 * layer.axis_v.w * distance * layer.centre.w, 0.5 / size);
+    float texels = 2.0 * half_width * size;
+    return clamp(table_box(l, uv, half_width, size).x / (texels * texels), 0.0, 1.0);
+}
+
 void main() {
     // Layers come sorted by region, so each region's V_o is complete when the region changes.
     vec3 blocked = vec3(0.0);
@@ -31,7 +58,8 @@ void main() {
         }
         vec3 offset = world_position - layer.centre.xyz;
         vec2 uv = vec2(dot(offset, layer.axis_u.xyz), dot(offset, layer.axis_v.xyz)) * layer.centre.w + 0.5;
-        occluded += textureLod(occlusion, vec3(uv, float(l)), 0.0).r;
+        occluded += draw.layers.z == 0u ? textureLod(occlusion, vec3(uv, float(l)), 0.0).r
+                                        : adaptive_occlusion(layer, l, uv, offset, float(draw.layers.w));
     }
     if (region != KAGE_NO_HIT) {
         blocked += region_energy[region].rgb * region_transfer[region / 4][region % 4] * min(occluded, 1.0);

@@ -9,6 +9,7 @@ use crate::scene::Scene;
 use crate::techniques::background::Background;
 use crate::techniques::env_sh::EnvSh;
 use crate::techniques::environment::GpuEnvironment;
+use crate::techniques::parallel_lights::ParallelLights;
 use crate::techniques::prt::TransferSet;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
@@ -144,6 +145,9 @@ pub enum TechniqueChoice {
     /// PRT: with `occlusion.regions == 0` Sloan's self-shadowing alone, otherwise the
     /// Tamura–Johan–Nishita technique with that many regions.
     Prt { transfer: Arc<TransferSet>, occlusion: OcclusionSettings },
+    /// The paper's Fig. 3 baseline: `regions` environment regions (1 to 128) as directional
+    /// lights with binary shadow maps of `shadow_map_size`² texels.
+    ParallelLights { regions: usize, shadow_map_size: u32 },
 }
 
 /// What to render and how large.
@@ -183,6 +187,9 @@ impl Renderer {
             TechniqueChoice::Unshadowed => Box::new(Unshadowed::new(ctx)?),
             TechniqueChoice::Prt { transfer, occlusion } => {
                 Box::new(PrtTechnique::new(ctx, scene, &gpu, transfer, *occlusion)?)
+            }
+            TechniqueChoice::ParallelLights { regions, shadow_map_size } => {
+                Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
             }
         };
         Ok(Renderer {

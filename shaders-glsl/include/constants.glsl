@@ -48,4 +48,9 @@
 // Invocations per workgroup of the occlusion box filter (one row or column each).
 #define KAGE_BLUR_GROUP 64
 
+// Most regions the parallel-lights baseline (the paper's Fig. 3) treats as directional lights:
+// one ParallelLight record each in a uniform buffer (96 bytes, 12 KiB in all, within the 16 KiB
+// every Vulkan device offers) and one shadow-map layer each.
+#define KAGE_MAX_PARALLEL_LIGHTS 128
+
 #endif

@@ -156,7 +156,7 @@ struct PrtDrawPush {
     mat4 model;
     vec4 albedo; // rgb: diffuse albedo, a: unused
     uvec4 mesh; // x: first self-shadow texel, y: texture width, z: group, w: regions (0: self-shadow only)
-    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z, w: unused
+    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: 0 fixed penumbra, 1 adaptive, w: mask size in texels
 };
 
 // One occlusion layer: the shadow of one occluder group on one receiver group for one region,
@@ -164,8 +164,8 @@ struct PrtDrawPush {
 // direction.
 struct OcclusionLayer {
     vec4 centre; // xyz: receiver bounding-sphere centre (world), w: 1 / (2 x half-extent of the mask)
-    vec4 axis_u; // xyz: first unit axis of the plane, w: box filter width in texels (odd)
-    vec4 axis_v; // xyz: second unit axis, w: unused
+    vec4 axis_u; // xyz: first unit axis of the plane, w: fixed penumbra: box filter width in texels (odd); adaptive: blocker search width in texels
+    vec4 axis_v; // xyz: second unit axis, w: sqrt of the region's solid angle
     uvec4 ids; // x: region, y: receiver group, z: occluder group, w: unused
 };
 
@@ -177,7 +177,28 @@ struct MaskPush {
 
 // Push constants of the occlusion box filter.
 struct BlurPush {
-    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: unused
+    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: 0 box filter, 1 prefix sums
+};
+
+// One region of the parallel-lights baseline as a directional light with a binary shadow map.
+struct ParallelLight {
+    mat4 view_proj; // world to the light's orthographic clip space (depth 0 to 1)
+    vec4 direction; // xyz: unit world direction towards the light (omega_i), w: unused
+    vec4 energy; // rgb: B_i, a: unused
+};
+
+// Push constants of the parallel-lights shadow-map pass: one draw per mesh per light.
+struct ParallelShadowPush {
+    mat4 model;
+    uvec4 light; // x: light (shadow-map layer) index, y, z, w: unused
+};
+
+// Push constants of the parallel-lights scene pass: one draw per mesh.
+struct ParallelDrawPush {
+    mat4 model;
+    vec4 albedo; // rgb: diffuse albedo, a: unused
+    uvec4 params; // x: light count, y: shadow-map side in texels, z, w: unused
+    vec4 shadow; // x: slope-scaled normal offset (world units, times the sine of the light's angle to the normal), y: constant normal offset (world units), z: depth bias (light depth units), w: unused
 };
 
 #endif

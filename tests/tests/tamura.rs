@@ -22,76 +22,99 @@ fn prt(transfer: &Arc<TransferSet>, regions: usize) -> TechniqueChoice {
     }
 }
 
-/// The two 1D passes of the box filter on one texel: the result is a w×w box of 1/w², exactly
-/// what sliding sums of zeros and a single one give (rounding only in the final scale).
-#[test]
-fn box_filter_of_a_point_is_a_box() {
-    let ctx = Validated::new();
-    let (size, width) = (16u32, 5u32);
+/// Runs the two 1D passes of the occlusion filter (mode 0: box of `width` texels; mode 1:
+/// prefix sums) over one `size`² layer of (coverage, coverage × height) texels.
+fn filter_layer(ctx: &Validated, size: u32, width: u32, mode: u32, texels: &[[f32; 2]]) -> Vec<[f32; 2]> {
     let image = |name: &str| {
-        Image::new(
-            &ctx,
-            &ImageDesc {
-                name,
-                width: size,
-                height: size,
-                layers: 1,
-                array: true,
-                format: vk::Format::R32_SFLOAT,
-                usage: vk::ImageUsageFlags::STORAGE
-                    | vk::ImageUsageFlags::TRANSFER_DST
-                    | vk::ImageUsageFlags::TRANSFER_SRC,
-            },
-        )
-        .unwrap()
+        let usage = vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let desc = ImageDesc {
+            name,
+            width: size,
+            height: size,
+            layers: 1,
+            array: true,
+            format: vk::Format::R32G32_SFLOAT,
+            usage,
+        };
+        Image::new(ctx, &desc).unwrap()
     };
     let (mask, temp, filtered) = (image("mask"), image("temp"), image("filtered"));
-    let mut texels = vec![0.0f32; (size * size) as usize];
-    texels[(7 * size + 9) as usize] = 1.0;
-    mask.upload(&texels.iter().flat_map(|t| t.to_ne_bytes()).collect::<Vec<u8>>()).unwrap();
+    mask.upload(&texels.iter().flatten().flat_map(|t| t.to_ne_bytes()).collect::<Vec<u8>>()).unwrap();
     let layer = OcclusionLayer { axis_u: [1.0, 0.0, 0.0, width as f32], ..Default::default() };
     let layers =
-        Buffer::with_data(&ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer]))
+        Buffer::with_data(ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer]))
             .unwrap();
+    let kinds = [BindingKind::StorageBuffer, BindingKind::StorageImage, BindingKind::StorageImage];
     let blur = ComputePipeline::new(
-        &ctx,
+        ctx,
         "occlusion_blur",
         spirv::OCCLUSION_BLUR_COMP,
-        &[BindingKind::StorageBuffer, BindingKind::StorageImage, BindingKind::StorageImage],
+        &kinds,
         size_of::<BlurPush>() as u32,
     )
     .unwrap();
-    let mut executor = FrameExecutor::new(&ctx, "blur").unwrap();
     let filter = |cmd, direction: u32, from: &Image, to: &Image| {
-        let push = BlurPush { params: [direction, size, 1, 0] };
+        let push = BlurPush { params: [direction, size, 1, mode] };
         let bindings = [Binding::Storage(&layers), Binding::StorageImage(from), Binding::StorageImage(to)];
         blur.dispatch(cmd, &bindings, bytes_of(&push), [1, 1, 1])
     };
-    executor
-        .run(
-            &[],
-            vec![
-                Pass::new("horizontal", &[], &["half"], |cmd| filter(cmd, 0, &mask, &temp)),
-                Pass::new("vertical", &["half"], &[], |cmd| filter(cmd, 1, &temp, &filtered)),
-            ],
-        )
-        .unwrap();
-    let out: Vec<f32> = filtered
+    let mut executor = FrameExecutor::new(ctx, "filter").unwrap();
+    let passes = vec![
+        Pass::new("horizontal", &[], &["half"], |cmd| filter(cmd, 0, &mask, &temp)),
+        Pass::new("vertical", &["half"], &[], |cmd| filter(cmd, 1, &temp, &filtered)),
+    ];
+    executor.run(&[], passes).unwrap();
+    let floats: Vec<f32> = filtered
         .read()
         .unwrap()
         .chunks_exact(4)
         .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
-    let scale = 1.0f32 / width as f32;
+    floats.chunks_exact(2).map(|c| [c[0], c[1]]).collect()
+}
+
+/// The paper's filter on one texel: a w×w box of 1/w² in both channels (sliding sums of zeros
+/// and one value are exact; rounding only in the final scale).
+#[test]
+fn box_filter_of_a_point_is_a_box() {
+    let ctx = Validated::new();
+    let (size, width) = (16u32, 5u32);
+    let mut texels = vec![[0.0f32; 2]; (size * size) as usize];
+    texels[(7 * size + 9) as usize] = [1.0, 2.5];
+    let out = filter_layer(&ctx, size, width, 0, &texels);
+    let scale = 1.0f32 / (width * width) as f32;
+    for (i, got) in out.iter().enumerate() {
+        let (x, y) = (i as i32 % size as i32, i as i32 / size as i32);
+        let inside = (x - 9).abs() <= 2 && (y - 7).abs() <= 2;
+        let expected = if inside { [scale, 2.5 * scale] } else { [0.0, 0.0] };
+        assert!(
+            (got[0] - expected[0]).abs() < 1e-7 && (got[1] - expected[1]).abs() < 1e-6,
+            "({x}, {y}): {got:?}"
+        );
+    }
+}
+
+/// The adaptive penumbra's prefix-sum mode: the two passes leave the summed-area table, checked
+/// exactly (small integers sum without rounding in f32).
+#[test]
+fn prefix_passes_build_the_summed_area_table() {
+    let ctx = Validated::new();
+    let size = 16u32;
+    let texels: Vec<[f32; 2]> = (0..size * size).map(|i| [(i % 3) as f32, ((i * 7) % 5) as f32]).collect();
+    let out = filter_layer(&ctx, size, 1, 1, &texels);
     for y in 0..size {
         for x in 0..size {
-            let inside = (x as i32 - 9).abs() <= 2 && (y as i32 - 7).abs() <= 2;
-            let expected = if inside { scale * scale } else { 0.0 };
-            assert!(
-                (out[(y * size + x) as usize] - expected).abs() < 1e-7,
-                "({x}, {y}): {}",
-                out[(y * size + x) as usize]
-            );
+            let mut expected = [0.0f32; 2];
+            for j in 0..=y {
+                for i in 0..=x {
+                    let t = texels[(j * size + i) as usize];
+                    expected[0] += t[0];
+                    expected[1] += t[1];
+                }
+            }
+            assert_eq!(out[(y * size + x) as usize], expected, "({x}, {y})");
         }
     }
 }

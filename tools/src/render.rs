@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::Scene;
-use kage::techniques::tamura::technique::OcclusionSettings;
+use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -20,18 +20,33 @@ pub enum TechniqueName {
     Sloan,
     /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups, q regions.
     Tamura,
+    /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
+    ParallelLights,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PenumbraName {
+    Fixed,
+    Adaptive,
 }
 
 #[derive(Args)]
 pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = TechniqueName::Unshadowed)]
     technique: TechniqueName,
-    /// Environment regions q of the Tamura technique (1 to 64).
+    /// Environment regions q of the Tamura technique (1 to 64) or of parallel-lights (1 to 128).
     #[arg(long, default_value_t = OcclusionSettings::default().regions)]
     regions: usize,
+    /// Penumbra of the Tamura shadows: `fixed` (the paper's box width per group pair) or
+    /// `adaptive` (a width per pixel from its distance to the occluder).
+    #[arg(long, value_enum, default_value_t = PenumbraName::Fixed)]
+    penumbra: PenumbraName,
     /// Side of a Tamura occlusion mask layer, texels.
     #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
     mask_size: u32,
+    /// Side of a parallel-lights shadow map, texels.
+    #[arg(long, default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
+    shadow_map_size: u32,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
@@ -83,6 +98,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let ctx = args.gpu.context()?;
     let technique = match args.technique {
         TechniqueName::Unshadowed => TechniqueChoice::Unshadowed,
+        TechniqueName::ParallelLights => {
+            TechniqueChoice::ParallelLights { regions: args.regions, shadow_map_size: args.shadow_map_size }
+        }
         TechniqueName::Sloan | TechniqueName::Tamura => {
             let (transfer, origin) = args.prt.obtain(&ctx, &scene)?;
             match origin {
@@ -100,6 +118,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 occlusion: OcclusionSettings {
                     regions,
                     mask_size: args.mask_size,
+                    penumbra: match args.penumbra {
+                        PenumbraName::Fixed => Penumbra::Fixed,
+                        PenumbraName::Adaptive => Penumbra::Adaptive,
+                    },
                     ..OcclusionSettings::default()
                 },
             }

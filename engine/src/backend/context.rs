@@ -184,6 +184,10 @@ impl Context {
                     layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
                 ),
                 ("shaderClipDistance (required)", features.shader_clip_distance == vk::TRUE),
+                (
+                    "shaderStorageImageExtendedFormats (required)",
+                    features.shader_storage_image_extended_formats == vk::TRUE,
+                ),
                 ("shaderFloat64", features.shader_float64 == vk::TRUE),
                 (
                     "ray query (not used: Kage casts rays through its own BVH)",
@@ -205,7 +209,9 @@ impl Context {
             [ash::khr::dynamic_rendering::NAME.as_ptr(), ash::khr::push_descriptor::NAME.as_ptr()];
         let mut dynamic_rendering_features =
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
-        let enabled = vk::PhysicalDeviceFeatures::default().shader_clip_distance(true);
+        let enabled = vk::PhysicalDeviceFeatures::default()
+            .shader_clip_distance(true)
+            .shader_storage_image_extended_formats(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&device_ext_ptrs)

@@ -46,6 +46,7 @@ fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
 fn texel_bytes(format: vk::Format) -> Option<u64> {
     match format {
         vk::Format::R32G32B32A32_SFLOAT => Some(16),
+        vk::Format::R32G32_SFLOAT => Some(8),
         vk::Format::R8G8B8A8_UNORM
         | vk::Format::R8G8B8A8_SRGB
         | vk::Format::R32_SFLOAT
@@ -309,18 +310,40 @@ pub struct Sampler {
     pub(crate) raw: vk::Sampler,
 }
 
+/// What a sampler returns beyond an image's edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edge {
+    /// Wrap around (longitude of an equirectangular map).
+    Repeat,
+    /// The edge texel.
+    Clamp,
+    /// Transparent black (the zero before a summed-area table's first texel).
+    Black,
+}
+
+impl Edge {
+    fn mode(self) -> vk::SamplerAddressMode {
+        match self {
+            Edge::Repeat => vk::SamplerAddressMode::REPEAT,
+            Edge::Clamp => vk::SamplerAddressMode::CLAMP_TO_EDGE,
+            Edge::Black => vk::SamplerAddressMode::CLAMP_TO_BORDER,
+        }
+    }
+}
+
 impl Sampler {
-    /// Linear filtering; `u` repeats (longitude wraps around), `v` clamps (poles).
-    pub fn new(ctx: &Arc<Context>, name: &str, linear: bool, repeat_u: bool) -> Result<Sampler> {
+    /// A sampler with linear or nearest filtering and the given behaviour beyond the edges in u
+    /// and v (w, layers of arrays, clamps).
+    pub fn new(ctx: &Arc<Context>, name: &str, linear: bool, u: Edge, v: Edge) -> Result<Sampler> {
         let filter = if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
-        let u = if repeat_u { vk::SamplerAddressMode::REPEAT } else { vk::SamplerAddressMode::CLAMP_TO_EDGE };
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(filter)
             .min_filter(filter)
             .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
-            .address_mode_u(u)
-            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_u(u.mode())
+            .address_mode_v(v.mode())
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .border_color(vk::BorderColor::FLOAT_TRANSPARENT_BLACK)
             .max_lod(0.0);
         // SAFETY: valid device and create info.
         let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;

@@ -16,7 +16,7 @@ pub use buffer::{Buffer, BufferDesc};
 pub use commands::CommandRecorder;
 pub use context::{Context, ContextDesc, DeviceInfo};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
-pub use image::{Image, ImageDesc, Sampler};
+pub use image::{Edge, Image, ImageDesc, Sampler};
 pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer};
 pub use rendering::Target;
 pub use timestamps::TimestampPool;

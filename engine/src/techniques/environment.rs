@@ -1,6 +1,6 @@
 //! The environment map on the GPU: an RGBA32F image (alpha unused) and a sampler that wraps in
 //! longitude and clamps at the poles.
-use crate::backend::{vk, Context, Image, ImageDesc, Sampler};
+use crate::backend::{vk, Context, Edge, Image, ImageDesc, Sampler};
 use crate::error::Result;
 use crate::scene::EnvMap;
 use std::sync::Arc;
@@ -27,7 +27,7 @@ impl GpuEnvironment {
         let texels: Vec<u8> =
             map.pixels().iter().flat_map(|p| [p[0], p[1], p[2], 0.0]).flat_map(f32::to_ne_bytes).collect();
         image.upload(&texels)?;
-        let sampler = Sampler::new(ctx, "environment.sampler", true, true)?;
+        let sampler = Sampler::new(ctx, "environment.sampler", true, Edge::Repeat, Edge::Clamp)?;
         Ok(GpuEnvironment { image, sampler })
     }
 }

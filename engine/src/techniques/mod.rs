@@ -4,6 +4,7 @@
 pub mod background;
 pub mod env_sh;
 pub mod environment;
+pub mod parallel_lights;
 pub mod prt;
 pub mod tamura;
 pub mod unshadowed;

@@ -1,7 +1,8 @@
 //! Occlusion between groups (section 3.3.2): for each receiver group, occluder group and region,
 //! the occluder is projected along the region's direction onto a plane at the receiver (a mask
 //! layer), then box-filtered in two 1D passes with the width s = sqrt(Ω_i)·R of eq. (13); the
-//! result V_o is looked up per pixel in the scene pass.
+//! result V_o is looked up per pixel in the scene pass. With [`Penumbra::Adaptive`] the same two
+//! passes build a summed-area table instead and the scene pass picks the width per pixel.
 //!
 //! Two choices differ from the paper's text, on purpose:
 //! - The plane goes through the receiver's bounding-sphere centre, not along the sphere's tangent
@@ -20,9 +21,10 @@
 //!   sphere. A group alone runs no occlusion pass at all.
 use super::regions::Regions;
 use super::self_shadow::rotation_of;
+use super::technique::Penumbra;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline,
-    Image, ImageDesc, MemoryLocation, Sampler, Target,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsDesc,
+    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
 use crate::error::Result;
 use crate::layouts::{
@@ -84,8 +86,9 @@ pub struct Occlusion {
     regions: Regions,
     bands: usize,
     bounds: Vec<GroupBounds>,
-    resolution: u32,
+    pub resolution: u32,
     capacity: u32,
+    pub penumbra: Penumbra,
     mask_pipeline: GraphicsPipeline,
     blur: ComputePipeline,
     mask: Image,
@@ -108,7 +111,7 @@ pub struct Occlusion {
     pub dropped: usize,
 }
 
-const MASK_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+const MASK_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
 
 fn layered(
     ctx: &Arc<Context>,
@@ -160,6 +163,7 @@ impl Occlusion {
         bounds: Vec<GroupBounds>,
         resolution: u32,
         capacity: u32,
+        penumbra: Penumbra,
     ) -> Result<Occlusion> {
         let q = regions.regions.len();
         let groups = bounds.len();
@@ -211,7 +215,13 @@ impl Occlusion {
                 layer_count,
                 vk::ImageUsageFlags::SAMPLED,
             )?,
-            sampler: Sampler::new(ctx, "occlusion.sampler", true, false)?,
+            // The fixed penumbra samples filtered coverage (the edge texel continues it); the
+            // adaptive one a summed-area table (zero before its first texel).
+            sampler: match penumbra {
+                Penumbra::Fixed => Sampler::new(ctx, "occlusion.sampler", true, Edge::Clamp, Edge::Clamp)?,
+                Penumbra::Adaptive => Sampler::new(ctx, "occlusion.sampler", true, Edge::Black, Edge::Black)?,
+            },
+            penumbra,
             layers: host_buffer(ctx, "occlusion.layers", layer_count as usize * size_of::<OcclusionLayer>())?,
             energy,
             region_basis: host_buffer(ctx, "occlusion.region_basis", groups * q * size_of::<RegionBasis>())?,
@@ -259,7 +269,17 @@ impl Occlusion {
                     }
                     let offset = occluder_centre - receiver_centre;
                     let along = offset.dot(w);
-                    let width = (region.solid_angle as f32).sqrt() * along.max(0.0);
+                    let root_omega = (region.solid_angle as f32).sqrt();
+                    // Fixed: the box width of eq. (13). Adaptive: the widest box a pixel can
+                    // ask for (blocker search), from the occluder's top to the receiver's bottom.
+                    let width = match self.penumbra {
+                        Penumbra::Fixed => root_omega * along.max(0.0),
+                        Penumbra::Adaptive => {
+                            root_omega
+                                * (self.bounds[o].reach_along(&transforms[o], receiver_centre, w)
+                                    + receiver_radius)
+                        }
+                    };
                     if (offset - along * w).length() > occluder_radius + receiver_radius + 0.5 * width {
                         continue;
                     }
@@ -274,7 +294,7 @@ impl Occlusion {
                         layer: OcclusionLayer {
                             centre: receiver_centre.extend(1.0 / (2.0 * half_extent)).to_array(),
                             axis_u: u.extend(odd).to_array(),
-                            axis_v: v.extend(0.0).to_array(),
+                            axis_v: v.extend(root_omega).to_array(),
                             ids: [i as u32, r as u32, o as u32, 0],
                         },
                     });
@@ -333,7 +353,8 @@ impl Occlusion {
         let count = self.jobs.len() as u32;
         let groups = [self.resolution.div_ceil(constants::BLUR_GROUP), count, 1];
         let blur = move |cmd, horizontal: bool, source: &Image, target: &Image| {
-            let push = BlurPush { params: [u32::from(!horizontal), self.resolution, count, 0] };
+            let mode = (self.penumbra == Penumbra::Adaptive) as u32;
+            let push = BlurPush { params: [u32::from(!horizontal), self.resolution, count, mode] };
             self.blur.dispatch(
                 cmd,
                 &[

@@ -4,7 +4,7 @@ use super::occlusion::{group_bounds, Occlusion};
 use super::regions::Regions;
 use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::backend::{
-    vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer,
+    vk, Binding, BindingKind, Context, Edge, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush};
@@ -16,6 +16,19 @@ use crate::techniques::unshadowed::MESH_POSITIONS;
 use crate::techniques::{FrameInputs, FrameState, Technique};
 use std::sync::Arc;
 
+/// How wide the penumbra of a shadow between groups is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Penumbra {
+    /// The paper's: one box width per (receiver, occluder, region), s = sqrt(Ω_i)·R with R
+    /// measured between the group centres (eqs. (12)–(13)).
+    #[default]
+    Fixed,
+    /// Beyond the paper: the same two 1D passes build a summed-area table, and each pixel takes
+    /// a box as wide as sqrt(Ω_i) times its own distance to the occluder, so shadows fade with
+    /// distance from their occluder.
+    Adaptive,
+}
+
 /// Settings of the occlusion between groups.
 #[derive(Clone, Copy, Debug)]
 pub struct OcclusionSettings {
@@ -25,11 +38,17 @@ pub struct OcclusionSettings {
     pub mask_size: u32,
     /// Most layers filtered per frame.
     pub max_layers: u32,
+    pub penumbra: Penumbra,
 }
 
 impl Default for OcclusionSettings {
     fn default() -> Self {
-        OcclusionSettings { regions: 32, mask_size: 128, max_layers: constants::MAX_OCCLUSION_LAYERS }
+        OcclusionSettings {
+            regions: 32,
+            mask_size: 128,
+            max_layers: constants::MAX_OCCLUSION_LAYERS,
+            penumbra: Penumbra::Fixed,
+        }
     }
 }
 
@@ -91,6 +110,7 @@ impl PrtTechnique {
                 group_bounds(scene),
                 settings.mask_size,
                 capacity,
+                settings.penumbra,
             )?,
             scene_pipeline: GraphicsPipeline::new(
                 ctx,
@@ -118,7 +138,7 @@ impl PrtTechnique {
                     additive: false,
                 },
             )?,
-            nearest: Sampler::new(ctx, "self_shadow.sampler", false, false)?,
+            nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
         })
     }
 
@@ -170,7 +190,12 @@ impl Technique for PrtTechnique {
                     model: scene.transforms[mesh.group].to_cols_array_2d(),
                     albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
                     mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
-                    layers: [first_layer, layer_count, 0, 0],
+                    layers: [
+                        first_layer,
+                        layer_count,
+                        (occlusion.penumbra == Penumbra::Adaptive) as u32,
+                        occlusion.resolution,
+                    ],
                 };
                 self.scene_pipeline.push(cmd, bytes_of(&push));
                 ctx.draw_indexed(

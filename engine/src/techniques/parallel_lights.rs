@@ -1,0 +1,263 @@
+//! The paper's Fig. 3 baseline: the environment's q regions (the same decomposition as the
+//! Tamura technique) treated as q directional lights, each with a binary shadow map in which
+//! every group, the receiver included, is an occluder. Per pixel
+//! L = albedo / π · Σ_i B_i · max(n·ω_i, 0) · V_i(p), with V_i one depth comparison in region
+//! i's map: no filtering, so the banding of q hard shadows shows, which is what the paper's
+//! figure compares against.
+//!
+//! Passes: `shadow_maps` renders every mesh into layer i of a D32 array image (one depth-only
+//! rendering scope per region, orthographic along ω_i over the scene's bounding sphere), then
+//! `scene` loops over the regions in one fragment shader, reading the lights from a uniform
+//! buffer (much cheaper per fragment than a storage buffer on CPU drivers) and the maps with
+//! `texelFetch` and a manual comparison.
+//!
+//! Shadow acne is avoided with a normal offset in the scene shader rather than the pipeline's
+//! depth bias: a slope-scaled depth bias grows as tan θ of the light's angle to the surface, and
+//! with q up to 128 many regions sit near the horizon, where it would detach the teapot's
+//! contact shadow from its base; a normal offset grows as sin θ (at most a texel and a half) and
+//! moves the lookup off the surface by a distance tied to the map's texel size. It also keeps
+//! `GraphicsDesc` free of a setting only this baseline would use. A small constant depth bias
+//! covers curved surfaces, where the texel's depth varies inside the texel.
+use super::tamura::occlusion::{group_bounds, GroupBounds};
+use super::tamura::regions::Regions;
+use super::tamura::self_shadow::env_rotation;
+use super::unshadowed::{MESH_POSITIONS, MESH_VERTICES};
+use super::{FrameInputs, FrameState, Technique};
+use crate::backend::{
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsDesc, GraphicsPipeline, Image,
+    ImageDesc, MemoryLocation, Sampler, Target,
+};
+use crate::error::{Error, Result};
+use crate::layouts::{
+    bytes_of, bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight, ParallelShadowPush,
+};
+use crate::pass::Pass;
+use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::scene::Scene;
+use glam::{Mat4, Vec3};
+use std::sync::Arc;
+
+/// Default side of a shadow map, texels.
+pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 512;
+/// Shadow-map sides accepted: 128 maps of 2048² D32 texels are 2 GiB already.
+pub const SHADOW_MAP_SIZES: std::ops::RangeInclusive<u32> = 16..=2048;
+
+/// Normal offset at grazing light, in shadow-map texels (scaled by sin θ).
+const SLOPE_OFFSET_TEXELS: f32 = 1.5;
+/// Normal offset at any angle, in texels.
+const CONSTANT_OFFSET_TEXELS: f32 = 0.25;
+/// Depth bias, in texels of world size along ω_i.
+const DEPTH_BIAS_TEXELS: f32 = 0.5;
+
+pub struct ParallelLights {
+    regions: Regions,
+    bounds: Vec<GroupBounds>,
+    size: u32,
+    shadow_pipeline: GraphicsPipeline,
+    scene_pipeline: GraphicsPipeline,
+    /// One D32 layer per region.
+    shadow_maps: Image,
+    nearest: Sampler,
+    /// `ParallelLight` per region, `MAX_PARALLEL_LIGHTS` records (the shader's array size).
+    lights: Buffer,
+    /// Lights (regions), one shadow-map layer each.
+    count: u32,
+    /// World size of a shadow-map texel and of the light depth range this frame.
+    texel: f32,
+    depth_range: f32,
+}
+
+impl ParallelLights {
+    /// `q` regions of the scene's environment (1 to `MAX_PARALLEL_LIGHTS`), shadow maps of
+    /// `shadow_map_size`² texels.
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, q: usize, shadow_map_size: u32) -> Result<ParallelLights> {
+        let max = constants::MAX_PARALLEL_LIGHTS as usize;
+        if !(1..=max).contains(&q) {
+            return Err(Error::InvalidArgument(format!(
+                "parallel lights: q = {q} regions, must be 1 to {max}"
+            )));
+        }
+        if !SHADOW_MAP_SIZES.contains(&shadow_map_size) {
+            return Err(Error::InvalidArgument(format!(
+                "shadow map size {shadow_map_size} must be {} to {} texels",
+                SHADOW_MAP_SIZES.start(),
+                SHADOW_MAP_SIZES.end()
+            )));
+        }
+        let regions = Regions::new(&scene.environment, q)?;
+        let shadow_pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "parallel_shadow",
+                vertex_spirv: spirv::PARALLEL_SHADOW_VERT,
+                fragment_spirv: spirv::PARALLEL_SHADOW_FRAG,
+                bindings: &[BindingKind::UniformBuffer],
+                push_size: size_of::<ParallelShadowPush>() as u32,
+                vertex_buffers: &[MESH_POSITIONS],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                additive: false,
+            },
+        )?;
+        let scene_pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "scene_parallel_lights",
+                vertex_spirv: spirv::PARALLEL_LIGHTS_VERT,
+                fragment_spirv: spirv::PARALLEL_LIGHTS_FRAG,
+                bindings: &[
+                    BindingKind::UniformBuffer,
+                    BindingKind::UniformBuffer,
+                    BindingKind::SampledImage,
+                ],
+                push_size: size_of::<ParallelDrawPush>() as u32,
+                vertex_buffers: &[MESH_VERTICES],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[COLOR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                additive: false,
+            },
+        )?;
+        let shadow_maps = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "parallel_lights.shadow_maps",
+                width: shadow_map_size,
+                height: shadow_map_size,
+                layers: q as u32,
+                array: true,
+                format: DEPTH_FORMAT,
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            },
+        )?;
+        let lights = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "parallel_lights.lights",
+                size: (max * size_of::<ParallelLight>()) as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        Ok(ParallelLights {
+            regions,
+            bounds: group_bounds(scene),
+            size: shadow_map_size,
+            shadow_pipeline,
+            scene_pipeline,
+            shadow_maps,
+            nearest: Sampler::new(ctx, "parallel_lights.sampler", false, Edge::Clamp, Edge::Clamp)?,
+            lights,
+            count: q as u32,
+            texel: 0.0,
+            depth_range: 1.0,
+        })
+    }
+
+    /// The regions used as lights, in the map's frame.
+    pub fn regions(&self) -> &Regions {
+        &self.regions
+    }
+}
+
+/// The smallest sphere around the groups' bounding spheres that this simple construction finds
+/// (centred on their box): each map covers all of it, so every group casts into every map.
+fn scene_sphere(bounds: &[GroupBounds], transforms: &[Mat4]) -> (Vec3, f32) {
+    let spheres: Vec<(Vec3, f32)> = bounds
+        .iter()
+        .zip(transforms)
+        .map(|(b, t)| (t.transform_point3(b.centre), b.radius * t.x_axis.truncate().length()))
+        .collect();
+    let (lo, hi) = spheres
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &(c, r)| (lo.min(c - r), hi.max(c + r)));
+    if spheres.is_empty() {
+        return (Vec3::ZERO, 1.0);
+    }
+    let centre = 0.5 * (lo + hi);
+    let radius = spheres.iter().map(|&(c, r)| c.distance(centre) + r).fold(0.0, f32::max);
+    (centre, radius.max(1e-3))
+}
+
+impl Technique for ParallelLights {
+    fn update(&mut self, state: &FrameState) -> Result<()> {
+        let (centre, radius) = scene_sphere(&self.bounds, state.transforms);
+        // The maps' depth range reaches a little past the sphere so nothing on it is clipped.
+        let margin = 0.01 * radius;
+        let projection =
+            Mat4::orthographic_rh(-radius, radius, -radius, radius, -margin, 2.0 * radius + margin);
+        let env = env_rotation(state.env_rotation);
+        let mut lights = Vec::with_capacity(self.regions.regions.len());
+        for region in &self.regions.regions {
+            let w = (env * region.direction.as_vec3()).normalize();
+            let up = if w.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+            let view_proj = projection * Mat4::look_at_rh(centre + radius * w, centre, up);
+            lights.push(ParallelLight {
+                view_proj: view_proj.to_cols_array_2d(),
+                direction: w.extend(0.0).to_array(),
+                energy: [region.energy[0] as f32, region.energy[1] as f32, region.energy[2] as f32, 0.0],
+            });
+        }
+        self.texel = 2.0 * radius / self.size as f32;
+        self.depth_range = 2.0 * (radius + margin);
+        self.lights.write(0, bytes_of_slice(&lights))
+    }
+
+    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
+        let shadow_maps = Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
+            for layer in 0..self.count {
+                let target = Target { image: &self.shadow_maps, layer };
+                ctx.begin_rendering(cmd, None, None, Some(target));
+                self.shadow_pipeline.bind(cmd, &[Binding::Uniform(&self.lights)]);
+                for mesh in &scene.meshes {
+                    let push = ParallelShadowPush {
+                        model: scene.transforms[mesh.group].to_cols_array_2d(),
+                        light: [layer, 0, 0, 0],
+                    };
+                    self.shadow_pipeline.push(cmd, bytes_of(&push));
+                    ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+                }
+                ctx.end_rendering(cmd);
+            }
+        });
+        let shadow = [
+            SLOPE_OFFSET_TEXELS * self.texel,
+            CONSTANT_OFFSET_TEXELS * self.texel,
+            DEPTH_BIAS_TEXELS * self.texel / self.depth_range,
+            0.0,
+        ];
+        let count = self.count;
+        let scene_pass = Pass::new(
+            "scene",
+            &["frame_uniforms", "shadow_maps", "color"],
+            &["color", "depth"],
+            move |cmd| {
+                ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
+                self.scene_pipeline.bind(
+                    cmd,
+                    &[
+                        Binding::Uniform(uniforms),
+                        Binding::Uniform(&self.lights),
+                        Binding::Sampled(&self.shadow_maps, &self.nearest),
+                    ],
+                );
+                for mesh in &scene.meshes {
+                    let push = ParallelDrawPush {
+                        model: scene.transforms[mesh.group].to_cols_array_2d(),
+                        albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                        params: [count, self.size, 0, 0],
+                        shadow,
+                    };
+                    self.scene_pipeline.push(cmd, bytes_of(&push));
+                    ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+                }
+                ctx.end_rendering(cmd);
+            },
+        );
+        vec![shadow_maps, scene_pass]
+    }
+}
