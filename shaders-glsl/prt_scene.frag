@@ -9,6 +9,8 @@ layout(set = 0, binding = 3, std430) readonly buffer Energy { vec4 region_energy
 layout(set = 0, binding = 4) uniform sampler2DArray occlusion;
 layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
 layout(push_constant) uniform Push { PrtDrawPush draw; };
+// 0: the paper's fixed penumbra, 1: the adaptive one (a pipeline constant: see GraphicsDesc).
+layout(constant_id = 0) const uint ADAPTIVE_PENUMBRA = 0u;
 
 layout(location = 0) in vec3 self_shadowed;
 layout(location = 1) in vec3 world_position;
@@ -42,24 +44,43 @@ float adaptive_occlusion(OcclusionLayer layer, uint l, vec2 uv, vec3 offset, flo
     return clamp(table_box(l, uv, half_width, size).x / (texels * texels), 0.0, 1.0);
 }
 
+vec2 mask_uv(OcclusionLayer layer, vec3 offset) {
+    return vec2(dot(offset, layer.axis_u.xyz), dot(offset, layer.axis_v.xyz)) * layer.centre.w + 0.5;
+}
+
 void main() {
     // Layers come sorted by region, so each region's V_o is complete when the region changes.
     vec3 blocked = vec3(0.0);
     uint region = KAGE_NO_HIT;
     float occluded = 0.0;
-    for (uint l = draw.layers.x; l < draw.layers.x + draw.layers.y; ++l) {
-        OcclusionLayer layer = layers[l];
-        if (layer.ids.x != region) {
-            if (region != KAGE_NO_HIT) {
-                blocked += region_energy[region].rgb * region_transfer[region / 4][region % 4] * min(occluded, 1.0);
-            }
-            region = layer.ids.x;
-            occluded = 0.0;
+    uint first = draw.layers.x, count = draw.layers.y;
+    for (uint base = 0u; base < count; base += 32u) {
+        // Most of a receiver lies outside any one occluder's shadow. The cheap footprint tests
+        // come first and the texture reads loop over the hits only: a branch around a read would
+        // not save it where the lanes of a SIMD group disagree (llvmpipe runs both sides of
+        // every branch), but a loop ends when all its lanes are done.
+        uint hits = 0u;
+        for (uint k = 0u; k < min(count - base, 32u); ++k) {
+            OcclusionLayer layer = layers[first + base + k];
+            vec2 from_occluder = mask_uv(layer, world_position - layer.centre.xyz) - layer.footprint.xy;
+            hits |= uint(dot(from_occluder, from_occluder) <= layer.footprint.z * layer.footprint.z) << k;
         }
-        vec3 offset = world_position - layer.centre.xyz;
-        vec2 uv = vec2(dot(offset, layer.axis_u.xyz), dot(offset, layer.axis_v.xyz)) * layer.centre.w + 0.5;
-        occluded += draw.layers.z == 0u ? textureLod(occlusion, vec3(uv, float(l)), 0.0).r
-                                        : adaptive_occlusion(layer, l, uv, offset, float(draw.layers.w));
+        while (hits != 0u) {
+            uint l = first + base + uint(findLSB(hits));
+            hits &= hits - 1u;
+            OcclusionLayer layer = layers[l];
+            if (layer.ids.x != region) {
+                if (region != KAGE_NO_HIT) {
+                    blocked += region_energy[region].rgb * region_transfer[region / 4][region % 4] * min(occluded, 1.0);
+                }
+                region = layer.ids.x;
+                occluded = 0.0;
+            }
+            vec3 offset = world_position - layer.centre.xyz;
+            vec2 uv = mask_uv(layer, offset);
+            occluded += ADAPTIVE_PENUMBRA == 0u ? textureLod(occlusion, vec3(uv, float(l)), 0.0).r
+                                                : adaptive_occlusion(layer, l, uv, offset, float(draw.layers.w));
+        }
     }
     if (region != KAGE_NO_HIT) {
         blocked += region_energy[region].rgb * region_transfer[region / 4][region % 4] * min(occluded, 1.0);

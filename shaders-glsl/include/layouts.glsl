@@ -156,7 +156,7 @@ struct PrtDrawPush {
     mat4 model;
     vec4 albedo; // rgb: diffuse albedo, a: unused
     uvec4 mesh; // x: first self-shadow texel, y: texture width, z: group, w: regions (0: self-shadow only)
-    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: 0 fixed penumbra, 1 adaptive, w: mask size in texels
+    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: unused, w: mask size in texels
 };
 
 // One occlusion layer: the shadow of one occluder group on one receiver group for one region,
@@ -166,6 +166,7 @@ struct OcclusionLayer {
     vec4 centre; // xyz: receiver bounding-sphere centre (world), w: 1 / (2 x half-extent of the mask)
     vec4 axis_u; // xyz: first unit axis of the plane, w: fixed penumbra: box filter width in texels (odd); adaptive: blocker search width in texels
     vec4 axis_v; // xyz: second unit axis, w: sqrt of the region's solid angle
+    vec4 footprint; // xy: the occluder's centre in mask uv, z: radius in uv beyond which the filtered layer is 0, w: unused
     uvec4 ids; // x: region, y: receiver group, z: occluder group, w: unused
 };
 

@@ -28,6 +28,7 @@ impl Background {
                 depth_format: None,
                 depth_test: false,
                 additive: false,
+                fragment_constants: &[],
             },
         )?;
         Ok(Background { pipeline })

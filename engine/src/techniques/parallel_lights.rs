@@ -99,6 +99,7 @@ impl ParallelLights {
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 additive: false,
+                fragment_constants: &[],
             },
         )?;
         let scene_pipeline = GraphicsPipeline::new(
@@ -119,6 +120,7 @@ impl ParallelLights {
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 additive: false,
+                fragment_constants: &[],
             },
         )?;
         let shadow_maps = Image::new(

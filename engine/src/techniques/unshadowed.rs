@@ -41,6 +41,7 @@ impl Unshadowed {
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 additive: false,
+                fragment_constants: &[],
             },
         )?;
         Ok(Unshadowed { scene })

@@ -77,7 +77,6 @@ impl GroupBounds {
 
 struct Job {
     receiver: usize,
-    occluder: usize,
     layer: OcclusionLayer,
     weight: f64,
 }
@@ -105,8 +104,8 @@ pub struct Occlusion {
     pub region_basis: Buffer,
     /// Per receiver group: its first layer and layer count.
     pub ranges: Vec<(u32, u32)>,
-    /// (receiver, occluder) of each layer in use.
-    jobs: Vec<(usize, usize)>,
+    /// The layers in use this frame, as uploaded to `layers`.
+    in_use: Vec<OcclusionLayer>,
     /// Pairs that were wanted but did not fit in `capacity` this frame (least energy first).
     pub dropped: usize,
 }
@@ -191,6 +190,7 @@ impl Occlusion {
                     depth_format: None,
                     depth_test: false,
                     additive: false,
+                    fragment_constants: &[],
                 },
             )?,
             blur: ComputePipeline::new(
@@ -213,7 +213,7 @@ impl Occlusion {
                 "occlusion.filtered",
                 resolution,
                 layer_count,
-                vk::ImageUsageFlags::SAMPLED,
+                vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC,
             )?,
             // The fixed penumbra samples filtered coverage (the edge texel continues it); the
             // adaptive one a summed-area table (zero before its first texel).
@@ -226,7 +226,7 @@ impl Occlusion {
             energy,
             region_basis: host_buffer(ctx, "occlusion.region_basis", groups * q * size_of::<RegionBasis>())?,
             ranges: vec![(0, 0); groups],
-            jobs: Vec::new(),
+            in_use: Vec::new(),
             dropped: 0,
             regions,
             bands,
@@ -234,6 +234,11 @@ impl Occlusion {
             resolution,
             capacity,
         })
+    }
+
+    /// This frame's layers, in the order of the layer images.
+    pub fn layers_in_use(&self) -> &[OcclusionLayer] {
+        &self.in_use
     }
 
     pub fn region_count(&self) -> usize {
@@ -287,14 +292,18 @@ impl Occlusion {
                     let texels = width / (2.0 * half_extent) * self.resolution as f32;
                     let odd = 2.0 * (0.5 * texels).round() + 1.0;
                     let (u, v) = plane_axes(w);
+                    let scale = 1.0 / (2.0 * half_extent);
+                    // The box (or blocker search) reaches half its odd width beyond the
+                    // occluder's silhouette, and bilinear filtering one texel more.
+                    let reach = occluder_radius * scale + (0.5 * odd + 1.0) / self.resolution as f32;
                     jobs.push(Job {
                         receiver: r,
-                        occluder: o,
                         weight: energy,
                         layer: OcclusionLayer {
-                            centre: receiver_centre.extend(1.0 / (2.0 * half_extent)).to_array(),
+                            centre: receiver_centre.extend(scale).to_array(),
                             axis_u: u.extend(odd).to_array(),
                             axis_v: v.extend(root_omega).to_array(),
+                            footprint: [offset.dot(u) * scale + 0.5, offset.dot(v) * scale + 0.5, reach, 0.0],
                             ids: [i as u32, r as u32, o as u32, 0],
                         },
                     });
@@ -319,11 +328,10 @@ impl Occlusion {
             }
             range.1 += 1;
         }
-        let layers: Vec<OcclusionLayer> = jobs.iter().map(|j| j.layer).collect();
-        if !layers.is_empty() {
-            self.layers.write(0, bytes_of_slice(&layers))?;
+        self.in_use = jobs.iter().map(|j| j.layer).collect();
+        if !self.in_use.is_empty() {
+            self.layers.write(0, bytes_of_slice(&self.in_use))?;
         }
-        self.jobs = jobs.iter().map(|j| (j.receiver, j.occluder)).collect();
 
         // The SH basis at each region's direction in each group's frame (exact, on the host).
         let mut basis = Vec::with_capacity(transforms.len() * q);
@@ -347,10 +355,10 @@ impl Occlusion {
 
     /// Masks and the two filter passes; none when no pair can cast a shadow.
     pub fn passes<'a>(&'a self, ctx: &'a Arc<Context>, scene: &'a GpuScene) -> Vec<Pass<'a>> {
-        if self.jobs.is_empty() {
+        if self.in_use.is_empty() {
             return Vec::new();
         }
-        let count = self.jobs.len() as u32;
+        let count = self.in_use.len() as u32;
         let groups = [self.resolution.div_ceil(constants::BLUR_GROUP), count, 1];
         let blur = move |cmd, horizontal: bool, source: &Image, target: &Image| {
             let mode = (self.penumbra == Penumbra::Adaptive) as u32;
@@ -368,7 +376,8 @@ impl Occlusion {
         };
         vec![
             Pass::new("occluder_masks", &[], &["occlusion_masks"], move |cmd| {
-                for (l, &(_, occluder)) in self.jobs.iter().enumerate() {
+                for (l, layer) in self.in_use.iter().enumerate() {
+                    let occluder = layer.ids[2] as usize;
                     let target = Target { image: &self.mask, layer: l as u32 };
                     ctx.begin_rendering(cmd, Some(target), Some([0.0; 4]), None);
                     self.mask_pipeline.bind(cmd, &[Binding::Storage(&self.layers)]);

@@ -136,6 +136,7 @@ impl PrtTechnique {
                     depth_format: Some(DEPTH_FORMAT),
                     depth_test: true,
                     additive: false,
+                    fragment_constants: &[(settings.penumbra == Penumbra::Adaptive) as u32],
                 },
             )?,
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
@@ -190,12 +191,7 @@ impl Technique for PrtTechnique {
                     model: scene.transforms[mesh.group].to_cols_array_2d(),
                     albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
                     mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
-                    layers: [
-                        first_layer,
-                        layer_count,
-                        (occlusion.penumbra == Penumbra::Adaptive) as u32,
-                        occlusion.resolution,
-                    ],
+                    layers: [first_layer, layer_count, 0, occlusion.resolution],
                 };
                 self.scene_pipeline.push(cmd, bytes_of(&push));
                 ctx.draw_indexed(
