@@ -195,7 +195,7 @@ fn filtered_layers_are_zero_outside_their_footprint() {
     let mut checked = 0usize;
     for t in [0.0, 0.1, 0.3, 0.6] {
         let mut transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
-        transforms[0] = pose(&scene.groups[0].transform, 1.0, t);
+        transforms[0] = pose(&scene.groups[0], t).matrix();
         occlusion.update(&transforms, Mat3::IDENTITY).unwrap();
         let layers = occlusion.layers_in_use().to_vec();
         assert!(!layers.is_empty(), "pose {t}: no occlusion layer");

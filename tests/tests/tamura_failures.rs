@@ -250,9 +250,8 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
 fn contact_with_the_floor_darkens_the_floor_beside_the_base() {
     let ctx = Validated::new();
     let mut scene = Scene::builtin("teapot").unwrap();
-    let rest = pose(&scene.groups[0].transform, 1.0, 0.0);
-    let (_, rotation, translation) = rest.to_scale_rotation_translation();
-    scene.groups[0].transform = Transform { translation, rotation, ..scene.groups[0].transform };
+    scene.groups[0].transform = pose(&scene.groups[0], 0.0);
+    let rest = scene.groups[0].transform.matrix();
     let size = 64;
     let (near, far) = (Vec3::new(0.0, 0.0, 0.6), Vec3::new(-1.0, 0.0, 1.8));
     assert_sees(&scene, size, near, 1);

@@ -7,6 +7,7 @@ mod reference;
 mod render;
 mod scene_cmd;
 mod sh_cmd;
+mod sweep;
 mod transfer_source;
 
 use anyhow::{bail, Result};
@@ -79,6 +80,9 @@ enum Command {
     /// Benchmarks.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
+    /// A technique's settings side by side: error against the reference at several poses, GPU
+    /// time per frame, precomputation time and memory, written to DIR/sweep.csv.
+    Sweep(sweep::SweepArgs),
 }
 
 fn main() {
@@ -92,6 +96,7 @@ fn main() {
         Command::Reference(args) => reference::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Bench(command) => bench::run(&command),
+        Command::Sweep(args) => sweep::run(&args),
     };
     if let Err(e) = result {
         eprintln!("kage: error: {e:#}");

@@ -131,7 +131,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height, technique })
             .context("setting up the renderer")?;
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
-    let animated = scene.groups.first().map(|g| (g.transform, group_height(g)));
     let bar = ProgressBar::new(args.frames as u64).with_style(
         ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
             .expect("static template"),
@@ -140,9 +139,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let start = Instant::now();
     let mut table = TimingTable::default();
     for frame in 0..args.frames {
-        if let (true, Some((base, height))) = (args.animate, animated) {
+        if let (true, Some(group)) = (args.animate, scene.groups.first()) {
             let t = frame as f32 / args.frames as f32;
-            renderer.set_group_transform(0, kage::scene::animation::pose(&base, height, t))?;
+            renderer.set_group_transform(0, kage::scene::animation::pose(group, t).matrix())?;
         }
         table.add_frame(&renderer.render()?);
         bar.inc(1);
@@ -183,15 +182,4 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     args.gpu.finish(&ctx)
-}
-
-/// The group's height in world units (its object-space extent along Y times its scale).
-fn group_height(group: &kage::scene::Group) -> f32 {
-    let ys = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| p[1]));
-    let (lo, hi) = ys.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
-    if lo <= hi {
-        (hi - lo) * group.transform.scale
-    } else {
-        0.0
-    }
 }

@@ -94,12 +94,14 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", bad_scene.to_str().unwrap()], "colour"),
         (&["render", "--width", "0"], "image size"),
         (&["render", "--out", "picture.jpg", "--width", "8", "--height", "8"], "picture.jpg"),
         (&["sh", "/nonexistent/map.exr"], "/nonexistent/map.exr"),
+        (&["sweep", "--technique", "prt", "--only", "tamura:3", "--out", "x"], "sloan:2, sloan:3"),
+        (&["sweep", "--technique", "prt", "--poses", "nan", "--out", "x"], "--poses"),
     ];
     for (args, expected) in cases {
         let out = kage(args);
@@ -158,4 +160,54 @@ fn precompute_caches_and_tamura_renders_from_the_cache() {
     for pass in ["self_shadow", "occluder_masks", "blur_horizontal", "blur_vertical", "scene"] {
         assert!(text(&render).contains(pass), "{pass} missing: {}", text(&render));
     }
+}
+
+/// A small sweep: one row per setting, the header naming every pose, errors that a working
+/// technique and reference give (finite, below 1, Tamura's below unshadowed's: the teapot's
+/// shadow on the floor is what unshadowed misses), times and memory filled in.
+#[test]
+fn sweep_writes_one_csv_row_per_setting() {
+    let dir = scratch_dir("cli-sweep");
+    let cache = dir.join("cache");
+    let out = kage(&[
+        "sweep",
+        "--technique",
+        "prt",
+        "--only",
+        "unshadowed,tamura:8",
+        "--poses",
+        "0,0.3",
+        "--size",
+        "32",
+        "--spp",
+        "64",
+        "--frames",
+        "2",
+        "--time-size",
+        "32",
+        "--rays",
+        "64",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--validate",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        lines[0],
+        "scene,env,technique,parameter,value,error_mean,error_t0,error_t0.3,frame_ms,precompute_s,memory_mb"
+    );
+    assert_eq!(lines.len(), 3, "{csv}");
+    let fields: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split(',').collect()).collect();
+    assert_eq!((fields[0][2], fields[1][2], fields[1][4]), ("unshadowed", "tamura", "8"));
+    let number = |row: &[&str], column: usize| row[column].parse::<f64>().unwrap();
+    for row in &fields {
+        assert!((0.0..1.0).contains(&number(row, 5)), "{row:?}");
+        assert!(number(row, 8) > 0.0 && number(row, 10) > 0.0, "{row:?}");
+    }
+    assert!(number(&fields[1], 5) < number(&fields[0], 5), "{csv}");
+    assert!(number(&fields[1], 9) > 0.0 && fields[0][9].is_empty(), "precompute seconds only for PRT: {csv}");
 }

@@ -281,6 +281,12 @@ impl Context {
         self.validation.as_ref().map(|log| log.take()).unwrap_or_default()
     }
 
+    /// Bytes of device memory held by Kage's live buffers and images right now (what a
+    /// technique costs in memory is the difference across its creation).
+    pub fn allocated_bytes(&self) -> u64 {
+        self.allocator().generate_report().total_allocated_bytes
+    }
+
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
         self.allocator.lock().unwrap_or_else(|e| e.into_inner())
     }

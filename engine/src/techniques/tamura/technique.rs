@@ -99,7 +99,11 @@ impl PrtTechnique {
         } else {
             Regions::new(&scene.environment, settings.regions)?
         };
-        let capacity = if settings.regions == 0 || scene.groups.len() < 2 { 0 } else { settings.max_layers };
+        // Layer images hold no more layers than the scene can ask for: one per ordered pair of
+        // groups and region (the two-group default scene at q = 32 needs 64, not 256).
+        let groups = scene.groups.len();
+        let wanted = (groups * groups.saturating_sub(1) * settings.regions).min(u32::MAX as usize) as u32;
+        let capacity = wanted.min(settings.max_layers);
         let transfer_attributes = transfer_vertex_buffer(2);
         Ok(PrtTechnique {
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,

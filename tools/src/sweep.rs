@@ -1,0 +1,343 @@
+//! `kage sweep`: a technique's settings side by side in one process: each setting's error
+//! against the ray-traced reference at several poses of the animation, its GPU time per frame
+//! while the scene moves, its precomputation time and its device memory, in `DIR/sweep.csv`.
+use crate::transfer_source::PrtArgs;
+use crate::GpuArgs;
+use anyhow::{bail, Context as _, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use kage::backend::Context;
+use kage::imageio::RgbaF32Image;
+use kage::pass::TimingTable;
+use kage::reference::{compare, LightMode, ReferenceOptions, ReferenceRenderer};
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::scene::animation::pose;
+use kage::scene::{EnvMap, Scene};
+use kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
+use kage::techniques::prt::{PrtParams, TransferSet};
+use kage::techniques::tamura::technique::OcclusionSettings;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweptTechnique {
+    /// Unshadowed SH irradiance; Sloan's PRT at 2 to 5 bands; Tamura at q = 4 to 64;
+    /// parallel lights at q = 32, 64, 128 (the paper's Fig. 3).
+    Prt,
+}
+
+#[derive(Args)]
+pub struct SweepArgs {
+    #[arg(long, value_enum)]
+    technique: SweptTechnique,
+    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    #[arg(long, default_value = "teapot")]
+    scene: String,
+    /// Environment maps to sweep over, each replacing the scene's (default: the scene's own).
+    #[arg(long = "env")]
+    envs: Vec<PathBuf>,
+    /// Poses of the scripted motion (fractions of its cycle) at which the error is measured;
+    /// 0 is the scene pose (the teapot standing on the floor: contact).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.125, 0.6])]
+    poses: Vec<f32>,
+    /// Only these settings, e.g. `unshadowed,sloan:3,tamura:32,parallel-lights:64`.
+    #[arg(long, value_delimiter = ',')]
+    only: Vec<String>,
+    /// Side of the images compared with the reference, pixels.
+    #[arg(long, default_value_t = 128)]
+    size: u32,
+    /// Reference samples per pixel.
+    #[arg(long, default_value_t = 512)]
+    spp: u32,
+    /// Frames timed per setting while the scene moves (the median is reported); 0: no timing.
+    #[arg(long, default_value_t = 100)]
+    frames: u32,
+    /// Side of the timed frames, pixels.
+    #[arg(long, default_value_t = 512)]
+    time_size: u32,
+    /// Visibility rays per vertex of the PRT precomputation.
+    #[arg(long, default_value_t = PrtParams::DEFAULT.rays)]
+    rays: u32,
+    /// Cache folder of the PRT transfers (as `kage precompute --cache`).
+    #[arg(long)]
+    cache: Option<PathBuf>,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+/// One point of the sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Setting {
+    Unshadowed,
+    Sloan { bands: u32 },
+    Tamura { regions: usize },
+    ParallelLights { regions: usize },
+}
+
+impl Setting {
+    fn all(technique: SweptTechnique) -> Vec<Setting> {
+        match technique {
+            SweptTechnique::Prt => std::iter::once(Setting::Unshadowed)
+                .chain((2..=5).map(|bands| Setting::Sloan { bands }))
+                .chain([4, 8, 16, 32, 64].map(|regions| Setting::Tamura { regions }))
+                .chain([32, 64, 128].map(|regions| Setting::ParallelLights { regions }))
+                .collect(),
+        }
+    }
+
+    /// (technique, parameter, value): the CSV's columns and the `--only` spelling.
+    fn describe(self) -> (&'static str, &'static str, String) {
+        match self {
+            Setting::Unshadowed => ("unshadowed", "", String::new()),
+            Setting::Sloan { bands } => ("sloan", "bands", bands.to_string()),
+            Setting::Tamura { regions } => ("tamura", "regions", regions.to_string()),
+            Setting::ParallelLights { regions } => ("parallel-lights", "regions", regions.to_string()),
+        }
+    }
+
+    fn name(self) -> String {
+        match self.describe() {
+            (technique, _, value) if value.is_empty() => technique.to_string(),
+            (technique, _, value) => format!("{technique}:{value}"),
+        }
+    }
+
+    /// SH bands of the PRT transfer it needs (Tamura's at the default bands).
+    fn bands(self) -> Option<u32> {
+        match self {
+            Setting::Sloan { bands } => Some(bands),
+            Setting::Tamura { .. } => Some(PrtParams::DEFAULT.bands),
+            Setting::Unshadowed | Setting::ParallelLights { .. } => None,
+        }
+    }
+
+    fn choice(self, transfer: Option<&Arc<TransferSet>>) -> TechniqueChoice {
+        let prt = |regions| TechniqueChoice::Prt {
+            transfer: transfer.expect("PRT settings come with their transfer").clone(),
+            occlusion: OcclusionSettings { regions, ..OcclusionSettings::default() },
+        };
+        match self {
+            Setting::Unshadowed => TechniqueChoice::Unshadowed,
+            Setting::Sloan { .. } => prt(0),
+            Setting::Tamura { regions } => prt(regions),
+            Setting::ParallelLights { regions } => {
+                TechniqueChoice::ParallelLights { regions, shadow_map_size: DEFAULT_SHADOW_MAP_SIZE }
+            }
+        }
+    }
+}
+
+/// The settings `--only` names, in the sweep's order; an unknown name is an error that lists
+/// the known ones.
+fn chosen(technique: SweptTechnique, only: &[String]) -> Result<Vec<Setting>> {
+    let all = Setting::all(technique);
+    for name in only {
+        if !all.iter().any(|s| s.name() == *name) {
+            let known: Vec<String> = all.iter().map(|s| s.name()).collect();
+            bail!("--only {name}: no such setting; the sweep has {}", known.join(", "));
+        }
+    }
+    Ok(all.into_iter().filter(|s| only.is_empty() || only.contains(&s.name())).collect())
+}
+
+struct Row {
+    env: String,
+    setting: Setting,
+    errors: Vec<f64>,
+    frame_ms: Option<f64>,
+    precompute_s: Option<f64>,
+    memory_mb: f64,
+}
+
+pub fn run(args: &SweepArgs) -> Result<()> {
+    if args.poses.is_empty() || args.poses.iter().any(|t| !t.is_finite()) {
+        bail!("--poses must list finite times, e.g. 0,0.125,0.6");
+    }
+    if args.size == 0 || args.time_size == 0 || args.spp == 0 {
+        bail!("--size, --time-size and --spp must be at least 1");
+    }
+    let settings = chosen(args.technique, &args.only)?;
+    let scene = Scene::from_arg(&args.scene)?;
+    if scene.groups.is_empty() {
+        bail!("scene {} has no groups to move", scene.name);
+    }
+    let envs: Vec<(String, EnvMap)> = if args.envs.is_empty() {
+        vec![("scene".to_string(), scene.environment.clone())]
+    } else {
+        args.envs
+            .iter()
+            .map(|path| {
+                let map = EnvMap::load(path).with_context(|| format!("--env {}", path.display()))?;
+                crate::report_clamped(&map);
+                let name = path
+                    .file_name()
+                    .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into());
+                Ok((name, map))
+            })
+            .collect::<Result<_>>()?
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let ctx = args.gpu.context()?;
+
+    // Transfers depend on the geometry only: one per band count, shared by every map.
+    let mut transfers = BTreeMap::new();
+    for bands in settings.iter().filter_map(|s| s.bands()) {
+        if let std::collections::btree_map::Entry::Vacant(slot) = transfers.entry(bands) {
+            let source = PrtArgs { rays: args.rays, bands, cache: args.cache.clone(), force: false };
+            let (transfer, _) = source.obtain(&ctx, &scene)?;
+            slot.insert(Arc::new(transfer));
+        }
+    }
+
+    let timed = if args.frames > 0 { 1 } else { 0 };
+    let steps = envs.len() * (args.poses.len() + settings.len() * (args.poses.len() + timed));
+    let bar = ProgressBar::new(steps as u64).with_style(
+        ProgressStyle::with_template("{msg:40} [{bar:30}] {pos}/{len}, {elapsed} elapsed, {eta} left")
+            .expect("static template"),
+    );
+    let mut rows = Vec::new();
+    for (env_name, map) in &envs {
+        let mut lit = scene.clone();
+        lit.environment = map.clone();
+        let references: Vec<RgbaF32Image> = args
+            .poses
+            .iter()
+            .map(|&t| {
+                bar.set_message(format!("{env_name}: reference at t = {t}"));
+                let image = reference(&ctx, &posed(&lit, t), args.size, args.spp);
+                bar.inc(1);
+                image
+            })
+            .collect::<Result<_>>()?;
+        for &setting in &settings {
+            bar.set_message(format!("{env_name}: {}", setting.name()));
+            let transfer = setting.bands().map(|b| &transfers[&b]);
+            let before = ctx.allocated_bytes();
+            let mut renderer = Renderer::new(
+                &ctx,
+                &lit,
+                &RenderOptions { width: args.size, height: args.size, technique: setting.choice(transfer) },
+            )
+            .with_context(|| format!("setting up {}", setting.name()))?;
+            let memory_mb = (ctx.allocated_bytes() - before) as f64 / (1 << 20) as f64;
+            let mut errors = Vec::new();
+            for (&t, reference) in args.poses.iter().zip(&references) {
+                renderer.set_group_transform(0, pose(&lit.groups[0], t).matrix())?;
+                renderer.render()?;
+                errors.push(compare(&renderer.image()?, reference)?.relative_rmse);
+                bar.inc(1);
+            }
+            drop(renderer);
+            let frame_ms = if args.frames > 0 {
+                let ms = frame_time(&ctx, &lit, setting.choice(transfer), args.time_size, args.frames)?;
+                bar.inc(1);
+                Some(ms)
+            } else {
+                None
+            };
+            let row = Row {
+                env: env_name.clone(),
+                setting,
+                errors,
+                frame_ms,
+                precompute_s: transfer.map(|t| t.seconds),
+                memory_mb,
+            };
+            bar.suspend(|| println!("{}", summary(&row)));
+            rows.push(row);
+        }
+    }
+    bar.finish_and_clear();
+
+    let path = args.out.join("sweep.csv");
+    std::fs::write(&path, csv(&scene.name, &args.poses, &rows))
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {} ({} rows, {})", path.display(), rows.len(), ctx.info().name);
+    print_ratios(&rows);
+    args.gpu.finish(&ctx)
+}
+
+/// `scene` with its first group at time `t` of the scripted motion.
+fn posed(scene: &Scene, t: f32) -> Scene {
+    let mut scene = scene.clone();
+    scene.groups[0].transform = pose(&scene.groups[0], t);
+    scene
+}
+
+fn reference(ctx: &Arc<Context>, scene: &Scene, size: u32, spp: u32) -> Result<RgbaF32Image> {
+    let options = ReferenceOptions { width: size, height: size, light: LightMode::Environment, seed: 0 };
+    let mut renderer = ReferenceRenderer::new(ctx, scene, &options).context("setting up the reference")?;
+    renderer.run_batch(spp)?;
+    Ok(renderer.image()?)
+}
+
+/// Median GPU milliseconds per frame over `frames` frames of the scripted motion.
+fn frame_time(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    choice: TechniqueChoice,
+    size: u32,
+    frames: u32,
+) -> Result<f64> {
+    let mut renderer =
+        Renderer::new(ctx, scene, &RenderOptions { width: size, height: size, technique: choice })?;
+    // One untimed frame: pipelines are compiled on first use on CPU drivers.
+    renderer.render()?;
+    let mut table = TimingTable::default();
+    for frame in 0..frames {
+        renderer.set_group_transform(0, pose(&scene.groups[0], frame as f32 / frames as f32).matrix())?;
+        table.add_frame(&renderer.render()?);
+    }
+    Ok(table.frame_median_ms())
+}
+
+fn summary(row: &Row) -> String {
+    let mean = row.errors.iter().sum::<f64>() / row.errors.len() as f64;
+    let ms = row.frame_ms.map_or_else(|| "-".to_string(), |ms| format!("{ms:.2} ms"));
+    format!(
+        "{:<12} {:<20} relative RMSE {mean:.4} (per pose {:.4?}), {ms}, {:.1} MB",
+        row.env,
+        row.setting.name(),
+        row.errors,
+        row.memory_mb
+    )
+}
+
+fn csv(scene: &str, poses: &[f32], rows: &[Row]) -> String {
+    let mut out = String::from("scene,env,technique,parameter,value,error_mean");
+    for t in poses {
+        write!(out, ",error_t{t}").expect("writing to a String");
+    }
+    out.push_str(",frame_ms,precompute_s,memory_mb\n");
+    let optional = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:.4}"));
+    for row in rows {
+        let (technique, parameter, value) = row.setting.describe();
+        let mean = row.errors.iter().sum::<f64>() / row.errors.len() as f64;
+        write!(out, "{scene},{},{technique},{parameter},{value},{mean:.5}", row.env)
+            .expect("writing to a String");
+        for e in &row.errors {
+            write!(out, ",{e:.5}").expect("writing to a String");
+        }
+        writeln!(out, ",{},{},{:.2}", optional(row.frame_ms), optional(row.precompute_s), row.memory_mb)
+            .expect("writing to a String");
+    }
+    out
+}
+
+/// Frame-time ratios to Sloan's PRT at the default bands, measured in this run.
+fn print_ratios(rows: &[Row]) {
+    let sloan = Setting::Sloan { bands: PrtParams::DEFAULT.bands };
+    for (env, base) in rows.iter().filter(|r| r.setting == sloan).filter_map(|r| Some((&r.env, r.frame_ms?)))
+    {
+        for row in rows.iter().filter(|r| &r.env == env && r.setting != sloan) {
+            if let Some(ms) = row.frame_ms {
+                println!("{env}: {} / {} frame time: {:.2}", row.setting.name(), sloan.name(), ms / base);
+            }
+        }
+    }
+}
