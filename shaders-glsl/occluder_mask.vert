@@ -5,7 +5,7 @@
 // a flat mask has no depth, and without the clip a floor would shadow what stands on it. The
 // mask's second channel holds the occluder's height above the plane, towards the light (for the
 // adaptive penumbra).
-#include "layouts.glsl"
+#include "occlusion.glsl"
 
 layout(set = 0, binding = 0, std430) readonly buffer Layers { OcclusionLayer layers[]; };
 layout(push_constant) uniform Push { MaskPush p; };
@@ -14,10 +14,9 @@ layout(location = 0) out float height;
 
 void main() {
     OcclusionLayer layer = layers[p.layer.x];
-    vec3 offset = (p.model * vec4(position, 1.0)).xyz - layer.centre.xyz;
-    vec2 uv = vec2(dot(offset, layer.axis_u.xyz), dot(offset, layer.axis_v.xyz)) * layer.centre.w;
+    vec3 world = (p.model * vec4(position, 1.0)).xyz;
     vec3 towards_light = cross(layer.axis_u.xyz, layer.axis_v.xyz);
-    height = dot(offset, towards_light);
+    height = dot(world - layer.centre.xyz, towards_light);
     gl_ClipDistance[0] = height;
-    gl_Position = vec4(uv * 2.0, 0.5, 1.0);
+    gl_Position = vec4(occlusion_uv(layer, world) * 2.0 - 1.0, 0.5, 1.0);
 }

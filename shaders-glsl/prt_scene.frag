@@ -4,6 +4,7 @@
 // one region never subtract the region twice, and L is clamped at 0.
 #include "constants.glsl"
 #include "layouts.glsl"
+#include "occlusion.glsl"
 
 layout(set = 0, binding = 3, std430) readonly buffer Energy { vec4 region_energy[]; };
 layout(set = 0, binding = 4) uniform sampler2DArray occlusion;
@@ -44,10 +45,6 @@ float adaptive_occlusion(OcclusionLayer layer, uint l, vec2 uv, vec3 offset, flo
     return clamp(table_box(l, uv, half_width, size).x / (texels * texels), 0.0, 1.0);
 }
 
-vec2 mask_uv(OcclusionLayer layer, vec3 offset) {
-    return vec2(dot(offset, layer.axis_u.xyz), dot(offset, layer.axis_v.xyz)) * layer.centre.w + 0.5;
-}
-
 void main() {
     // Layers come sorted by region, so each region's V_o is complete when the region changes.
     vec3 blocked = vec3(0.0);
@@ -61,9 +58,7 @@ void main() {
         // every branch), but a loop ends when all its lanes are done.
         uint hits = 0u;
         for (uint k = 0u; k < min(count - base, 32u); ++k) {
-            OcclusionLayer layer = layers[first + base + k];
-            vec2 from_occluder = mask_uv(layer, world_position - layer.centre.xyz) - layer.footprint.xy;
-            hits |= uint(dot(from_occluder, from_occluder) <= layer.footprint.z * layer.footprint.z) << k;
+            hits |= uint(within_footprint(layers[first + base + k], world_position)) << k;
         }
         while (hits != 0u) {
             uint l = first + base + uint(findLSB(hits));
@@ -76,10 +71,10 @@ void main() {
                 region = layer.ids.x;
                 occluded = 0.0;
             }
-            vec3 offset = world_position - layer.centre.xyz;
-            vec2 uv = mask_uv(layer, offset);
-            occluded += ADAPTIVE_PENUMBRA == 0u ? textureLod(occlusion, vec3(uv, float(l)), 0.0).r
-                                                : adaptive_occlusion(layer, l, uv, offset, float(draw.layers.w));
+            vec2 uv = occlusion_uv(layer, world_position);
+            occluded += ADAPTIVE_PENUMBRA == 0u
+                ? textureLod(occlusion, vec3(uv, float(l)), 0.0).r
+                : adaptive_occlusion(layer, l, uv, world_position - layer.centre.xyz, float(draw.layers.w));
         }
     }
     if (region != KAGE_NO_HIT) {

@@ -42,9 +42,9 @@
 // Most environment regions the Tamura technique handles (interpolated as vertex outputs).
 #define KAGE_MAX_REGIONS 64
 // Most occlusion layers per frame: their records sit in a uniform buffer (cheaper to read per
-// fragment than a storage buffer on CPU drivers), 64 bytes each, within the 16 KiB every
-// Vulkan device offers.
-#define KAGE_MAX_OCCLUSION_LAYERS 256
+// fragment than a storage buffer on CPU drivers), 80 bytes each, within the 16 KiB every
+// Vulkan device offers. A multiple of 32: the scene pass keeps one bit per layer.
+#define KAGE_MAX_OCCLUSION_LAYERS 192
 // Invocations per workgroup of the occlusion box filter (one row or column each).
 #define KAGE_BLUR_GROUP 64
 

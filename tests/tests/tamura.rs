@@ -190,7 +190,7 @@ fn filtered_layers_are_zero_outside_their_footprint() {
     let size = 128;
     let regions = Regions::new(&scene.environment, 32).unwrap();
     let mut occlusion =
-        Occlusion::new(&ctx, regions, 3, group_bounds(&scene), size, 256, Penumbra::Fixed).unwrap();
+        Occlusion::new(&ctx, regions, 3, group_bounds(&scene), size, 64, Penumbra::Fixed).unwrap();
     let mut executor = FrameExecutor::new(&ctx, "footprint").unwrap();
     let mut checked = 0usize;
     for t in [0.0, 0.1, 0.3, 0.6] {

@@ -111,6 +111,10 @@ pub struct Occlusion {
 }
 
 const MASK_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
+// The scene pass reads the layers from a uniform buffer (16 KiB on every device) and keeps one
+// bit per layer in 32-bit words.
+const _: () = assert!(constants::MAX_OCCLUSION_LAYERS as usize * size_of::<OcclusionLayer>() <= 16 * 1024);
+const _: () = assert!(constants::MAX_OCCLUSION_LAYERS % 32 == 0);
 
 fn layered(
     ctx: &Arc<Context>,

@@ -1,0 +1,19 @@
+// Where a world point falls in an occlusion layer, and whether the layer can hold any shadow
+// there: shared by the occluder masks and the scene pass.
+#ifndef KAGE_OCCLUSION_GLSL
+#define KAGE_OCCLUSION_GLSL
+#include "layouts.glsl"
+
+// The layer's mask coordinates of `world`: the orthographic projection along the region's
+// direction onto the plane through the receiver's centre, [0, 1]² over the mask.
+vec2 occlusion_uv(OcclusionLayer layer, vec3 world) {
+    vec3 offset = world - layer.centre.xyz;
+    return vec2(dot(offset, layer.axis_u.xyz), dot(offset, layer.axis_v.xyz)) * layer.centre.w + 0.5;
+}
+
+// Whether a read of the layer at `world` can return anything but 0 (see OcclusionLayer).
+bool within_footprint(OcclusionLayer layer, vec3 world) {
+    vec2 from_occluder = occlusion_uv(layer, world) - layer.footprint.xy;
+    return dot(from_occluder, from_occluder) <= layer.footprint.z * layer.footprint.z;
+}
+#endif
