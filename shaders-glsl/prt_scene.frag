@@ -6,7 +6,7 @@
 #include "layouts.glsl"
 #include "occlusion.glsl"
 
-layout(set = 0, binding = 3, std430) readonly buffer Energy { vec4 region_energy[]; };
+layout(set = 0, binding = 3, std140) uniform Energy { vec4 region_energy[KAGE_MAX_REGIONS]; };
 layout(set = 0, binding = 4) uniform sampler2DArray occlusion;
 layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
 layout(push_constant) uniform Push { PrtDrawPush draw; };

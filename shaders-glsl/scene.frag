@@ -5,7 +5,7 @@
 #include "envmap.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 1, std430) readonly buffer Sh { ShCoeffs sh; };
+layout(set = 0, binding = 1, std140) uniform Sh { ShCoeffs sh; };
 layout(push_constant) uniform Push { DrawPush draw; };
 layout(location = 0) in vec3 world_normal;
 layout(location = 0) out vec4 color;

@@ -56,7 +56,10 @@ impl EnvSh {
                 &BufferDesc {
                     name: "env_sh",
                     size: size_of::<ShCoeffs>() as u64,
-                    usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
+                    // Read per fragment as uniforms: far cheaper than a storage buffer on CPU drivers.
+                    usage: storage
+                        | vk::BufferUsageFlags::UNIFORM_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_SRC,
                     location: MemoryLocation::GpuOnly,
                 },
             )?,

@@ -33,7 +33,7 @@ impl Unshadowed {
                 name: "scene_unshadowed",
                 vertex_spirv: spirv::SCENE_VERT,
                 fragment_spirv: spirv::SCENE_FRAG,
-                bindings: &[BindingKind::UniformBuffer, BindingKind::StorageBuffer],
+                bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
                 push_size: size_of::<DrawPush>() as u32,
                 vertex_buffers: &[MESH_VERTICES],
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
@@ -58,7 +58,7 @@ impl Technique for Unshadowed {
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
         vec![Pass::new("scene", &["frame_uniforms", "env_sh", "color"], &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Storage(env_sh)]);
+            self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(env_sh)]);
             for mesh in &scene.meshes {
                 let push = DrawPush {
                     model: scene.transforms[mesh.group].to_cols_array_2d(),

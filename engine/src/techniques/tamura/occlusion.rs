@@ -171,7 +171,8 @@ impl Occlusion {
         let q = regions.regions.len();
         let groups = bounds.len();
         let layer_count = capacity.max(1);
-        let mut energy = host_buffer(ctx, "occlusion.region_energy", q * 16)?;
+        // Sized for the shader's whole array: the scene pass reads it as uniforms.
+        let mut energy = host_buffer(ctx, "occlusion.region_energy", constants::MAX_REGIONS as usize * 16)?;
         let rgb: Vec<u8> = regions
             .regions
             .iter()
