@@ -281,6 +281,13 @@ impl Renderer {
         Ok(timings)
     }
 
+    /// Occlusion layers the last frame wanted but had no room for (see
+    /// `OcclusionSettings::max_layers`): the least energetic regions' shadows between groups
+    /// were left out.
+    pub fn dropped_layers(&self) -> usize {
+        self.technique.dropped_layers()
+    }
+
     /// The last rendered frame: linear radiance, row 0 at the top.
     pub fn image(&self) -> Result<RgbaF32Image> {
         let bytes = self.targets.readback.read()?;

@@ -142,6 +142,32 @@ fn a_group_alone_runs_no_occlusion_pass() {
     assert!(tamura.image().unwrap().pixels == sloan.image().unwrap().pixels);
 }
 
+/// More layers than fit: five teapots in a row on the floor ask for more (receiver, occluder,
+/// region) layers than the 192 kept. The renderer says how many it left out, and the picture
+/// stays finite and non-negative (the dropped regions are merely unshadowed between groups).
+#[test]
+fn layers_beyond_the_budget_are_dropped_and_counted() {
+    let ctx = Validated::new();
+    let mut scene = Scene::builtin("teapot").unwrap();
+    let teapot = scene.groups[0].clone();
+    for (i, x) in [-4.0f32, -2.0, 2.0, 4.0].into_iter().enumerate() {
+        let mut copy = teapot.clone();
+        copy.name = format!("teapot-{i}");
+        copy.transform.translation.x += x;
+        scene.groups.push(copy);
+    }
+    let transfer = transfer_of(&ctx, &scene);
+    let mut renderer =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 32) })
+            .unwrap();
+    renderer.render().unwrap();
+    let dropped = renderer.dropped_layers();
+    println!("{dropped} layers dropped");
+    assert!(dropped > 0, "five teapots at q = 32 should exceed the layer budget");
+    let image = renderer.image().unwrap();
+    assert!(image.pixels.iter().all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
+}
+
 fn luminance(p: [f32; 4]) -> f32 {
     0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
 }

@@ -138,12 +138,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.set_message("rendering");
     let start = Instant::now();
     let mut table = TimingTable::default();
+    let mut dropped = 0;
     for frame in 0..args.frames {
         if let (true, Some(group)) = (args.animate, scene.groups.first()) {
             let t = frame as f32 / args.frames as f32;
             renderer.set_group_transform(0, kage::scene::animation::pose(group, t).matrix())?;
         }
         table.add_frame(&renderer.render()?);
+        dropped = dropped.max(renderer.dropped_layers());
         bar.inc(1);
         if start.elapsed().as_secs_f32() < 1.0 {
             bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -152,6 +154,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     bar.finish_and_clear();
+    if dropped > 0 {
+        eprintln!(
+            "kage: note: up to {dropped} occlusion layer(s) per frame did not fit the {} Kage keeps; the least energetic regions' shadows between groups were left out",
+            kage::layouts::constants::MAX_OCCLUSION_LAYERS
+        );
+    }
     let image = renderer.image()?;
     kage::imageio::write(&args.out, &image, args.exposure)?;
     println!("wrote {} ({}x{}, scene {})", args.out.display(), args.width, args.height, scene.name);

@@ -47,4 +47,9 @@ pub trait Technique {
         &[]
     }
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>>;
+    /// Occlusion layers the last frame wanted but had no room for (their light was left
+    /// unshadowed): 0 for techniques without a layer budget.
+    fn dropped_layers(&self) -> usize {
+        0
+    }
 }

@@ -146,14 +146,13 @@ impl PrtTechnique {
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
         })
     }
-
-    /// Occlusion layers wanted last frame that did not fit (see `OcclusionSettings::max_layers`).
-    pub fn dropped_layers(&self) -> usize {
-        self.occlusion.dropped
-    }
 }
 
 impl Technique for PrtTechnique {
+    fn dropped_layers(&self) -> usize {
+        self.occlusion.dropped
+    }
+
     fn update(&mut self, state: &FrameState) -> Result<()> {
         let env = env_rotation(state.env_rotation);
         self.self_shadow.update(state.transforms, env)?;
