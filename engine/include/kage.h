@@ -470,7 +470,8 @@ kage_result kage_renderer_create(const kage_context *context,
 
 /**
  * Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The
- * handle must not be used afterwards.
+ * handle must not be used afterwards (also when this fails with `KAGE_RESULT_VALIDATION`,
+ * which reports what the layer said while its objects were destroyed).
  *
  * # Safety
  * `renderer` must not be in use by another thread.

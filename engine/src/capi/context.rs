@@ -62,6 +62,7 @@ pub unsafe extern "C" fn kage_context_create(
             false => Some(unsafe { args::text(desc.device_name, "desc->device_name") }?.to_owned()),
         };
         let ctx = Context::new(&ContextDesc { validation: desc.validation, device })?;
+        kage_context::check_validation(&ctx)?;
         *context = handles::register(kage_context { ctx });
         Ok(())
     })

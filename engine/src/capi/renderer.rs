@@ -86,13 +86,22 @@ pub unsafe extern "C" fn kage_renderer_create(
 }
 
 /// Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The
-/// handle must not be used afterwards.
+/// handle must not be used afterwards (also when this fails with `KAGE_RESULT_VALIDATION`,
+/// which reports what the layer said while its objects were destroyed).
 ///
 /// # Safety
 /// `renderer` must not be in use by another thread.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_destroy(renderer: *mut kage_renderer) -> kage_result {
-    boundary(|| handles::destroy(renderer, "renderer"))
+    boundary(|| {
+        if renderer.is_null() {
+            return Ok(());
+        }
+        // SAFETY: the host does not use the handle elsewhere during the call.
+        let ctx = unsafe { handles::get(renderer, "renderer") }?.ctx.clone();
+        handles::destroy(renderer, "renderer")?;
+        kage_context::check_validation(&ctx)
+    })
 }
 
 /// Places group `group` (0 to `kage_scene_group_count` - 1) for the next frames. `transform`
