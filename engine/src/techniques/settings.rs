@@ -105,3 +105,40 @@ impl TechniqueSettings {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn transfer(bands: u32) -> Option<Arc<TransferSet>> {
+        Some(Arc::new(TransferSet { params: PrtParams { bands, rays: 1 }, seconds: 0.0, meshes: vec![] }))
+    }
+
+    fn error(settings: TechniqueSettings, transfer: Option<Arc<TransferSet>>) -> String {
+        settings.choice(transfer).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn each_kind_becomes_its_choice() {
+        let of = |kind| TechniqueSettings { kind, regions: 4, ..Default::default() };
+        assert!(matches!(of(TechniqueKind::Unshadowed).choice(None), Ok(TechniqueChoice::Unshadowed)));
+        let sloan = of(TechniqueKind::Sloan).choice(transfer(3)).unwrap();
+        assert!(matches!(sloan, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 0));
+        let tamura = of(TechniqueKind::Tamura).choice(transfer(3)).unwrap();
+        assert!(matches!(tamura, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 4));
+        let lights = of(TechniqueKind::ParallelLights).choice(None).unwrap();
+        assert!(matches!(lights, TechniqueChoice::ParallelLights { regions: 4, .. }));
+        assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
+        assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
+    }
+
+    #[test]
+    fn missing_or_mismatched_precomputation_and_bad_parameters_are_errors() {
+        let tamura = TechniqueSettings { kind: TechniqueKind::Tamura, ..Default::default() };
+        assert!(error(tamura, None).contains("precompute it first"));
+        assert!(error(tamura, transfer(4)).contains("4 SH bands"));
+        assert!(error(TechniqueSettings { regions: 0, ..tamura }, transfer(3)).contains("at least 1"));
+        let bands = PrtParams { bands: 9, ..PrtParams::DEFAULT };
+        assert!(error(TechniqueSettings { prt: bands, ..tamura }, transfer(9)).contains("9 SH bands"));
+    }
+}
