@@ -25,3 +25,15 @@ fn committed_header_matches_the_c_abi() {
          KAGE_BLESS=1 cargo test --release -p kage-tests --test c_header\nand commit it"
     );
 }
+
+/// C++ hosts (game engines) include the same header.
+#[test]
+fn header_compiles_as_cpp() {
+    let header = Path::new(env!("CARGO_MANIFEST_DIR")).join("../engine/include/kage.h");
+    let output = std::process::Command::new("c++")
+        .args(["-std=c++17", "-fsyntax-only", "-Wall", "-Wextra", "-Werror", "-pedantic", "-x", "c++"])
+        .arg(&header)
+        .output()
+        .expect("c++ (Debian: g++)");
+    assert!(output.status.success(), "kage.h as C++:\n{}", String::from_utf8_lossy(&output.stderr));
+}

@@ -25,6 +25,18 @@ pub(crate) unsafe fn out<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, Fa
     unsafe { ptr.as_mut() }.ok_or_else(|| null(name))
 }
 
+/// Where to write a new handle; set to NULL at once, so that the host finds NULL there after
+/// any failure.
+///
+/// # Safety
+/// `ptr` must be NULL or valid for writes of a pointer for `'a`.
+pub(crate) unsafe fn handle_out<'a, T>(ptr: *mut *mut T, name: &str) -> Result<&'a mut *mut T, Failure> {
+    // SAFETY: the caller's promise.
+    let out = unsafe { out(ptr, name) }?;
+    *out = std::ptr::null_mut();
+    Ok(out)
+}
+
 /// `count` values at `ptr`; NULL is allowed when `count` is 0.
 ///
 /// # Safety

@@ -52,8 +52,7 @@ pub unsafe extern "C" fn kage_context_create(
 ) -> kage_result {
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
-        let context = unsafe { args::out(context, "context") }?;
-        *context = std::ptr::null_mut();
+        let context = unsafe { args::handle_out(context, "context") }?;
         // SAFETY: the caller promises NULL or a valid desc.
         let desc = unsafe { args::value(desc, "desc") }?;
         let device = match desc.device_name.is_null() {
@@ -110,8 +109,7 @@ pub unsafe extern "C" fn kage_context_create_from_vulkan(
 ) -> kage_result {
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
-        let context = unsafe { args::out(context, "context") }?;
-        *context = std::ptr::null_mut();
+        let context = unsafe { args::handle_out(context, "context") }?;
         // SAFETY: the caller promises NULL or a valid struct.
         let host = unsafe { args::value(handles, "handles") }?;
         for (name, handle) in [

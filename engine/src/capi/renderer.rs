@@ -69,8 +69,7 @@ pub unsafe extern "C" fn kage_renderer_create(
 ) -> kage_result {
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
-        let out = unsafe { args::out(renderer, "renderer") }?;
-        *out = std::ptr::null_mut();
+        let out = unsafe { args::handle_out(renderer, "renderer") }?;
         // SAFETY: the host does not destroy the handles during the call; desc is NULL or valid.
         let (context, scene, desc) = unsafe {
             (handles::get(context, "context")?, handles::get(scene, "scene")?, args::value(desc, "desc")?)

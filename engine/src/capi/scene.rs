@@ -104,8 +104,7 @@ pub struct kage_scene_desc {
 pub unsafe extern "C" fn kage_scene_load(path: *const c_char, scene: *mut *mut kage_scene) -> kage_result {
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
-        let out = unsafe { args::out(scene, "scene") }?;
-        *out = std::ptr::null_mut();
+        let out = unsafe { args::handle_out(scene, "scene") }?;
         // SAFETY: the caller promises NULL or a NUL-terminated string.
         let path = unsafe { args::text(path, "path") }?;
         let scene = Scene::from_arg(path).map_err(crate::Error::from)?;
@@ -135,8 +134,7 @@ pub unsafe extern "C" fn kage_scene_create(
 ) -> kage_result {
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
-        let out = unsafe { args::out(scene, "scene") }?;
-        *out = std::ptr::null_mut();
+        let out = unsafe { args::handle_out(scene, "scene") }?;
         // SAFETY: the caller promises NULL or a valid desc with arrays as stated.
         let scene = unsafe { scene_from_desc(args::value(desc, "desc")?) }?;
         *out = handles::register(kage_scene { scene, transfer: None });
