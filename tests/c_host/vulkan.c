@@ -121,6 +121,9 @@ int main(int argc, char **argv) {
   kage_vulkan_handles handles = {instance, physical, bare, family, bare_queue, validation};
   kage_context *context = NULL;
   EXPECT(kage_context_create_from_vulkan(&handles, &context), KAGE_RESULT_UNSUPPORTED);
+  char message[512];
+  CHECK(kage_last_error_message(message, sizeof message, NULL));
+  REQUIRE(strstr(message, "VK_KHR_dynamic_rendering enabled on the host's device") != NULL);
   vkDestroyDevice(bare, NULL);
 
   VkDevice device = make_device(physical, family, 1);
