@@ -3,9 +3,9 @@
 //!
 //! Rules every function follows, so that a host cannot crash Kage from the outside:
 //! - It returns a [`kage_result`]; on failure [`kage_last_error_message`] says why.
-//! - It runs behind a panic boundary ([`result::boundary`]): a panic becomes
+//! - It runs behind a panic boundary (`result::boundary`): a panic becomes
 //!   `KAGE_RESULT_PANIC`, never an unwind into C.
-//! - Handles are opaque and checked against the set of live handles ([`handles`]) before use:
+//! - Handles are opaque and checked against the set of live handles (`handles.rs`) before use:
 //!   NULL is `KAGE_RESULT_NULL_ARGUMENT`; a destroyed, foreign or wrong-kind handle is
 //!   `KAGE_RESULT_INVALID_HANDLE`, not undefined behaviour.
 //! - Enumerations arrive as `uint32_t`, so that an out-of-range value from C is
