@@ -4,8 +4,10 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
+# gcc, g++, libvulkan-dev and valgrind: the C ABI tests compile C hosts (and kage.h as C++),
+# link them with -lvulkan and run them under memcheck.
 packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-tools vulkan-validationlayers
-          libshaderc-dev glslang-dev spirv-tools valgrind)
+          libshaderc-dev glslang-dev spirv-tools valgrind gcc g++)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -14,6 +14,7 @@
 #![warn(unsafe_op_in_unsafe_fn)]
 
 pub mod backend;
+pub mod capi;
 pub mod error;
 pub mod imageio;
 pub mod layouts;

@@ -5,13 +5,14 @@ use anyhow::{Context as _, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
+use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The lighting techniques `kage render` offers.
+/// The lighting techniques `kage render` offers (one per [`TechniqueKind`]).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TechniqueName {
     /// SH irradiance, no shadows.
@@ -96,12 +97,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = Scene::from_arg(&args.scene)?;
     crate::report_clamped(&scene.environment);
     let ctx = args.gpu.context()?;
-    let technique = match args.technique {
-        TechniqueName::Unshadowed => TechniqueChoice::Unshadowed,
-        TechniqueName::ParallelLights => {
-            TechniqueChoice::ParallelLights { regions: args.regions, shadow_map_size: args.shadow_map_size }
-        }
-        TechniqueName::Sloan | TechniqueName::Tamura => {
+    let settings = TechniqueSettings {
+        kind: match args.technique {
+            TechniqueName::Unshadowed => TechniqueKind::Unshadowed,
+            TechniqueName::Sloan => TechniqueKind::Sloan,
+            TechniqueName::Tamura => TechniqueKind::Tamura,
+            TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
+        },
+        prt: args.prt.params()?,
+        regions: args.regions,
+        mask_size: args.mask_size,
+        penumbra: match args.penumbra {
+            PenumbraName::Fixed => Penumbra::Fixed,
+            PenumbraName::Adaptive => Penumbra::Adaptive,
+        },
+        shadow_map_size: args.shadow_map_size,
+    }
+    .validated()?;
+    let transfer = match settings.precomputation() {
+        None => None,
+        Some(_) => {
             let (transfer, origin) = args.prt.obtain(&ctx, &scene)?;
             match origin {
                 Origin::Cached(path) => eprintln!("transfer: from {}", path.display()),
@@ -109,24 +124,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     eprintln!("transfer: computed in {:.2} s, cached in {}", transfer.seconds, path.display())
                 }
             }
-            let regions = if args.technique == TechniqueName::Sloan { 0 } else { args.regions };
-            if args.technique == TechniqueName::Tamura && regions == 0 {
-                anyhow::bail!("--regions must be at least 1 for the Tamura technique");
-            }
-            TechniqueChoice::Prt {
-                transfer: std::sync::Arc::new(transfer),
-                occlusion: OcclusionSettings {
-                    regions,
-                    mask_size: args.mask_size,
-                    penumbra: match args.penumbra {
-                        PenumbraName::Fixed => Penumbra::Fixed,
-                        PenumbraName::Adaptive => Penumbra::Adaptive,
-                    },
-                    ..OcclusionSettings::default()
-                },
-            }
+            Some(std::sync::Arc::new(transfer))
         }
     };
+    let technique = settings.choice(transfer)?;
     let mut renderer =
         Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height, technique })
             .context("setting up the renderer")?;

@@ -1,13 +1,12 @@
 //! Instance, device, queue and allocator: the one object every other piece borrows.
+use super::device::{self, has_extension, VALIDATION_LAYER};
 use super::validation::{self, ValidationLog};
 use crate::error::{Error, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
-use std::ffi::{c_char, CStr, CString};
+use std::ffi::{c_char, CString};
 use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex, MutexGuard};
-
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to create a [`Context`].
 #[derive(Clone, Debug, Default)]
@@ -18,6 +17,24 @@ pub struct ContextDesc {
     /// Pick the first device whose name contains this (case-insensitive). `None` reads the
     /// `KAGE_DEVICE` environment variable; unset, a discrete GPU is preferred.
     pub device: Option<String>,
+}
+
+/// A host's Vulkan objects for [`Context::adopt`]: Kage uses them and never destroys them.
+///
+/// The device must have been created with `VK_KHR_dynamic_rendering` and
+/// `VK_KHR_push_descriptor` enabled and the features `dynamicRendering`, `shaderClipDistance`
+/// and `shaderStorageImageExtendedFormats` on, from an instance of API version 1.2 or later.
+#[derive(Clone, Copy, Debug)]
+pub struct HostVulkan {
+    pub instance: vk::Instance,
+    pub physical_device: vk::PhysicalDevice,
+    pub device: vk::Device,
+    /// A family with graphics and compute; `queue` belongs to it.
+    pub queue_family: u32,
+    pub queue: vk::Queue,
+    /// Whether the instance has `VK_EXT_debug_utils` enabled (Kage then names and labels its
+    /// objects and passes).
+    pub debug_utils: bool,
 }
 
 /// What `kage info` reports about the device.
@@ -48,14 +65,24 @@ pub struct Context {
     pub(crate) command_pool: Mutex<vk::CommandPool>,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     info: DeviceInfo,
+    /// False for a host's device ([`Context::adopt`]): then the host destroys device and instance.
+    owns_device: bool,
 }
 
-fn has_extension(list: &[vk::ExtensionProperties], name: &CStr) -> bool {
-    list.iter().any(|e| e.extension_name_as_c_str() == Ok(name))
-}
-
-fn version_string(v: u32) -> String {
-    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+/// What both constructors hand to [`Context::assemble`].
+struct Parts {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    validation: Option<Box<ValidationLog>>,
+    debug_utils: bool,
+    physical: vk::PhysicalDevice,
+    device: ash::Device,
+    queue_family: u32,
+    queue: vk::Queue,
+    info: DeviceInfo,
+    owns_device: bool,
 }
 
 impl Context {
@@ -131,75 +158,8 @@ impl Context {
         };
 
         let wanted = desc.device.clone().or_else(|| std::env::var("KAGE_DEVICE").ok());
-        let (physical, queue_family) = pick_device(&instance, wanted.as_deref())?;
-
-        // SAFETY: valid physical device from this instance.
-        let props = unsafe { instance.get_physical_device_properties(physical) };
-        // SAFETY: as above.
-        let device_exts = unsafe { instance.enumerate_device_extension_properties(physical) }
-            .map_err(Error::vk("vkEnumerateDeviceExtensionProperties"))?;
-        // SAFETY: as above.
-        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-        // SAFETY: as above.
-        let features = unsafe { instance.get_physical_device_features(physical) };
-        let timestamps = props.limits.timestamp_compute_and_graphics == vk::TRUE
-            && families[queue_family as usize].timestamp_valid_bits > 0;
-        // SAFETY: as above.
-        let rgba32f = unsafe {
-            instance.get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
-        };
-        let rgba32f_linear =
-            rgba32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
-
-        let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-        // SAFETY: Vulkan 1.2 device (checked by pick_device); the chain is well formed.
-        unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
-        let driver_text = format!(
-            "{} ({})",
-            driver.driver_name_as_c_str().unwrap_or(c"?").to_string_lossy(),
-            driver.driver_info_as_c_str().unwrap_or(c"?").to_string_lossy()
-        );
-
-        let info = DeviceInfo {
-            name: props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned(),
-            device_type: format!("{:?}", props.device_type),
-            driver: driver_text,
-            api_version: version_string(props.api_version),
-            timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
-            features: vec![
-                (
-                    "VK_KHR_dynamic_rendering (required)",
-                    has_extension(&device_exts, ash::khr::dynamic_rendering::NAME),
-                ),
-                (
-                    "VK_KHR_push_descriptor (required)",
-                    has_extension(&device_exts, ash::khr::push_descriptor::NAME),
-                ),
-                ("RGBA32F linear filtering (required)", rgba32f_linear),
-                ("timestamps on the graphics/compute queue (pass timings)", timestamps),
-                ("VK_EXT_debug_utils (object names, labels)", debug_utils),
-                (
-                    "VK_LAYER_KHRONOS_validation (installed)",
-                    layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
-                ),
-                ("shaderClipDistance (required)", features.shader_clip_distance == vk::TRUE),
-                (
-                    "shaderStorageImageExtendedFormats (required)",
-                    features.shader_storage_image_extended_formats == vk::TRUE,
-                ),
-                ("shaderFloat64", features.shader_float64 == vk::TRUE),
-                (
-                    "ray query (not used: Kage casts rays through its own BVH)",
-                    has_extension(&device_exts, ash::khr::ray_query::NAME),
-                ),
-            ],
-        };
-        for (name, present) in &info.features {
-            if name.ends_with("(required)") && !present {
-                return Err(Error::Unsupported(format!("{name} on {}", info.name)));
-            }
-        }
+        let (physical, queue_family) = device::pick(&instance, wanted.as_deref())?;
+        let info = device::probe(&instance, physical, queue_family, debug_utils, &layers)?;
 
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
@@ -224,6 +184,79 @@ impl Context {
         // SAFETY: queue 0 of a family requested above.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
 
+        let ctx = Context::assemble(Parts {
+            entry,
+            instance,
+            debug_instance,
+            messenger,
+            validation,
+            debug_utils,
+            physical,
+            device,
+            queue_family,
+            queue,
+            info,
+            owns_device: true,
+        })?;
+        std::mem::forget(guard);
+        Ok(ctx)
+    }
+
+    /// Uses a host's instance, device and queue. Kage never destroys them: the host does, after
+    /// the context and everything made from it are gone. Validation, if wanted, is the host's
+    /// (its layers and messenger); [`Context::take_validation_messages`] stays empty.
+    ///
+    /// # Safety
+    /// The handles must be valid, created as [`HostVulkan`] says and from the system Vulkan
+    /// loader, and stay valid until the context drops. The host must not use `queue` while a
+    /// Kage call runs (Vulkan requires queue access to be externally synchronized).
+    pub unsafe fn adopt(host: &HostVulkan) -> Result<Arc<Context>> {
+        // SAFETY: as in `new`. The host's handles came from the same system loader, which the
+        // process has open already, so this finds the same library.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
+        // SAFETY: plain enumeration on a loaded entry.
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
+        // SAFETY: the caller promises a valid instance from this loader.
+        let instance = unsafe { ash::Instance::load(entry.static_fn(), host.instance) };
+        let info =
+            device::probe(&instance, host.physical_device, host.queue_family, host.debug_utils, &layers)?;
+        // SAFETY: the caller promises a valid device of this instance.
+        let device = unsafe { ash::Device::load(instance.fp_v1_0(), host.device) };
+        // A device created without an extension gives no entry points for it (Vulkan 1.3 and
+        // Mesa): say which is missing rather than crash at the first draw.
+        for (extension, function) in [
+            (ash::khr::dynamic_rendering::NAME, c"vkCmdBeginRenderingKHR"),
+            (ash::khr::push_descriptor::NAME, c"vkCmdPushDescriptorSetKHR"),
+        ] {
+            // SAFETY: a valid device and a NUL-terminated name.
+            let found = unsafe { (instance.fp_v1_0().get_device_proc_addr)(host.device, function.as_ptr()) };
+            if found.is_none() {
+                return Err(Error::Unsupported(format!(
+                    "{} enabled on the host's device",
+                    extension.to_string_lossy()
+                )));
+            }
+        }
+        Context::assemble(Parts {
+            entry,
+            instance,
+            debug_instance: None,
+            messenger: vk::DebugUtilsMessengerEXT::null(),
+            validation: None,
+            debug_utils: host.debug_utils,
+            physical: host.physical_device,
+            device,
+            queue_family: host.queue_family,
+            queue: host.queue,
+            info,
+            owns_device: false,
+        })
+    }
+
+    /// The allocator and command pool on top of a device, then the context itself.
+    fn assemble(parts: Parts) -> Result<Arc<Context>> {
+        let Parts { entry, instance, device, physical, queue, queue_family, .. } = parts;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -241,22 +274,22 @@ impl Context {
         let command_pool = unsafe { device.create_command_pool(&pool_info, None) }
             .map_err(Error::vk("vkCreateCommandPool"))?;
 
-        std::mem::forget(guard);
         let ctx = Context {
-            debug: debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
+            debug: parts.debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
             dynamic_rendering: ash::khr::dynamic_rendering::Device::new(&instance, &device),
             push_descriptor: ash::khr::push_descriptor::Device::new(&instance, &device),
             _entry: entry,
             instance,
-            debug_instance,
-            messenger,
-            validation,
+            debug_instance: parts.debug_instance,
+            messenger: parts.messenger,
+            validation: parts.validation,
             physical,
             device,
             queue: Mutex::new(queue),
             command_pool: Mutex::new(command_pool),
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
-            info,
+            info: parts.info,
+            owns_device: parts.owns_device,
         };
         ctx.set_name(command_pool, "kage.command_pool");
         ctx.set_name(queue, "kage.queue");
@@ -318,15 +351,20 @@ impl Context {
 impl Drop for Context {
     fn drop(&mut self) {
         // SAFETY: every resource holds an Arc<Context>, so none is alive here; waiting first
-        // makes sure no submitted work still uses the pool.
+        // makes sure no submitted work still uses the pool. Kage submits to its one queue
+        // only, so waiting for it is enough, and on a host's device waiting for the whole
+        // device would also wait for (and race with) the host's own queues.
         unsafe {
-            let _ = self.device.device_wait_idle();
+            let _ = self.device.queue_wait_idle(*self.queue.get_mut().unwrap_or_else(|e| e.into_inner()));
             self.device
                 .destroy_command_pool(*self.command_pool.get_mut().unwrap_or_else(|e| e.into_inner()), None);
         }
         // The allocator frees its memory blocks through the device: drop it before the device.
         // SAFETY: dropped exactly once, here.
         unsafe { ManuallyDrop::drop(&mut self.allocator) };
+        if !self.owns_device {
+            return;
+        }
         // SAFETY: all children of the device and instance are gone.
         unsafe {
             self.device.destroy_device(None);
@@ -359,60 +397,4 @@ impl Drop for Guard {
             self.instance.destroy_instance(None);
         }
     }
-}
-
-/// Chooses a Vulkan 1.2+ device with a graphics+compute queue: by name when asked, otherwise
-/// discrete GPU first, then integrated, virtual, CPU.
-fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::PhysicalDevice, u32)> {
-    // SAFETY: plain enumeration on a valid instance.
-    let devices =
-        unsafe { instance.enumerate_physical_devices() }.map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
-    let mut candidates = Vec::new();
-    let mut names = Vec::new();
-    for physical in devices {
-        // SAFETY: physical device from this instance.
-        let props = unsafe { instance.get_physical_device_properties(physical) };
-        let name = props.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
-        names.push(name.clone());
-        if props.api_version < vk::API_VERSION_1_2 {
-            continue;
-        }
-        // SAFETY: as above.
-        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-        let Some(family) = families
-            .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
-        else {
-            continue;
-        };
-        let rank = match props.device_type {
-            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-            vk::PhysicalDeviceType::CPU => 3,
-            _ => 4,
-        };
-        candidates.push((rank, name, physical, family as u32));
-    }
-    if let Some(wanted) = wanted {
-        let needle = wanted.to_lowercase();
-        return candidates
-            .into_iter()
-            .find(|c| c.1.to_lowercase().contains(&needle))
-            .map(|c| (c.2, c.3))
-            .ok_or_else(|| {
-                Error::NoDevice(format!(
-                    "no Vulkan 1.2 device named like {wanted:?}; devices: {}",
-                    if names.is_empty() { "none".into() } else { names.join(", ") }
-                ))
-            });
-    }
-    candidates.sort_by_key(|c| c.0);
-    candidates.into_iter().next().map(|c| (c.2, c.3)).ok_or_else(|| {
-        Error::NoDevice(if names.is_empty() {
-            "the loader found no device (Debian: install mesa-vulkan-drivers for lavapipe)".into()
-        } else {
-            format!("none of {} has Vulkan 1.2 and a graphics+compute queue", names.join(", "))
-        })
-    })
 }

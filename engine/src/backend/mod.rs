@@ -6,6 +6,7 @@ mod buffer;
 mod commands;
 mod context;
 mod descriptor;
+mod device;
 mod image;
 mod pipeline;
 mod rendering;
@@ -14,7 +15,7 @@ mod validation;
 
 pub use buffer::{Buffer, BufferDesc};
 pub use commands::CommandRecorder;
-pub use context::{Context, ContextDesc, DeviceInfo};
+pub use context::{Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
 pub use image::{Edge, Image, ImageDesc, Sampler};
 pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer};

@@ -30,6 +30,17 @@ impl Camera {
         flip_y * Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, NEAR, FAR)
     }
 
+    /// A checked camera from plain arrays, as scene files and the C ABI give it.
+    pub fn from_arrays(
+        position: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fov_y_deg: f32,
+    ) -> Result<Camera, SceneError> {
+        Camera { position: Vec3::from(position), target: Vec3::from(target), up: Vec3::from(up), fov_y_deg }
+            .validated()
+    }
+
     /// Checks that the view and projection matrices will be well defined.
     pub fn validated(self) -> Result<Camera, SceneError> {
         for (name, v) in [("position", self.position), ("target", self.target), ("up", self.up)] {

@@ -21,13 +21,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// Assembles a scene from its description; `folder` anchors the relative paths in it.
 fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
     let c = &file.camera;
-    let camera = Camera {
-        position: Vec3::from(c.position),
-        target: Vec3::from(c.target),
-        up: Vec3::from(c.up),
-        fov_y_deg: c.fov_y_deg,
-    }
-    .validated()?;
+    let camera = Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg)?;
     let environment = environment(&file.environment, folder)?;
     if file.groups.is_empty() {
         return Err(SceneError::invalid("it has no groups"));

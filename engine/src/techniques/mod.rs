@@ -6,6 +6,7 @@ pub mod env_sh;
 pub mod environment;
 pub mod parallel_lights;
 pub mod prt;
+pub mod settings;
 pub mod tamura;
 pub mod unshadowed;
 

@@ -1,0 +1,26 @@
+//! The C ABI: what `engine/include/kage.h` declares (generated from this folder by cbindgen;
+//! `cargo test -p kage-tests --test c_header` checks it, `KAGE_BLESS=1` rewrites it).
+//!
+//! Rules every function follows, so that a host cannot crash Kage from the outside:
+//! - It returns a [`kage_result`]; on failure [`kage_last_error_message`] says why.
+//! - It runs behind a panic boundary (`result::boundary`): a panic becomes
+//!   `KAGE_RESULT_PANIC`, never an unwind into C.
+//! - Handles are opaque and checked against the set of live handles (`handles.rs`) before use:
+//!   NULL is `KAGE_RESULT_NULL_ARGUMENT`; a destroyed, foreign or wrong-kind handle is
+//!   `KAGE_RESULT_INVALID_HANDLE`, not undefined behaviour.
+//! - Enumerations arrive as `uint32_t`, so that an out-of-range value from C is
+//!   `KAGE_RESULT_INVALID_VALUE` rather than an invalid Rust enum.
+//!
+//! Threading: a handle may move between threads, but calls on one handle, or on handles made
+//! from one context, must not overlap. The last error message is per thread.
+#![allow(non_camel_case_types)]
+
+mod args;
+pub mod context;
+mod handles;
+pub mod renderer;
+pub mod result;
+pub mod scene;
+pub mod technique;
+
+pub use result::{kage_last_error_message, kage_result};

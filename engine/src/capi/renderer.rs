@@ -1,0 +1,252 @@
+//! `kage_renderer`: a scene on the GPU with a technique; frames, pixels and pass timings.
+use super::args;
+use super::context::kage_context;
+use super::handles;
+use super::result::{boundary, kage_result, Failure};
+use super::scene::{kage_scene, kage_transform};
+use super::technique::kage_technique_desc;
+use crate::imageio::tonemap_srgb8;
+use crate::pass::PassTiming;
+use crate::renderer::{RenderOptions, Renderer};
+use std::ffi::c_char;
+
+/// A scene on the GPU, lit by one technique, with its render targets.
+pub struct kage_renderer {
+    renderer: Renderer,
+    ctx: std::sync::Arc<crate::backend::Context>,
+    /// The pass timings of the last frame; `None` before the first.
+    timings: Option<Vec<PassTiming>>,
+}
+
+/// What `kage_renderer_create` builds.
+#[repr(C)]
+pub struct kage_renderer_desc {
+    /// Image size in pixels, 1 to 8192 each.
+    pub width: u32,
+    pub height: u32,
+    pub technique: kage_technique_desc,
+}
+
+/// Pixel formats of `kage_renderer_read_pixels`.
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_pixel_format {
+    /// 4 bytes per pixel: radiance × exposure, tonemapped (ACES fit), sRGB-encoded; alpha 255.
+    Rgba8Srgb = 0,
+    /// 16 bytes per pixel: linear radiance as 32-bit floats; alpha 1.
+    Rgba32fLinear = 1,
+}
+
+/// The GPU time of one pass in the last frame.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct kage_pass_timing {
+    /// NUL-terminated, at most 31 bytes, e.g. "background", "scene", "readback". (A literal
+    /// size: cbindgen would export every constant of the engine to name it.)
+    pub name: [c_char; 32],
+    /// Milliseconds; -1 when the device has no timestamps.
+    pub milliseconds: f64,
+}
+
+/// Uploads the scene and builds the technique's pipelines and targets. `kage_precompute` with
+/// the same technique (at least the same SH bands) must have run on the scene first for
+/// techniques that need it, else `KAGE_RESULT_INVALID_VALUE`.
+///
+/// The renderer copies what it needs: the scene may be destroyed afterwards. It holds a
+/// reference to the context's device, which stays alive until the renderer is destroyed even if
+/// the context handle is destroyed first. On success `*renderer` is a new handle that the host
+/// owns and frees with `kage_renderer_destroy`; on failure it is set to NULL.
+///
+/// # Safety
+/// `context` and `scene` must be NULL or handles not in use by another thread; `desc` NULL or
+/// valid; `renderer` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_create(
+    context: *const kage_context,
+    scene: *const kage_scene,
+    desc: *const kage_renderer_desc,
+    renderer: *mut *mut kage_renderer,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the caller promises NULL or a writable pointer.
+        let out = unsafe { args::handle_out(renderer, "renderer") }?;
+        // SAFETY: the host does not destroy the handles during the call; desc is NULL or valid.
+        let (context, scene, desc) = unsafe {
+            (handles::get(context, "context")?, handles::get(scene, "scene")?, args::value(desc, "desc")?)
+        };
+        let technique = desc.technique.settings()?.choice(scene.transfer.clone())?;
+        let options = RenderOptions { width: desc.width, height: desc.height, technique };
+        let made = Renderer::new(&context.ctx, &scene.scene, &options);
+        kage_context::check_validation(&context.ctx)?;
+        let made = kage_renderer { renderer: made?, ctx: context.ctx.clone(), timings: None };
+        *out = handles::register(made);
+        Ok(())
+    })
+}
+
+/// Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The
+/// handle must not be used afterwards (also when this fails with `KAGE_RESULT_VALIDATION`,
+/// which reports what the layer said while its objects were destroyed).
+///
+/// # Safety
+/// `renderer` must not be in use by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_destroy(renderer: *mut kage_renderer) -> kage_result {
+    boundary(|| {
+        if renderer.is_null() {
+            return Ok(());
+        }
+        // SAFETY: the host does not use the handle elsewhere during the call.
+        let ctx = unsafe { handles::get(renderer, "renderer") }?.ctx.clone();
+        handles::destroy(renderer, "renderer")?;
+        kage_context::check_validation(&ctx)
+    })
+}
+
+/// Places group `group` (0 to `kage_scene_group_count` - 1) for the next frames. `transform`
+/// is only read during the call.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread; `transform` NULL or valid.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_set_group_transform(
+    renderer: *mut kage_renderer,
+    group: u32,
+    transform: *const kage_transform,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: exclusive use of a live handle (threading rules); transform NULL or valid.
+        let (r, transform) =
+            unsafe { (handles::get_mut(renderer, "renderer")?, args::value(transform, "transform")?) };
+        let transform = transform.validated().map_err(|e| Failure::invalid(format!("group {group}: {e}")))?;
+        Ok(r.renderer.set_group_transform(group as usize, transform.matrix())?)
+    })
+}
+
+/// Renders one frame and waits for it; then `kage_renderer_read_pixels` and
+/// `kage_renderer_timings` give its picture and pass timings.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_render(renderer: *mut kage_renderer) -> kage_result {
+    boundary(|| {
+        // SAFETY: exclusive use of a live handle (threading rules).
+        let r = unsafe { handles::get_mut(renderer, "renderer") }?;
+        let timings = r.renderer.render();
+        kage_context::check_validation(&r.ctx)?;
+        r.timings = Some(timings?);
+        Ok(())
+    })
+}
+
+/// Copies the last frame into `pixels`, row 0 at the top, rows tightly packed, in `format` (a
+/// `kage_pixel_format` value). `size` is the buffer's size in bytes and must be at least
+/// width × height × bytes per pixel, else `KAGE_RESULT_BUFFER_TOO_SMALL`. `exposure` (> 0)
+/// scales radiance before tonemapping `KAGE_PIXEL_FORMAT_RGBA8_SRGB`; the linear format ignores
+/// it. Before the first `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread; `pixels` NULL or `size`
+/// writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_read_pixels(
+    renderer: *const kage_renderer,
+    format: u32,
+    exposure: f32,
+    pixels: *mut u8,
+    size: usize,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the host does not destroy the handle during the call.
+        let r = unsafe { handles::get(renderer, "renderer") }?;
+        let format = args::enumeration(
+            format,
+            "format",
+            &[
+                (kage_pixel_format::Rgba8Srgb as u32, kage_pixel_format::Rgba8Srgb),
+                (kage_pixel_format::Rgba32fLinear as u32, kage_pixel_format::Rgba32fLinear),
+            ],
+        )?;
+        if pixels.is_null() {
+            return Err(Failure::new(kage_result::NullArgument, "pixels is NULL"));
+        }
+        if r.timings.is_none() {
+            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
+        }
+        let image = r.renderer.image()?;
+        let bytes: Vec<u8> = match format {
+            kage_pixel_format::Rgba8Srgb => {
+                if !(exposure.is_finite() && exposure > 0.0) {
+                    return Err(Failure::invalid(format!("exposure {exposure} is not a positive number")));
+                }
+                let srgb = |p: &[f32; 4]| {
+                    let [r, g, b] = tonemap_srgb8([p[0], p[1], p[2]], exposure);
+                    [r, g, b, 255]
+                };
+                image.pixels.iter().flat_map(srgb).collect()
+            }
+            kage_pixel_format::Rgba32fLinear => {
+                image.pixels.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect()
+            }
+        };
+        if size < bytes.len() {
+            return Err(Failure::new(
+                kage_result::BufferTooSmall,
+                format!(
+                    "a {}x{} frame needs {} bytes, pixels holds {size}",
+                    image.width,
+                    image.height,
+                    bytes.len()
+                ),
+            ));
+        }
+        // SAFETY: the caller promises `size` >= bytes.len() writable bytes at `pixels`.
+        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), pixels, bytes.len()) };
+        Ok(())
+    })
+}
+
+/// Copies the last frame's per-pass GPU timings, in the order the passes ran, into `timings`
+/// (room for `capacity`), and writes how many passes the frame had to `*count`. When `capacity`
+/// is smaller, the first `capacity` are written and `KAGE_RESULT_BUFFER_TOO_SMALL` is returned;
+/// `timings` may be NULL when `capacity` is 0 (to ask for the count). Before the first frame
+/// the count is 0.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread; `timings` NULL or
+/// `capacity` writable elements; `count` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_timings(
+    renderer: *const kage_renderer,
+    timings: *mut kage_pass_timing,
+    capacity: usize,
+    count: *mut usize,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the host does not destroy the handle during the call; count NULL or writable.
+        let (r, count) = unsafe { (handles::get(renderer, "renderer")?, args::out(count, "count")?) };
+        let frame = r.timings.as_deref().unwrap_or_default();
+        *count = frame.len();
+        if capacity > 0 && timings.is_null() {
+            return Err(Failure::new(kage_result::NullArgument, "timings is NULL"));
+        }
+        for (at, pass) in frame.iter().take(capacity).enumerate() {
+            let mut name = [0 as c_char; 32];
+            let room = name.len() - 1;
+            for (to, byte) in name.iter_mut().zip(pass.name.bytes().take(room)) {
+                *to = byte as c_char;
+            }
+            let timing = kage_pass_timing { name, milliseconds: pass.gpu_ms.unwrap_or(-1.0) };
+            // SAFETY: at < capacity, and the caller promises `capacity` writable elements.
+            unsafe { timings.add(at).write(timing) };
+        }
+        if capacity < frame.len() {
+            return Err(Failure::new(
+                kage_result::BufferTooSmall,
+                format!("the frame had {} passes, timings holds {capacity}", frame.len()),
+            ));
+        }
+        Ok(())
+    })
+}

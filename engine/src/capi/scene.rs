@@ -1,0 +1,237 @@
+//! `kage_scene`: a scene from a file, a built-in name, or the host's arrays.
+use super::args;
+use super::handles;
+use super::result::{boundary, kage_result, Failure};
+use crate::scene::{Camera, EnvMap, Group, Mesh, Scene, SceneError, Transform};
+use crate::techniques::prt::TransferSet;
+use glam::{Quat, Vec3};
+use std::ffi::c_char;
+use std::sync::Arc;
+
+/// A scene (geometry, environment light, camera) and what was precomputed for it.
+pub struct kage_scene {
+    pub(crate) scene: Scene,
+    /// The PRT transfer from `kage_precompute`, shared with the renderers made from it.
+    pub(crate) transfer: Option<Arc<TransferSet>>,
+}
+
+/// A group's rigid placement: uniform `scale`, then `rotation`, then `translation`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct kage_transform {
+    pub translation: [f32; 3],
+    /// A unit quaternion (x, y, z, w); one slightly off unit length is renormalized.
+    pub rotation: [f32; 4],
+    /// Greater than 0.
+    pub scale: f32,
+}
+
+impl kage_transform {
+    pub(crate) fn validated(&self) -> Result<Transform, SceneError> {
+        Transform {
+            translation: Vec3::from(self.translation),
+            rotation: Quat::from_array(self.rotation),
+            scale: self.scale,
+        }
+        .validated()
+    }
+}
+
+/// One triangle mesh of a group, in the group's object space.
+#[repr(C)]
+pub struct kage_mesh_desc {
+    /// 3 floats (x, y, z) per vertex.
+    pub positions: *const f32,
+    /// 3 floats per vertex, or NULL: then area-weighted vertex normals are computed.
+    pub normals: *const f32,
+    pub vertex_count: u32,
+    /// 3 per triangle, counter-clockwise seen from the side the normals point to.
+    pub indices: *const u32,
+    pub index_count: u32,
+    /// Diffuse reflectance per channel, in [0, 1].
+    pub albedo: [f32; 3],
+}
+
+/// Meshes that move together (a rigid group); `kage_renderer_set_group_transform` moves it.
+#[repr(C)]
+pub struct kage_group_desc {
+    /// A name for messages and debuggers, or NULL.
+    pub name: *const c_char,
+    pub transform: kage_transform,
+    pub meshes: *const kage_mesh_desc,
+    pub mesh_count: u32,
+}
+
+/// The environment light: an equirectangular map (width = 2 × height) of linear RGB radiance,
+/// row 0 at the top (+Y); direction (x, y, z) is at u = atan2(x, -z) / 2π, v = acos(y) / π.
+#[repr(C)]
+pub struct kage_environment_desc {
+    /// 3 floats (r, g, b) per pixel, row-major; finite (negative values are clamped to 0).
+    pub pixels: *const f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A pinhole camera (right-handed, +Y up).
+#[repr(C)]
+pub struct kage_camera_desc {
+    pub position: [f32; 3],
+    pub target: [f32; 3],
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f32,
+}
+
+/// A whole scene from the host's memory, no files involved.
+#[repr(C)]
+pub struct kage_scene_desc {
+    pub groups: *const kage_group_desc,
+    pub group_count: u32,
+    pub environment: kage_environment_desc,
+    pub camera: kage_camera_desc,
+}
+
+/// Loads a scene: a path to a scene file (JSON, see the README), or the name of a built-in
+/// scene ("teapot", "teapot-hires-floor"). A path that exists or ends in ".json" is a file.
+///
+/// On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
+/// on failure it is set to NULL, and a bad or missing file is `KAGE_RESULT_FILE`, with the file
+/// and the problem in the message. Needs no context (no GPU work).
+///
+/// # Safety
+/// `path` must be NULL or a NUL-terminated UTF-8 string; `scene` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_scene_load(path: *const c_char, scene: *mut *mut kage_scene) -> kage_result {
+    boundary(|| {
+        // SAFETY: the caller promises NULL or a writable pointer.
+        let out = unsafe { args::handle_out(scene, "scene") }?;
+        // SAFETY: the caller promises NULL or a NUL-terminated string.
+        let path = unsafe { args::text(path, "path") }?;
+        let scene = Scene::from_arg(path).map_err(crate::Error::from)?;
+        *out = handles::register(kage_scene { scene, transfer: None });
+        Ok(())
+    })
+}
+
+/// Builds a scene from the host's arrays. Everything is copied during the call: the host may
+/// free or reuse its arrays as soon as it returns.
+///
+/// Bad data is `KAGE_RESULT_INVALID_VALUE` naming the group and mesh: no groups or meshes,
+/// NaN or infinite values, indices out of range or not a multiple of 3, albedo outside [0, 1],
+/// a map that is not 2:1, a degenerate camera or transform. A NULL array with a non-zero count
+/// is `KAGE_RESULT_NULL_ARGUMENT`.
+///
+/// On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
+/// on failure it is set to NULL.
+///
+/// # Safety
+/// `desc` must be NULL or point to a `kage_scene_desc` whose arrays are NULL or hold the
+/// counts it states; `scene` must be NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_scene_create(
+    desc: *const kage_scene_desc,
+    scene: *mut *mut kage_scene,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the caller promises NULL or a writable pointer.
+        let out = unsafe { args::handle_out(scene, "scene") }?;
+        // SAFETY: the caller promises NULL or a valid desc with arrays as stated.
+        let scene = unsafe { scene_from_desc(args::value(desc, "desc")?) }?;
+        *out = handles::register(kage_scene { scene, transfer: None });
+        Ok(())
+    })
+}
+
+/// # Safety
+/// The arrays of `desc` must be NULL or hold the counts it states.
+unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
+    // SAFETY: the caller promises `group_count` groups.
+    let groups = unsafe { args::slice(desc.groups, desc.group_count as usize, "desc->groups") }?;
+    if groups.is_empty() {
+        return Err(Failure::invalid("the scene has no groups"));
+    }
+    let groups = groups
+        .iter()
+        .enumerate()
+        // SAFETY: the caller promises valid arrays in every group.
+        .map(|(at, g)| unsafe { group(at, g) })
+        .collect::<Result<_, _>>()?;
+    let env = &desc.environment;
+    let texels = env.width as usize * env.height as usize;
+    // SAFETY: the caller promises width × height RGB pixels.
+    let pixels = unsafe { args::chunks::<3>(env.pixels, texels, "desc->environment.pixels") }?;
+    let environment = EnvMap::from_pixels(env.width, env.height, pixels.to_vec()).map_err(invalid)?;
+    let c = &desc.camera;
+    let camera = Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg).map_err(invalid)?;
+    Ok(Scene { name: "host".into(), groups, environment, lights: Vec::new(), camera })
+}
+
+/// # Safety
+/// The arrays of `desc` must be NULL or hold the counts it states.
+unsafe fn group(at: usize, desc: &kage_group_desc) -> Result<Group, Failure> {
+    let name = match desc.name.is_null() {
+        true => format!("group{at}"),
+        // SAFETY: the caller promises a NUL-terminated string.
+        false => unsafe { args::text(desc.name, "group name") }?.to_owned(),
+    };
+    let place = |e: SceneError| invalid(e.within(&format!("group {at} (\"{name}\")")));
+    let transform = desc.transform.validated().map_err(place)?;
+    // SAFETY: the caller promises `mesh_count` meshes.
+    let meshes = unsafe { args::slice(desc.meshes, desc.mesh_count as usize, "group meshes") }?;
+    if meshes.is_empty() {
+        return Err(place(SceneError::invalid("it has no meshes")));
+    }
+    let meshes = meshes
+        .iter()
+        .enumerate()
+        .map(|(m, mesh)| {
+            let vertices = mesh.vertex_count as usize;
+            // SAFETY: the caller promises `vertex_count` positions (and normals, if any) and
+            // `index_count` indices.
+            let (positions, normals, indices) = unsafe {
+                (
+                    args::chunks::<3>(mesh.positions, vertices, "mesh positions")?,
+                    match mesh.normals.is_null() {
+                        true => None,
+                        false => Some(args::chunks::<3>(mesh.normals, vertices, "mesh normals")?.to_vec()),
+                    },
+                    args::slice(mesh.indices, mesh.index_count as usize, "mesh indices")?,
+                )
+            };
+            Mesh::new(format!("mesh{m}"), positions.to_vec(), normals, indices.to_vec(), mesh.albedo)
+                .map_err(|e| place(e.within(&format!("mesh {m}"))))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Group { name, meshes, transform })
+}
+
+/// The host's data is at fault (no file is involved).
+fn invalid(error: SceneError) -> Failure {
+    Failure::invalid(error.to_string())
+}
+
+/// Destroys a scene handle. Renderers made from it keep what they need and stay usable. NULL is
+/// allowed and does nothing. The handle must not be used afterwards.
+///
+/// # Safety
+/// `scene` must not be in use by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn kage_scene_destroy(scene: *mut kage_scene) -> kage_result {
+    boundary(|| handles::destroy(scene, "scene"))
+}
+
+/// The number of groups in the scene (the valid `group` indices of
+/// `kage_renderer_set_group_transform` are 0 to count - 1).
+///
+/// # Safety
+/// `scene` must be NULL or a handle; `count` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_scene_group_count(scene: *const kage_scene, count: *mut u32) -> kage_result {
+    boundary(|| {
+        // SAFETY: the host does not destroy the handle during the call (threading rules).
+        let scene = unsafe { handles::get(scene, "scene") }?;
+        // SAFETY: the caller promises NULL or writable.
+        *unsafe { args::out(count, "count") }? = scene.scene.groups.len() as u32;
+        Ok(())
+    })
+}

@@ -1,0 +1,152 @@
+//! Choosing a technique and its parameters, and the precomputation it needs.
+use super::args;
+use super::context::kage_context;
+use super::handles;
+use super::result::{boundary, kage_result, Failure};
+use super::scene::kage_scene;
+use crate::techniques::prt::{transfer, PrtParams};
+use crate::techniques::settings::{TechniqueKind, TechniqueSettings};
+use crate::techniques::tamura::technique::Penumbra;
+use std::sync::Arc;
+
+/// The lighting techniques (the values of `kage_technique_desc.technique`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_technique {
+    /// SH irradiance, no shadows.
+    Unshadowed = 0,
+    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs
+    /// `kage_precompute`.
+    Sloan = 1,
+    /// Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from `regions`
+    /// environment regions. Needs `kage_precompute`.
+    Tamura = 2,
+    /// Baseline: `regions` environment regions as directional lights with binary shadow maps.
+    ParallelLights = 3,
+}
+
+/// Width of Tamura's penumbrae (the values of `kage_technique_desc.penumbra`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_penumbra {
+    /// The paper's: one filter width per group pair and region.
+    Fixed = 0,
+    /// A width per pixel from its distance to the occluder.
+    Adaptive = 1,
+}
+
+/// A technique and all its parameters; each technique reads the fields it uses and ignores the
+/// rest. Start from `kage_technique_desc_default` and change what you need: techniques still to
+/// come (adaptive shadow maps: a page budget; light probes: a probe set) will add their fields
+/// here, and a host that starts from the default needs no other change than a recompile.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct kage_technique_desc {
+    /// A `kage_technique` value.
+    pub technique: u32,
+    /// SH bands of the PRT transfer (Sloan, Tamura), 2 to 5; default 3.
+    pub sh_bands: u32,
+    /// Visibility rays per vertex of the PRT precomputation, 1 to 1048576; default 2048.
+    pub prt_rays: u32,
+    /// q, environment regions: Tamura 1 to 64, parallel-lights 1 to 128; default 32.
+    pub regions: u32,
+    /// Side of a Tamura occlusion mask layer in texels; default 128.
+    pub mask_size: u32,
+    /// A `kage_penumbra` value (Tamura); default fixed.
+    pub penumbra: u32,
+    /// Side of a parallel-lights shadow map in texels; default 512.
+    pub shadow_map_size: u32,
+}
+
+impl kage_technique_desc {
+    pub(crate) fn settings(&self) -> Result<TechniqueSettings, Failure> {
+        use kage_technique as T;
+        let kind = args::enumeration(
+            self.technique,
+            "technique",
+            &[
+                (T::Unshadowed as u32, TechniqueKind::Unshadowed),
+                (T::Sloan as u32, TechniqueKind::Sloan),
+                (T::Tamura as u32, TechniqueKind::Tamura),
+                (T::ParallelLights as u32, TechniqueKind::ParallelLights),
+            ],
+        )?;
+        let penumbra = args::enumeration(
+            self.penumbra,
+            "penumbra",
+            &[
+                (kage_penumbra::Fixed as u32, Penumbra::Fixed),
+                (kage_penumbra::Adaptive as u32, Penumbra::Adaptive),
+            ],
+        )?;
+        Ok(TechniqueSettings {
+            kind,
+            prt: PrtParams { bands: self.sh_bands, rays: self.prt_rays },
+            regions: self.regions as usize,
+            mask_size: self.mask_size,
+            penumbra,
+            shadow_map_size: self.shadow_map_size,
+        }
+        .validated()?)
+    }
+}
+
+/// Fills `*desc` with `technique` and the default of every parameter.
+///
+/// # Safety
+/// `desc` must be NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_technique_desc_default(
+    technique: u32,
+    desc: *mut kage_technique_desc,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the caller promises NULL or writable.
+        let desc = unsafe { args::out(desc, "desc") }?;
+        let d = TechniqueSettings::default();
+        let filled = kage_technique_desc {
+            technique,
+            sh_bands: d.prt.bands,
+            prt_rays: d.prt.rays,
+            regions: d.regions as u32,
+            mask_size: d.mask_size,
+            penumbra: kage_penumbra::Fixed as u32,
+            shadow_map_size: d.shadow_map_size,
+        };
+        // An unknown technique is reported here already, not at the first use.
+        filled.settings()?;
+        *desc = filled;
+        Ok(())
+    })
+}
+
+/// Computes on the context's device what `technique` needs before its first frame, and keeps
+/// it in the scene for `kage_renderer_create`: for Sloan and Tamura the per-vertex PRT transfer
+/// (seconds to minutes: it casts `prt_rays` rays per vertex); for the other techniques nothing.
+/// A later call replaces what an earlier one computed.
+///
+/// The scene keeps no reference to the context.
+///
+/// # Safety
+/// `context` and `scene` must be NULL or handles not in use by another thread; `technique` NULL
+/// or a valid desc.
+#[no_mangle]
+pub unsafe extern "C" fn kage_precompute(
+    context: *const kage_context,
+    scene: *mut kage_scene,
+    technique: *const kage_technique_desc,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the host does not destroy or share the handles during the call.
+        let (context, scene) =
+            unsafe { (handles::get(context, "context")?, handles::get_mut(scene, "scene")?) };
+        // SAFETY: the caller promises NULL or a valid desc.
+        let settings = unsafe { args::value(technique, "technique") }?.settings()?;
+        if let Some(params) = settings.precomputation() {
+            let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut |_, _| {});
+            kage_context::check_validation(&context.ctx)?;
+            scene.transfer = Some(Arc::new(set?));
+        }
+        Ok(())
+    })
+}

@@ -1,0 +1,144 @@
+//! A technique named with all its parameters: what the command line's options and the C ABI's
+//! `kage_technique_desc` both turn into, checked in one place, and turned into the renderer's
+//! [`TechniqueChoice`] once the precomputation it needs is done.
+use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
+use super::prt::{PrtParams, TransferSet};
+use super::tamura::technique::{OcclusionSettings, Penumbra};
+use crate::error::{Error, Result};
+use crate::renderer::TechniqueChoice;
+use std::sync::Arc;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TechniqueKind {
+    /// SH irradiance, no shadows.
+    #[default]
+    Unshadowed,
+    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only.
+    Sloan,
+    /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups, q regions.
+    Tamura,
+    /// The paper's Fig. 3 baseline: q regions as directional lights with binary shadow maps.
+    ParallelLights,
+}
+
+/// Every parameter of every technique; each technique reads the ones it uses.
+#[derive(Clone, Copy, Debug)]
+pub struct TechniqueSettings {
+    pub kind: TechniqueKind,
+    /// The PRT precomputation of Sloan and Tamura (SH bands, rays per vertex).
+    pub prt: PrtParams,
+    /// q: environment regions of Tamura (1 to 64) and parallel-lights (1 to 128).
+    pub regions: usize,
+    /// Side of a Tamura occlusion mask layer, texels.
+    pub mask_size: u32,
+    pub penumbra: Penumbra,
+    /// Side of a parallel-lights shadow map, texels.
+    pub shadow_map_size: u32,
+}
+
+impl Default for TechniqueSettings {
+    fn default() -> Self {
+        let occlusion = OcclusionSettings::default();
+        TechniqueSettings {
+            kind: TechniqueKind::default(),
+            prt: PrtParams::DEFAULT,
+            regions: occlusion.regions,
+            mask_size: occlusion.mask_size,
+            penumbra: occlusion.penumbra,
+            shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
+        }
+    }
+}
+
+impl TechniqueSettings {
+    /// The PRT precomputation the technique needs before its first frame, if any.
+    pub fn precomputation(&self) -> Option<PrtParams> {
+        matches!(self.kind, TechniqueKind::Sloan | TechniqueKind::Tamura).then_some(self.prt)
+    }
+
+    /// Checks what can be checked before any GPU work (the techniques check the rest when
+    /// they are built), so that a bad parameter fails before a long precomputation.
+    pub fn validated(self) -> Result<TechniqueSettings> {
+        if self.precomputation().is_some() {
+            self.prt.validated()?;
+        }
+        // Zero regions would quietly be Sloan's technique (see `TechniqueChoice::Prt`).
+        if self.kind == TechniqueKind::Tamura && self.regions == 0 {
+            return Err(Error::InvalidArgument("regions must be at least 1 for the Tamura technique".into()));
+        }
+        Ok(self)
+    }
+
+    /// What the renderer runs. `transfer` is the result of [`Self::precomputation`] (ignored
+    /// by techniques that need none); it must have been computed with `self.prt`'s bands.
+    pub fn choice(&self, transfer: Option<Arc<TransferSet>>) -> Result<TechniqueChoice> {
+        let settings = self.validated()?;
+        let prt = |regions| match transfer {
+            None => Err(Error::InvalidArgument(format!(
+                "the {:?} technique needs the PRT transfer: precompute it first",
+                settings.kind
+            ))),
+            Some(transfer) if transfer.params.bands != settings.prt.bands => {
+                Err(Error::InvalidArgument(format!(
+                    "the transfer was precomputed with {} SH bands, the technique asks for {}",
+                    transfer.params.bands, settings.prt.bands
+                )))
+            }
+            Some(transfer) => Ok(TechniqueChoice::Prt {
+                transfer,
+                occlusion: OcclusionSettings {
+                    regions,
+                    mask_size: settings.mask_size,
+                    penumbra: settings.penumbra,
+                    ..OcclusionSettings::default()
+                },
+            }),
+        };
+        match settings.kind {
+            TechniqueKind::Unshadowed => Ok(TechniqueChoice::Unshadowed),
+            TechniqueKind::Sloan => prt(0),
+            TechniqueKind::Tamura => prt(settings.regions),
+            TechniqueKind::ParallelLights => Ok(TechniqueChoice::ParallelLights {
+                regions: settings.regions,
+                shadow_map_size: settings.shadow_map_size,
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn transfer(bands: u32) -> Option<Arc<TransferSet>> {
+        Some(Arc::new(TransferSet { params: PrtParams { bands, rays: 1 }, seconds: 0.0, meshes: vec![] }))
+    }
+
+    fn error(settings: TechniqueSettings, transfer: Option<Arc<TransferSet>>) -> String {
+        settings.choice(transfer).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn each_kind_becomes_its_choice() {
+        let of = |kind| TechniqueSettings { kind, regions: 4, ..Default::default() };
+        assert!(matches!(of(TechniqueKind::Unshadowed).choice(None), Ok(TechniqueChoice::Unshadowed)));
+        let sloan = of(TechniqueKind::Sloan).choice(transfer(3)).unwrap();
+        assert!(matches!(sloan, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 0));
+        let tamura = of(TechniqueKind::Tamura).choice(transfer(3)).unwrap();
+        assert!(matches!(tamura, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 4));
+        let lights = of(TechniqueKind::ParallelLights).choice(None).unwrap();
+        assert!(matches!(lights, TechniqueChoice::ParallelLights { regions: 4, .. }));
+        assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
+        assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
+    }
+
+    #[test]
+    fn missing_or_mismatched_precomputation_and_bad_parameters_are_errors() {
+        let tamura = TechniqueSettings { kind: TechniqueKind::Tamura, ..Default::default() };
+        assert!(error(tamura, None).contains("precompute it first"));
+        assert!(error(tamura, transfer(4)).contains("4 SH bands"));
+        assert!(error(TechniqueSettings { regions: 0, ..tamura }, transfer(3)).contains("at least 1"));
+        let bands = PrtParams { bands: 9, ..PrtParams::DEFAULT };
+        assert!(error(TechniqueSettings { prt: bands, ..tamura }, transfer(9)).contains("9 SH bands"));
+    }
+}

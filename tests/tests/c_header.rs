@@ -1,0 +1,39 @@
+//! The committed C header is what cbindgen makes of the C ABI today. On a difference the test
+//! fails; `KAGE_BLESS=1` rewrites the header instead (then review and commit it).
+use std::path::Path;
+
+#[test]
+fn committed_header_matches_the_c_abi() {
+    let engine = Path::new(env!("CARGO_MANIFEST_DIR")).join("../engine");
+    let config = cbindgen::Config::from_file(engine.join("cbindgen.toml")).expect("engine/cbindgen.toml");
+    let bindings = cbindgen::Builder::new()
+        .with_crate(&engine)
+        .with_config(config)
+        .generate()
+        .expect("cbindgen parses engine/src/capi");
+    let mut fresh = Vec::new();
+    bindings.write(&mut fresh);
+    let path = engine.join("include/kage.h");
+    if std::env::var_os("KAGE_BLESS").is_some_and(|v| v == "1") {
+        std::fs::write(&path, &fresh).expect("writing engine/include/kage.h");
+        return;
+    }
+    let committed = std::fs::read(&path).unwrap_or_default();
+    assert!(
+        committed == fresh,
+        "engine/include/kage.h is not what cbindgen generates from engine/src/capi/; regenerate it with\n  \
+         KAGE_BLESS=1 cargo test --release -p kage-tests --test c_header\nand commit it"
+    );
+}
+
+/// C++ hosts (game engines) include the same header.
+#[test]
+fn header_compiles_as_cpp() {
+    let header = Path::new(env!("CARGO_MANIFEST_DIR")).join("../engine/include/kage.h");
+    let output = std::process::Command::new("c++")
+        .args(["-std=c++17", "-fsyntax-only", "-Wall", "-Wextra", "-Werror", "-pedantic", "-x", "c++"])
+        .arg(&header)
+        .output()
+        .expect("c++ (Debian: g++)");
+    assert!(output.status.success(), "kage.h as C++:\n{}", String::from_utf8_lossy(&output.stderr));
+}

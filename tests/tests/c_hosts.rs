@@ -1,0 +1,130 @@
+//! The C hosts in tests/c_host/, compiled with `cc` against engine/include/kage.h and the
+//! engine's staticlib and cdylib from this same cargo build: first on the default device with
+//! validation on, then under valgrind memcheck.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Where cargo put this test's libraries: the test runs from `<target>/<profile>/deps/`, and
+/// the engine's staticlib and cdylib sit in `<target>/<profile>/`.
+fn library(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test executable's path");
+    let dir = exe.parent().and_then(Path::parent).expect("<target>/<profile>/deps/<test>");
+    let path = dir.join(name);
+    assert!(path.exists(), "{} is missing: cargo builds it with the kage crate (crate-type)", path.display());
+    path
+}
+
+/// The two hosts, compiled once per test run.
+struct Hosts {
+    /// Builds a scene from arrays and checks every function's bad-argument codes; linked with
+    /// libkage.a.
+    arrays: PathBuf,
+    /// Creates its own Vulkan device and hands it to Kage; linked with libkage.so.
+    vulkan: PathBuf,
+}
+
+fn hosts() -> &'static Hosts {
+    static HOSTS: OnceLock<Hosts> = OnceLock::new();
+    HOSTS.get_or_init(|| {
+        let dir = kage_tests::scratch_dir("c_hosts");
+        let src = repo().join("tests/c_host");
+        let compile = |name: &str, link: &[&str]| {
+            let out = dir.join(name);
+            let mut cc = Command::new("cc");
+            cc.args(["-std=c11", "-g", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+                .arg("-I")
+                .arg(repo().join("engine/include"))
+                .arg(src.join(format!("{name}.c")))
+                .arg("-o")
+                .arg(&out)
+                .args(link);
+            succeeded(&format!("cc {name}.c"), cc.output().expect("cc (Debian: gcc)"));
+            out
+        };
+        let staticlib = library("libkage.a").display().to_string();
+        let cdylib_dir = library("libkage.so").parent().expect("folder").display().to_string();
+        let rpath = format!("-Wl,-rpath,{cdylib_dir}");
+        let common = src.join("common.c").display().to_string();
+        Hosts {
+            // After the archive, the system libraries Rust's standard library needs (what
+            // `rustc --print native-static-libs` lists for linux-gnu).
+            arrays: compile(
+                "arrays",
+                &[&common, &staticlib, "-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"],
+            ),
+            vulkan: compile("vulkan", &[&common, &format!("-L{cdylib_dir}"), "-lkage", &rpath, "-lvulkan"]),
+        }
+    })
+}
+
+#[track_caller]
+fn succeeded(what: &str, output: Output) -> String {
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{what} failed ({}):\n{stdout}\n{stderr}", output.status);
+    stdout
+}
+
+/// The full runs: 10 frames at 64², validation on. Tamura through the arrays host, Sloan
+/// through the host's own device (techniques as numbered in kage.h).
+#[test]
+fn c_hosts_run_with_validation() {
+    let hosts = hosts();
+    let out =
+        succeeded("arrays host", Command::new(&hosts.arrays).args(["10", "64", "1", "2"]).output().unwrap());
+    assert!(out.contains("frame 9:") && out.ends_with("ok\n"), "{out}");
+    let out =
+        succeeded("vulkan host", Command::new(&hosts.vulkan).args(["10", "64", "1", "1"]).output().unwrap());
+    assert!(out.contains("frame 9:") && out.ends_with("ok\n"), "{out}");
+}
+
+/// Memcheck: no invalid read or write, no definite leak. Lavapipe compiles every shader with
+/// LLVM, which under valgrind takes most of the time, so these runs are small (2 frames at 16²,
+/// unshadowed, validation off) and the two hosts run side by side.
+#[test]
+fn c_hosts_are_clean_under_valgrind() {
+    let hosts = hosts();
+    let suppressions = repo().join("tests/c_host/valgrind.supp");
+    let memcheck = |host: &Path, args: &[&str]| {
+        let mut valgrind = Command::new("valgrind");
+        valgrind
+            .args([
+                "--error-exitcode=99",
+                "--leak-check=full",
+                "--show-leak-kinds=definite",
+                "--errors-for-leak-kinds=definite",
+                // Keeps the symbols of the driver after the loader unloads it, so that the
+                // suppressions can name it in leak reports made at exit.
+                "--keep-debuginfo=yes",
+                "--num-callers=40",
+            ])
+            .arg(format!("--suppressions={}", suppressions.display()))
+            .arg(host)
+            .args(args);
+        let start = Instant::now();
+        let output = valgrind.output().expect("valgrind (Debian: valgrind; scripts/deps.sh installs it)");
+        (output, start.elapsed())
+    };
+    let (arrays, vulkan) = std::thread::scope(|s| {
+        let arrays = s.spawn(|| memcheck(&hosts.arrays, &["2", "16", "0", "0"]));
+        let vulkan = s.spawn(|| memcheck(&hosts.vulkan, &["2", "16", "0", "0"]));
+        (arrays.join().unwrap(), vulkan.join().unwrap())
+    });
+    let (canary, _) = memcheck(&hosts.arrays, &["forget-a-scene"]);
+    let report = String::from_utf8_lossy(&canary.stderr);
+    assert!(
+        canary.status.code() == Some(99) && report.contains("kage_scene_create"),
+        "memcheck did not report the canary's forgotten scene ({}):\n{report}",
+        canary.status
+    );
+    for (name, (output, took)) in [("arrays", arrays), ("vulkan", vulkan)] {
+        eprintln!("valgrind {name} host: {:.1} s", took.as_secs_f64());
+        succeeded(&format!("valgrind of the {name} host"), output);
+    }
+}
