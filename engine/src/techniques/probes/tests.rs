@@ -142,8 +142,14 @@ fn check_lookups_inside(mesh: &TetMesh, points: &[DVec3]) {
         }
         assert!(at.weights.iter().all(|w| (0.0..=1.0).contains(w)), "{:?}", at.weights);
         assert!((at.weights.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{:?}", at.weights);
+        // The weights are as accurate as the tetrahedron is well shaped: rounding errors of
+        // the coordinates' size are amplified by (longest edge)³ / volume.
+        let longest = (0..4)
+            .flat_map(|i| (0..i).map(move |j| (i, j)))
+            .fold(0.0f64, |m, (i, j)| m.max(v[i].distance(v[j])));
+        let aspect = longest.powi(3) / volume(v);
         let back: DVec3 = (0..4).map(|k| at.weights[k] * v[k]).sum();
-        assert!(back.distance(p) <= 1e-9 * scale, "{p} comes back as {back}");
+        assert!(back.distance(p) <= 1e-14 * scale * aspect, "{p} comes back as {back}");
     }
 }
 
@@ -372,4 +378,39 @@ fn leaving_the_hull_and_coming_back_is_continuous() {
         last = Some(w);
     }
     assert!(outside > 2000, "the path leaves the hull");
+}
+
+#[test]
+fn highly_degenerate_sets() {
+    // Every integer point on the sphere of radius 15, and its centre: 5 or more cospherical
+    // points everywhere, many of them coplanar and cocircular on the hull.
+    let mut sphere = vec![DVec3::ZERO];
+    for x in -15i32..=15 {
+        for y in -15i32..=15 {
+            for z in -15i32..=15 {
+                if x * x + y * y + z * z == 225 {
+                    sphere.push(DVec3::new(x as f64, y as f64, z as f64));
+                }
+            }
+        }
+    }
+    // A plane grid whose points are off the plane by at most 1e-12, and two points off it.
+    let mut rng = XorShift::new(77);
+    let mut sheet: Vec<DVec3> = grid([8, 8, 1], 1.0)
+        .into_iter()
+        .map(|p| p + DVec3::Z * (rng.below(3) as f64 - 1.0) * 1e-12)
+        .collect();
+    sheet.extend([DVec3::new(3.5, 3.5, 1.0), DVec3::new(2.0, 5.0, -1.0)]);
+    // Stacked layers of a grid, offset by half a cell every other layer.
+    let layers: Vec<DVec3> = grid([6, 6, 4], 1.0)
+        .into_iter()
+        .map(|p| if p.z as u32 % 2 == 1 { p + DVec3::new(0.5, 0.5, 0.0) } else { p })
+        .collect();
+    for (name, points) in
+        [("sphere", sphere), ("sheet", sheet), ("layers", layers), ("grid", grid([10, 10, 10], 0.5))]
+    {
+        let mesh = TetMesh::build(&points).unwrap_or_else(|e| panic!("{name}: {e}"));
+        check_valid(&mesh, 200);
+        check_lookups_inside(&mesh, &inside_points(&mesh, 300, 6));
+    }
 }

@@ -105,7 +105,9 @@ impl TetMesh {
         &self.hull
     }
 
-    /// The barycentric weights of p in tetrahedron `tet` (in the order of its vertices).
+    /// The barycentric weights of p in tetrahedron `tet` (in the order of its vertices). Like any
+    /// floating-point solve, they are accurate to about 1e-16 × (longest edge)³ / volume of the
+    /// tetrahedron, relative to the coordinates: slivers (nearly coplanar probes) lose digits.
     pub fn weights(&self, tet: u32, p: DVec3) -> [f64; 4] {
         let b = &self.barycentric[tet as usize];
         let origin = self.positions[self.tets[tet as usize][b.origin] as usize];
