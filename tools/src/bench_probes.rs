@@ -31,8 +31,9 @@ pub fn run(args: &ProbesBenchArgs) -> Result<()> {
         "{:>8} {:>8} {:>10} {:>10} {:>13} {:>8} {:>13} {:>8}",
         "probes", "tets", "build ms", "µs/probe", "coh. M/s", "steps", "cold M/s", "steps"
     );
-    let mut rng = Pcg32(0xda3e_39cb_94b9_5bdb);
     for &n in &args.sizes {
+        // Seeded by the size alone, so a set does not change with the other options.
+        let mut rng = Pcg32(0xda3e_39cb_94b9_5bdb ^ n as u64);
         let points: Vec<DVec3> =
             (0..n).map(|_| DVec3::new(rng.next() as f64, rng.next() as f64, rng.next() as f64)).collect();
         let mut times = Vec::new();

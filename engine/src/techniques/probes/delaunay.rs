@@ -15,6 +15,8 @@ use glam::DVec3;
 const INF: u32 = u32::MAX;
 /// No neighbour yet (only while a star is being linked).
 const UNSET: u32 = u32::MAX;
+/// An empty slot of the edge table (no edge joins the infinite vertex to itself).
+const NO_EDGE: u64 = u64::MAX;
 
 /// A tetrahedron: vertices positively oriented (for a ghost cell, with the infinite vertex
 /// replaced by any point beyond its hull face), and the neighbour across the face opposite each.
@@ -92,6 +94,7 @@ struct Builder<'a> {
     rng: XorShift,
     cavity: Vec<u32>,
     star: Vec<StarFace>,
+    /// The star's edges, each with a new cell and the slot opposite the face on it.
     edges: Vec<(u64, u32, usize)>,
 }
 
@@ -164,8 +167,13 @@ impl<'a> Builder<'a> {
     /// Replaces the cavity by the cells of `self.star` and links them to each other and to the
     /// cells outside.
     fn build_star(&mut self) {
+        // Open addressing, at most 3/4 full: each edge's first face waits there for its second.
+        let size = (4 * self.star.len()).next_power_of_two();
+        let shift = 64 - size.trailing_zeros();
         self.edges.clear();
-        for face in std::mem::take(&mut self.star) {
+        self.edges.resize(size, (NO_EDGE, 0, 0));
+        let star = std::mem::take(&mut self.star);
+        for face in &star {
             let cell = Cell {
                 v: face.v,
                 n: std::array::from_fn(|i| if i == face.apex { face.outer } else { UNSET }),
@@ -188,16 +196,26 @@ impl<'a> Builder<'a> {
                 let f = opposite(face.v, k);
                 let apex = face.apex - usize::from(k < face.apex);
                 let (a, b) = (f[(apex + 1) % 3], f[(apex + 2) % 3]);
-                self.edges.push(((a.min(b) as u64) << 32 | a.max(b) as u64, id, k));
+                let key = (a.min(b) as u64) << 32 | a.max(b) as u64;
+                // Fibonacci hashing: the top bits of the key times 2⁶⁴/φ.
+                let mut at = (key.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> shift) as usize;
+                loop {
+                    let (other_key, other, other_slot) = self.edges[at];
+                    if other_key == NO_EDGE {
+                        self.edges[at] = (key, id, k);
+                        break;
+                    }
+                    if other_key == key {
+                        self.cells[id as usize].n[k] = other;
+                        self.cells[other as usize].n[other_slot] = id;
+                        break;
+                    }
+                    at = (at + 1) & (size - 1);
+                }
             }
             self.hint = id;
         }
-        self.edges.sort_unstable_by_key(|e| e.0);
-        for pair in self.edges.chunks_exact(2) {
-            debug_assert_eq!(pair[0].0, pair[1].0, "each edge of the star is in two faces");
-            self.cells[pair[0].1 as usize].n[pair[0].2] = pair[1].1;
-            self.cells[pair[1].1 as usize].n[pair[1].2] = pair[0].1;
-        }
+        self.star = star;
     }
 
     /// Whether p is inside the (perturbed) circumsphere of cell c; for a ghost cell, whether p is

@@ -414,3 +414,23 @@ fn highly_degenerate_sets() {
         check_lookups_inside(&mesh, &inside_points(&mesh, 300, 6));
     }
 }
+
+/// Random subsets of a small integer lattice, in random order: four or more coplanar and five or
+/// more cospherical points nearly everywhere, on the hull and inside.
+#[test]
+fn random_subsets_of_a_lattice() {
+    let lattice = grid([4, 3, 3], 1.0);
+    let mut rng = XorShift::new(91);
+    let mut built = 0;
+    for _ in 0..400 {
+        let mut points: Vec<DVec3> = lattice.iter().copied().filter(|_| rng.below(3) == 0).collect();
+        for i in (1..points.len()).rev() {
+            points.swap(i, rng.below(i as u32 + 1) as usize);
+        }
+        let Ok(mesh) = TetMesh::build(&points) else { continue };
+        check_valid(&mesh, usize::MAX);
+        check_lookups_inside(&mesh, &inside_points(&mesh, 20, rng.next_u32()));
+        built += 1;
+    }
+    assert!(built > 300, "{built} sets were not flat");
+}
