@@ -15,18 +15,3 @@ pub enum ProbeError {
     #[error("{total} probes given: at most {max} are supported")]
     TooMany { total: usize, max: usize },
 }
-
-/// Coordinates beyond this are refused: the exact in-sphere test multiplies five coordinate
-/// differences, and its expansions must not overflow.
-pub const MAX_COORDINATE: f64 = 1e30;
-
-/// Why a position cannot be used, if it cannot.
-pub fn position_problem(p: [f64; 3]) -> Option<&'static str> {
-    if !p.iter().all(|c| c.is_finite()) {
-        Some("coordinates must be finite")
-    } else if p.iter().any(|c| c.abs() > MAX_COORDINATE) {
-        Some("coordinates must be within ±1e30")
-    } else {
-        None
-    }
-}

@@ -1,5 +1,6 @@
 //! Finding the tetrahedron that holds a point, by walking from where the last lookup ended.
-use super::error::{position_problem, ProbeError};
+use super::error::ProbeError;
+use super::input::usable;
 use super::predicates::orient;
 use super::rng::XorShift;
 use super::tetmesh::{Across, TetMesh};
@@ -44,9 +45,7 @@ impl Walker {
     /// Teillaud 2002, "remembering stochastic walk"): it cannot cycle, whatever the mesh's
     /// degeneracies, and leaves through a hull face only when p is outside the hull.
     pub fn locate(&mut self, mesh: &TetMesh, p: DVec3) -> Result<Location, ProbeError> {
-        if let Some(problem) = position_problem(p.to_array()) {
-            return Err(ProbeError::BadPoint { position: p.to_array(), problem });
-        }
+        let p = usable(p).map_err(|problem| ProbeError::BadPoint { position: p.to_array(), problem })?;
         let positions = mesh.positions();
         let mut t = if (self.tet as usize) < mesh.tets().len() { self.tet } else { 0 };
         let mut from = None;

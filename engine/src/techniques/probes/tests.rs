@@ -130,7 +130,7 @@ fn brute_force_hull_volume(p: &[DVec3]) -> f64 {
 /// tetrahedron that holds it by exact predicates.
 fn check_lookups_inside(mesh: &TetMesh, points: &[DVec3]) {
     let mut walker = Walker::default();
-    let scale = mesh.positions().iter().fold(1.0f64, |m, p| m.max(p.abs().max_element()));
+    let scale = mesh.positions().iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     for &p in points {
         let at = walker.locate(mesh, p).unwrap();
         assert!(!at.extrapolated, "{p} is inside the hull");
@@ -433,4 +433,15 @@ fn random_subsets_of_a_lattice() {
         built += 1;
     }
     assert!(built > 300, "{built} sets were not flat");
+}
+
+#[test]
+fn extreme_scales_stay_exact() {
+    for scale in [1e-25, 1e29] {
+        let mut points = random_points(50, 101, DVec3::ZERO, DVec3::splat(scale));
+        points.extend(grid([3, 3, 3], scale / 2.0));
+        let mesh = TetMesh::build(&points).unwrap();
+        check_valid(&mesh, usize::MAX);
+        check_lookups_inside(&mesh, &inside_points(&mesh, 100, 102));
+    }
 }

@@ -69,18 +69,18 @@ impl TetMesh {
                 })
             })
             .collect();
-        let barycentric = tets.iter().map(|t| Barycentric::new(t.map(|i| positions[i as usize]))).collect();
+        let barycentric = tets.iter().map(|t| Barycentric::new(t.map(|i| set.all[i as usize]))).collect();
         Ok(TetMesh {
-            positions: positions.to_vec(),
+            hull: Hull::new(set.all.len(), faces),
+            positions: set.all,
             tets,
             neighbours,
             barycentric,
-            hull: Hull::new(positions.len(), faces),
             merged: set.merged,
         })
     }
 
-    /// The input positions (duplicates included).
+    /// The input positions (duplicates included; coordinates nearer 0 than 1e-30 set to 0).
     pub fn positions(&self) -> &[DVec3] {
         &self.positions
     }
