@@ -21,9 +21,9 @@ const NO_EDGE: u64 = u64::MAX;
 /// A tetrahedron: vertices positively oriented (for a ghost cell, with the infinite vertex
 /// replaced by any point beyond its hull face), and the neighbour across the face opposite each.
 #[derive(Clone, Copy, Debug)]
-pub struct Cell {
-    pub v: [u32; 4],
-    pub n: [u32; 4],
+struct Cell {
+    v: [u32; 4],
+    n: [u32; 4],
 }
 
 impl Cell {

@@ -358,6 +358,7 @@ fn extrapolation_is_continuous_at_the_hull_and_finite_far_away() {
     }
 }
 
+/// A moving object: from tetrahedron to tetrahedron inside (no pop), out of the hull and back.
 #[test]
 fn leaving_the_hull_and_coming_back_is_continuous() {
     let mesh = TetMesh::build(&grid([4, 4, 4], 1.0)).unwrap();
