@@ -17,6 +17,11 @@ pub struct ProbesBenchArgs {
     /// Tetrahedralizations per size; the median time is reported.
     #[arg(long, default_value_t = 3)]
     runs: usize,
+    /// Probes on a cubic lattice over the unit cube instead (the cube of the nearest whole side
+    /// to each size): every cell's corners are cospherical, so every in-sphere tie is broken by
+    /// the symbolic perturbation.
+    #[arg(long)]
+    grid: bool,
 }
 
 pub fn run(args: &ProbesBenchArgs) -> Result<()> {
@@ -24,18 +29,21 @@ pub fn run(args: &ProbesBenchArgs) -> Result<()> {
         bail!("--runs and --lookups must be at least 1");
     }
     println!(
-        "random probes in the unit cube; build: median of {} runs; {} lookups each: coherent (a point moving by a tenth of the probe spacing per lookup, one walker), cold (random points, each walk from tetrahedron 0)",
-        args.runs, args.lookups
+        "{} probes in the unit cube; build: median of {} runs; {} lookups each: coherent (a point moving by a tenth of the probe spacing per lookup, one walker), cold (random points, each walk from tetrahedron 0)",
+        if args.grid { "lattice" } else { "random" },
+        args.runs,
+        args.lookups
     );
     println!(
         "{:>8} {:>8} {:>10} {:>10} {:>13} {:>8} {:>13} {:>8}",
         "probes", "tets", "build ms", "µs/probe", "coh. M/s", "steps", "cold M/s", "steps"
     );
-    for &n in &args.sizes {
+    for &size in &args.sizes {
         // Seeded by the size alone, so a set does not change with the other options.
-        let mut rng = Pcg32(0xda3e_39cb_94b9_5bdb ^ n as u64);
-        let points: Vec<DVec3> =
-            (0..n).map(|_| DVec3::new(rng.next() as f64, rng.next() as f64, rng.next() as f64)).collect();
+        let mut rng = Pcg32(0xda3e_39cb_94b9_5bdb ^ size as u64);
+        let points =
+            if args.grid { lattice(size) } else { (0..size).map(|_| random_point(&mut rng)).collect() };
+        let n = points.len();
         let mut times = Vec::new();
         let mut mesh = None;
         for _ in 0..args.runs {
@@ -54,9 +62,7 @@ pub fn run(args: &ProbesBenchArgs) -> Result<()> {
                 DVec3::new(0.5 + 0.3 * t.cos(), 0.5 + 0.3 * t.sin(), 0.5 + 0.2 * (0.37 * t).sin())
             })
             .collect();
-        let random: Vec<DVec3> = (0..args.lookups)
-            .map(|_| DVec3::new(rng.next() as f64, rng.next() as f64, rng.next() as f64))
-            .collect();
+        let random: Vec<DVec3> = (0..args.lookups).map(|_| random_point(&mut rng)).collect();
         let mut walker = Walker::default();
         let coherent = time_lookups(&path, |p| walker.locate(&mesh, p))?;
         let cold = time_lookups(&random, |p| Walker::default().locate(&mesh, p))?;
@@ -72,6 +78,19 @@ pub fn run(args: &ProbesBenchArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+fn random_point(rng: &mut Pcg32) -> DVec3 {
+    DVec3::new(rng.next() as f64, rng.next() as f64, rng.next() as f64)
+}
+
+/// side³ points on a lattice over the unit cube, side the whole number nearest ∛size (at least 2).
+fn lattice(size: usize) -> Vec<DVec3> {
+    let side = ((size as f64).cbrt().round() as usize).max(2);
+    let at = |i: usize| i as f64 / (side - 1) as f64;
+    (0..side * side * side)
+        .map(|i| DVec3::new(at(i % side), at(i / side % side), at(i / (side * side))))
+        .collect()
 }
 
 /// Lookups per second and mean steps per lookup.
