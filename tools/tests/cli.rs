@@ -279,3 +279,20 @@ fn probes_bad_input_is_a_clear_error() {
     let out = kage(&["probes", "lookup", "--in", &flat, "--at", "nan,0,0"]);
     assert!(!out.status.success() && text(&out).contains("three finite numbers"), "{}", text(&out));
 }
+
+#[test]
+fn probes_bench_runs_small_sets() {
+    for grid in [false, true] {
+        let mut args = vec!["bench", "probes", "--sizes", "100,300", "--lookups", "500", "--runs", "1"];
+        if grid {
+            args.push("--grid");
+        }
+        let out = kage(&args);
+        assert!(out.status.success(), "{}", text(&out));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        // A header line, the column names and one row per size.
+        assert_eq!(stdout.lines().count(), 4, "{stdout}");
+        let first_row = stdout.lines().nth(2).unwrap();
+        assert!(first_row.trim_start().starts_with(if grid { "125" } else { "100" }), "{stdout}");
+    }
+}
