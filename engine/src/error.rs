@@ -28,6 +28,8 @@ pub enum Error {
     Scene(#[from] crate::scene::SceneError),
     #[error(transparent)]
     Image(#[from] crate::imageio::ImageIoError),
+    #[error(transparent)]
+    Probes(#[from] crate::techniques::probes::ProbeError),
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
 }

@@ -1,4 +1,5 @@
-//! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU.
+//! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU; `kage bench
+//! probes` (in bench_probes.rs): how fast probe sets are tetrahedralized and looked up.
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Subcommand};
@@ -14,6 +15,9 @@ pub enum BenchCommand {
     /// BVH build time and size, and rays per second for coherent (camera) and incoherent
     /// (random directions from random surface points) rays, closest hit and any hit.
     Rays(RaysArgs),
+    /// Tetrahedralization time of random probe sets, and lookups per second, coherent (a moving
+    /// object) and cold (each from the first tetrahedron).
+    Probes(crate::bench_probes::ProbesBenchArgs),
 }
 
 #[derive(Args)]
@@ -35,6 +39,7 @@ pub struct RaysArgs {
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
         BenchCommand::Rays(args) => rays(args),
+        BenchCommand::Probes(args) => crate::bench_probes::run(args),
     }
 }
 
@@ -184,11 +189,11 @@ fn ray(origin: Vec3, dir: Vec3) -> CastRay {
 }
 
 /// PCG32 (O'Neill 2014): reproducible ray sets without a dependency.
-struct Pcg32(u64);
+pub struct Pcg32(pub u64);
 
 impl Pcg32 {
     /// Uniform in [0, 1).
-    fn next(&mut self) -> f32 {
+    pub fn next(&mut self) -> f32 {
         self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
         let x = ((((self.0 >> 18) ^ self.0) >> 27) as u32).rotate_right((self.0 >> 59) as u32);
         (x >> 8) as f32 / (1 << 24) as f32

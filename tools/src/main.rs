@@ -1,8 +1,10 @@
 //! `kage`: the command-line front end of the Kage engine.
 mod bench;
+mod bench_probes;
 mod compare;
 mod info;
 mod precompute;
+mod probes;
 mod reference;
 mod render;
 mod scene_cmd;
@@ -59,6 +61,22 @@ pub fn report_clamped(map: &kage::scene::EnvMap) {
     }
 }
 
+/// Parses "x,y,z" (a `--at`-style argument) into three finite numbers.
+pub fn parse_xyz<T>(s: &str) -> Result<[T; 3], String>
+where
+    T: std::str::FromStr + Into<f64> + Copy,
+    T::Err: std::fmt::Display,
+{
+    let parts: Vec<T> = s
+        .split(',')
+        .map(|p| p.trim().parse::<T>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match parts[..] {
+        [x, y, z] if parts.iter().all(|&v| v.into().is_finite()) => Ok([x, y, z]),
+        _ => Err(format!("expected three finite numbers x,y,z, got {s:?}")),
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene offscreen to PNG (tonemapped, sRGB) or EXR (linear radiance).
@@ -83,6 +101,9 @@ enum Command {
     /// A technique's settings side by side: error against the reference at several poses, GPU
     /// time per frame, precomputation time and memory, written to DIR/sweep.csv.
     Sweep(sweep::SweepArgs),
+    /// Light probes: tetrahedralize a probe set, look a point up in it.
+    #[command(subcommand)]
+    Probes(probes::ProbesCommand),
 }
 
 fn main() {
@@ -97,6 +118,7 @@ fn main() {
         Command::Compare(args) => compare::run(&args),
         Command::Bench(command) => bench::run(&command),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Probes(command) => probes::run(&command),
     };
     if let Err(e) = result {
         eprintln!("kage: error: {e:#}");

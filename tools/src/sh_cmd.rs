@@ -16,15 +16,8 @@ pub struct ShArgs {
     gpu: GpuArgs,
 }
 
-pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
-    let parts: Vec<f32> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f32>().map_err(|e| format!("{p:?}: {e}")))
-        .collect::<Result<_, _>>()?;
-    match parts.as_slice() {
-        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok(glam::Vec3::new(*x, *y, *z)),
-        _ => Err(format!("expected three finite numbers x,y,z, got {s:?}")),
-    }
+fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    crate::parse_xyz(s).map(glam::Vec3::from_array)
 }
 
 pub fn run(args: &ShArgs) -> Result<()> {

@@ -13,9 +13,8 @@ use kage::reference::{compare, LightMode, ReferenceOptions, ReferenceRenderer};
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
-use kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
-use kage::techniques::prt::{PrtParams, TransferSet};
-use kage::techniques::tamura::technique::OcclusionSettings;
+use kage::techniques::prt::PrtParams;
+use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -107,28 +106,21 @@ impl Setting {
         }
     }
 
-    /// SH bands of the PRT transfer it needs (Tamura's at the default bands).
-    fn bands(self) -> Option<u32> {
-        match self {
-            Setting::Sloan { bands } => Some(bands),
-            Setting::Tamura { .. } => Some(PrtParams::DEFAULT.bands),
-            Setting::Unshadowed | Setting::ParallelLights { .. } => None,
-        }
+    /// The technique and its parameters, as `kage render` and the C ABI take them.
+    fn technique(self) -> TechniqueSettings {
+        let defaults = TechniqueSettings::default();
+        let (kind, prt, regions) = match self {
+            Setting::Unshadowed => (TechniqueKind::Unshadowed, defaults.prt, defaults.regions),
+            Setting::Sloan { bands } => (TechniqueKind::Sloan, PrtParams { bands, ..defaults.prt }, 0),
+            Setting::Tamura { regions } => (TechniqueKind::Tamura, defaults.prt, regions),
+            Setting::ParallelLights { regions } => (TechniqueKind::ParallelLights, defaults.prt, regions),
+        };
+        TechniqueSettings { kind, prt, regions, ..defaults }
     }
 
-    fn choice(self, transfer: Option<&Arc<TransferSet>>) -> TechniqueChoice {
-        let prt = |regions| TechniqueChoice::Prt {
-            transfer: transfer.expect("PRT settings come with their transfer").clone(),
-            occlusion: OcclusionSettings { regions, ..OcclusionSettings::default() },
-        };
-        match self {
-            Setting::Unshadowed => TechniqueChoice::Unshadowed,
-            Setting::Sloan { .. } => prt(0),
-            Setting::Tamura { regions } => prt(regions),
-            Setting::ParallelLights { regions } => {
-                TechniqueChoice::ParallelLights { regions, shadow_map_size: DEFAULT_SHADOW_MAP_SIZE }
-            }
-        }
+    /// SH bands of the PRT transfer it needs, if any.
+    fn bands(self) -> Option<u32> {
+        self.technique().precomputation().map(|p| p.bands)
     }
 }
 
@@ -216,12 +208,16 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             .collect::<Result<_>>()?;
         for &setting in &settings {
             bar.set_message(format!("{env_name}: {}", setting.name()));
-            let transfer = setting.bands().map(|b| &transfers[&b]);
+            let transfer = setting.bands().map(|b| transfers[&b].clone());
             let before = ctx.allocated_bytes();
             let mut renderer = Renderer::new(
                 &ctx,
                 &lit,
-                &RenderOptions { width: args.size, height: args.size, technique: setting.choice(transfer) },
+                &RenderOptions {
+                    width: args.size,
+                    height: args.size,
+                    technique: setting.technique().choice(transfer.clone())?,
+                },
             )
             .with_context(|| format!("setting up {}", setting.name()))?;
             let memory_mb = (ctx.allocated_bytes() - before) as f64 / (1 << 20) as f64;
@@ -234,7 +230,8 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             }
             drop(renderer);
             let frame_ms = if args.frames > 0 {
-                let ms = frame_time(&ctx, &lit, setting.choice(transfer), args.time_size, args.frames)?;
+                let choice = setting.technique().choice(transfer.clone())?;
+                let ms = frame_time(&ctx, &lit, choice, args.time_size, args.frames)?;
                 bar.inc(1);
                 Some(ms)
             } else {

@@ -89,6 +89,18 @@ fn sh_prints_coefficients_and_irradiance() {
     assert!((e - std::f32::consts::PI).abs() < 1e-3, "{stdout}");
 }
 
+/// Each command fails with exit code 1 and a `kage: error:` line containing the expected text,
+/// without a panic.
+fn assert_clear_errors(cases: &[(&[&str], &str)]) {
+    for &(args, expected) in cases {
+        let out = kage(args);
+        let all = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {all}");
+        assert!(all.contains("kage: error:") && all.contains(expected), "{args:?}: {all}");
+        assert!(!all.contains("panicked"), "{args:?}: {all}");
+    }
+}
+
 #[test]
 fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
@@ -103,13 +115,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["sweep", "--technique", "prt", "--only", "tamura:3", "--out", "x"], "sloan:2, sloan:3"),
         (&["sweep", "--technique", "prt", "--poses", "nan", "--out", "x"], "--poses"),
     ];
-    for (args, expected) in cases {
-        let out = kage(args);
-        let all = text(&out);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {all}");
-        assert!(all.contains("kage: error:") && all.contains(expected), "{args:?}: {all}");
-        assert!(!all.contains("panicked"), "{args:?}: {all}");
-    }
+    assert_clear_errors(&cases);
 }
 
 #[test]
@@ -210,4 +216,135 @@ fn sweep_writes_one_csv_row_per_setting() {
     }
     assert!(number(&fields[1], 5) < number(&fields[0], 5), "{csv}");
     assert!(number(&fields[1], 9) > 0.0 && fields[0][9].is_empty(), "precompute seconds only for PRT: {csv}");
+}
+
+/// A 3×3×3 grid over [0, 2]³ (every cube's corners cospherical) and two duplicates.
+fn probe_file(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut positions = Vec::new();
+    for x in 0..3 {
+        for y in 0..3 {
+            for z in 0..3 {
+                positions.push([x, y, z]);
+            }
+        }
+    }
+    positions.extend([positions[4], positions[0]]);
+    let path = dir.join("probes.json");
+    std::fs::write(&path, serde_json::json!({ "positions": positions }).to_string()).unwrap();
+    path
+}
+
+#[test]
+fn probes_tetrahedralize_writes_positive_tetrahedra_filling_the_hull() {
+    let dir = scratch_dir("cli-probes");
+    let probes = probe_file(&dir);
+    let tets = dir.join("tets.json");
+    let out = kage(&[
+        "probes",
+        "tetrahedralize",
+        "--in",
+        probes.to_str().unwrap(),
+        "--out",
+        tets.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("27 into 4, 28 into 0"), "{}", text(&out));
+
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&tets).unwrap()).unwrap();
+    let tets: Vec<[usize; 4]> = serde_json::from_value(json["tetrahedra"].clone()).unwrap();
+    let p = |i: usize| glam::DVec3::new((i / 9) as f64, (i / 3 % 3) as f64, (i % 3) as f64);
+    let mut total = 0.0;
+    for t in &tets {
+        assert!(t.iter().all(|&i| i < 27), "{t:?} uses a merged duplicate");
+        // Six times the volume: an integer here, so the sum is exact.
+        let volume6 = (p(t[1]) - p(t[0])).dot((p(t[2]) - p(t[0])).cross(p(t[3]) - p(t[0])));
+        assert!(volume6 > 0.0, "{t:?} is not positively oriented");
+        total += volume6;
+    }
+    assert_eq!(total, 6.0 * 8.0, "the tetrahedra fill the hull, a 2×2×2 cube");
+}
+
+#[test]
+fn probes_lookup_prints_weights_inside_and_outside() {
+    let dir = scratch_dir("cli-probes-lookup");
+    let probes = probe_file(&dir);
+    let probes = probes.to_str().unwrap();
+    for (at, inside) in [("0.5,1.25,0.3", true), ("-1,0.5,0.5", false), ("10,10,10", false)] {
+        let out = kage(&["probes", "lookup", "--in", probes, "--at", at]);
+        assert!(out.status.success(), "{at}: {}", text(&out));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let number = |line: &str| {
+            line.split_whitespace().skip(1).map(|w| w.parse::<f64>().unwrap()).collect::<Vec<_>>()
+        };
+        let probe_line = stdout.lines().find(|l| l.starts_with("tetrahedron")).unwrap();
+        let indices: Vec<usize> = probe_line
+            .split("probes")
+            .nth(1)
+            .unwrap()
+            .split_whitespace()
+            .map(|w| w.parse().unwrap())
+            .collect();
+        let weights = number(stdout.lines().find(|l| l.starts_with("weights")).unwrap());
+        assert_eq!((indices.len(), weights.len()), (4, 4), "{stdout}");
+        assert!((weights.iter().sum::<f64>() - 1.0).abs() < 1e-8, "{stdout}");
+        assert!(weights.iter().all(|w| (0.0..=1.0).contains(w)), "{stdout}");
+        assert_eq!(stdout.contains("inside the hull"), inside, "{at}: {stdout}");
+        assert_eq!(stdout.contains("extrapolated"), !inside, "{at}: {stdout}");
+        if at == "10,10,10" {
+            // The nearest point of the hull is the grid's corner (2, 2, 2), probe 26.
+            let corner = indices.iter().position(|&i| i == 26).unwrap();
+            assert!((weights[corner] - 1.0).abs() < 1e-8, "{stdout}");
+        }
+    }
+}
+
+#[test]
+fn probes_bad_input_is_a_clear_error() {
+    let dir = scratch_dir("cli-probes-bad");
+    let write = |name: &str, json: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, json).unwrap();
+        path.to_str().unwrap().to_owned()
+    };
+    let flat = write("flat.json", r#"{"positions": [[0,0,0],[1,0,0],[0,1,0],[1,1,0],[2,3,0]]}"#);
+    let few = write("few.json", r#"{"positions": [[0,0,0],[1,0,0],[0,1,0],[0,1,0]]}"#);
+    let huge = write("huge.json", r#"{"positions": [[0,0,0],[1,0,0],[0,1,0],[0,0,1e31]]}"#);
+    let syntax = write("syntax.json", r#"{"positions": [[0,0,0],[1,0,0]"#);
+    let unknown = write("unknown.json", r#"{"positions": [], "roles": []}"#);
+    let tets = dir.join("tets.json");
+    let tets = tets.to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (&["probes", "tetrahedralize", "--in", &flat, "--out", tets], "lie in one plane"),
+        (
+            &["probes", "tetrahedralize", "--in", &few, "--out", tets],
+            "3 distinct probe position(s) among the 4",
+        ),
+        (&["probes", "tetrahedralize", "--in", &huge, "--out", tets], "probe 3 at"),
+        (&["probes", "lookup", "--in", &syntax, "--at", "0,0,0"], "syntax.json: not a probe file"),
+        (&["probes", "lookup", "--in", &unknown, "--at", "0,0,0"], "unknown field `roles`"),
+        (
+            &["probes", "lookup", "--in", "/nonexistent/probes.json", "--at", "0,0,0"],
+            "/nonexistent/probes.json",
+        ),
+    ];
+    assert_clear_errors(&cases);
+    let out = kage(&["probes", "lookup", "--in", &flat, "--at", "nan,0,0"]);
+    assert!(!out.status.success() && text(&out).contains("three finite numbers"), "{}", text(&out));
+}
+
+#[test]
+fn probes_bench_runs_small_sets() {
+    for grid in [false, true] {
+        let mut args = vec!["bench", "probes", "--sizes", "100,300", "--lookups", "500", "--runs", "1"];
+        if grid {
+            args.push("--grid");
+        }
+        let out = kage(&args);
+        assert!(out.status.success(), "{}", text(&out));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        // A header line, the column names and one row per size.
+        assert_eq!(stdout.lines().count(), 4, "{stdout}");
+        let first_row = stdout.lines().nth(2).unwrap();
+        assert!(first_row.trim_start().starts_with(if grid { "125" } else { "100" }), "{stdout}");
+    }
 }

@@ -76,7 +76,7 @@ fn code_of(error: &Error) -> kage_result {
         // A scene error names a file when one was read; otherwise the host's data is at fault.
         Error::Scene(e) if e.file().is_some() => kage_result::File,
         Error::Image(_) => kage_result::File,
-        Error::Scene(_) | Error::InvalidArgument(_) => kage_result::InvalidValue,
+        Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) => kage_result::InvalidValue,
     }
 }
 

@@ -5,6 +5,7 @@ pub mod background;
 pub mod env_sh;
 pub mod environment;
 pub mod parallel_lights;
+pub mod probes;
 pub mod prt;
 pub mod settings;
 pub mod tamura;
