@@ -5,9 +5,10 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # gcc, g++, libvulkan-dev and valgrind: the C ABI tests compile C hosts (and kage.h as C++),
-# link them with -lvulkan and run them under memcheck.
+# link them with -lvulkan and run them under memcheck. fonts-dejavu-core: the text of the charts
+# `kage sweep` draws.
 packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-tools vulkan-validationlayers
-          libshaderc-dev glslang-dev spirv-tools valgrind gcc g++)
+          libshaderc-dev glslang-dev spirv-tools valgrind gcc g++ fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

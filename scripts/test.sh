@@ -4,4 +4,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/deps.sh
+# `cargo test` builds the engine only as the tests' rlib; the C hosts link its staticlib and
+# cdylib, which only `cargo build` makes.
+cargo build --release --workspace
 cargo test --release --workspace "$@"

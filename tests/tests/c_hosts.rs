@@ -16,7 +16,11 @@ fn library(name: &str) -> PathBuf {
     let exe = std::env::current_exe().expect("the test executable's path");
     let dir = exe.parent().and_then(Path::parent).expect("<target>/<profile>/deps/<test>");
     let path = dir.join(name);
-    assert!(path.exists(), "{} is missing: cargo builds it with the kage crate (crate-type)", path.display());
+    assert!(
+        path.exists(),
+        "{} is missing: `cargo test` does not make the engine's staticlib and cdylib; run `cargo build --release -p kage` first (scripts/test.sh does)",
+        path.display()
+    );
     path
 }
 

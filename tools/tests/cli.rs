@@ -106,7 +106,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 8] = [
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", bad_scene.to_str().unwrap()], "colour"),
         (&["render", "--width", "0"], "image size"),
@@ -114,6 +114,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["sh", "/nonexistent/map.exr"], "/nonexistent/map.exr"),
         (&["sweep", "--technique", "prt", "--only", "tamura:3", "--out", "x"], "sloan:2, sloan:3"),
         (&["sweep", "--technique", "prt", "--poses", "nan", "--out", "x"], "--poses"),
+        (&["sweep", "--technique", "prt", "--pick", "--out", "x"], "--pick needs a bound"),
     ];
     assert_clear_errors(&cases);
 }
@@ -198,8 +199,17 @@ fn sweep_writes_one_csv_row_per_setting() {
         "--validate",
         "--out",
         dir.to_str().unwrap(),
+        "--pick",
+        "--max-error",
+        "1",
+        "--max-ms",
+        "1e-6",
     ]);
     assert!(out.status.success(), "{}", text(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("scene: cheapest within relative RMSE 1: unshadowed"), "{stdout}");
+    assert!(stdout.contains("scene: no setting runs within 0.000001 ms"), "{stdout}");
+    assert_eq!(&std::fs::read(dir.join("pareto.png")).unwrap()[1..4], b"PNG");
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(

@@ -1,6 +1,10 @@
 //! `kage sweep`: a technique's settings side by side in one process: each setting's error
 //! against the ray-traced reference at several poses of the animation, its GPU time per frame
-//! while the scene moves, its precomputation time and its device memory, in `DIR/sweep.csv`.
+//! while the scene moves, its precomputation time and its device memory, in `DIR/sweep.csv`;
+//! time against error in `DIR/pareto.png`; and, asked, the setting to pick under a bound.
+mod chart;
+mod pick;
+
 use crate::transfer_source::PrtArgs;
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
@@ -15,6 +19,7 @@ use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
 use kage::techniques::prt::PrtParams;
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
+use pick::Point;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -65,6 +70,16 @@ pub struct SweepArgs {
     /// Output folder (created if missing).
     #[arg(long)]
     out: PathBuf,
+    /// Print the setting to use: the cheapest within `--max-error`, the most accurate within
+    /// `--max-ms` (either or both).
+    #[arg(long)]
+    pick: bool,
+    /// With `--pick`: the largest acceptable relative RMSE (mean over the poses).
+    #[arg(long, requires = "pick")]
+    max_error: Option<f64>,
+    /// With `--pick`: the largest acceptable GPU time per frame, ms.
+    #[arg(long, requires = "pick")]
+    max_ms: Option<f64>,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -146,12 +161,41 @@ struct Row {
     memory_mb: f64,
 }
 
+impl Row {
+    fn mean_error(&self) -> f64 {
+        self.errors.iter().sum::<f64>() / self.errors.len() as f64
+    }
+
+    /// The row on the chart: only with a time, and with both values above 0 (log scales).
+    fn point(&self) -> Option<Point> {
+        let ms = self.frame_ms.filter(|ms| *ms > 0.0)?;
+        let error = Some(self.mean_error()).filter(|e| *e > 0.0)?;
+        let series = match self.setting {
+            Setting::Unshadowed => "unshadowed",
+            Setting::Sloan { .. } => "sloan (SH bands)",
+            Setting::Tamura { .. } => "tamura (q)",
+            Setting::ParallelLights { .. } => "parallel lights (q)",
+        };
+        let label = self.setting.describe().2;
+        Some(Point { series, name: self.setting.name(), label, ms, error })
+    }
+}
+
 pub fn run(args: &SweepArgs) -> Result<()> {
     if args.poses.is_empty() || args.poses.iter().any(|t| !t.is_finite()) {
         bail!("--poses must list finite times, e.g. 0,0.125,0.6");
     }
     if args.size == 0 || args.time_size == 0 || args.spp == 0 {
         bail!("--size, --time-size and --spp must be at least 1");
+    }
+    if args.pick && args.max_error.is_none() && args.max_ms.is_none() {
+        bail!("--pick needs a bound: --max-error E, --max-ms T, or both");
+    }
+    if args.max_error.into_iter().chain(args.max_ms).any(|b| !(b.is_finite() && b > 0.0)) {
+        bail!("--max-error and --max-ms must be positive numbers");
+    }
+    if args.pick && args.frames == 0 {
+        bail!("--pick compares frame times: it needs --frames of at least 1");
     }
     let settings = chosen(args.technique, &args.only)?;
     let scene = Scene::from_arg(&args.scene)?;
@@ -256,7 +300,45 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))?;
     println!("wrote {} ({} rows, {})", path.display(), rows.len(), ctx.info().name);
     print_ratios(&rows);
+    for (e, (env, _)) in envs.iter().enumerate() {
+        let points: Vec<Point> = rows.iter().filter(|r| &r.env == env).filter_map(Row::point).collect();
+        if points.is_empty() {
+            continue;
+        }
+        let file = if e == 0 { "pareto.png".to_string() } else { format!("pareto-{env}.png") };
+        let lit_by = if env == "scene" { "its own map" } else { env.as_str() };
+        let title = format!(
+            "{} under {lit_by}: {} frames at {}², error at {}²",
+            scene.name, args.frames, args.time_size, args.size
+        );
+        chart::write(&args.out.join(&file), &title, &points)?;
+        println!("wrote {}", args.out.join(&file).display());
+        if args.pick {
+            print_picks(env, &points, args.max_error, args.max_ms);
+        }
+    }
     args.gpu.finish(&ctx)
+}
+
+fn print_picks(env: &str, points: &[Point], max_error: Option<f64>, max_ms: Option<f64>) {
+    if let Some(bound) = max_error {
+        match pick::cheapest_within(points, bound) {
+            Some(p) => println!(
+                "{env}: cheapest within relative RMSE {bound}: {} ({:.2} ms, error {:.4})",
+                p.name, p.ms, p.error
+            ),
+            None => println!("{env}: no setting reaches relative RMSE {bound}"),
+        }
+    }
+    if let Some(bound) = max_ms {
+        match pick::most_accurate_within(points, bound) {
+            Some(p) => println!(
+                "{env}: most accurate within {bound} ms: {} ({:.2} ms, error {:.4})",
+                p.name, p.ms, p.error
+            ),
+            None => println!("{env}: no setting runs within {bound} ms"),
+        }
+    }
 }
 
 /// `scene` with its first group at time `t` of the scripted motion.
@@ -294,7 +376,7 @@ fn frame_time(
 }
 
 fn summary(row: &Row) -> String {
-    let mean = row.errors.iter().sum::<f64>() / row.errors.len() as f64;
+    let mean = row.mean_error();
     let ms = row.frame_ms.map_or_else(|| "-".to_string(), |ms| format!("{ms:.2} ms"));
     format!(
         "{:<12} {:<20} relative RMSE {mean:.4} (per pose {:.4?}), {ms}, {:.1} MB",
@@ -314,7 +396,7 @@ fn csv(scene: &str, poses: &[f32], rows: &[Row]) -> String {
     let optional = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:.4}"));
     for row in rows {
         let (technique, parameter, value) = row.setting.describe();
-        let mean = row.errors.iter().sum::<f64>() / row.errors.len() as f64;
+        let mean = row.mean_error();
         write!(out, "{scene},{},{technique},{parameter},{value},{mean:.5}", row.env)
             .expect("writing to a String");
         for e in &row.errors {

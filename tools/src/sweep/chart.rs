@@ -1,0 +1,118 @@
+//! `pareto.png`: GPU time against error on log scales, one series per technique, the Pareto
+//! front drawn through the settings nothing beats.
+use super::pick::{pareto_front, Point};
+use anyhow::{anyhow, Context as _, Result};
+use plotters::coord::combinators::BindKeyPoints;
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// The chart's text face: DejaVu Sans from Debian's fonts-dejavu-core, or `$KAGE_CHART_FONT`.
+const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+const SIZE: (u32, u32) = (960, 640);
+
+/// Registers the font once per process (plotters keeps fonts for the program's life).
+fn font() -> Result<()> {
+    static REGISTERED: OnceLock<std::result::Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            let path = std::env::var("KAGE_CHART_FONT").unwrap_or_else(|_| DEFAULT_FONT.to_string());
+            let bytes = std::fs::read(&path).map_err(|e| {
+                format!("reading the chart font {path}: {e} (install fonts-dejavu-core, as scripts/deps.sh does, or set KAGE_CHART_FONT to a .ttf file)")
+            })?;
+            plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(bytes.into_boxed_slice()))
+                .map_err(|_| format!("{path} is not a TrueType font"))
+        })
+        .clone()
+        .map_err(|e| anyhow!(e))
+}
+
+/// Draws `points` (all with a time and an error above 0) to the PNG at `path`.
+pub fn write(path: &Path, title: &str, points: &[Point]) -> Result<()> {
+    font()?;
+    let range = |values: Vec<f64>| {
+        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = values.iter().copied().fold(0.0, f64::max);
+        (lo / 1.5)..(hi * 1.5)
+    };
+    let xs = range(points.iter().map(|p| p.ms).collect());
+    let ys = range(points.iter().map(|p| p.error).collect());
+    let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    draw(&mut pixels, title, points, xs, ys).map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+    image::RgbImage::from_raw(SIZE.0, SIZE.1, pixels)
+        .expect("the buffer holds SIZE.0 × SIZE.1 RGB pixels")
+        .save(path)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+fn draw(
+    pixels: &mut [u8],
+    title: &str,
+    points: &[Point],
+    xs: std::ops::Range<f64>,
+    ys: std::ops::Range<f64>,
+) -> std::result::Result<(), Box<dyn std::error::Error>> {
+    let root = BitMapBackend::with_buffer(pixels, SIZE).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(
+            xs.clone().log_scale().with_key_points(ticks(&xs)),
+            ys.clone().log_scale().with_key_points(ticks(&ys)),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("GPU ms per frame (median)")
+        .y_desc("relative RMSE against the reference")
+        .label_style(("sans-serif", 14))
+        .draw()?;
+    let front: Vec<(f64, f64)> =
+        pareto_front(points).iter().map(|&i| (points[i].ms, points[i].error)).collect();
+    chart
+        .draw_series(LineSeries::new(front, BLACK.stroke_width(2)))?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+    let mut names: Vec<&str> = points.iter().map(|p| p.series).collect();
+    names.dedup();
+    for (i, name) in names.into_iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        let series = points.iter().filter(|p| p.series == name);
+        chart
+            .draw_series(series.map(|p| {
+                EmptyElement::at((p.ms, p.error))
+                    + Circle::new((0, 0), 6, colour.filled())
+                    + Text::new(p.label.clone(), (8, -16), ("sans-serif", 14))
+            }))?
+            .label(name)
+            .legend(move |(x, y)| Circle::new((x + 10, y), 6, colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Labelled values of a log axis: 1, 2 and 5 times the powers of ten within `range`, and every
+/// digit's where fewer than four of those fall inside (a narrow range).
+fn ticks(range: &std::ops::Range<f64>) -> Vec<f64> {
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (lo, hi) = (range.start.log10().floor() as i32, range.end.log10().ceil() as i32);
+        (lo..=hi)
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .filter(|v| range.contains(v))
+            .collect()
+    };
+    let coarse = within(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 4 {
+        coarse
+    } else {
+        within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
