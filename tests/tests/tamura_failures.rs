@@ -151,16 +151,18 @@ fn masked_relative_rmse(a: &RgbaF32Image, b: &RgbaF32Image, keep: &[bool]) -> f6
     (sq / n as f64).sqrt() / (sum / n as f64)
 }
 
-/// `../shared/assets/env/NAME` beside the repository (or under `$KAGE_SHARED_DIR/assets/env`,
-/// or `shared/` inside the checkout). Missing is a failure, not a skip: CI has `shared/`.
+/// The map `NAME` from tests/assets/ (where the tests' maps are kept), else from the shared
+/// assets (`$KAGE_SHARED_DIR/assets/env`, `shared/` in the checkout or beside it). Missing is a
+/// failure, not a skip.
 fn shared_env(name: &str) -> EnvMap {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let candidates: Vec<PathBuf> = std::env::var_os("KAGE_SHARED_DIR")
+    let shared = std::env::var_os("KAGE_SHARED_DIR")
         .map(PathBuf::from)
         .into_iter()
         .chain([root.join("shared"), root.join("../shared")])
-        .map(|d| d.join("assets/env").join(name))
-        .collect();
+        .map(|d| d.join("assets/env").join(name));
+    let candidates: Vec<PathBuf> =
+        std::iter::once(root.join("tests/assets").join(name)).chain(shared).collect();
     let path = candidates.iter().find(|p| p.exists()).unwrap_or_else(|| {
         panic!("{name} not found (looked at {candidates:?}); the shared assets are part of the test set-up")
     });
