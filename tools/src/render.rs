@@ -56,7 +56,7 @@ pub struct RenderArgs {
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[arg(long, default_value_t = 512)]
