@@ -7,10 +7,10 @@ use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::Scene;
 use crate::techniques::background::Background;
-use crate::techniques::env_sh::EnvSh;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
 use crate::techniques::prt::TransferSet;
+use crate::techniques::sh_projection::ShProjection;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
@@ -169,7 +169,7 @@ pub struct Renderer {
     scene: GpuScene,
     camera: crate::scene::Camera,
     env: GpuEnvironment,
-    env_sh: EnvSh,
+    env_sh: ShProjection,
     env_dirty: bool,
     env_rotation: f32,
     background: Background,
@@ -197,7 +197,7 @@ impl Renderer {
             scene: gpu,
             camera: scene.camera,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
-            env_sh: EnvSh::new(ctx, &scene.environment)?,
+            env_sh: ShProjection::environment(ctx, &scene.environment)?,
             env_dirty: true,
             env_rotation: 0.0,
             background: Background::new(ctx)?,
@@ -263,7 +263,7 @@ impl Renderer {
         };
         let mut passes: Vec<Pass> = Vec::new();
         if self.env_dirty {
-            passes.extend(self.env_sh.passes(&self.env));
+            passes.extend(self.env_sh.passes(&self.env.image, &self.env.sampler));
         }
         passes.push(self.background.pass(&inputs));
         passes.extend(self.technique.passes(&inputs));

@@ -1,12 +1,12 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, DrawPush};
 use crate::pass::Pass;
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use std::sync::Arc;
 
 /// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
@@ -58,16 +58,34 @@ impl Technique for Unshadowed {
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
         vec![Pass::new("scene", &["frame_uniforms", "env_sh", "color"], &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(env_sh)]);
-            for mesh in &scene.meshes {
-                let push = DrawPush {
-                    model: scene.transforms[mesh.group].to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                };
-                self.scene.push(cmd, bytes_of(&push));
-                ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-            }
+            self.draw(ctx, cmd, uniforms, env_sh, scene, |mesh| Some(mesh.albedo));
             ctx.end_rendering(cmd);
         })]
+    }
+}
+
+impl Unshadowed {
+    /// Draws the meshes of `scene` lit by `sh` (`ShCoeffs` in the map's frame) as seen with
+    /// `uniforms` (`FrameUniforms`), inside a rendering scope with colour and depth. `albedo`
+    /// gives each mesh's albedo, or `None` to leave the mesh out (black draws an occluder that
+    /// reflects nothing).
+    pub fn draw(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        uniforms: &Buffer,
+        sh: &Buffer,
+        scene: &GpuScene,
+        albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
+    ) {
+        self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(sh)]);
+        for (mesh, albedo) in scene.meshes.iter().filter_map(|m| Some((m, albedo(m)?))) {
+            let push = DrawPush {
+                model: scene.transforms[mesh.group].to_cols_array_2d(),
+                albedo: [albedo[0], albedo[1], albedo[2], 0.0],
+            };
+            self.scene.push(cmd, bytes_of(&push));
+            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        }
     }
 }

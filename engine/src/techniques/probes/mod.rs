@@ -9,6 +9,7 @@
 //! Duplicate positions are merged, keeping the first ([`TetMesh::merged`]); fewer than four
 //! distinct positions, or all of them in one plane, is an error ([`ProbeError`]): there is no
 //! lower-dimensional fallback.
+mod capture;
 mod delaunay;
 mod error;
 mod extrapolate;
@@ -21,6 +22,7 @@ mod spatial_sort;
 mod tests;
 mod tetmesh;
 
+pub use capture::{CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE};
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
