@@ -9,6 +9,8 @@ use crate::scene::Scene;
 use crate::techniques::background::Background;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
+use crate::techniques::probes::technique::ProbeTechnique;
+use crate::techniques::probes::ProbeSettings;
 use crate::techniques::prt::TransferSet;
 use crate::techniques::sh_projection::ShProjection;
 use crate::techniques::tamura::technique::OcclusionSettings;
@@ -148,6 +150,9 @@ pub enum TechniqueChoice {
     /// The paper's Fig. 3 baseline: `regions` environment regions (1 to 128) as directional
     /// lights with binary shadow maps of `shadow_map_size`² texels.
     ParallelLights { regions: usize, shadow_map_size: u32 },
+    /// Light probes captured when the renderer is built light the moving group; the static
+    /// groups are lit as by `Unshadowed`.
+    Probes(ProbeSettings),
 }
 
 /// What to render and how large.
@@ -191,6 +196,7 @@ impl Renderer {
             TechniqueChoice::ParallelLights { regions, shadow_map_size } => {
                 Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
             }
+            TechniqueChoice::Probes(settings) => Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings)?),
         };
         Ok(Renderer {
             ctx: ctx.clone(),

@@ -27,24 +27,48 @@ pub struct Unshadowed {
 
 impl Unshadowed {
     pub fn new(ctx: &Arc<Context>) -> Result<Unshadowed> {
-        let scene = GraphicsPipeline::new(
-            ctx,
-            &GraphicsDesc {
-                name: "scene_unshadowed",
-                vertex_spirv: spirv::SCENE_VERT,
-                fragment_spirv: spirv::SCENE_FRAG,
-                bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
-                push_size: size_of::<DrawPush>() as u32,
-                vertex_buffers: &[MESH_VERTICES],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                additive: false,
-                fragment_constants: &[],
-            },
-        )?;
-        Ok(Unshadowed { scene })
+        Ok(Unshadowed { scene: scene_pipeline(ctx, "scene_unshadowed", spirv::SCENE_FRAG)? })
+    }
+}
+
+/// A pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
+/// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1) and a `DrawPush`.
+pub fn scene_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        ctx,
+        &GraphicsDesc {
+            name,
+            vertex_spirv: spirv::SCENE_VERT,
+            fragment_spirv,
+            bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
+            push_size: size_of::<DrawPush>() as u32,
+            vertex_buffers: &[MESH_VERTICES],
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[COLOR_FORMAT],
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: true,
+            additive: false,
+            fragment_constants: &[],
+        },
+    )
+}
+
+/// Draws, with `pipeline` bound, the meshes of `scene` for which `albedo` gives an albedo
+/// (`None` leaves a mesh out), each with its group's transform.
+pub fn draw_meshes(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    pipeline: &GraphicsPipeline,
+    scene: &GpuScene,
+    albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
+) {
+    for (mesh, albedo) in scene.meshes.iter().filter_map(|m| Some((m, albedo(m)?))) {
+        let push = DrawPush {
+            model: scene.transforms[mesh.group].to_cols_array_2d(),
+            albedo: [albedo[0], albedo[1], albedo[2], 0.0],
+        };
+        pipeline.push(cmd, bytes_of(&push));
+        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
     }
 }
 
@@ -79,13 +103,6 @@ impl Unshadowed {
         albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
     ) {
         self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(sh)]);
-        for (mesh, albedo) in scene.meshes.iter().filter_map(|m| Some((m, albedo(m)?))) {
-            let push = DrawPush {
-                model: scene.transforms[mesh.group].to_cols_array_2d(),
-                albedo: [albedo[0], albedo[1], albedo[2], 0.0],
-            };
-            self.scene.push(cmd, bytes_of(&push));
-            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-        }
+        draw_meshes(ctx, cmd, &self.scene, scene, albedo);
     }
 }
