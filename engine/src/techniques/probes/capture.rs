@@ -13,7 +13,7 @@ use crate::backend::{vk, Buffer, BufferDesc, Context, Edge, Image, ImageDesc, Me
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass};
-use crate::renderer::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::scene::{Camera, Scene};
 use crate::sh::ShRgb9;
 use crate::techniques::background::Background;
@@ -171,9 +171,8 @@ impl ProbeCapture {
             buffer.write(0, bytes_of(&uniforms))?;
         }
         let lit = self.settings.light == CapturedLight::SkyAndWalls;
-        let albedo = |mesh: &crate::renderer::GpuMesh| {
-            is_static(mesh.group).then_some(if lit { mesh.albedo } else { [0.0; 3] })
-        };
+        let albedo =
+            |mesh: &GpuMesh| is_static(mesh.group).then_some(if lit { mesh.albedo } else { [0.0; 3] });
         let (ctx, cube, depth, faces, side) =
             (&self.ctx, &self.cube, &self.depth, &self.faces, self.settings.cube_size);
         let face_area = |f: u32| vk::Rect2D {
