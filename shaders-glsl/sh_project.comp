@@ -1,5 +1,7 @@
 #version 460
-// Projects the environment map onto 9 SH coefficients per channel. Invocation `lane` of group
+// Projects an image of radiance onto 9 SH coefficients per channel, with each texel's exact
+// solid angle: an equirectangular environment map or a probe's cube map (p.size.w, one of
+// KAGE_SH_MAPPING_*). Invocation `lane` of group
 // `g` adds texels g*N*T + t*N + lane (t < T, N invocations per group), so neighbouring
 // invocations read neighbouring texels; each group writes one partial, which sh_reduce.comp
 // adds up.
@@ -7,12 +9,29 @@
 #include "layouts.glsl"
 #include "sh.glsl"
 #include "envmap.glsl"
+#include "cube.glsl"
 #include "sh_reduce.glsl"
 
 layout(local_size_x = KAGE_SH_GROUP) in;
 layout(set = 0, binding = 0) uniform sampler2D env;
 layout(set = 0, binding = 1, std430) writeonly buffer Partials { ShCoeffs partials[]; };
-layout(push_constant) uniform Push { ShProjectPush p; };  // size.xy: map size, z: texels per invocation
+layout(push_constant) uniform Push { ShProjectPush p; };
+
+// The direction of a texel's centre and the solid angle it covers.
+void texel_direction(uvec2 texel, uint w, uint h, out vec3 dir, out float solid_angle) {
+    if (p.size.w == KAGE_SH_MAPPING_CUBE) {
+        uint face;
+        vec2 lo, hi;
+        cube_texel(texel, w, face, lo, hi);
+        dir = cube_direction(face, 0.5 * (lo + hi));
+        solid_angle = cube_solid_angle(lo, hi);
+    } else {
+        dir = env_uv_to_dir((vec2(texel) + 0.5) / vec2(w, h));
+        // Exact solid angle of an equirectangular texel: (2pi / w) (cos theta0 - cos theta1).
+        solid_angle = (2.0 * KAGE_PI / float(w))
+            * (cos(KAGE_PI * float(texel.y) / float(h)) - cos(KAGE_PI * float(texel.y + 1) / float(h)));
+    }
+}
 
 void main() {
     uint w = p.size.x, h = p.size.y;
@@ -23,10 +42,9 @@ void main() {
         uint index = first + t * KAGE_SH_GROUP;
         if (index >= w * h) break;
         uvec2 texel = uvec2(index % w, index / w);
-        vec3 dir = env_uv_to_dir((vec2(texel) + 0.5) / vec2(w, h));
-        // Exact solid angle of an equirectangular texel: (2pi / w) (cos theta0 - cos theta1).
-        float solid_angle = (2.0 * KAGE_PI / float(w))
-            * (cos(KAGE_PI * float(texel.y) / float(h)) - cos(KAGE_PI * float(texel.y + 1) / float(h)));
+        vec3 dir;
+        float solid_angle;
+        texel_direction(texel, w, h, dir, solid_angle);
         vec3 weighted = texelFetch(env, ivec2(texel), 0).rgb * solid_angle;
         float y[9];
         sh9_basis(dir, y);

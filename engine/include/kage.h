@@ -110,6 +110,12 @@ enum kage_technique
    * Baseline: `regions` environment regions as directional lights with binary shadow maps.
    */
   KAGE_TECHNIQUE_PARALLEL_LIGHTS = 3,
+  /**
+   * Morishige 2014: light probes on a `probe_grid` over the static groups, captured as SH
+   * when the renderer is created, light the scene's first group (the moving one); the other
+   * groups are lit as by `Unshadowed`.
+   */
+  KAGE_TECHNIQUE_PROBES = 4,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -274,6 +280,19 @@ typedef struct {
    * Side of a parallel-lights shadow map in texels; default 512.
    */
   uint32_t shadow_map_size;
+  /**
+   * Light probes along X, Y and Z, 2 to 64 each, at the cell centres of that grid over the
+   * static groups' bounding box; default 3, 2, 3.
+   */
+  uint32_t probe_grid[3];
+  /**
+   * Texels per side of a probe's cube-map face, 8 to 256; default 128.
+   */
+  uint32_t probe_cube_size;
+  /**
+   * A `kage_probe_light` value; default sky and walls.
+   */
+  uint32_t probe_light;
 } kage_technique_desc;
 
 /**

@@ -7,10 +7,12 @@ use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::Scene;
 use crate::techniques::background::Background;
-use crate::techniques::env_sh::EnvSh;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
+use crate::techniques::probes::technique::ProbeTechnique;
+use crate::techniques::probes::ProbeSettings;
 use crate::techniques::prt::TransferSet;
+use crate::techniques::sh_projection::ShProjection;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
@@ -148,6 +150,9 @@ pub enum TechniqueChoice {
     /// The paper's Fig. 3 baseline: `regions` environment regions (1 to 128) as directional
     /// lights with binary shadow maps of `shadow_map_size`² texels.
     ParallelLights { regions: usize, shadow_map_size: u32 },
+    /// Light probes captured when the renderer is built light the moving group; the static
+    /// groups are lit as by `Unshadowed`.
+    Probes(ProbeSettings),
 }
 
 /// What to render and how large.
@@ -169,7 +174,7 @@ pub struct Renderer {
     scene: GpuScene,
     camera: crate::scene::Camera,
     env: GpuEnvironment,
-    env_sh: EnvSh,
+    env_sh: ShProjection,
     env_dirty: bool,
     env_rotation: f32,
     background: Background,
@@ -191,13 +196,14 @@ impl Renderer {
             TechniqueChoice::ParallelLights { regions, shadow_map_size } => {
                 Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
             }
+            TechniqueChoice::Probes(settings) => Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings)?),
         };
         Ok(Renderer {
             ctx: ctx.clone(),
             scene: gpu,
             camera: scene.camera,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
-            env_sh: EnvSh::new(ctx, &scene.environment)?,
+            env_sh: ShProjection::environment(ctx, &scene.environment)?,
             env_dirty: true,
             env_rotation: 0.0,
             background: Background::new(ctx)?,
@@ -263,7 +269,7 @@ impl Renderer {
         };
         let mut passes: Vec<Pass> = Vec::new();
         if self.env_dirty {
-            passes.extend(self.env_sh.passes(&self.env));
+            passes.extend(self.env_sh.passes(&self.env.image, &self.env.sampler));
         }
         passes.push(self.background.pass(&inputs));
         passes.extend(self.technique.passes(&inputs));

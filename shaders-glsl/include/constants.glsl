@@ -11,6 +11,11 @@
 #define KAGE_SH_GROUP 64
 // Environment texels each SH projection invocation adds up.
 #define KAGE_SH_TEXELS_PER_INVOCATION 16
+// How the SH projection maps a texel of its source image to a direction and a solid angle
+// (ShProjectPush.size.w): an equirectangular environment map, or the six faces of a probe's
+// cube map stacked top to bottom in one image (include/cube.glsl).
+#define KAGE_SH_MAPPING_EQUIRECT 0
+#define KAGE_SH_MAPPING_CUBE 1
 
 // Storage buffers that bvh.glsl declares at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1; a shader
 // that includes it numbers its own bindings from here.

@@ -30,7 +30,15 @@ struct ShCoeffs {
 
 // Push constants of the SH projection compute pass.
 struct ShProjectPush {
-    uvec4 size; // x: width, y: height, z: groups in x, w: unused
+    uvec4 size; // x: width, y: height, z: texels per invocation, w: mapping (KAGE_SH_MAPPING_*)
+};
+
+// Irradiance of a moving group from the light probes: E(n) = (n, 1)^T M (n, 1) per channel
+// (Ramamoorthi & Hanrahan 2001, eq. 12), M from the SH interpolated at the group's position.
+struct ProbeLight {
+    mat4 red;
+    mat4 green;
+    mat4 blue;
 };
 
 // A BVH node, 32 bytes; the children of an interior node are adjacent (index, index + 1).

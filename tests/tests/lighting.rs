@@ -2,7 +2,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, uv_to_direction, Camera, EnvMap, Scene};
-use kage::techniques::env_sh;
+use kage::techniques::sh_projection;
 use kage_tests::{render_once, single_mesh_scene, Validated};
 use std::f32::consts::PI;
 
@@ -17,7 +17,7 @@ fn constant_map_projects_to_the_first_coefficient_only() {
     // Real maps' size: the basis is evaluated at texel centres, an error that falls as 1/h^2
     // (about 5e-4 of c0 in band 2 at h = 32, 2e-6 at h = 512).
     let map = EnvMap::from_pixels(1024, 512, vec![[c, 2.0 * c, 3.0 * c]; 1024 * 512]).unwrap();
-    let sh = env_sh::project(&ctx, &map).unwrap();
+    let sh = sh_projection::project(&ctx, &map).unwrap();
     for k in 0..3 {
         let expected = 2.0 * PI.sqrt() * c * (k + 1) as f32;
         assert!(
@@ -42,7 +42,7 @@ fn linear_map_projects_to_bands_0_and_1() {
             [1.0 + coefficients.dot(uv_to_direction(uv)); 3]
         })
         .collect();
-    let sh = env_sh::project(&ctx, &EnvMap::from_pixels(w, h, pixels).unwrap()).unwrap();
+    let sh = sh_projection::project(&ctx, &EnvMap::from_pixels(w, h, pixels).unwrap()).unwrap();
     let band1 = (4.0 * PI / 3.0).sqrt();
     // Index order: y00, y1-1 (y), y10 (z), y11 (x), then band 2.
     let expected = [
@@ -67,7 +67,7 @@ fn gpu_projection_matches_the_cpu_reference_on_a_real_map() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
     let map = &scene.environment;
-    let gpu = env_sh::project(&ctx, map).unwrap();
+    let gpu = sh_projection::project(&ctx, map).unwrap();
     let cpu = kage::sh::project_equirect(map.width(), map.height(), map.pixels(), 3).unwrap();
     let scale = cpu[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for (i, (g, c)) in gpu.c.iter().zip(&cpu).enumerate() {

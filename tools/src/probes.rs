@@ -56,12 +56,17 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
     }
 }
 
-/// Reads and tetrahedralizes a probe file, warning about merged duplicates.
-fn load(path: &Path) -> Result<TetMesh> {
+/// The positions of a probe file.
+pub fn read_positions(path: &Path) -> Result<Vec<DVec3>> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let file: ProbeFile = serde_json::from_str(&text)
         .with_context(|| format!("{}: not a probe file {{\"positions\": [[x,y,z], ...]}}", path.display()))?;
-    let positions: Vec<DVec3> = file.positions.into_iter().map(DVec3::from_array).collect();
+    Ok(file.positions.into_iter().map(DVec3::from_array).collect())
+}
+
+/// Reads and tetrahedralizes a probe file, warning about merged duplicates.
+fn load(path: &Path) -> Result<TetMesh> {
+    let positions = read_positions(path)?;
     let mesh = TetMesh::build(&positions).with_context(|| format!("tetrahedralizing {}", path.display()))?;
     if !mesh.merged().is_empty() {
         let pairs: Vec<String> =

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 #[derive(Args)]
 pub struct ReferenceArgs {
-    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     /// Samples per pixel (or per point). Each sample casts two shadow rays (one drawn from the

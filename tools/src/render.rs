@@ -7,6 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
+use kage::techniques::probes::{CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings};
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
@@ -23,6 +24,16 @@ pub enum TechniqueName {
     Tamura,
     /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
     ParallelLights,
+    /// Morishige 2014: light probes captured as SH light the moving group (the first).
+    Probes,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProbeLightName {
+    /// The sky where the probe sees it, and the static groups lit without shadows.
+    SkyAndWalls,
+    /// The sky where the probe sees it; the static groups only occlude.
+    Sky,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,6 +59,16 @@ pub struct RenderArgs {
     /// Side of a parallel-lights shadow map, texels.
     #[arg(long, default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
+    /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
+    /// bounding box, 2 to 64 each) or a file {"positions": [[x,y,z], ...]}.
+    #[arg(long, default_value = "grid:3,2,3")]
+    probes: String,
+    /// Texels per side of a probe's cube-map face, 8 to 256.
+    #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_CUBE_SIZE)]
+    probe_cube_size: u32,
+    /// What the probes capture besides the sky they see.
+    #[arg(long, value_enum, default_value_t = ProbeLightName::SkyAndWalls)]
+    probe_light: ProbeLightName,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
@@ -56,7 +77,7 @@ pub struct RenderArgs {
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[arg(long, default_value_t = 512)]
@@ -103,6 +124,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             TechniqueName::Sloan => TechniqueKind::Sloan,
             TechniqueName::Tamura => TechniqueKind::Tamura,
             TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
+            TechniqueName::Probes => TechniqueKind::Probes,
         },
         prt: args.prt.params()?,
         regions: args.regions,
@@ -112,6 +134,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             PenumbraName::Adaptive => Penumbra::Adaptive,
         },
         shadow_map_size: args.shadow_map_size,
+        probes: ProbeSettings {
+            placement: probe_placement(&args.probes)?,
+            capture: CaptureSettings {
+                cube_size: args.probe_cube_size,
+                light: match args.probe_light {
+                    ProbeLightName::SkyAndWalls => CapturedLight::SkyAndWalls,
+                    ProbeLightName::Sky => CapturedLight::Sky,
+                },
+            },
+        },
     }
     .validated()?;
     let transfer = match settings.precomputation() {
@@ -128,9 +160,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     };
     let technique = settings.choice(transfer)?;
+    let setup = Instant::now();
     let mut renderer =
         Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height, technique })
             .context("setting up the renderer")?;
+    if settings.kind == TechniqueKind::Probes {
+        eprintln!("probes: captured in {:.2} s", setup.elapsed().as_secs_f64());
+    }
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
     let bar = ProgressBar::new(args.frames as u64).with_style(
         ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
@@ -191,4 +227,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     args.gpu.finish(&ctx)
+}
+
+/// `--probes`: `grid:NX,NY,NZ` or a probe file.
+fn probe_placement(arg: &str) -> Result<ProbePlacement> {
+    match arg.strip_prefix("grid:") {
+        Some(counts) => {
+            let counts: Vec<u32> = counts
+                .split(',')
+                .map(|n| n.trim().parse())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--probes {arg}: expected grid:NX,NY,NZ with whole numbers"))?;
+            let counts: [u32; 3] = counts
+                .try_into()
+                .map_err(|_| anyhow::anyhow!("--probes {arg}: expected three counts, grid:NX,NY,NZ"))?;
+            Ok(ProbePlacement::Grid(counts))
+        }
+        None => {
+            Ok(ProbePlacement::Positions(crate::probes::read_positions(std::path::Path::new(arg))?.into()))
+        }
+    }
 }

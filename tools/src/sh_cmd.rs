@@ -24,7 +24,7 @@ pub fn run(args: &ShArgs) -> Result<()> {
     let map = EnvMap::load(&args.map)?;
     crate::report_clamped(&map);
     let ctx = args.gpu.context()?;
-    let sh = kage::techniques::env_sh::project(&ctx, &map).context("projecting on the GPU")?;
+    let sh = kage::techniques::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
     println!("# real SH, index = l*(l+1)+m, orthonormal basis (see README, \"SH basis\")");
     println!("# {:>5} {:>3} {:>3} {:>14} {:>14} {:>14}", "index", "l", "m", "red", "green", "blue");
     for (i, c) in sh.c.iter().enumerate() {

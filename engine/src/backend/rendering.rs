@@ -81,6 +81,24 @@ impl Context {
         }
     }
 
+    /// Restricts drawing to `area` of the targets (viewport and scissor), within a rendering
+    /// scope: several views drawn side by side into one image, such as a probe's cube faces.
+    pub fn set_viewport(&self, cmd: vk::CommandBuffer, area: vk::Rect2D) {
+        let viewport = vk::Viewport {
+            x: area.offset.x as f32,
+            y: area.offset.y as f32,
+            width: area.extent.width as f32,
+            height: area.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: recording command buffer inside a rendering scope (dynamic viewport and scissor).
+        unsafe {
+            self.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            self.device.cmd_set_scissor(cmd, 0, &[area]);
+        }
+    }
+
     pub fn end_rendering(&self, cmd: vk::CommandBuffer) {
         // SAFETY: closes the scope opened by begin_rendering.
         unsafe { self.dynamic_rendering.cmd_end_rendering(cmd) };

@@ -4,6 +4,9 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
+use crate::techniques::probes::{
+    CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings, DEFAULT_GRID,
+};
 use crate::techniques::prt::{transfer, PrtParams};
 use crate::techniques::settings::{TechniqueKind, TechniqueSettings};
 use crate::techniques::tamura::technique::Penumbra;
@@ -23,6 +26,21 @@ pub enum kage_technique {
     Tamura = 2,
     /// Baseline: `regions` environment regions as directional lights with binary shadow maps.
     ParallelLights = 3,
+    /// Morishige 2014: light probes on a `probe_grid` over the static groups, captured as SH
+    /// when the renderer is created, light the scene's first group (the moving one); the other
+    /// groups are lit as by `Unshadowed`.
+    Probes = 4,
+}
+
+/// What the light probes capture (the values of `kage_technique_desc.probe_light`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_probe_light {
+    /// The environment where the probe sees it, plus the static groups lit directly by the
+    /// environment without shadows.
+    SkyAndWalls = 0,
+    /// The environment where the probe sees it; the static groups only occlude it.
+    Sky = 1,
 }
 
 /// Width of Tamura's penumbrae (the values of `kage_technique_desc.penumbra`).
@@ -56,6 +74,13 @@ pub struct kage_technique_desc {
     pub penumbra: u32,
     /// Side of a parallel-lights shadow map in texels; default 512.
     pub shadow_map_size: u32,
+    /// Light probes along X, Y and Z, 2 to 64 each, at the cell centres of that grid over the
+    /// static groups' bounding box; default 3, 2, 3.
+    pub probe_grid: [u32; 3],
+    /// Texels per side of a probe's cube-map face, 8 to 256; default 128.
+    pub probe_cube_size: u32,
+    /// A `kage_probe_light` value; default sky and walls.
+    pub probe_light: u32,
 }
 
 impl kage_technique_desc {
@@ -69,6 +94,15 @@ impl kage_technique_desc {
                 (T::Sloan as u32, TechniqueKind::Sloan),
                 (T::Tamura as u32, TechniqueKind::Tamura),
                 (T::ParallelLights as u32, TechniqueKind::ParallelLights),
+                (T::Probes as u32, TechniqueKind::Probes),
+            ],
+        )?;
+        let probe_light = args::enumeration(
+            self.probe_light,
+            "probe_light",
+            &[
+                (kage_probe_light::SkyAndWalls as u32, CapturedLight::SkyAndWalls),
+                (kage_probe_light::Sky as u32, CapturedLight::Sky),
             ],
         )?;
         let penumbra = args::enumeration(
@@ -86,6 +120,10 @@ impl kage_technique_desc {
             mask_size: self.mask_size,
             penumbra,
             shadow_map_size: self.shadow_map_size,
+            probes: ProbeSettings {
+                placement: ProbePlacement::Grid(self.probe_grid),
+                capture: CaptureSettings { cube_size: self.probe_cube_size, light: probe_light },
+            },
         }
         .validated()?)
     }
@@ -112,6 +150,9 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             mask_size: d.mask_size,
             penumbra: kage_penumbra::Fixed as u32,
             shadow_map_size: d.shadow_map_size,
+            probe_grid: DEFAULT_GRID,
+            probe_cube_size: d.probes.capture.cube_size,
+            probe_light: kage_probe_light::SkyAndWalls as u32,
         };
         // An unknown technique is reported here already, not at the first use.
         filled.settings()?;

@@ -2,7 +2,7 @@
 //! Their assets live in `engine/assets/` (licences in `engine/assets/LICENSES.md`).
 use glam::Vec3;
 
-use super::{obj, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
+use super::{obj, probe_room, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
 
 const TEAPOT_OBJ: &[u8] = include_bytes!("../../assets/teapot.obj");
 const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
@@ -11,9 +11,12 @@ const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
 const TEAPOT_HEIGHT: f32 = 15.75;
 
 /// Names accepted by [`Scene::builtin`]; the first is the default.
-pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor"];
+pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room"];
 
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
+    if name == "probe-room" {
+        return probe_room_scene(name);
+    }
     // Floor grid vertices per side: 31×31 is the paper's low-resolution receiver, 111×111 its
     // high-resolution one.
     let floor_vertices = match name {
@@ -26,8 +29,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
             )))
         }
     };
-    // The embedded assets are known good, but a failure still reports rather than panics.
-    let context = |e: SceneError| e.within(&format!("built-in scene \"{name}\""));
+    let context = context(name);
     let teapot = obj::parse_obj(TEAPOT_OBJ, "teapot", [0.75; 3]).map_err(context)?;
     let floor = shapes::plane("floor", [6.0, 6.0], [floor_vertices; 2], [0.6; 3]).map_err(context)?;
     let environment = EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?;
@@ -51,6 +53,29 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
             target: Vec3::new(0.0, 0.4, 0.0),
             up: Vec3::Y,
             fov_y_deg: 40.0,
+        },
+    })
+}
+
+/// The embedded assets are known good, but a failure still reports rather than panics.
+fn context(name: &str) -> impl Fn(SceneError) -> SceneError + Copy + '_ {
+    move |e: SceneError| e.within(&format!("built-in scene \"{name}\""))
+}
+
+/// See [`probe_room`]: the room lit by the courtyard through its opening, seen from inside
+/// near the front wall.
+fn probe_room_scene(name: &str) -> Result<Scene, SceneError> {
+    let context = context(name);
+    Ok(Scene {
+        name: name.to_string(),
+        groups: probe_room::groups().map_err(context)?,
+        environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
+        lights: Vec::new(),
+        camera: Camera {
+            position: Vec3::new(0.0, 1.4, 1.9),
+            target: Vec3::new(0.0, 0.5, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 70.0,
         },
     })
 }

@@ -29,6 +29,7 @@ mod light;
 mod load;
 mod mesh;
 mod obj;
+mod probe_room;
 pub mod shapes;
 mod transform;
 

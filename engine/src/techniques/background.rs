@@ -1,7 +1,8 @@
 //! The environment seen directly, behind everything: one full-screen triangle that clears the
 //! colour target and looks up the map along each pixel's view ray.
+use super::environment::GpuEnvironment;
 use super::FrameInputs;
-use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline};
+use crate::backend::{vk, Binding, BindingKind, Buffer, Context, GraphicsDesc, GraphicsPipeline};
 use crate::error::Result;
 use crate::layouts::spirv;
 use crate::pass::Pass;
@@ -39,10 +40,15 @@ impl Background {
             (inputs.ctx, inputs.uniforms, inputs.environment, &inputs.targets.color);
         Pass::new("background", &["frame_uniforms", "environment"], &["color"], move |cmd| {
             ctx.begin_rendering(cmd, Some(color.into()), Some([0.0; 4]), None);
-            self.pipeline
-                .bind(cmd, &[Binding::Uniform(uniforms), Binding::Sampled(&env.image, &env.sampler)]);
-            ctx.draw(cmd, &[], 3);
+            self.draw(ctx, cmd, uniforms, env);
             ctx.end_rendering(cmd);
         })
+    }
+
+    /// Draws the environment as seen with `uniforms` (`FrameUniforms`) into the current
+    /// viewport, inside a rendering scope with a colour target only.
+    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, uniforms: &Buffer, env: &GpuEnvironment) {
+        self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Sampled(&env.image, &env.sampler)]);
+        ctx.draw(cmd, &[], 3);
     }
 }

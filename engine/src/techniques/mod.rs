@@ -1,13 +1,13 @@
-//! Lighting techniques, each built from passes. `environment`, `env_sh` and `background` are
+//! Lighting techniques, each built from passes. `environment`, `sh_projection` and `background` are
 //! shared by all of them: the environment map on the GPU, its SH projection, and the pass that
 //! shows it behind the scene.
 pub mod background;
-pub mod env_sh;
 pub mod environment;
 pub mod parallel_lights;
 pub mod probes;
 pub mod prt;
 pub mod settings;
+pub mod sh_projection;
 pub mod tamura;
 pub mod unshadowed;
 

@@ -2,6 +2,7 @@
 //! `kage_technique_desc` both turn into, checked in one place, and turned into the renderer's
 //! [`TechniqueChoice`] once the precomputation it needs is done.
 use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
+use super::probes::ProbeSettings;
 use super::prt::{PrtParams, TransferSet};
 use super::tamura::technique::{OcclusionSettings, Penumbra};
 use crate::error::{Error, Result};
@@ -19,10 +20,12 @@ pub enum TechniqueKind {
     Tamura,
     /// The paper's Fig. 3 baseline: q regions as directional lights with binary shadow maps.
     ParallelLights,
+    /// Morishige 2014: light probes captured as SH light the moving group (group 0).
+    Probes,
 }
 
 /// Every parameter of every technique; each technique reads the ones it uses.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct TechniqueSettings {
     pub kind: TechniqueKind,
     /// The PRT precomputation of Sloan and Tamura (SH bands, rays per vertex).
@@ -34,6 +37,8 @@ pub struct TechniqueSettings {
     pub penumbra: Penumbra,
     /// Side of a parallel-lights shadow map, texels.
     pub shadow_map_size: u32,
+    /// Placement and capture of the light probes.
+    pub probes: ProbeSettings,
 }
 
 impl Default for TechniqueSettings {
@@ -46,6 +51,7 @@ impl Default for TechniqueSettings {
             mask_size: occlusion.mask_size,
             penumbra: occlusion.penumbra,
             shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
+            probes: ProbeSettings::default(),
         }
     }
 }
@@ -58,9 +64,12 @@ impl TechniqueSettings {
 
     /// Checks what can be checked before any GPU work (the techniques check the rest when
     /// they are built), so that a bad parameter fails before a long precomputation.
-    pub fn validated(self) -> Result<TechniqueSettings> {
+    pub fn validated(mut self) -> Result<TechniqueSettings> {
         if self.precomputation().is_some() {
             self.prt.validated()?;
+        }
+        if self.kind == TechniqueKind::Probes {
+            self.probes = self.probes.validated()?;
         }
         // Zero regions would quietly be Sloan's technique (see `TechniqueChoice::Prt`).
         if self.kind == TechniqueKind::Tamura && self.regions == 0 {
@@ -72,7 +81,7 @@ impl TechniqueSettings {
     /// What the renderer runs. `transfer` is the result of [`Self::precomputation`] (ignored
     /// by techniques that need none); it must have been computed with `self.prt`'s bands.
     pub fn choice(&self, transfer: Option<Arc<TransferSet>>) -> Result<TechniqueChoice> {
-        let settings = self.validated()?;
+        let settings = self.clone().validated()?;
         let prt = |regions| match transfer {
             None => Err(Error::InvalidArgument(format!(
                 "the {:?} technique needs the PRT transfer: precompute it first",
@@ -102,6 +111,7 @@ impl TechniqueSettings {
                 regions: settings.regions,
                 shadow_map_size: settings.shadow_map_size,
             }),
+            TechniqueKind::Probes => Ok(TechniqueChoice::Probes(settings.probes)),
         }
     }
 }
@@ -130,15 +140,23 @@ mod tests {
         assert!(matches!(lights, TechniqueChoice::ParallelLights { regions: 4, .. }));
         assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
         assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
+        assert!(matches!(of(TechniqueKind::Probes).choice(None), Ok(TechniqueChoice::Probes(_))));
+        assert_eq!(of(TechniqueKind::Probes).precomputation(), None);
     }
 
     #[test]
     fn missing_or_mismatched_precomputation_and_bad_parameters_are_errors() {
         let tamura = TechniqueSettings { kind: TechniqueKind::Tamura, ..Default::default() };
-        assert!(error(tamura, None).contains("precompute it first"));
-        assert!(error(tamura, transfer(4)).contains("4 SH bands"));
-        assert!(error(TechniqueSettings { regions: 0, ..tamura }, transfer(3)).contains("at least 1"));
+        assert!(error(tamura.clone(), None).contains("precompute it first"));
+        assert!(error(tamura.clone(), transfer(4)).contains("4 SH bands"));
+        assert!(error(TechniqueSettings { regions: 0, ..tamura.clone() }, transfer(3)).contains("at least 1"));
         let bands = PrtParams { bands: 9, ..PrtParams::DEFAULT };
         assert!(error(TechniqueSettings { prt: bands, ..tamura }, transfer(9)).contains("9 SH bands"));
+        let mut probes = TechniqueSettings { kind: TechniqueKind::Probes, ..Default::default() };
+        probes.probes.placement = crate::techniques::probes::ProbePlacement::Grid([2, 1, 2]);
+        assert!(error(probes.clone(), None).contains("probe grid [2, 1, 2]"));
+        probes.probes = ProbeSettings::default();
+        probes.probes.capture.cube_size = 512;
+        assert!(error(probes, None).contains("cube map size 512"));
     }
 }

@@ -1,12 +1,12 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, DrawPush};
 use crate::pass::Pass;
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use std::sync::Arc;
 
 /// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
@@ -27,24 +27,48 @@ pub struct Unshadowed {
 
 impl Unshadowed {
     pub fn new(ctx: &Arc<Context>) -> Result<Unshadowed> {
-        let scene = GraphicsPipeline::new(
-            ctx,
-            &GraphicsDesc {
-                name: "scene_unshadowed",
-                vertex_spirv: spirv::SCENE_VERT,
-                fragment_spirv: spirv::SCENE_FRAG,
-                bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
-                push_size: size_of::<DrawPush>() as u32,
-                vertex_buffers: &[MESH_VERTICES],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                additive: false,
-                fragment_constants: &[],
-            },
-        )?;
-        Ok(Unshadowed { scene })
+        Ok(Unshadowed { scene: scene_pipeline(ctx, "scene_unshadowed", spirv::SCENE_FRAG)? })
+    }
+}
+
+/// A pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
+/// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1) and a `DrawPush`.
+pub fn scene_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        ctx,
+        &GraphicsDesc {
+            name,
+            vertex_spirv: spirv::SCENE_VERT,
+            fragment_spirv,
+            bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
+            push_size: size_of::<DrawPush>() as u32,
+            vertex_buffers: &[MESH_VERTICES],
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[COLOR_FORMAT],
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: true,
+            additive: false,
+            fragment_constants: &[],
+        },
+    )
+}
+
+/// Draws, with `pipeline` bound, the meshes of `scene` for which `albedo` gives an albedo
+/// (`None` leaves a mesh out), each with its group's transform.
+pub fn draw_meshes(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    pipeline: &GraphicsPipeline,
+    scene: &GpuScene,
+    albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
+) {
+    for (mesh, albedo) in scene.meshes.iter().filter_map(|m| Some((m, albedo(m)?))) {
+        let push = DrawPush {
+            model: scene.transforms[mesh.group].to_cols_array_2d(),
+            albedo: [albedo[0], albedo[1], albedo[2], 0.0],
+        };
+        pipeline.push(cmd, bytes_of(&push));
+        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
     }
 }
 
@@ -58,16 +82,27 @@ impl Technique for Unshadowed {
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
         vec![Pass::new("scene", &["frame_uniforms", "env_sh", "color"], &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(env_sh)]);
-            for mesh in &scene.meshes {
-                let push = DrawPush {
-                    model: scene.transforms[mesh.group].to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                };
-                self.scene.push(cmd, bytes_of(&push));
-                ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-            }
+            self.draw(ctx, cmd, uniforms, env_sh, scene, |mesh| Some(mesh.albedo));
             ctx.end_rendering(cmd);
         })]
+    }
+}
+
+impl Unshadowed {
+    /// Draws the meshes of `scene` lit by `sh` (`ShCoeffs` in the map's frame) as seen with
+    /// `uniforms` (`FrameUniforms`), inside a rendering scope with colour and depth. `albedo`
+    /// gives each mesh's albedo, or `None` to leave the mesh out (black draws an occluder that
+    /// reflects nothing).
+    pub fn draw(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        uniforms: &Buffer,
+        sh: &Buffer,
+        scene: &GpuScene,
+        albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
+    ) {
+        self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(sh)]);
+        draw_meshes(ctx, cmd, &self.scene, scene, albedo);
     }
 }

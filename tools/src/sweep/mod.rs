@@ -36,7 +36,7 @@ pub enum SweptTechnique {
 pub struct SweepArgs {
     #[arg(long, value_enum)]
     technique: SweptTechnique,
-    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     /// Environment maps to sweep over, each replacing the scene's (default: the scene's own).

@@ -1,4 +1,8 @@
-//! Light probes (Morishige 2014; ../shared/papers/README.md, section 3): the geometry.
+//! Light probes (Morishige 2014; ../shared/papers/README.md, section 3).
+//!
+//! Capture ([`ProbeCapture`]): a cube map of the scene at each probe projected to SH on the GPU;
+//! [`ProbeSet`]: placement, capture and interpolation; [`technique`]: the moving group lit by
+//! the probes. The geometry:
 //!
 //! [`TetMesh::build`] tetrahedralizes the probe positions (3D Delaunay, incremental, with exact
 //! orientation and in-sphere predicates and a symbolic perturbation for cospherical sets such as
@@ -9,6 +13,7 @@
 //! Duplicate positions are merged, keeping the first ([`TetMesh::merged`]); fewer than four
 //! distinct positions, or all of them in one plane, is an error ([`ProbeError`]): there is no
 //! lower-dimensional fallback.
+mod capture;
 mod delaunay;
 mod error;
 mod extrapolate;
@@ -16,12 +21,16 @@ mod input;
 mod lookup;
 mod predicates;
 mod rng;
+mod set;
 mod spatial_sort;
+pub mod technique;
 #[cfg(test)]
 mod tests;
 mod tetmesh;
 
+pub use capture::{CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE};
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
+pub use set::{is_static, ProbePlacement, ProbeSet, ProbeSettings, DEFAULT_GRID, MAX_GRID, MOVING_GROUP};
 pub use tetmesh::{Across, TetMesh};

@@ -1,0 +1,129 @@
+//! Light probes in use: the probes technique renders, and probe-interpolated irradiance in
+//! probe-room checked against the ray-cast ground truth with a bound derived per point.
+use glam::{Mat4, Vec3};
+use kage::reference::irradiance::Point;
+use kage::reference::IrradianceReference;
+use kage::renderer::{GpuScene, RenderOptions, Renderer, TechniqueChoice};
+use kage::scene::Scene;
+use kage::techniques::probes::{
+    is_static, CaptureSettings, CapturedLight, ProbeCapture, ProbePlacement, ProbeSet, ProbeSettings, Walker,
+    MOVING_GROUP,
+};
+use kage_tests::Validated;
+
+#[test]
+fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
+    let ctx = Validated::new();
+    let mut scene = Scene::builtin("probe-room").unwrap();
+    // Looking at the bunny side on, so that its left half faces the red wall (−X).
+    scene.camera.position = Vec3::new(0.0, 0.35, 1.2);
+    scene.camera.target = Vec3::new(0.0, 0.35, 0.0);
+    scene.camera.fov_y_deg = 45.0;
+    let probes = ProbeSettings {
+        placement: ProbePlacement::Grid([2, 2, 2]),
+        capture: CaptureSettings { cube_size: 8, light: CapturedLight::SkyAndWalls },
+    };
+    let options = RenderOptions { width: 48, height: 48, technique: TechniqueChoice::Probes(probes) };
+    let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
+    // Two frames, the first with the bunny near the green wall: the second frame's walk starts
+    // from the first's tetrahedron.
+    let rest = scene.groups[MOVING_GROUP].transform.matrix();
+    renderer.set_group_transform(MOVING_GROUP, Mat4::from_translation(Vec3::X) * rest).unwrap();
+    renderer.render().unwrap();
+    renderer.set_group_transform(MOVING_GROUP, rest).unwrap();
+    renderer.render().unwrap();
+    let image = renderer.image().unwrap();
+    let at = |x: u32, y: u32| image.pixels[(y * image.width + x) as usize];
+    // Left and right of the bunny's middle row: red over green on the left, the other way
+    // round on the right.
+    let (left, right) = (at(18, 30), at(30, 30));
+    assert!(left.iter().chain(&right).all(|v| v.is_finite()));
+    assert!(left[0] / left[1] > right[0] / right[1], "left {left:?} right {right:?}");
+}
+
+/// Points in probe-room, inside the probe grid's hull, each with a normal that sees the sky
+/// through the opening.
+const POINTS: [([f32; 3], [f32; 3]); 5] = [
+    ([0.0, 0.6, 0.0], [0.0, 1.0, 0.0]),
+    ([-0.9, 1.2, 0.4], [1.0, 0.0, 0.0]),
+    ([0.7, 0.9, -0.8], [0.0, 1.0, 0.0]),
+    ([0.3, 1.5, 0.9], [0.0, 0.6, -0.8]),
+    ([-0.5, 0.5, -0.5], [0.0, 0.0, 1.0]),
+];
+
+/// The largest error of the 9-coefficient clamped cosine: max over t of
+/// |max(t, 0) − (1/4 + t/2 + 5/32 (3t² − 1))| = 3/32, at t = 0.
+const KERNEL_ERROR: f32 = 3.0 / 32.0;
+
+#[test]
+fn interpolated_irradiance_matches_the_ray_cast_reference_within_its_derived_bound() {
+    let ctx = Validated::new();
+    let mut scene = Scene::builtin("probe-room").unwrap();
+    // The probes leave the moving bunny out; so does the reference, with the bunny moved under
+    // the floor.
+    scene.groups[MOVING_GROUP].transform.translation = Vec3::new(0.0, -50.0, 0.0);
+    let gpu = GpuScene::new(&ctx, &scene).unwrap();
+    // Sky only: the light paths the reference integrates (environment, full visibility).
+    let settings = ProbeSettings {
+        placement: ProbePlacement::Grid([3, 3, 3]),
+        capture: CaptureSettings { cube_size: 64, light: CapturedLight::Sky },
+    };
+    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings).unwrap();
+
+    let points: Vec<Point> = POINTS.iter().map(|&(position, normal)| Point { position, normal }).collect();
+    let mut reference = IrradianceReference::new(&ctx, &scene, &points, 7).unwrap();
+    // The sky through the small opening makes the estimator noisy: σ is about 10% of E here.
+    reference.run_batch(2048).unwrap();
+    let statistics = reference.statistics().unwrap();
+    let sigma = statistics.standard_error.unwrap();
+
+    // A probe captured at each point itself: its error is the capture's and the SH truncation's
+    // alone; the rest of the interpolated one's is the interpolation's.
+    let mut capture = ProbeCapture::new(&ctx, &scene, settings.capture).unwrap();
+    let mut walker = Walker::default();
+    for (i, point) in points.iter().enumerate() {
+        let (p, n) = (Vec3::from(point.position), Vec3::from(point.normal).normalize());
+        let location = walker.locate(&set.mesh, p.as_dvec3()).unwrap();
+        assert!(!location.extrapolated, "{p} is outside the probes' hull");
+        let interpolated = set.interpolate(&mut walker, p).unwrap().irradiance(n);
+        let direct_sh = capture.capture(&gpu, is_static, p).unwrap();
+        let direct = direct_sh.irradiance(n);
+        for k in 0..3 {
+            let exact = statistics.mean[i][k];
+            let noise = 4.0 * sigma[i][k];
+            // The probe at p: E = ∫ L k(n·ω) dω with k the clamped cosine, E₂ the same with k's
+            // 9-coefficient projection, so |E₂ − E| ≤ max|k − k₂| · ∫ L dω = 3/32 · 2√π · c₀;
+            // plus the reference's noise and 2% of E for the cube map's texels along the
+            // opening's edges and the environment's bilinear lookup (the reference takes the
+            // map's texels as constant).
+            let capture_bound =
+                KERNEL_ERROR * 2.0 * std::f32::consts::PI.sqrt() * direct_sh.c[0][k] + noise + 0.02 * exact;
+            let capture_error = (direct[k].max(0.0) - exact).abs();
+            // The interpolated SH's irradiance is the weighted mean of the four probes' (weights
+            // ≥ 0 adding to 1; E is linear in the SH), so before the clamp, which only brings a
+            // negative value nearer E ≥ 0, it lies between their smallest and largest:
+            // its error is at most the largest |E₂(pᵢ) − E(p)|, E(p) known to the noise.
+            let interpolation_bound = location
+                .probes
+                .iter()
+                .map(|&probe| (set.sh[probe as usize].irradiance(n)[k] - exact).abs())
+                .fold(0.0, f32::max)
+                + noise;
+            let error = (interpolated[k].max(0.0) - exact).abs();
+            eprintln!(
+                "point {i} channel {k}: reference {exact:.4} ± {:.4}; probe at the point {:.4} (error {capture_error:.4}, bound {capture_bound:.4}); interpolated {:.4} (error {error:.4}, bound {interpolation_bound:.4})",
+                sigma[i][k],
+                direct[k].max(0.0),
+                interpolated[k].max(0.0),
+            );
+            assert!(
+                capture_error <= capture_bound,
+                "point {i} channel {k}: capture error {capture_error} over {capture_bound}"
+            );
+            assert!(
+                error <= interpolation_bound,
+                "point {i} channel {k}: error {error} over {interpolation_bound}"
+            );
+        }
+    }
+}
