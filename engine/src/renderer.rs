@@ -11,6 +11,7 @@ use crate::techniques::env_sh::EnvSh;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
 use crate::techniques::prt::TransferSet;
+use crate::techniques::shadow_map::ShadowMap;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
@@ -148,6 +149,9 @@ pub enum TechniqueChoice {
     /// The paper's Fig. 3 baseline: `regions` environment regions (1 to 128) as directional
     /// lights with binary shadow maps of `shadow_map_size`² texels.
     ParallelLights { regions: usize, shadow_map_size: u32 },
+    /// The scene's point and spot lights with hard shadows from one conventional shadow map of
+    /// `size`² texels per light (the baseline of adaptive shadow maps).
+    ShadowMap { size: u32 },
 }
 
 /// What to render and how large.
@@ -191,6 +195,7 @@ impl Renderer {
             TechniqueChoice::ParallelLights { regions, shadow_map_size } => {
                 Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
             }
+            TechniqueChoice::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
         };
         Ok(Renderer {
             ctx: ctx.clone(),

@@ -53,4 +53,8 @@
 // every Vulkan device offers) and one shadow-map layer each.
 #define KAGE_MAX_PARALLEL_LIGHTS 128
 
+// Most point and spot lights the shadowmap technique shadows: one ShadowLight record each in a
+// uniform buffer and one shadow-map layer each.
+#define KAGE_MAX_LOCAL_LIGHTS 8
+
 #endif

@@ -23,6 +23,8 @@ pub enum TechniqueName {
     Tamura,
     /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
     ParallelLights,
+    /// The scene's point and spot lights, one conventional shadow map each (hard shadows).
+    Shadowmap,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,8 +47,8 @@ pub struct RenderArgs {
     /// Side of a Tamura occlusion mask layer, texels.
     #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
     mask_size: u32,
-    /// Side of a parallel-lights shadow map, texels.
-    #[arg(long, default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
+    /// Side of a shadow map, texels: parallel-lights 16 to 2048, shadowmap 16 to 8192.
+    #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
@@ -103,6 +105,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             TechniqueName::Sloan => TechniqueKind::Sloan,
             TechniqueName::Tamura => TechniqueKind::Tamura,
             TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
+            TechniqueName::Shadowmap => TechniqueKind::ShadowMap,
         },
         prt: args.prt.params()?,
         regions: args.regions,

@@ -23,6 +23,9 @@ pub enum kage_technique {
     Tamura = 2,
     /// Baseline: `regions` environment regions as directional lights with binary shadow maps.
     ParallelLights = 3,
+    /// The scene's point and spot lights with hard shadows from one conventional shadow map of
+    /// `shadow_map_size`² texels per light (1 to 8 lights).
+    ShadowMap = 4,
 }
 
 /// Width of Tamura's penumbrae (the values of `kage_technique_desc.penumbra`).
@@ -54,7 +57,8 @@ pub struct kage_technique_desc {
     pub mask_size: u32,
     /// A `kage_penumbra` value (Tamura); default fixed.
     pub penumbra: u32,
-    /// Side of a parallel-lights shadow map in texels; default 512.
+    /// Side of a shadow map in texels: parallel-lights 16 to 2048, shadowmap 16 to 8192;
+    /// default 512.
     pub shadow_map_size: u32,
 }
 
@@ -69,6 +73,7 @@ impl kage_technique_desc {
                 (T::Sloan as u32, TechniqueKind::Sloan),
                 (T::Tamura as u32, TechniqueKind::Tamura),
                 (T::ParallelLights as u32, TechniqueKind::ParallelLights),
+                (T::ShadowMap as u32, TechniqueKind::ShadowMap),
             ],
         )?;
         let penumbra = args::enumeration(

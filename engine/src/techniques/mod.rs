@@ -7,7 +7,10 @@ pub mod environment;
 pub mod parallel_lights;
 pub mod probes;
 pub mod prt;
+pub mod scene_pass;
 pub mod settings;
+pub mod shadow_depth;
+pub mod shadow_map;
 pub mod tamura;
 pub mod unshadowed;
 

@@ -19,6 +19,9 @@ pub enum TechniqueKind {
     Tamura,
     /// The paper's Fig. 3 baseline: q regions as directional lights with binary shadow maps.
     ParallelLights,
+    /// The scene's point and spot lights with hard shadows from one conventional shadow map
+    /// per light.
+    ShadowMap,
 }
 
 /// Every parameter of every technique; each technique reads the ones it uses.
@@ -32,7 +35,7 @@ pub struct TechniqueSettings {
     /// Side of a Tamura occlusion mask layer, texels.
     pub mask_size: u32,
     pub penumbra: Penumbra,
-    /// Side of a parallel-lights shadow map, texels.
+    /// Side of a shadow map (parallel-lights, shadowmap), texels.
     pub shadow_map_size: u32,
 }
 
@@ -102,6 +105,7 @@ impl TechniqueSettings {
                 regions: settings.regions,
                 shadow_map_size: settings.shadow_map_size,
             }),
+            TechniqueKind::ShadowMap => Ok(TechniqueChoice::ShadowMap { size: settings.shadow_map_size }),
         }
     }
 }
@@ -128,6 +132,8 @@ mod tests {
         assert!(matches!(tamura, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 4));
         let lights = of(TechniqueKind::ParallelLights).choice(None).unwrap();
         assert!(matches!(lights, TechniqueChoice::ParallelLights { regions: 4, .. }));
+        let map = TechniqueSettings { shadow_map_size: 2048, ..of(TechniqueKind::ShadowMap) };
+        assert!(matches!(map.choice(None), Ok(TechniqueChoice::ShadowMap { size: 2048 })));
         assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
         assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
     }

@@ -1,12 +1,10 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
+use super::scene_pass::{scene_pass, scene_pipeline};
 use super::{FrameInputs, FrameState, Technique};
-use crate::backend::{
-    vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
-};
+use crate::backend::{vk, Binding, BindingKind, Context, GraphicsPipeline, VertexAttribute, VertexBuffer};
 use crate::error::Result;
-use crate::layouts::{bytes_of, spirv, DrawPush};
+use crate::layouts::{spirv, DrawPush};
 use crate::pass::Pass;
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT};
 use std::sync::Arc;
 
 /// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
@@ -27,22 +25,12 @@ pub struct Unshadowed {
 
 impl Unshadowed {
     pub fn new(ctx: &Arc<Context>) -> Result<Unshadowed> {
-        let scene = GraphicsPipeline::new(
+        let scene = scene_pipeline(
             ctx,
-            &GraphicsDesc {
-                name: "scene_unshadowed",
-                vertex_spirv: spirv::SCENE_VERT,
-                fragment_spirv: spirv::SCENE_FRAG,
-                bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
-                push_size: size_of::<DrawPush>() as u32,
-                vertex_buffers: &[MESH_VERTICES],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                additive: false,
-                fragment_constants: &[],
-            },
+            "scene_unshadowed",
+            (spirv::SCENE_VERT, spirv::SCENE_FRAG),
+            &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
+            size_of::<DrawPush>(),
         )?;
         Ok(Unshadowed { scene })
     }
@@ -54,20 +42,16 @@ impl Technique for Unshadowed {
     }
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
-        let (ctx, uniforms, env_sh, scene, targets) =
-            (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
-        vec![Pass::new("scene", &["frame_uniforms", "env_sh", "color"], &["color", "depth"], move |cmd| {
-            ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(env_sh)]);
-            for mesh in &scene.meshes {
-                let push = DrawPush {
-                    model: scene.transforms[mesh.group].to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                };
-                self.scene.push(cmd, bytes_of(&push));
-                ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-            }
-            ctx.end_rendering(cmd);
-        })]
+        let bindings = vec![Binding::Uniform(inputs.uniforms), Binding::Uniform(inputs.env_sh)];
+        vec![scene_pass(
+            inputs,
+            &["frame_uniforms", "env_sh", "color"],
+            &self.scene,
+            bindings,
+            |mesh, model| DrawPush {
+                model: model.to_cols_array_2d(),
+                albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+            },
+        )]
     }
 }
