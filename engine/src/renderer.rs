@@ -230,6 +230,12 @@ impl Renderer {
         Ok(())
     }
 
+    /// Moves the camera (checked as a scene file's camera is).
+    pub fn set_camera(&mut self, camera: crate::scene::Camera) -> Result<()> {
+        self.camera = camera.validated()?;
+        Ok(())
+    }
+
     /// Moves a group (a rigid transform: rotation, translation, uniform scale).
     pub fn set_group_transform(&mut self, group: usize, transform: Mat4) -> Result<()> {
         let count = self.scene.transforms.len();

@@ -28,6 +28,7 @@ fn box_over_floor() -> Scene {
             fov_deg: FOV_DEG,
             intensity: [8.0; 3],
         }],
+        walkthrough: vec![],
         camera: Camera {
             position: Vec3::new(0.0, 2.5, 3.5),
             target: Vec3::ZERO,
@@ -131,4 +132,23 @@ fn needs_local_lights_and_a_map_size_in_range() {
     for size in [8, 16384] {
         assert!(attempt(&box_over_floor(), size).contains("shadow map size"), "{size}");
     }
+}
+
+/// The built-in `asm` scene renders through its walkthrough with no validation message, and a
+/// close-up of the grating's shadow shows it: most of the floor under the grating is lit, and
+/// a good part of it is in shadow.
+#[test]
+fn the_asm_walkthrough_renders_cleanly() {
+    let ctx = Validated::new();
+    let scene = Scene::builtin("asm").unwrap();
+    let options =
+        RenderOptions { width: 48, height: 48, technique: TechniqueChoice::ShadowMap { size: 1024 } };
+    let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
+    for t in [0.0, 0.2] {
+        renderer.set_camera(kage::scene::animation::camera_at(&scene.walkthrough, t).unwrap()).unwrap();
+        renderer.render().unwrap();
+    }
+    let image = renderer.image().unwrap();
+    let lit = image.pixels.iter().filter(|p| p[1] > 0.0).count() as f32 / image.pixels.len() as f32;
+    assert!((0.3..0.9).contains(&lit), "lit fraction of the grating close-up: {lit}");
 }

@@ -6,7 +6,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::Scene;
+use kage::scene::{animation, Scene};
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
@@ -53,12 +53,13 @@ pub struct RenderArgs {
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
-    /// Play the scripted motion of the scene's first group over the frames (see README).
+    /// Play the scene's camera walkthrough over the frames, or, for a scene without one, the
+    /// scripted motion of its first group (see README).
     #[arg(long)]
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, asm) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[arg(long, default_value_t = 512)]
@@ -144,9 +145,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut table = TimingTable::default();
     let mut dropped = 0;
     for frame in 0..args.frames {
-        if let (true, Some(group)) = (args.animate, scene.groups.first()) {
-            let t = frame as f32 / args.frames as f32;
-            renderer.set_group_transform(0, kage::scene::animation::pose(group, t).matrix())?;
+        let t = frame as f32 / args.frames as f32;
+        if let (true, Some(camera)) = (args.animate, animation::camera_at(&scene.walkthrough, t)) {
+            renderer.set_camera(camera)?;
+        } else if let (true, Some(group)) = (args.animate, scene.groups.first()) {
+            renderer.set_group_transform(0, animation::pose(group, t).matrix())?;
         }
         table.add_frame(&renderer.render()?);
         dropped = dropped.max(renderer.dropped_layers());
