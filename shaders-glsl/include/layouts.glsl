@@ -219,4 +219,12 @@ struct LocalDrawPush {
     vec4 bias; // x: constant depth bias, y: slope-scaled depth bias (both in texels at the receiver's depth), z: the largest slope (tangent) the bias follows, w: unused
 };
 
+// A node of the adaptive shadow map's page table: one resident tile of the quadtree over the
+// light's view. Node 0 is the root; the lookup descends into the child holding the point while
+// it is resident and uses the last node's page (engine/src/techniques/asm/page_table.rs).
+struct AsmNode {
+    uvec4 children; // node index of the child in quadrant 2 * (y & 1) + (x & 1); 0: not resident
+    uvec4 tile; // x: physical page (layer of the tile array), y: level, z, w: tile x, y at that level
+};
+
 #endif

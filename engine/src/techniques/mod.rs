@@ -1,6 +1,7 @@
 //! Lighting techniques, each built from passes. `environment`, `env_sh` and `background` are
 //! shared by all of them: the environment map on the GPU, its SH projection, and the pass that
 //! shows it behind the scene.
+pub mod asm;
 pub mod background;
 pub mod env_sh;
 pub mod environment;
