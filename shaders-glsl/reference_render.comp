@@ -9,6 +9,7 @@
 #include "layouts.glsl"
 #include "bvh.glsl"
 #include "reference.glsl"
+#include "local_light.glsl"
 
 layout(local_size_x = KAGE_REFERENCE_GROUP, local_size_y = KAGE_REFERENCE_GROUP) in;
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 4, std430) readonly buffer Lights {
@@ -16,24 +17,18 @@ layout(set = 0, binding = KAGE_BVH_BINDINGS + 4, std430) readonly buffer Lights 
 };
 layout(push_constant) uniform Push { ReferencePush p; };
 
-// Radiant intensity I over squared distance, no attenuation beyond inverse square; spot lights
-// are hard-edged cones (full intensity inside, none outside).
+// Point and spot lights (local_light.glsl), one shadow ray each.
 vec3 local_lighting(SurfacePoint s) {
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
     vec3 sum = vec3(0.0);
     for (uint k = 0u; k < p.params.y; ++k) {
         ReferenceLight light = lights[k];
-        vec3 to_light = light.position.xyz - s.position;
-        float d2 = dot(to_light, to_light);
-        if (d2 <= 0.0) continue;
-        vec3 l = to_light * inversesqrt(d2);
-        float cos_n = dot(s.shading_normal, l);
-        if (cos_n <= 0.0 || dot(s.geometric_normal, l) <= 0.0) continue;
-        if (light.position.w > 0.5 && dot(-l, light.direction.xyz) < light.direction.w) continue;
+        vec3 e = local_light_unshadowed(light, s.position, s.shading_normal, s.geometric_normal);
+        if (all(equal(e, vec3(0.0)))) continue;
         vec3 to_light_from_origin = light.position.xyz - origin;
         float tmax = length(to_light_from_origin);
         if (bvh_occluded(origin, to_light_from_origin / tmax, tmax)) continue;
-        sum += light.intensity.rgb * (cos_n / d2);
+        sum += e;
     }
     return s.albedo / REFERENCE_PI * sum;
 }

@@ -116,6 +116,11 @@ enum kage_technique
    * groups are lit as by `Unshadowed`.
    */
   KAGE_TECHNIQUE_PROBES = 4,
+  /**
+   * The scene's point and spot lights with hard shadows from one conventional shadow map of
+   * `shadow_map_size`² texels per light (1 to 8 lights).
+   */
+  KAGE_TECHNIQUE_SHADOW_MAP = 5,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -277,7 +282,8 @@ typedef struct {
    */
   uint32_t penumbra;
   /**
-   * Side of a parallel-lights shadow map in texels; default 512.
+   * Side of a shadow map in texels: parallel-lights 16 to 2048, shadowmap 16 to 8192;
+   * default 512.
    */
   uint32_t shadow_map_size;
   /**

@@ -13,6 +13,7 @@ use crate::techniques::probes::technique::ProbeTechnique;
 use crate::techniques::probes::ProbeSettings;
 use crate::techniques::prt::TransferSet;
 use crate::techniques::sh_projection::ShProjection;
+use crate::techniques::shadow_map::ShadowMap;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
@@ -153,6 +154,9 @@ pub enum TechniqueChoice {
     /// Light probes captured when the renderer is built light the moving group; the static
     /// groups are lit as by `Unshadowed`.
     Probes(ProbeSettings),
+    /// The scene's point and spot lights with hard shadows from one conventional shadow map of
+    /// `size`² texels per light (the baseline of adaptive shadow maps).
+    ShadowMap { size: u32 },
 }
 
 /// What to render and how large.
@@ -197,6 +201,7 @@ impl Renderer {
                 Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
             }
             TechniqueChoice::Probes(settings) => Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings)?),
+            TechniqueChoice::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
         };
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -228,6 +233,12 @@ impl Renderer {
             return Err(Error::InvalidArgument(format!("environment rotation {radians} is not finite")));
         }
         self.env_rotation = radians;
+        Ok(())
+    }
+
+    /// Moves the camera (checked as a scene file's camera is).
+    pub fn set_camera(&mut self, camera: crate::scene::Camera) -> Result<()> {
+        self.camera = camera.validated()?;
         Ok(())
     }
 

@@ -58,4 +58,14 @@
 // every Vulkan device offers) and one shadow-map layer each.
 #define KAGE_MAX_PARALLEL_LIGHTS 128
 
+// Most point and spot lights the shadowmap technique shadows: one ShadowLight record each in a
+// uniform buffer and one shadow-map layer each.
+#define KAGE_MAX_LOCAL_LIGHTS 8
+
+// Adaptive shadow maps: texels per side of a tile (one page of the pool, 64 KiB of D32).
+#define KAGE_ASM_TILE_TEXELS 128
+// The deepest quadtree level: 2^16 tiles per side, an effective 8,388,608² map (the paper
+// reports the equivalent of 524,288²).
+#define KAGE_ASM_MAX_LEVEL 16
+
 #endif

@@ -196,10 +196,11 @@ struct ParallelLight {
     vec4 energy; // rgb: B_i, a: unused
 };
 
-// Push constants of the parallel-lights shadow-map pass: one draw per mesh per light.
-struct ParallelShadowPush {
+// Push constants of the depth-only shadow-map pass (parallel lights and local lights): one draw
+// per mesh per map. 128 bytes, the push-constant size every Vulkan device offers.
+struct ShadowDepthPush {
     mat4 model;
-    uvec4 light; // x: light (shadow-map layer) index, y, z, w: unused
+    mat4 view_proj; // world to the map's clip space (depth 0 to 1)
 };
 
 // Push constants of the parallel-lights scene pass: one draw per mesh.
@@ -208,6 +209,30 @@ struct ParallelDrawPush {
     vec4 albedo; // rgb: diffuse albedo, a: unused
     uvec4 params; // x: light count, y: shadow-map side in texels, z, w: unused
     vec4 shadow; // x: slope-scaled normal offset (world units, times the sine of the light's angle to the normal), y: constant normal offset (world units), z: depth bias (light depth units), w: unused
+};
+
+// A point or spot light of the shadowmap technique with its conventional shadow map (one
+// layer of a D32 array image), in the reference's conventions (ReferenceLight).
+struct ShadowLight {
+    mat4 view_proj; // world to the map's perspective clip space (depth 0 to 1)
+    ReferenceLight light;
+    vec4 map; // x: near, y: far plane of the map's projection (world units), z: world size of a texel at unit depth, w: unused
+};
+
+// Push constants of the shadowmap technique's scene pass: one draw per mesh.
+struct LocalDrawPush {
+    mat4 model;
+    vec4 albedo; // rgb: diffuse albedo, a: unused
+    uvec4 params; // x: light count, y, z, w: unused
+    vec4 bias; // x: constant depth bias, y: slope-scaled depth bias (both in texels at the receiver's depth), z: the largest slope (tangent) the bias follows, w: unused
+};
+
+// A node of the adaptive shadow map's page table: one resident tile of the quadtree over the
+// light's view. Node 0 is the root; the lookup descends into the child holding the point while
+// it is resident and uses the last node's page (engine/src/techniques/asm/page_table.rs).
+struct AsmNode {
+    uvec4 children; // node index of the child in quadrant 2 * (y & 1) + (x & 1); 0: not resident
+    uvec4 tile; // x: physical page (layer of the tile array), y: level, z, w: tile x, y at that level
 };
 
 #endif

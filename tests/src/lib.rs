@@ -46,6 +46,7 @@ pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Sce
         groups: vec![Group { name: "object".into(), meshes: vec![mesh], transform: Transform::default() }],
         environment,
         lights: vec![],
+        walkthrough: vec![],
         camera,
     }
 }

@@ -53,6 +53,7 @@ fn scene(groups: Vec<Group>) -> Scene {
         groups,
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![],
+        walkthrough: vec![],
         camera: Camera {
             position: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

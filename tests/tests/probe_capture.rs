@@ -19,6 +19,7 @@ fn constant_environment_with_no_walls_captures_its_own_sh() {
         groups: vec![],
         environment: EnvMap::constant(radiance),
         lights: vec![],
+        walkthrough: vec![],
         camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
     };
     let gpu = GpuScene::new(&ctx, &scene).unwrap();

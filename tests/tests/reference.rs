@@ -113,6 +113,7 @@ fn tilted_planes_under_a_real_map_match_cpu_integration() {
             groups: vec![group("plane", plane(4.0), transform)],
             environment: map.clone(),
             lights: vec![],
+            walkthrough: vec![],
             camera: Camera { position: 2.0 * n, target: Vec3::ZERO, up, fov_y_deg: 40.0 },
         };
         let stats = render(&ctx, &scene, 16, LightMode::Environment, 10 + k as u32, 256);
@@ -180,6 +181,7 @@ fn a_blocker_darkens_the_floor_by_its_form_factor() {
         ],
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![],
+        walkthrough: vec![],
         camera: side_camera(),
     };
     let size = 33;
@@ -203,6 +205,7 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
         // Ignored in local mode: the environment contributes nothing.
         environment: EnvMap::constant([1.0; 3]),
         lights,
+        walkthrough: vec![],
         camera: side_camera(),
     };
     let size = 33;
@@ -242,6 +245,7 @@ fn spot_light_lights_only_inside_its_cone() {
             groups: vec![group("floor", plane(20.0), Transform::default())],
             environment: EnvMap::constant([1.0; 3]),
             lights: vec![spot(direction).validated().unwrap()],
+            walkthrough: vec![],
             camera: side_camera(),
         };
         let stats = render(&ctx, &scene, size, LightMode::Local, 0, 1);

@@ -277,27 +277,31 @@ fn built_in_scenes_are_listed_and_unknown_names_rejected() {
 }
 
 #[test]
-fn exported_teapot_reads_back_identical() {
-    let dir = temp_dir("export");
-    let scene = Scene::builtin("teapot").unwrap();
-    let floor = scene.groups.iter().find(|g| g.name == "floor").unwrap();
+fn exported_builtins_read_back_identical() {
+    let teapot = Scene::builtin("teapot").unwrap();
+    let floor = teapot.groups.iter().find(|g| g.name == "floor").unwrap();
     assert_eq!(floor.meshes[0].vertex_count(), 31 * 31);
-    scene.export(&dir).unwrap();
-    let back = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
-    // Field by field first, so a failure says what differs; then everything at once.
-    assert_eq!(back.name, scene.name);
-    assert_eq!(back.camera, scene.camera);
-    assert_eq!(back.lights, scene.lights);
-    for (a, b) in back.groups.iter().zip(&scene.groups) {
-        assert_eq!((&a.name, a.transform), (&b.name, b.transform));
-        for (m, n) in a.meshes.iter().zip(&b.meshes) {
-            assert_eq!(m.name, n.name);
-            assert_eq!(m.albedo, n.albedo);
-            assert!(m.positions == n.positions, "positions of {} differ", m.name);
-            assert!(m.normals == n.normals, "normals of {} differ", m.name);
-            assert!(m.indices == n.indices, "indices of {} differ", m.name);
+    // The asm scene adds box meshes, a spot light and a camera walkthrough.
+    for scene in [teapot, Scene::builtin("asm").unwrap()] {
+        let dir = temp_dir(&format!("export-{}", scene.name));
+        scene.export(&dir).unwrap();
+        let back = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
+        // Field by field first, so a failure says what differs; then everything at once.
+        assert_eq!(back.name, scene.name);
+        assert_eq!(back.camera, scene.camera);
+        assert_eq!(back.lights, scene.lights);
+        assert_eq!(back.walkthrough, scene.walkthrough);
+        for (a, b) in back.groups.iter().zip(&scene.groups) {
+            assert_eq!((&a.name, a.transform), (&b.name, b.transform));
+            for (m, n) in a.meshes.iter().zip(&b.meshes) {
+                assert_eq!(m.name, n.name);
+                assert_eq!(m.albedo, n.albedo);
+                assert!(m.positions == n.positions, "positions of {} differ", m.name);
+                assert!(m.normals == n.normals, "normals of {} differ", m.name);
+                assert!(m.indices == n.indices, "indices of {} differ", m.name);
+            }
         }
+        assert!(back.environment == scene.environment, "environment pixels differ");
+        assert!(back == scene);
     }
-    assert!(back.environment == scene.environment, "environment pixels differ");
-    assert!(back == scene);
 }

@@ -202,6 +202,7 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
         groups: spheres.into_iter().chain([floor.clone()]).collect(),
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![],
+        walkthrough: vec![],
         camera: base.camera,
     };
     let lower = sphere_group("lower", radius, Vec3::new(0.0, low, 0.0));

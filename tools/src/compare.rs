@@ -1,7 +1,7 @@
 //! `kage compare A.exr B.exr`: error metrics of image A against the reference B.
 use anyhow::{Context as _, Result};
 use clap::Args;
-use kage::reference::{compare, diff_image};
+use kage::reference::{compare, diff_image, shadow_mismatch, SHADOW_THRESHOLD};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -14,6 +14,14 @@ pub struct CompareArgs {
     /// yellow at the 99th percentile of those errors).
     #[arg(long)]
     diff: Option<PathBuf>,
+    /// Also print the fraction of pixels lit in one image and shadowed in the other (for
+    /// local-light renders against `kage reference --light local`).
+    #[arg(long)]
+    shadow_mismatch: bool,
+    /// With --shadow-mismatch: a pixel is lit when its luminance exceeds this fraction of B's
+    /// brightest pixel.
+    #[arg(long, default_value_t = SHADOW_THRESHOLD)]
+    shadow_threshold: f64,
 }
 
 pub fn run(args: &CompareArgs) -> Result<()> {
@@ -33,6 +41,14 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     println!("mean abs error   {:.6e}", m.mean_abs_error);
     println!("p99 abs error    {:.6e}", m.p99_abs_error);
     println!("max abs error    {:.6e}", m.max_abs_error);
+    if args.shadow_mismatch {
+        let relative = args.shadow_threshold;
+        let s = shadow_mismatch(&a, &b, relative)?;
+        println!(
+            "shadow mismatch  {:.6e}   ({} pixels lit in one image only, {} of them lit in A only; lit above {:.3e} = {relative} x B's brightest)",
+            s.fraction, s.differing, s.lit_in_render_only, s.threshold
+        );
+    }
     if let Some(path) = &args.diff {
         let diff = diff_image(&a, &b)?;
         diff.write_png(path)?;

@@ -6,7 +6,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::Scene;
+use kage::scene::{animation, Scene};
 use kage::techniques::probes::{CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings};
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
@@ -24,6 +24,8 @@ pub enum TechniqueName {
     Tamura,
     /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
     ParallelLights,
+    /// The scene's point and spot lights, one conventional shadow map each (hard shadows).
+    Shadowmap,
     /// Morishige 2014: light probes captured as SH light the moving group (the first).
     Probes,
 }
@@ -56,8 +58,8 @@ pub struct RenderArgs {
     /// Side of a Tamura occlusion mask layer, texels.
     #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
     mask_size: u32,
-    /// Side of a parallel-lights shadow map, texels.
-    #[arg(long, default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
+    /// Side of a shadow map, texels: parallel-lights 16 to 2048, shadowmap 16 to 8192.
+    #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each) or a file {"positions": [[x,y,z], ...]}.
@@ -72,12 +74,13 @@ pub struct RenderArgs {
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
-    /// Play the scripted motion of the scene's first group over the frames (see README).
+    /// Play the scene's camera walkthrough over the frames, or, for a scene without one, the
+    /// scripted motion of its first group (see README).
     #[arg(long)]
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[arg(long, default_value_t = 512)]
@@ -125,6 +128,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             TechniqueName::Tamura => TechniqueKind::Tamura,
             TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
             TechniqueName::Probes => TechniqueKind::Probes,
+            TechniqueName::Shadowmap => TechniqueKind::ShadowMap,
         },
         prt: args.prt.params()?,
         regions: args.regions,
@@ -177,9 +181,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut table = TimingTable::default();
     let mut dropped = 0;
     for frame in 0..args.frames {
-        if let (true, Some(group)) = (args.animate, scene.groups.first()) {
-            let t = frame as f32 / args.frames as f32;
-            renderer.set_group_transform(0, kage::scene::animation::pose(group, t).matrix())?;
+        let t = frame as f32 / args.frames as f32;
+        if let (true, Some(camera)) = (args.animate, animation::camera_at(&scene.walkthrough, t)) {
+            renderer.set_camera(camera)?;
+        } else if let (true, Some(group)) = (args.animate, scene.groups.first()) {
+            renderer.set_group_transform(0, animation::pose(group, t).matrix())?;
         }
         table.add_frame(&renderer.render()?);
         dropped = dropped.max(renderer.dropped_layers());

@@ -91,6 +91,49 @@ fn sh_prints_coefficients_and_irradiance() {
 
 /// Each command fails with exit code 1 and a `kage: error:` line containing the expected text,
 /// without a panic.
+/// The conventional shadow map of the `asm` scene against the local-light reference through
+/// the CLI: render, reference and `compare --shadow-mismatch`; the teapot (no local light) is a
+/// clear error for the technique.
+#[test]
+fn shadowmap_against_the_local_reference_reports_the_mismatch() {
+    let dir = scratch_dir("cli-shadowmap");
+    let (map, truth) = (dir.join("sm.exr"), dir.join("ref.exr"));
+    let size = ["--scene", "asm", "--width", "48", "--height", "48", "--validate"];
+    let out = kage(
+        &[
+            &["render", "--technique", "shadowmap", "--shadowmap-size", "1024"],
+            &size[..],
+            &["--out", map.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let out = kage(
+        &[&["reference", "--light", "local", "--spp", "1"], &size[..], &["--out", truth.to_str().unwrap()]]
+            .concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let out = kage(&["compare", map.to_str().unwrap(), truth.to_str().unwrap(), "--shadow-mismatch"]);
+    let all = text(&out);
+    let line = all.lines().find(|l| l.starts_with("shadow mismatch")).unwrap_or_else(|| panic!("{all}"));
+    let fraction: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!((0.0..0.05).contains(&fraction), "{line}");
+    assert_clear_errors(&[
+        (&["render", "--technique", "shadowmap", "--width", "8", "--height", "8"], "point or spot lights"),
+        (
+            &[
+                "compare",
+                map.to_str().unwrap(),
+                truth.to_str().unwrap(),
+                "--shadow-mismatch",
+                "--shadow-threshold",
+                "2",
+            ],
+            "between 0 and 1",
+        ),
+    ]);
+}
+
 fn assert_clear_errors(cases: &[(&[&str], &str)]) {
     for &(args, expected) in cases {
         let out = kage(args);

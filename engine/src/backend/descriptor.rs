@@ -67,6 +67,11 @@ pub fn push_descriptors(
     bindings: &[Binding],
 ) {
     debug_assert_eq!(expected, bindings.iter().map(Binding::kind).collect::<Vec<_>>().as_slice());
+    // A push with no writes is invalid (descriptorWriteCount must be at least 1): pipelines
+    // without resources, such as the depth-only shadow pass, push nothing.
+    if bindings.is_empty() {
+        return;
+    }
     let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
         .iter()
         .map(|b| match b {

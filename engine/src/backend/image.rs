@@ -21,6 +21,19 @@ pub struct ImageDesc<'a> {
     pub usage: vk::ImageUsageFlags,
 }
 
+impl<'a> ImageDesc<'a> {
+    /// `layers` square layers of `size`² texels, viewed as a 2D array (shadow maps, masks).
+    pub fn square_array(
+        name: &'a str,
+        size: u32,
+        layers: u32,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> ImageDesc<'a> {
+        ImageDesc { name, width: size, height: size, layers, array: true, format, usage }
+    }
+}
+
 pub struct Image {
     ctx: Arc<Context>,
     pub(crate) raw: vk::Image,

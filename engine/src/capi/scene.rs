@@ -163,7 +163,14 @@ unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
     let environment = EnvMap::from_pixels(env.width, env.height, pixels.to_vec()).map_err(invalid)?;
     let c = &desc.camera;
     let camera = Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg).map_err(invalid)?;
-    Ok(Scene { name: "host".into(), groups, environment, lights: Vec::new(), camera })
+    Ok(Scene {
+        name: "host".into(),
+        groups,
+        environment,
+        lights: Vec::new(),
+        camera,
+        walkthrough: Vec::new(),
+    })
 }
 
 /// # Safety

@@ -30,6 +30,9 @@ pub enum kage_technique {
     /// when the renderer is created, light the scene's first group (the moving one); the other
     /// groups are lit as by `Unshadowed`.
     Probes = 4,
+    /// The scene's point and spot lights with hard shadows from one conventional shadow map of
+    /// `shadow_map_size`² texels per light (1 to 8 lights).
+    ShadowMap = 5,
 }
 
 /// What the light probes capture (the values of `kage_technique_desc.probe_light`).
@@ -72,7 +75,8 @@ pub struct kage_technique_desc {
     pub mask_size: u32,
     /// A `kage_penumbra` value (Tamura); default fixed.
     pub penumbra: u32,
-    /// Side of a parallel-lights shadow map in texels; default 512.
+    /// Side of a shadow map in texels: parallel-lights 16 to 2048, shadowmap 16 to 8192;
+    /// default 512.
     pub shadow_map_size: u32,
     /// Light probes along X, Y and Z, 2 to 64 each, at the cell centres of that grid over the
     /// static groups' bounding box; default 3, 2, 3.
@@ -94,6 +98,7 @@ impl kage_technique_desc {
                 (T::Sloan as u32, TechniqueKind::Sloan),
                 (T::Tamura as u32, TechniqueKind::Tamura),
                 (T::ParallelLights as u32, TechniqueKind::ParallelLights),
+                (T::ShadowMap as u32, TechniqueKind::ShadowMap),
                 (T::Probes as u32, TechniqueKind::Probes),
             ],
         )?;

@@ -220,6 +220,7 @@ mod tests {
             groups: vec![sphere("a", -2.0), sphere("b", 2.0)],
             environment: EnvMap::constant([1.0; 3]),
             lights: vec![],
+            walkthrough: vec![],
             camera: Camera { position: Vec3::Z * 5.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
         }
     }

@@ -71,6 +71,57 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[rank.clamp(1, sorted.len()) - 1]
 }
 
+/// How many pixels a render shadows differently from the reference (`kage reference --light
+/// local`): a pixel counts as lit when its luminance exceeds `threshold` × the reference's
+/// largest luminance, else as shadowed. Meant for renders by local lights alone (the shadowmap
+/// and ASM techniques) against the local-light reference: there a shadowed pixel is exactly
+/// black, so any positive threshold far below the smallest lit value separates the two states.
+/// With several lights "lit" means "receives direct light from at least one".
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ShadowMismatch {
+    /// `differing` / all pixels.
+    pub fraction: f64,
+    /// Pixels lit in one image and shadowed in the other.
+    pub differing: usize,
+    /// Of those, pixels the render lights and the reference shadows (light leaks).
+    pub lit_in_render_only: usize,
+    /// The luminance that separates lit from shadowed.
+    pub threshold: f64,
+}
+
+/// Default relative threshold of [`shadow_mismatch`]: 10⁻⁴ of the brightest reference pixel
+/// (a lit point at 100 times the brightest point's distance, or at grazing light, still counts).
+pub const SHADOW_THRESHOLD: f64 = 1e-4;
+
+/// The lit/shadowed disagreement of `a` against the reference `b`; `relative_threshold` in
+/// (0, 1) (see [`ShadowMismatch`]).
+pub fn shadow_mismatch(
+    a: &RgbaF32Image,
+    b: &RgbaF32Image,
+    relative_threshold: f64,
+) -> Result<ShadowMismatch> {
+    check_sizes(a, b)?;
+    if !(relative_threshold > 0.0 && relative_threshold < 1.0) {
+        return Err(Error::InvalidArgument(format!(
+            "shadow threshold {relative_threshold} must be between 0 and 1 (a fraction of the reference's brightest pixel)"
+        )));
+    }
+    let y = |p: &[f32; 4]| f64::from(luminance([p[0], p[1], p[2]]));
+    let threshold = relative_threshold * b.pixels.iter().map(y).fold(0.0, f64::max);
+    let (mut differing, mut lit_in_render_only) = (0, 0);
+    for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
+        let (lit_a, lit_b) = (y(pa) > threshold, y(pb) > threshold);
+        differing += usize::from(lit_a != lit_b);
+        lit_in_render_only += usize::from(lit_a && !lit_b);
+    }
+    Ok(ShadowMismatch {
+        fraction: differing as f64 / a.pixels.len() as f64,
+        differing,
+        lit_in_render_only,
+        threshold,
+    })
+}
+
 /// The false-colour difference picture: per pixel |Y(a) − Y(b)| (luminance), divided by
 /// `scale` and mapped through viridis (dark blue 0 → yellow at `scale` and above).
 pub struct DiffImage {
@@ -159,6 +210,26 @@ mod tests {
         assert_eq!(m.max_abs_error, 3.0);
         let same = compare(&b, &b).unwrap();
         assert_eq!((same.rmse, same.relative_rmse, same.max_abs_error), (0.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn shadow_mismatch_counts_pixels_whose_lit_state_differs() {
+        // Reference: brightest 2.0, so the threshold at 0.25 is 0.5; lit pixels 1, 2 and 3.
+        let reference = image(4, 2, &[0.0, 2.0, 0.6, 0.9, 0.0, 0.0, 0.4, 0.0]);
+        // Pixel 0 leaks light, pixel 2 is shadowed wrongly, pixel 6 stays under the threshold.
+        let render = image(4, 2, &[0.7, 1.5, 0.0, 0.9, 0.0, 0.0, 0.5, 0.0]);
+        let m = shadow_mismatch(&render, &reference, 0.25).unwrap();
+        assert_eq!(m.threshold, 0.5);
+        assert_eq!((m.differing, m.lit_in_render_only), (2, 1));
+        assert_eq!(m.fraction, 0.25);
+        // Any two images that agree on every pixel's state, whatever the values, match.
+        let brighter = image(4, 2, &[0.0, 4.0, 3.0, 2.0, 0.0, 0.0, 0.1, 0.0]);
+        assert_eq!(shadow_mismatch(&brighter, &reference, 0.25).unwrap().differing, 0);
+        for bad in [0.0, 1.0, -1.0, f64::NAN] {
+            let err = shadow_mismatch(&render, &reference, bad).unwrap_err().to_string();
+            assert!(err.contains("between 0 and 1"), "{bad}: {err}");
+        }
+        assert!(shadow_mismatch(&image(2, 1, &[0.0; 2]), &reference, 0.25).is_err());
     }
 
     #[test]

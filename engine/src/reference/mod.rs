@@ -6,7 +6,8 @@
 //! - [`irradiance`]: E(p, n) at listed points, for light probes;
 //! - [`env_sampling`]: the environment map's 2D sampling distribution;
 //! - [`statistics`]: the mean and standard error per pixel or point;
-//! - [`metrics`]: error metrics between images, and a false-colour difference picture.
+//! - [`metrics`]: error metrics between images, the fraction of pixels shadowed differently,
+//!   and a false-colour difference picture.
 //!
 //! Estimator (shaders-glsl/include/reference.glsl): per sample, one direction drawn from the
 //! environment distribution and one cosine-weighted, each with one shadow ray, combined by the
@@ -20,7 +21,7 @@ pub mod render;
 pub mod statistics;
 
 pub use irradiance::{IrradianceFile, IrradianceReference, PointsFile};
-pub use metrics::{compare, diff_image, ImageMetrics};
+pub use metrics::{compare, diff_image, shadow_mismatch, ImageMetrics, ShadowMismatch, SHADOW_THRESHOLD};
 pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
 pub use statistics::Statistics;
 

@@ -148,7 +148,7 @@ impl ReferenceRenderer {
 /// Light units: `intensity` is radiant intensity (W/sr per channel); the irradiance at distance
 /// d is I cos θ / d² (inverse square, nothing else); a spot light is a hard-edged cone of full
 /// angle `fov_deg`.
-fn reference_light(light: &Light) -> ReferenceLight {
+pub(crate) fn reference_light(light: &Light) -> ReferenceLight {
     match *light {
         Light::Point { position, intensity } => ReferenceLight {
             position: position.extend(0.0).to_array(),

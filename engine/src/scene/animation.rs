@@ -1,8 +1,11 @@
-//! The scripted motion of `kage render --animate`: the scene's first group slides across the
-//! floor and back, spinning about +Y and hopping. At t = 0 and t = 0.5 it rests in its scene
-//! pose (for the teapot: standing on the floor, the contact case of the soft-shadow method);
-//! in between it rises by up to 40% of its height.
-use super::{Group, Transform};
+//! The scripted motion of `kage render --animate`, one of two kinds:
+//! - a scene with a walkthrough ([`super::Scene::walkthrough`]) moves its camera through the
+//!   keyframes ([`camera_at`]) and leaves its groups where they are;
+//! - otherwise the scene's first group slides across the floor and back, spinning about +Y and
+//!   hopping ([`pose`]). At t = 0 and t = 0.5 it rests in its scene pose (for the teapot:
+//!   standing on the floor, the contact case of the soft-shadow method); in between it rises by
+//!   up to 40% of its height.
+use super::{Camera, Group, Transform};
 use glam::{Quat, Vec3};
 use std::f32::consts::TAU;
 
@@ -30,6 +33,28 @@ fn height(group: &Group) -> f32 {
     }
 }
 
+/// The camera at time `t` of one cycle through `keys` (`t` wraps): each keyframe gets an equal
+/// share of the cycle, moving to the next (the last back to the first) with smoothstep easing,
+/// so the camera slows to rest at every keyframe (the close-ups stay in view for a while).
+/// Position, target, up and field of view are interpolated linearly; `None` without keys.
+pub fn camera_at(keys: &[Camera], t: f32) -> Option<Camera> {
+    let n = keys.len();
+    let first = keys.first()?;
+    let x = t.rem_euclid(1.0) * n as f32;
+    let k = (x.floor() as usize).min(n - 1);
+    let (a, b) = (&keys[k], &keys[(k + 1) % n]);
+    let f = x - k as f32;
+    let s = f * f * (3.0 - 2.0 * f);
+    let up = a.up.lerp(b.up, s);
+    Some(Camera {
+        position: a.position.lerp(b.position, s),
+        target: a.target.lerp(b.target, s),
+        // Opposite up vectors would cancel half-way; keyframes never have them, but stay defined.
+        up: if up.length_squared() > 1e-12 { up } else { first.up },
+        fov_y_deg: a.fov_y_deg + (b.fov_y_deg - a.fov_y_deg) * s,
+    })
+}
+
 fn motion(base: &Transform, height: f32, t: f32) -> Transform {
     let t = t.rem_euclid(1.0);
     let phase = TAU * t;
@@ -41,6 +66,27 @@ fn motion(base: &Transform, height: f32, t: f32) -> Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_walkthrough_rests_at_each_keyframe_and_wraps() {
+        let key = |x: f32, fov| Camera {
+            position: Vec3::new(x, 1.0, 5.0),
+            target: Vec3::new(x, 0.0, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: fov,
+        };
+        let keys = [key(0.0, 40.0), key(2.0, 20.0), key(-2.0, 60.0)];
+        assert_eq!(camera_at(&keys, 0.0), Some(keys[0]));
+        assert_eq!(camera_at(&keys, 1.0 / 3.0), Some(keys[1]));
+        assert_eq!(camera_at(&keys, 1.0), Some(keys[0]));
+        // Half-way from the last key back to the first.
+        let back = camera_at(&keys, 5.0 / 6.0).unwrap();
+        assert!((back.position.x + 1.0).abs() < 1e-5 && (back.fov_y_deg - 50.0).abs() < 1e-4);
+        // Eased: a little after a keyframe the camera has moved much less than linearly.
+        let early = camera_at(&keys, 0.05).unwrap();
+        assert!(early.position.x > 0.0 && early.position.x < 0.5 * 2.0 * 0.15);
+        assert_eq!(camera_at(&[], 0.5), None);
+    }
 
     #[test]
     fn rests_at_the_start_and_half_way_and_is_periodic() {

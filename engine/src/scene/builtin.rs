@@ -1,5 +1,6 @@
 //! Scenes compiled into the library, so that Kage renders something with no file on disk.
-//! Their assets live in `engine/assets/` (licences in `engine/assets/LICENSES.md`).
+//! Their assets live in `engine/assets/` (licences in `engine/assets/LICENSES.md`): copies of
+//! the shared reference assets, embedded so the library needs no file at run time.
 use glam::Vec3;
 
 use super::{obj, probe_room, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
@@ -11,7 +12,7 @@ const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
 const TEAPOT_HEIGHT: f32 = 15.75;
 
 /// Names accepted by [`Scene::builtin`]; the first is the default.
-pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room"];
+pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room", "asm"];
 
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     if name == "probe-room" {
@@ -22,6 +23,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     let floor_vertices = match name {
         "teapot" => 31,
         "teapot-hires-floor" => 111,
+        "asm" => return super::asm_room::asm_scene(),
         _ => {
             return Err(SceneError::invalid(format!(
                 "no built-in scene \"{name}\"; the built-in scenes are: {}",
@@ -48,6 +50,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         ],
         environment,
         lights: Vec::new(),
+        walkthrough: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 2.2, 4.2),
             target: Vec3::new(0.0, 0.4, 0.0),
@@ -71,6 +74,7 @@ fn probe_room_scene(name: &str) -> Result<Scene, SceneError> {
         groups: probe_room::groups().map_err(context)?,
         environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
         lights: Vec::new(),
+        walkthrough: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 1.4, 1.9),
             target: Vec3::new(0.0, 0.5, 0.0),

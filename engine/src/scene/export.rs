@@ -6,7 +6,7 @@ use std::path::Path;
 use super::file::{
     CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, PointDesc, SceneFile, SpotDesc,
 };
-use super::{obj, Light, Scene, SceneError};
+use super::{obj, Camera, Light, Scene, SceneError};
 
 pub const SCENE_FILE: &str = "scene.json";
 pub const ENVIRONMENT_FILE: &str = "environment.exr";
@@ -43,18 +43,19 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
         });
     }
 
-    let c = &scene.camera;
+    let camera = |c: &Camera| CameraDesc {
+        position: c.position.to_array(),
+        target: c.target.to_array(),
+        up: c.up.to_array(),
+        fov_y_deg: c.fov_y_deg,
+    };
     let file = SceneFile {
         name: Some(scene.name.clone()),
-        camera: CameraDesc {
-            position: c.position.to_array(),
-            target: c.target.to_array(),
-            up: c.up.to_array(),
-            fov_y_deg: c.fov_y_deg,
-        },
+        camera: camera(&scene.camera),
         environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
         groups,
         lights: scene.lights.iter().map(light).collect(),
+        walkthrough: scene.walkthrough.iter().map(camera).collect(),
     };
     let path = dir.join(SCENE_FILE);
     let json = serde_json::to_string_pretty(&file)

@@ -22,6 +22,8 @@
 //! - A mesh is exactly one of `obj`, `plane` (in XZ, normal +Y, `vertices` = grid vertex counts
 //!   along X and Z) or `sphere`; `name` defaults to the OBJ's file stem or the shape's kind.
 //! - `name` defaults to the scene file's stem; `camera.up` defaults to +Y; `lights` defaults to none.
+//! - `walkthrough` (optional): cameras, in the form of `camera`, that `kage render --animate`
+//!   visits in order.
 //! - Relative paths are relative to the folder of the scene file.
 use serde::{Deserialize, Serialize};
 
@@ -35,6 +37,8 @@ pub struct SceneFile {
     pub groups: Vec<GroupDesc>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<LightDesc>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub walkthrough: Vec<CameraDesc>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]

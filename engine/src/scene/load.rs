@@ -20,8 +20,15 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 
 /// Assembles a scene from its description; `folder` anchors the relative paths in it.
 fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
-    let c = &file.camera;
-    let camera = Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg)?;
+    let camera_of =
+        |c: &super::file::CameraDesc| Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg);
+    let camera = camera_of(&file.camera)?;
+    let walkthrough = file
+        .walkthrough
+        .iter()
+        .enumerate()
+        .map(|(at, c)| camera_of(c).map_err(|e| e.within(&format!("walkthrough camera {at}"))))
+        .collect::<Result<_, _>>()?;
     let environment = environment(&file.environment, folder)?;
     if file.groups.is_empty() {
         return Err(SceneError::invalid("it has no groups"));
@@ -41,7 +48,7 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .enumerate()
         .map(|(at, l)| light(l).map_err(|e| e.within(&format!("light {at}"))))
         .collect::<Result<_, _>>()?;
-    Ok(Scene { name, groups, environment, lights, camera })
+    Ok(Scene { name, groups, environment, lights, camera, walkthrough })
 }
 
 fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneError> {

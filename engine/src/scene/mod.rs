@@ -19,6 +19,7 @@
 use std::path::Path;
 
 pub mod animation;
+mod asm_room;
 mod builtin;
 mod camera;
 pub mod envmap;
@@ -50,6 +51,9 @@ pub struct Scene {
     pub environment: EnvMap,
     pub lights: Vec<Light>,
     pub camera: Camera,
+    /// Camera keyframes of the scripted walkthrough (`kage render --animate`), visited in order
+    /// and back to the first; empty for a scene without one (see [`animation::camera_at`]).
+    pub walkthrough: Vec<Camera>,
 }
 
 /// Meshes that move together.

@@ -1,4 +1,5 @@
-//! Generated meshes: a floor grid and a UV sphere, counter-clockwise seen from outside.
+//! Generated meshes: a floor grid, a UV sphere and sets of boxes, counter-clockwise seen from
+//! outside.
 use std::f32::consts::{PI, TAU};
 
 use glam::Vec3;
@@ -89,6 +90,47 @@ pub fn sphere(name: &str, radius: f32, segments: u32, albedo: [f32; 3]) -> Resul
     Mesh::new(name, positions, Some(normals), indices, albedo)
 }
 
+/// Most boxes one [`boxes`] mesh may hold (24 vertices each).
+pub const MAX_BOXES: usize = 65_536;
+
+/// Axis-aligned boxes, each given by its minimum and maximum corner, as one mesh with flat
+/// faces (4 vertices per face, so edges stay sharp): lattices and rods built from bars.
+pub fn boxes(name: &str, corners: &[([f32; 3], [f32; 3])], albedo: [f32; 3]) -> Result<Mesh, SceneError> {
+    if !(1..=MAX_BOXES).contains(&corners.len()) {
+        return Err(SceneError::invalid(format!(
+            "a box mesh holds 1 to {MAX_BOXES} boxes, got {}",
+            corners.len()
+        )));
+    }
+    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    for &(lo, hi) in corners {
+        let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+        if !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
+            return Err(SceneError::invalid(format!(
+                "box from {lo} to {hi}: the corners must be finite, the first below the second on every axis"
+            )));
+        }
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                // The face's normal n and two in-plane axes u, v with u × v = n, so the
+                // corners taken in (u, v) order turn counter-clockwise seen from outside.
+                let n = sign * Vec3::AXES[axis];
+                let u = Vec3::AXES[(axis + 1) % 3];
+                let v = n.cross(u);
+                let centre = 0.5 * (lo + hi) + n * 0.5 * (hi - lo);
+                let half = 0.5 * (hi - lo);
+                let first = positions.len() as u32;
+                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    positions.push((centre + a * u * half + b * v * half).to_array());
+                    normals.push(n.to_array());
+                }
+                indices.extend([first, first + 1, first + 2, first, first + 2, first + 3]);
+            }
+        }
+    }
+    Mesh::new(name, positions, Some(normals), indices, albedo)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -131,7 +173,25 @@ mod tests {
     }
 
     #[test]
+    fn boxes_are_closed_and_face_outwards() {
+        let mesh = boxes("bars", &[([0.0; 3], [1.0, 2.0, 3.0]), ([-1.0; 3], [-0.5; 3])], [0.5; 3]).unwrap();
+        assert_eq!((mesh.vertex_count(), mesh.triangle_count()), (48, 24));
+        assert_ccw_along_normals(&mesh);
+        // The first box's corners are exactly its extremes, its faces' normals point away.
+        let first = &mesh.positions[..24];
+        let max = first.iter().fold([f32::MIN; 3], |m, p| std::array::from_fn(|k| m[k].max(p[k])));
+        assert_eq!(max, [1.0, 2.0, 3.0]);
+        for (p, n) in mesh.positions.iter().zip(&mesh.normals).take(24) {
+            let centre = Vec3::new(0.5, 1.0, 1.5);
+            assert!((Vec3::from(*p) - centre).dot(Vec3::from(*n)) > 0.0);
+        }
+    }
+
+    #[test]
     fn bad_shapes_are_rejected() {
+        assert!(boxes("b", &[], [0.5; 3]).is_err());
+        assert!(boxes("b", &[([0.0; 3], [1.0, 0.0, 1.0])], [0.5; 3]).is_err());
+        assert!(boxes("b", &[([f32::NAN; 3], [1.0; 3])], [0.5; 3]).is_err());
         assert!(plane("p", [0.0, 1.0], [2, 2], [0.5; 3]).is_err());
         assert!(plane("p", [1.0, 1.0], [1, 2], [0.5; 3]).is_err());
         assert!(sphere("s", -1.0, 8, [0.5; 3]).is_err());

@@ -1,13 +1,17 @@
 //! Lighting techniques, each built from passes. `environment`, `sh_projection` and `background` are
 //! shared by all of them: the environment map on the GPU, its SH projection, and the pass that
 //! shows it behind the scene.
+pub mod asm;
 pub mod background;
 pub mod environment;
 pub mod parallel_lights;
 pub mod probes;
 pub mod prt;
+pub mod scene_pass;
 pub mod settings;
 pub mod sh_projection;
+pub mod shadow_depth;
+pub mod shadow_map;
 pub mod tamura;
 pub mod unshadowed;
 

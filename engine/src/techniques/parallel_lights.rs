@@ -6,7 +6,8 @@
 //! figure compares against.
 //!
 //! Passes: `shadow_maps` renders every mesh into layer i of a D32 array image (one depth-only
-//! rendering scope per region, orthographic along ω_i over the scene's bounding sphere), then
+//! rendering scope per region, orthographic along ω_i over the scene's bounding sphere, with
+//! the [`ShadowDepth`] pass shared with the shadowmap technique), then
 //! `scene` loops over the regions in one fragment shader, reading the lights from a uniform
 //! buffer (much cheaper per fragment than a storage buffer on CPU drivers) and the maps with
 //! `texelFetch` and a manual comparison.
@@ -18,21 +19,18 @@
 //! moves the lookup off the surface by a distance tied to the map's texel size. It also keeps
 //! `GraphicsDesc` free of a setting only this baseline would use. A small constant depth bias
 //! covers curved surfaces, where the texel's depth varies inside the texel.
+use super::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use super::shadow_depth::ShadowMaps;
 use super::tamura::occlusion::{group_bounds, GroupBounds};
 use super::tamura::regions::Regions;
 use super::tamura::self_shadow::env_rotation;
-use super::unshadowed::{MESH_POSITIONS, MESH_VERTICES};
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsDesc, GraphicsPipeline, Image,
-    ImageDesc, MemoryLocation, Sampler, Target,
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
-use crate::layouts::{
-    bytes_of, bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight, ParallelShadowPush,
-};
+use crate::layouts::{bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight};
 use crate::pass::Pass;
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::scene::Scene;
 use glam::{Mat4, Vec3};
 use std::sync::Arc;
@@ -53,15 +51,11 @@ pub struct ParallelLights {
     regions: Regions,
     bounds: Vec<GroupBounds>,
     size: u32,
-    shadow_pipeline: GraphicsPipeline,
+    /// One map per region.
+    shadow_maps: ShadowMaps,
     scene_pipeline: GraphicsPipeline,
-    /// One D32 layer per region.
-    shadow_maps: Image,
-    nearest: Sampler,
     /// `ParallelLight` per region, `MAX_PARALLEL_LIGHTS` records (the shader's array size).
     lights: Buffer,
-    /// Lights (regions), one shadow-map layer each.
-    count: u32,
     /// World size of a shadow-map texel and of the light depth range this frame.
     texel: f32,
     depth_range: f32,
@@ -85,55 +79,12 @@ impl ParallelLights {
             )));
         }
         let regions = Regions::new(&scene.environment, q)?;
-        let shadow_pipeline = GraphicsPipeline::new(
+        let scene_pipeline = scene_pipeline(
             ctx,
-            &GraphicsDesc {
-                name: "parallel_shadow",
-                vertex_spirv: spirv::PARALLEL_SHADOW_VERT,
-                fragment_spirv: spirv::PARALLEL_SHADOW_FRAG,
-                bindings: &[BindingKind::UniformBuffer],
-                push_size: size_of::<ParallelShadowPush>() as u32,
-                vertex_buffers: &[MESH_POSITIONS],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                additive: false,
-                fragment_constants: &[],
-            },
-        )?;
-        let scene_pipeline = GraphicsPipeline::new(
-            ctx,
-            &GraphicsDesc {
-                name: "scene_parallel_lights",
-                vertex_spirv: spirv::PARALLEL_LIGHTS_VERT,
-                fragment_spirv: spirv::PARALLEL_LIGHTS_FRAG,
-                bindings: &[
-                    BindingKind::UniformBuffer,
-                    BindingKind::UniformBuffer,
-                    BindingKind::SampledImage,
-                ],
-                push_size: size_of::<ParallelDrawPush>() as u32,
-                vertex_buffers: &[MESH_VERTICES],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                additive: false,
-                fragment_constants: &[],
-            },
-        )?;
-        let shadow_maps = Image::new(
-            ctx,
-            &ImageDesc {
-                name: "parallel_lights.shadow_maps",
-                width: shadow_map_size,
-                height: shadow_map_size,
-                layers: q as u32,
-                array: true,
-                format: DEPTH_FORMAT,
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
-            },
+            "scene_parallel_lights",
+            (spirv::PARALLEL_LIGHTS_VERT, spirv::PARALLEL_LIGHTS_FRAG),
+            &[BindingKind::UniformBuffer, BindingKind::UniformBuffer, BindingKind::SampledImage],
+            size_of::<ParallelDrawPush>(),
         )?;
         let lights = Buffer::new(
             ctx,
@@ -148,12 +99,9 @@ impl ParallelLights {
             regions,
             bounds: group_bounds(scene),
             size: shadow_map_size,
-            shadow_pipeline,
+            shadow_maps: ShadowMaps::new(ctx, "parallel_lights", shadow_map_size, q as u32)?,
             scene_pipeline,
-            shadow_maps,
-            nearest: Sampler::new(ctx, "parallel_lights.sampler", false, Edge::Clamp, Edge::Clamp)?,
             lights,
-            count: q as u32,
             texel: 0.0,
             depth_range: 1.0,
         })
@@ -167,7 +115,7 @@ impl ParallelLights {
 
 /// The smallest sphere around the groups' bounding spheres that this simple construction finds
 /// (centred on their box): each map covers all of it, so every group casts into every map.
-fn scene_sphere(bounds: &[GroupBounds], transforms: &[Mat4]) -> (Vec3, f32) {
+pub(super) fn scene_sphere(bounds: &[GroupBounds], transforms: &[Mat4]) -> (Vec3, f32) {
     let spheres: Vec<(Vec3, f32)> = bounds
         .iter()
         .zip(transforms)
@@ -193,10 +141,12 @@ impl Technique for ParallelLights {
             Mat4::orthographic_rh(-radius, radius, -radius, radius, -margin, 2.0 * radius + margin);
         let env = env_rotation(state.env_rotation);
         let mut lights = Vec::with_capacity(self.regions.regions.len());
+        self.shadow_maps.view_projs.clear();
         for region in &self.regions.regions {
             let w = (env * region.direction.as_vec3()).normalize();
             let up = if w.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
             let view_proj = projection * Mat4::look_at_rh(centre + radius * w, centre, up);
+            self.shadow_maps.view_projs.push(view_proj);
             lights.push(ParallelLight {
                 view_proj: view_proj.to_cols_array_2d(),
                 direction: w.extend(0.0).to_array(),
@@ -209,57 +159,28 @@ impl Technique for ParallelLights {
     }
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
-        let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
-        let shadow_maps = Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
-            for layer in 0..self.count {
-                let target = Target { image: &self.shadow_maps, layer };
-                ctx.begin_rendering(cmd, None, None, Some(target));
-                self.shadow_pipeline.bind(cmd, &[Binding::Uniform(&self.lights)]);
-                for mesh in &scene.meshes {
-                    let push = ParallelShadowPush {
-                        model: scene.transforms[mesh.group].to_cols_array_2d(),
-                        light: [layer, 0, 0, 0],
-                    };
-                    self.shadow_pipeline.push(cmd, bytes_of(&push));
-                    ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-                }
-                ctx.end_rendering(cmd);
-            }
-        });
+        let shadow_maps = self.shadow_maps.pass(inputs.ctx, inputs.scene);
         let shadow = [
             SLOPE_OFFSET_TEXELS * self.texel,
             CONSTANT_OFFSET_TEXELS * self.texel,
             DEPTH_BIAS_TEXELS * self.texel / self.depth_range,
             0.0,
         ];
-        let count = self.count;
-        let scene_pass = Pass::new(
-            "scene",
-            &["frame_uniforms", "shadow_maps", "color"],
-            &["color", "depth"],
-            move |cmd| {
-                ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-                self.scene_pipeline.bind(
-                    cmd,
-                    &[
-                        Binding::Uniform(uniforms),
-                        Binding::Uniform(&self.lights),
-                        Binding::Sampled(&self.shadow_maps, &self.nearest),
-                    ],
-                );
-                for mesh in &scene.meshes {
-                    let push = ParallelDrawPush {
-                        model: scene.transforms[mesh.group].to_cols_array_2d(),
-                        albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                        params: [count, self.size, 0, 0],
-                        shadow,
-                    };
-                    self.scene_pipeline.push(cmd, bytes_of(&push));
-                    ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        let (count, size) = (self.shadow_maps.view_projs.len() as u32, self.size);
+        let bindings = vec![
+            Binding::Uniform(inputs.uniforms),
+            Binding::Uniform(&self.lights),
+            self.shadow_maps.binding(),
+        ];
+        let scene_pass =
+            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
+                ParallelDrawPush {
+                    model: model.to_cols_array_2d(),
+                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                    params: [count, size, 0, 0],
+                    shadow,
                 }
-                ctx.end_rendering(cmd);
-            },
-        );
+            });
         vec![shadow_maps, scene_pass]
     }
 }

@@ -22,6 +22,9 @@ pub enum TechniqueKind {
     ParallelLights,
     /// Morishige 2014: light probes captured as SH light the moving group (group 0).
     Probes,
+    /// The scene's point and spot lights with hard shadows from one conventional shadow map
+    /// per light.
+    ShadowMap,
 }
 
 /// Every parameter of every technique; each technique reads the ones it uses.
@@ -35,7 +38,7 @@ pub struct TechniqueSettings {
     /// Side of a Tamura occlusion mask layer, texels.
     pub mask_size: u32,
     pub penumbra: Penumbra,
-    /// Side of a parallel-lights shadow map, texels.
+    /// Side of a shadow map (parallel-lights, shadowmap), texels.
     pub shadow_map_size: u32,
     /// Placement and capture of the light probes.
     pub probes: ProbeSettings,
@@ -112,6 +115,7 @@ impl TechniqueSettings {
                 shadow_map_size: settings.shadow_map_size,
             }),
             TechniqueKind::Probes => Ok(TechniqueChoice::Probes(settings.probes)),
+            TechniqueKind::ShadowMap => Ok(TechniqueChoice::ShadowMap { size: settings.shadow_map_size }),
         }
     }
 }
@@ -138,6 +142,8 @@ mod tests {
         assert!(matches!(tamura, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 4));
         let lights = of(TechniqueKind::ParallelLights).choice(None).unwrap();
         assert!(matches!(lights, TechniqueChoice::ParallelLights { regions: 4, .. }));
+        let map = TechniqueSettings { shadow_map_size: 2048, ..of(TechniqueKind::ShadowMap) };
+        assert!(matches!(map.choice(None), Ok(TechniqueChoice::ShadowMap { size: 2048 })));
         assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
         assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
         assert!(matches!(of(TechniqueKind::Probes).choice(None), Ok(TechniqueChoice::Probes(_))));

@@ -1,12 +1,13 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
+use super::scene_pass;
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, Context, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, Context, GraphicsPipeline, VertexAttribute, VertexBuffer,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, DrawPush};
 use crate::pass::Pass;
-use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene};
 use std::sync::Arc;
 
 /// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
@@ -34,22 +35,13 @@ impl Unshadowed {
 /// A pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
 /// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1) and a `DrawPush`.
 pub fn scene_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> Result<GraphicsPipeline> {
-    GraphicsPipeline::new(
+    let bindings = [BindingKind::UniformBuffer, BindingKind::UniformBuffer];
+    scene_pass::scene_pipeline(
         ctx,
-        &GraphicsDesc {
-            name,
-            vertex_spirv: spirv::SCENE_VERT,
-            fragment_spirv,
-            bindings: &[BindingKind::UniformBuffer, BindingKind::UniformBuffer],
-            push_size: size_of::<DrawPush>() as u32,
-            vertex_buffers: &[MESH_VERTICES],
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            color_formats: &[COLOR_FORMAT],
-            depth_format: Some(DEPTH_FORMAT),
-            depth_test: true,
-            additive: false,
-            fragment_constants: &[],
-        },
+        name,
+        (spirv::SCENE_VERT, fragment_spirv),
+        &bindings,
+        size_of::<DrawPush>(),
     )
 }
 

@@ -125,15 +125,7 @@ fn layered(
 ) -> Result<Image> {
     Image::new(
         ctx,
-        &ImageDesc {
-            name,
-            width: size,
-            height: size,
-            layers,
-            array: true,
-            format: MASK_FORMAT,
-            usage: usage | vk::ImageUsageFlags::STORAGE,
-        },
+        &ImageDesc::square_array(name, size, layers, MASK_FORMAT, usage | vk::ImageUsageFlags::STORAGE),
     )
 }
 

@@ -1,0 +1,93 @@
+//! What every shadow-map technique keeps and records first: a D32 array of square maps, one
+//! layer per light, each rendered depth-only with every mesh of the scene from that light's
+//! view, and read back with nearest-texel lookups. Shared by the parallel-lights baseline
+//! (orthographic maps) and the shadowmap technique (perspective maps of local lights).
+use super::unshadowed::MESH_POSITIONS;
+use crate::backend::{
+    vk, Binding, Context, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, Target,
+};
+use crate::error::Result;
+use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
+use crate::pass::Pass;
+use crate::renderer::{GpuScene, DEPTH_FORMAT};
+use glam::Mat4;
+use std::sync::Arc;
+
+pub struct ShadowMaps {
+    pipeline: GraphicsPipeline,
+    /// One layer per light.
+    maps: Image,
+    nearest: Sampler,
+    /// World to clip space of each layer's light this frame (set by the technique's update).
+    pub view_projs: Vec<Mat4>,
+}
+
+impl ShadowMaps {
+    /// `layers` maps of `size`² texels; `name` prefixes the debug names of its objects.
+    pub fn new(ctx: &Arc<Context>, name: &str, size: u32, layers: u32) -> Result<ShadowMaps> {
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: &format!("{name}.depth"),
+                vertex_spirv: spirv::SHADOW_DEPTH_VERT,
+                fragment_spirv: spirv::SHADOW_DEPTH_FRAG,
+                bindings: &[],
+                push_size: size_of::<ShadowDepthPush>() as u32,
+                vertex_buffers: &[MESH_POSITIONS],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                additive: false,
+                fragment_constants: &[],
+            },
+        )?;
+        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let maps_name = format!("{name}.maps");
+        let desc = ImageDesc::square_array(&maps_name, size, layers, DEPTH_FORMAT, usage);
+        Ok(ShadowMaps {
+            pipeline,
+            maps: Image::new(ctx, &desc)?,
+            nearest: Sampler::new(ctx, &format!("{name}.sampler"), false, Edge::Clamp, Edge::Clamp)?,
+            view_projs: Vec::new(),
+        })
+    }
+
+    /// The maps as a scene shader samples them (`sampler2DArray`, nearest texel).
+    pub fn binding(&self) -> Binding<'_> {
+        Binding::Sampled(&self.maps, &self.nearest)
+    }
+
+    /// The `shadow_maps` pass: layer i from `view_projs[i]`.
+    pub fn pass<'a>(&'a self, ctx: &'a Context, scene: &'a GpuScene) -> Pass<'a> {
+        Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
+            for (layer, view_proj) in self.view_projs.iter().enumerate() {
+                let target = Target { image: &self.maps, layer: layer as u32 };
+                self.record(ctx, cmd, scene, target, view_proj);
+            }
+        })
+    }
+
+    /// Records one rendering scope that clears `target` and draws every mesh of `scene` with
+    /// `view_proj` (world to the map's clip space).
+    fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        target: Target,
+        view_proj: &Mat4,
+    ) {
+        ctx.begin_rendering(cmd, None, None, Some(target));
+        self.pipeline.bind(cmd, &[]);
+        for mesh in &scene.meshes {
+            let push = ShadowDepthPush {
+                model: scene.transforms[mesh.group].to_cols_array_2d(),
+                view_proj: view_proj.to_cols_array_2d(),
+            };
+            self.pipeline.push(cmd, bytes_of(&push));
+            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        }
+        ctx.end_rendering(cmd);
+    }
+}

@@ -1,0 +1,163 @@
+//! The conventional shadow map for the scene's point and spot lights (the baseline of Adaptive
+//! Shadow Maps, ../shared/papers/README.md section 2): one perspective depth map per light, hard
+//! shadows, lit exactly as `kage reference --light local` (shaders-glsl/include/local_light.glsl)
+//! so that the two compare pixel by pixel.
+//!
+//! Each light's map is a perspective view from the light:
+//! - a spot light's map looks along its axis with the cone's full angle as field of view: the
+//!   cone is inscribed in the square map, so every point the spot lights has a texel;
+//! - a point light has no axis: like the paper's point light (a 122° field of view on the
+//!   ceiling), its map looks down −Y with [`POINT_LIGHT_FOV_DEG`]. Points outside that view are
+//!   lit without a shadow test (a single perspective map cannot cover a whole sphere; a cube
+//!   map would be the next step if a scene needed it).
+//!
+//! Near and far planes hug the scene's bounding sphere, so the D32 depth keeps its precision
+//! where the geometry is. The lookup compares view depths (the stored depth linearized) with a
+//! slope-scaled bias in texels of the receiver's depth: a surface at angle θ to the light spans
+//! a depth of tan θ per unit of width inside a texel, so the bias grows with tan θ (capped:
+//! grazing surfaces would otherwise detach their shadows entirely).
+use super::parallel_lights::scene_sphere;
+use super::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use super::shadow_depth::ShadowMaps;
+use super::tamura::occlusion::{group_bounds, GroupBounds};
+use super::{FrameInputs, FrameState, Technique};
+use crate::backend::{
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, GraphicsPipeline, MemoryLocation,
+};
+use crate::error::{Error, Result};
+use crate::layouts::{bytes_of_slice, constants, spirv, LocalDrawPush, ShadowLight};
+use crate::pass::Pass;
+use crate::reference::render::reference_light;
+use crate::renderer::MAX_SIZE;
+use crate::scene::{Light, Scene};
+use glam::{Mat4, Vec3};
+use std::sync::Arc;
+
+/// Shadow-map sides accepted, texels: up to the largest image Kage renders.
+pub const SHADOW_MAP_SIZES: std::ops::RangeInclusive<u32> = 16..=MAX_SIZE;
+/// The field of view of a point light's single map, looking down −Y (the paper's light).
+pub const POINT_LIGHT_FOV_DEG: f32 = 122.0;
+
+/// Depth bias at any slope, in texels of the receiver's depth: half a texel covers the
+/// nearest-texel lookup's offset from the texel centre on a surface facing the light.
+const CONSTANT_BIAS_TEXELS: f32 = 0.5;
+/// Depth bias per unit of tan θ, in texels: the depth a tilted surface spans across the
+/// distance (at most √½ texel) from the lookup point to the texel centre, with some margin.
+const SLOPE_BIAS_TEXELS: f32 = 1.0;
+/// tan θ beyond which the bias stops growing (θ ≈ 84°).
+const MAX_SLOPE: f32 = 10.0;
+
+pub struct ShadowMap {
+    lights: Vec<Light>,
+    bounds: Vec<GroupBounds>,
+    size: u32,
+    /// One map per light.
+    shadow_maps: ShadowMaps,
+    scene_pipeline: GraphicsPipeline,
+    /// `ShadowLight` per light, `MAX_LOCAL_LIGHTS` records (the shader's array size).
+    records: Buffer,
+}
+
+impl ShadowMap {
+    /// Maps of `size`² texels for each of the scene's local lights (1 to `MAX_LOCAL_LIGHTS`).
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, size: u32) -> Result<ShadowMap> {
+        let max = constants::MAX_LOCAL_LIGHTS as usize;
+        if !(1..=max).contains(&scene.lights.len()) {
+            return Err(Error::InvalidArgument(format!(
+                "the shadowmap technique shadows 1 to {max} point or spot lights; scene {} has {}",
+                scene.name,
+                scene.lights.len()
+            )));
+        }
+        if !SHADOW_MAP_SIZES.contains(&size) {
+            return Err(Error::InvalidArgument(format!(
+                "shadow map size {size} must be {} to {} texels",
+                SHADOW_MAP_SIZES.start(),
+                SHADOW_MAP_SIZES.end()
+            )));
+        }
+        let scene_pipeline = scene_pipeline(
+            ctx,
+            "scene_local_lights",
+            (spirv::LOCAL_LIGHTS_VERT, spirv::LOCAL_LIGHTS_FRAG),
+            &[BindingKind::UniformBuffer, BindingKind::UniformBuffer, BindingKind::SampledImage],
+            size_of::<LocalDrawPush>(),
+        )?;
+        let records = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "shadow_map.lights",
+                size: (max * size_of::<ShadowLight>()) as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        Ok(ShadowMap {
+            lights: scene.lights.clone(),
+            bounds: group_bounds(scene),
+            size,
+            shadow_maps: ShadowMaps::new(ctx, "shadow_map", size, scene.lights.len() as u32)?,
+            scene_pipeline,
+            records,
+        })
+    }
+}
+
+/// A light's map: its position, axis and full field of view in degrees.
+fn map_view(light: &Light) -> (Vec3, Vec3, f32) {
+    match *light {
+        Light::Point { position, .. } => (position, Vec3::NEG_Y, POINT_LIGHT_FOV_DEG),
+        Light::Spot { position, direction, fov_deg, .. } => (position, direction.normalize(), fov_deg),
+    }
+}
+
+/// The record of one light for this frame's scene sphere (`centre`, `radius`): the map's
+/// view-projection with near and far planes around the sphere.
+fn shadow_light(light: &Light, centre: Vec3, radius: f32, size: u32) -> ShadowLight {
+    let (position, axis, fov_deg) = map_view(light);
+    let distance = position.distance(centre);
+    // A light inside the sphere still gets a near plane in front of it: 1/1000 of the scene
+    // keeps the D32 depth's view-depth error well below a texel's bias at every distance.
+    let near = (distance - radius).max(1e-3 * radius);
+    let far = distance + radius;
+    let up = if axis.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+    let fov = fov_deg.to_radians();
+    let view_proj =
+        Mat4::perspective_rh(fov, 1.0, near, far) * Mat4::look_at_rh(position, position + axis, up);
+    ShadowLight {
+        view_proj: view_proj.to_cols_array_2d(),
+        light: reference_light(light),
+        map: [near, far, 2.0 * (0.5 * fov).tan() / size as f32, 0.0],
+    }
+}
+
+impl Technique for ShadowMap {
+    fn update(&mut self, state: &FrameState) -> Result<()> {
+        let (centre, radius) = scene_sphere(&self.bounds, state.transforms);
+        let records: Vec<ShadowLight> =
+            self.lights.iter().map(|l| shadow_light(l, centre, radius, self.size)).collect();
+        self.shadow_maps.view_projs =
+            records.iter().map(|r| Mat4::from_cols_array_2d(&r.view_proj)).collect();
+        self.records.write(0, bytes_of_slice(&records))
+    }
+
+    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        let shadow_maps = self.shadow_maps.pass(inputs.ctx, inputs.scene);
+        let count = self.shadow_maps.view_projs.len() as u32;
+        let bindings = vec![
+            Binding::Uniform(inputs.uniforms),
+            Binding::Uniform(&self.records),
+            self.shadow_maps.binding(),
+        ];
+        let scene_pass =
+            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
+                LocalDrawPush {
+                    model: model.to_cols_array_2d(),
+                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                    params: [count, 0, 0, 0],
+                    bias: [CONSTANT_BIAS_TEXELS, SLOPE_BIAS_TEXELS, MAX_SLOPE, 0.0],
+                }
+            });
+        vec![shadow_maps, scene_pass]
+    }
+}

@@ -1,0 +1,154 @@
+//! The shadowmap technique (the conventional baseline of adaptive shadow maps) against the
+//! ray-traced local-light reference, pixel by pixel.
+use glam::Vec3;
+use kage::reference::{shadow_mismatch, LightMode, ReferenceOptions, ReferenceRenderer, SHADOW_THRESHOLD};
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::scene::{shapes, Camera, EnvMap, Group, Light, Scene, Transform};
+use kage_tests::Validated;
+
+const SIZE: u32 = 128;
+/// The spot light's cone, degrees: also its map's field of view.
+const FOV_DEG: f32 = 90.0;
+const LIGHT: Vec3 = Vec3::new(0.3, 3.0, 0.2);
+
+/// A box (1 × 0.5 × 1, floating 0.5 above the floor) over a 6 × 6 floor, one spot light straight
+/// down from 3 above the floor, no environment light (the reference's local mode has none).
+fn box_over_floor() -> Scene {
+    let cube = shapes::boxes("box", &[([-0.5, 0.5, -0.5], [0.5, 1.0, 0.5])], [0.8; 3]).unwrap();
+    let floor = shapes::plane("floor", [6.0, 6.0], [2, 2], [0.6; 3]).unwrap();
+    let group =
+        |name: &str, mesh| Group { name: name.into(), meshes: vec![mesh], transform: Transform::default() };
+    Scene {
+        name: "box-over-floor".into(),
+        groups: vec![group("box", cube), group("floor", floor)],
+        environment: EnvMap::constant([0.0; 3]),
+        lights: vec![Light::Spot {
+            position: LIGHT,
+            direction: Vec3::NEG_Y,
+            fov_deg: FOV_DEG,
+            intensity: [8.0; 3],
+        }],
+        walkthrough: vec![],
+        camera: Camera {
+            position: Vec3::new(0.0, 2.5, 3.5),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 45.0,
+        },
+    }
+}
+
+fn render(ctx: &Validated, scene: &Scene, technique: TechniqueChoice) -> kage::imageio::RgbaF32Image {
+    let mut r = Renderer::new(ctx, scene, &RenderOptions { width: SIZE, height: SIZE, technique }).unwrap();
+    r.render().unwrap();
+    r.image().unwrap()
+}
+
+fn reference(ctx: &Validated, scene: &Scene) -> kage::imageio::RgbaF32Image {
+    let options = ReferenceOptions { width: SIZE, height: SIZE, light: LightMode::Local, seed: 1 };
+    let mut r = ReferenceRenderer::new(ctx, scene, &options).unwrap();
+    r.run_batch(1).unwrap();
+    r.image().unwrap()
+}
+
+/// Pixels of the reference whose lit state differs from a 4-neighbour's: the boundaries
+/// between lit and unlit (shadow edges, and where surfaces turn away from the light).
+fn boundary_pixels(image: &kage::imageio::RgbaF32Image, threshold: f64) -> usize {
+    let lit = |x: u32, y: u32| f64::from(image.pixels[(y * image.width + x) as usize][1]) > threshold;
+    let (w, h) = (image.width, image.height);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let n = [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)];
+            n.iter().any(|&(i, j)| i < w && j < h && lit(i, j) != lit(x, y))
+        })
+        .count()
+}
+
+/// The bound on misclassified pixels, derived from the map's texel size: the nearest-texel
+/// lookup places a shadow edge at most half a texel diagonal (√½ texel) away from where the
+/// ray-traced edge lies. On the floor, at view depth d below the light, a texel spans
+/// d · 2 tan(fov/2) / S in world units (the floor faces the light: no stretching); seen from
+/// the camera at distance D with a vertical field of view φ over H pixels, a floor segment
+/// spans at most its length / (D · 2 tan(φ/2) / H) pixels. So every misclassified pixel lies
+/// within t = √½ · texel / pixel of a reference boundary, and their number is at most
+/// B · (2t + 1) for B boundary pixels (a band 2t wide plus the pixel the edge crosses). The
+/// boundary count B also holds the box's own lit/unlit face edges and the cone's edge, where
+/// both images agree, so the bound is loose (measured: 9 pixels at S = 512 against a bound of
+/// 1107, 252 against 8082 at S = 32).
+fn texel_bound(scene: &Scene, map_size: u32, boundary: usize) -> usize {
+    let depth = LIGHT.y; // the floor is y = 0, the light looks straight down
+    let texel = depth * 2.0 * (0.5 * FOV_DEG.to_radians()).tan() / map_size as f32;
+    // The camera's nearest point of the shadow region (|x|, |z| < 1 around the box) is the
+    // closest, where a pixel is smallest and a texel spans the most pixels.
+    let nearest = scene.camera.position.distance(Vec3::new(0.0, 0.0, 1.0));
+    let pixel = nearest * 2.0 * (0.5 * scene.camera.fov_y_deg.to_radians()).tan() / SIZE as f32;
+    let t = std::f32::consts::FRAC_1_SQRT_2 * texel / pixel;
+    (boundary as f32 * (2.0 * t + 1.0)).ceil() as usize
+}
+
+#[test]
+fn shadows_match_the_reference_within_the_texel_bound() {
+    let ctx = Validated::new();
+    let scene = box_over_floor();
+    let truth = reference(&ctx, &scene);
+    let max = truth.pixels.iter().map(|p| f64::from(p[1])).fold(0.0, f64::max);
+    let boundary = boundary_pixels(&truth, SHADOW_THRESHOLD * max);
+    assert!(boundary > 100, "the scene should show a shadow edge: {boundary} boundary pixels");
+    let mut previous = None;
+    for map_size in [32, 512] {
+        let image = render(&ctx, &scene, TechniqueChoice::ShadowMap { size: map_size });
+        let m = shadow_mismatch(&image, &truth, SHADOW_THRESHOLD).unwrap();
+        let bound = texel_bound(&scene, map_size, boundary);
+        eprintln!("map {map_size}: {} pixels misclassified ({:.5}), bound {bound}", m.differing, m.fraction);
+        assert!(m.differing <= bound, "map {map_size}: {} pixels misclassified, bound {bound}", m.differing);
+        if let Some(coarser) = previous {
+            assert!(m.differing < coarser, "a finer map should misclassify fewer pixels");
+        }
+        previous = Some(m.differing);
+    }
+    // Lit pixels get the reference's radiance: the same falloff and BRDF.
+    let image = render(&ctx, &scene, TechniqueChoice::ShadowMap { size: 512 });
+    for (a, b) in image.pixels.iter().zip(&truth.pixels) {
+        if a[1] > 0.0 && b[1] > 0.0 {
+            assert!((a[1] - b[1]).abs() <= 1e-3 * b[1].max(1e-3), "{a:?} against {b:?}");
+        }
+    }
+}
+
+#[test]
+fn needs_local_lights_and_a_map_size_in_range() {
+    let ctx = Validated::new();
+    let attempt = |scene: &Scene, size| {
+        let options = RenderOptions { width: 16, height: 16, technique: TechniqueChoice::ShadowMap { size } };
+        match Renderer::new(&ctx, scene, &options) {
+            Ok(_) => panic!("accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let mut dark = box_over_floor();
+    dark.lights.clear();
+    assert!(attempt(&dark, 512).contains("1 to 8 point or spot lights"));
+    for size in [8, 16384] {
+        assert!(attempt(&box_over_floor(), size).contains("shadow map size"), "{size}");
+    }
+}
+
+/// The built-in `asm` scene renders through its walkthrough with no validation message, and a
+/// close-up of the grating's shadow shows it: most of the floor under the grating is lit, and
+/// a good part of it is in shadow.
+#[test]
+fn the_asm_walkthrough_renders_cleanly() {
+    let ctx = Validated::new();
+    let scene = Scene::builtin("asm").unwrap();
+    let options =
+        RenderOptions { width: 48, height: 48, technique: TechniqueChoice::ShadowMap { size: 1024 } };
+    let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
+    for t in [0.0, 0.2] {
+        renderer.set_camera(kage::scene::animation::camera_at(&scene.walkthrough, t).unwrap()).unwrap();
+        renderer.render().unwrap();
+    }
+    let image = renderer.image().unwrap();
+    let lit = image.pixels.iter().filter(|p| p[1] > 0.0).count() as f32 / image.pixels.len() as f32;
+    assert!((0.3..0.9).contains(&lit), "lit fraction of the grating close-up: {lit}");
+}
