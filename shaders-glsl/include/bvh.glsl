@@ -107,6 +107,21 @@ float bvh_enter_box(BvhNode node, vec3 origin, vec3 inv_dir, float tmax) {
 uint bvh_node_index(BvhNode node) { return floatBitsToUint(node.lo.w); }
 uint bvh_node_count(BvhNode node) { return floatBitsToUint(node.hi.w); }
 
+// The children of inner node `index` (at index and index + 1) that the ray enters before
+// `tmax`: how many (0, 1 or 2); `next`, the one to visit now (the nearer of two, so that tmax
+// shrinks early and prunes the farther one); `pushed`, the other one's index when both.
+int bvh_children(BvhNode left_node, BvhNode right_node, uint index, vec3 origin, vec3 inv_dir, float tmax,
+                 inout BvhNode next, out uint pushed) {
+    float enter_left = bvh_enter_box(left_node, origin, inv_dir, tmax);
+    float enter_right = bvh_enter_box(right_node, origin, inv_dir, tmax);
+    bool left = enter_left != 1.0 / 0.0;
+    bool right = enter_right != 1.0 / 0.0;
+    bool left_first = left && (!right || enter_left <= enter_right);
+    pushed = left_first ? index + 1u : index;
+    if (left || right) next = left_first ? left_node : right_node;
+    return int(left) + int(right);
+}
+
 // Traverses one bottom-level tree, ray in object space. With any_hit it returns at the first
 // hit found; otherwise it narrows hit.t to the closest one. hit.t is the running tmax.
 bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
@@ -132,23 +147,10 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
                 }
             }
         } else {
-            // Nearer child first, so that hit.t shrinks early and prunes the farther one.
-            BvhNode left_node = bvh_blas_nodes[index];
-            BvhNode right_node = bvh_blas_nodes[index + 1u];
-            float enter_left = bvh_enter_box(left_node, origin, inv_dir, hit.t);
-            float enter_right = bvh_enter_box(right_node, origin, inv_dir, hit.t);
-            bool left = enter_left != 1.0 / 0.0;
-            bool right = enter_right != 1.0 / 0.0;
-            if (left && right) {
-                bool left_first = enter_left <= enter_right;
-                stack[top++] = left_first ? index + 1u : index;
-                node = left_first ? left_node : right_node;
-                continue;
-            }
-            if (left || right) {
-                node = left ? left_node : right_node;
-                continue;
-            }
+            uint pushed;
+            int entered = bvh_children(bvh_blas_nodes[index], bvh_blas_nodes[index + 1u], index, origin, inv_dir, hit.t, node, pushed);
+            if (entered == 2) stack[top++] = pushed;
+            if (entered > 0) continue;
         }
         // Entries pushed earlier may lie beyond a hit found since: test them again on pop.
         bool next = false;
@@ -183,22 +185,10 @@ bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
                 if (any_hit) return true;
             }
         } else {
-            BvhNode left_node = bvh_tlas_nodes[index];
-            BvhNode right_node = bvh_tlas_nodes[index + 1u];
-            float enter_left = bvh_enter_box(left_node, origin, inv_dir, hit.t);
-            float enter_right = bvh_enter_box(right_node, origin, inv_dir, hit.t);
-            bool left = enter_left != 1.0 / 0.0;
-            bool right = enter_right != 1.0 / 0.0;
-            if (left && right) {
-                bool left_first = enter_left <= enter_right;
-                stack[top++] = left_first ? index + 1u : index;
-                node = left_first ? left_node : right_node;
-                continue;
-            }
-            if (left || right) {
-                node = left ? left_node : right_node;
-                continue;
-            }
+            uint pushed;
+            int entered = bvh_children(bvh_tlas_nodes[index], bvh_tlas_nodes[index + 1u], index, origin, inv_dir, hit.t, node, pushed);
+            if (entered == 2) stack[top++] = pushed;
+            if (entered > 0) continue;
         }
         bool next = false;
         while (top > 0) {

@@ -7,7 +7,7 @@
 //! normalised; unknown fields are errors). Output: `{"irradiance": [[r, g, b], ...], "spp": N,
 //! "standard_error": [[r, g, b], ...]}`, in the input's order.
 use super::lighting::{ReferenceLighting, IMPORTS};
-use super::statistics::{accum_buffer, Statistics};
+use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{vk, BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, IrradiancePoint, IrradiancePush};
@@ -134,17 +134,7 @@ impl IrradianceReference {
 
     /// Adds `spp` samples per point in one submission.
     pub fn run_batch(&mut self, spp: u32) -> Result<()> {
-        if spp == 0 {
-            return Err(Error::InvalidArgument(
-                "an irradiance batch needs at least one sample per point".into(),
-            ));
-        }
-        let after = self.samples.checked_add(spp).ok_or_else(|| {
-            Error::InvalidArgument(format!(
-                "{} + {spp} samples per point overflow the sample counter",
-                self.samples
-            ))
-        })?;
+        let after = samples_after(self.samples, spp, "point")?;
         let groups = [self.count.div_ceil(constants::IRRADIANCE_GROUP), 1, 1];
         let pipeline = &self.pipeline;
         let (lighting, accum, points) = (&self.lighting, &self.accum, &self.points);

@@ -5,7 +5,7 @@
 //! projection matrices and one primary ray through each pixel centre ((i + ½) / width, row 0 at
 //! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
 use super::lighting::{ReferenceLighting, IMPORTS};
-use super::statistics::{accum_buffer, Statistics};
+use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{vk, BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::imageio::RgbaF32Image;
@@ -87,17 +87,7 @@ impl ReferenceRenderer {
     /// Adds `spp` samples per pixel in one submission (keep it short: a submission must finish
     /// well within the driver's timeout).
     pub fn run_batch(&mut self, spp: u32) -> Result<()> {
-        if spp == 0 {
-            return Err(Error::InvalidArgument(
-                "a reference batch needs at least one sample per pixel".into(),
-            ));
-        }
-        let after = self.samples.checked_add(spp).ok_or_else(|| {
-            Error::InvalidArgument(format!(
-                "{} + {spp} samples per pixel overflow the sample counter",
-                self.samples
-            ))
-        })?;
+        let after = samples_after(self.samples, spp, "pixel")?;
         let (width, height) = (self.options.width, self.options.height);
         let view_proj = self.camera.projection(width as f32 / height as f32) * self.camera.view();
         let group = constants::REFERENCE_GROUP;

@@ -1,9 +1,20 @@
 //! The per-pixel (or per-point) statistics the reference shaders accumulate, read back: the
 //! mean of the samples and the standard error of that mean.
 use crate::backend::{vk, Buffer, BufferDesc, Context, MemoryLocation};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::layouts::ReferenceAccum;
 use std::sync::Arc;
+
+/// The sample count after a batch of `spp` more per `item` (pixel, point): a batch of none, or
+/// a count past u32, is an error naming both.
+pub fn samples_after(samples: u32, spp: u32, item: &str) -> Result<u32> {
+    if spp == 0 {
+        return Err(Error::InvalidArgument(format!("a batch needs at least one sample per {item}")));
+    }
+    samples.checked_add(spp).ok_or_else(|| {
+        Error::InvalidArgument(format!("{samples} + {spp} samples per {item} overflow the sample counter"))
+    })
+}
 
 /// A GPU array of [`ReferenceAccum`], one per pixel or point.
 pub fn accum_buffer(ctx: &Arc<Context>, name: &str, items: usize) -> Result<Buffer> {
