@@ -12,10 +12,12 @@ layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE
 layout(push_constant) uniform Push { PrtDrawPush draw; };
 // 0: the paper's fixed penumbra, 1: the adaptive one (a pipeline constant: see GraphicsDesc).
 layout(constant_id = 0) const uint ADAPTIVE_PENUMBRA = 0u;
+// ceil(q / 4), as prt_scene.vert declares it.
+layout(constant_id = 1) const uint REGION_VEC4 = KAGE_MAX_REGIONS / 4;
 
 layout(location = 0) in vec3 self_shadowed;
 layout(location = 1) in vec3 world_position;
-layout(location = 2) in vec4 region_transfer[KAGE_MAX_REGIONS / 4];
+layout(location = 2) in vec4 region_transfer[REGION_VEC4];
 layout(location = 0) out vec4 color;
 
 // Sums of both channels of a summed-area table layer over the square of half-width `half_width`

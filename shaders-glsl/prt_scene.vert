@@ -1,4 +1,5 @@
 #version 460
+#extension GL_EXT_control_flow_attributes : require
 // The scene pass of Sloan's PRT and of the Tamura technique. Per vertex: the self-shadowed
 // radiance L_s from its texel of the self-shadow pass, and the transfer T(x, w_i) towards each
 // region, reconstructed from the transfer vector (eq. (15)); the rasterizer interpolates both.
@@ -9,6 +10,13 @@ layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D self_shadow;
 layout(set = 0, binding = 2, std430) readonly buffer Basis { RegionBasis region_basis[]; };
 layout(push_constant) uniform Push { PrtDrawPush draw; };
+// Pipeline constants (see GraphicsDesc::constants; id 0 is the fragment shader's): vec4s of
+// region transfers, ceil(q / 4) (at least 1), and of SH coefficients, ceil(bands^2 / 4).
+// llvmpipe interpolates every declared output for every fragment, so the outputs are sized to
+// q; with constant bounds the loops below unroll and every output index is a constant (a
+// dynamically indexed output costs a select over all of them per write on llvmpipe).
+layout(constant_id = 1) const uint REGION_VEC4 = KAGE_MAX_REGIONS / 4;
+layout(constant_id = 2) const uint BASIS_VEC4 = KAGE_TRANSFER_VEC4;
 
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
@@ -16,20 +24,23 @@ layout(location = 2) in vec4 transfer[KAGE_TRANSFER_VEC4];
 
 layout(location = 0) out vec3 self_shadowed;
 layout(location = 1) out vec3 world_position;
-layout(location = 2) out vec4 region_transfer[KAGE_MAX_REGIONS / 4];
+layout(location = 2) out vec4 region_transfer[REGION_VEC4];
 
 void main() {
     uint texel = draw.mesh.x + uint(gl_VertexIndex);
     self_shadowed = texelFetch(self_shadow, ivec2(texel % draw.mesh.y, texel / draw.mesh.y), 0).rgb;
-    uint regions = draw.mesh.w;
-    for (uint k = 0; k < KAGE_MAX_REGIONS / 4; ++k) region_transfer[k] = vec4(0.0);
+    uint regions = draw.mesh.w, first = draw.mesh.z * regions;
     // The basis at each region's direction is evaluated exactly on the host once per group and
     // frame (Cartesian real SH, no table); here only the dot products remain.
-    for (uint i = 0; i < regions; ++i) {
-        RegionBasis b = region_basis[draw.mesh.z * regions + i];
-        float t = 0.0;
-        for (int j = 0; j < KAGE_TRANSFER_VEC4; ++j) t += dot(transfer[j], b.y[j]);
-        region_transfer[i / 4][i % 4] = t;
+    [[unroll]] for (uint k = 0u; k < REGION_VEC4; ++k) {
+        vec4 t = vec4(0.0);
+        [[unroll]] for (uint c = 0u; c < 4u; ++c) {
+            if (4u * k + c < regions) {
+                RegionBasis b = region_basis[first + 4u * k + c];
+                [[unroll]] for (uint j = 0u; j < BASIS_VEC4; ++j) t[c] += dot(transfer[j], b.y[j]);
+            }
+        }
+        region_transfer[k] = t;
     }
     vec4 world = draw.model * vec4(position, 1.0);
     world_position = world.xyz;

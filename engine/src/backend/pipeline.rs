@@ -174,10 +174,12 @@ pub struct GraphicsDesc<'a> {
     pub depth_test: bool,
     /// Add to the colour target instead of replacing it (accumulating lights).
     pub additive: bool,
-    /// The fragment shader's specialization constants, `constant_id` 0, 1, … in order: choices
-    /// fixed for the pipeline's life, so the shader compiler removes the branches not taken
-    /// (llvmpipe runs both sides of a branch that depends on a uniform value).
-    pub fragment_constants: &'a [u32],
+    /// Specialization constants of both stages, `constant_id` 0, 1, … in order (a stage ignores
+    /// the ids it does not declare): choices fixed for the pipeline's life, so the shader
+    /// compiler removes the branches not taken and sizes arrays to what is used (llvmpipe runs
+    /// both sides of a branch that depends on a uniform value, and interpolates every declared
+    /// fragment input).
+    pub constants: &'a [u32],
 }
 
 pub struct GraphicsPipeline {
@@ -191,16 +193,17 @@ impl GraphicsPipeline {
         let vs = Module::new(ctx, &format!("{}.vert", desc.name), desc.vertex_spirv)?;
         let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv)?;
         let layout = create_layout(ctx, desc.name, desc.bindings, desc.push_size)?;
-        let entries: Vec<vk::SpecializationMapEntry> = (0..desc.fragment_constants.len() as u32)
+        let entries: Vec<vk::SpecializationMapEntry> = (0..desc.constants.len() as u32)
             .map(|id| vk::SpecializationMapEntry { constant_id: id, offset: 4 * id, size: 4 })
             .collect();
-        let constant_bytes: Vec<u8> = desc.fragment_constants.iter().flat_map(|c| c.to_ne_bytes()).collect();
+        let constant_bytes: Vec<u8> = desc.constants.iter().flat_map(|c| c.to_ne_bytes()).collect();
         let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&constant_bytes);
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
                 .module(vs.raw)
-                .name(c"main"),
+                .name(c"main")
+                .specialization_info(&specialization),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
                 .module(fs.raw)

@@ -29,7 +29,7 @@ impl Background {
                 depth_format: None,
                 depth_test: false,
                 additive: false,
-                fragment_constants: &[],
+                constants: &[],
             },
         )?;
         Ok(Background { pipeline })

@@ -36,7 +36,7 @@ pub fn scene_pipeline(
             depth_format: Some(DEPTH_FORMAT),
             depth_test: true,
             additive: false,
-            fragment_constants: &[],
+            constants: &[],
         },
     )
 }

@@ -39,7 +39,7 @@ impl ShadowMaps {
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 additive: false,
-                fragment_constants: &[],
+                constants: &[],
             },
         )?;
         let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;

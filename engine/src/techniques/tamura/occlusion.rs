@@ -187,7 +187,7 @@ impl Occlusion {
                     depth_format: None,
                     depth_test: false,
                     additive: false,
-                    fragment_constants: &[],
+                    constants: &[],
                 },
             )?,
             blur: ComputePipeline::new(

@@ -136,7 +136,7 @@ impl SelfShadow {
                 depth_format: None,
                 depth_test: false,
                 additive: false,
-                fragment_constants: &[],
+                constants: &[],
             },
         )?;
         Ok(SelfShadow {

@@ -105,6 +105,9 @@ impl PrtTechnique {
         let wanted = (groups * groups.saturating_sub(1) * settings.regions).min(u32::MAX as usize) as u32;
         let capacity = wanted.min(settings.max_layers);
         let transfer_attributes = transfer_vertex_buffer(2);
+        // prt_scene.vert's pipeline constants: vec4s of region transfers and of SH coefficients.
+        let region_vec4 = regions.regions.len().div_ceil(4).max(1) as u32;
+        let basis_vec4 = (bands * bands).div_ceil(4) as u32;
         Ok(PrtTechnique {
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
             occlusion: Occlusion::new(
@@ -140,7 +143,7 @@ impl PrtTechnique {
                     depth_format: Some(DEPTH_FORMAT),
                     depth_test: true,
                     additive: false,
-                    fragment_constants: &[(settings.penumbra == Penumbra::Adaptive) as u32],
+                    constants: &[(settings.penumbra == Penumbra::Adaptive) as u32, region_vec4, basis_vec4],
                 },
             )?,
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
