@@ -329,6 +329,34 @@ typedef struct {
 } kage_transform;
 
 /**
+ * A pinhole camera (right-handed, +Y up).
+ */
+typedef struct {
+  float position[3];
+  float target[3];
+  float up[3];
+  /**
+   * Vertical field of view in degrees, in (0, 180).
+   */
+  float fov_y_deg;
+} kage_camera_desc;
+
+/**
+ * What a renderer holds and what its last frame had to leave out.
+ */
+typedef struct {
+  /**
+   * Bytes of GPU memory the renderer's device has allocated (all of Kage's objects on it).
+   */
+  uint64_t gpu_bytes;
+  /**
+   * Occluder/receiver/region layers the Tamura technique wanted in the last frame but had
+   * no room for (its layer limit): their shadows are missing. 0 for other techniques.
+   */
+  uint32_t dropped_layers;
+} kage_renderer_stats;
+
+/**
  * The GPU time of one pass in the last frame.
  */
 typedef struct {
@@ -392,19 +420,6 @@ typedef struct {
   uint32_t width;
   uint32_t height;
 } kage_environment_desc;
-
-/**
- * A pinhole camera (right-handed, +Y up).
- */
-typedef struct {
-  float position[3];
-  float target[3];
-  float up[3];
-  /**
-   * Vertical field of view in degrees, in (0, 180).
-   */
-  float fov_y_deg;
-} kage_camera_desc;
 
 /**
  * A whole scene from the host's memory, no files involved.
@@ -513,6 +528,33 @@ kage_result kage_renderer_destroy(kage_renderer *renderer);
 kage_result kage_renderer_set_group_transform(kage_renderer *renderer,
                                               uint32_t group,
                                               const kage_transform *transform);
+
+/**
+ * Moves the camera for the next frames (checked as `kage_scene_desc`'s camera is). `camera` is
+ * only read during the call.
+ *
+ * # Safety
+ * `renderer` must be NULL or a handle not in use by another thread; `camera` NULL or valid.
+ */
+kage_result kage_renderer_set_camera(kage_renderer *renderer, const kage_camera_desc *camera);
+
+/**
+ * Turns the environment about +Y (counter-clockwise seen from above) by `radians` (finite) for
+ * the next frames, as `kage render --env-rotation` does. Techniques that capture the
+ * environment once (the light probes) keep their captured light.
+ *
+ * # Safety
+ * `renderer` must be NULL or a handle not in use by another thread.
+ */
+kage_result kage_renderer_set_env_rotation(kage_renderer *renderer, float radians);
+
+/**
+ * Writes the renderer's statistics to `*stats`.
+ *
+ * # Safety
+ * `renderer` must be NULL or a handle not in use by another thread; `stats` NULL or writable.
+ */
+kage_result kage_renderer_get_stats(const kage_renderer *renderer, kage_renderer_stats *stats);
 
 /**
  * Renders one frame and waits for it; then `kage_renderer_read_pixels` and

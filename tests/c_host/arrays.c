@@ -166,6 +166,28 @@ static void check_bad_arguments(kage_context *context) {
   transform.rotation[3] = 1;
   CHECK(kage_renderer_set_group_transform(renderer, 0, &transform));
 
+  kage_camera_desc camera = {{0, 1, 2}, {0, 0, 0}, {0, 1, 0}, 60.0f};
+  EXPECT(kage_renderer_set_camera(NULL, &camera), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_set_camera(renderer, NULL), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_set_camera(no_renderer, &camera), KAGE_RESULT_INVALID_HANDLE);
+  camera.fov_y_deg = 180.0f;
+  EXPECT(kage_renderer_set_camera(renderer, &camera), KAGE_RESULT_INVALID_VALUE);
+  camera.fov_y_deg = 60.0f;
+  camera.target[1] = 1, camera.target[2] = 2; /* target on the position */
+  EXPECT(kage_renderer_set_camera(renderer, &camera), KAGE_RESULT_INVALID_VALUE);
+  camera.target[1] = 0, camera.target[2] = 0;
+  CHECK(kage_renderer_set_camera(renderer, &camera));
+  EXPECT(kage_renderer_set_env_rotation(NULL, 0.5f), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_set_env_rotation(no_renderer, 0.5f), KAGE_RESULT_INVALID_HANDLE);
+  EXPECT(kage_renderer_set_env_rotation(renderer, NAN), KAGE_RESULT_INVALID_VALUE);
+  CHECK(kage_renderer_set_env_rotation(renderer, 0.5f));
+  kage_renderer_stats stats;
+  EXPECT(kage_renderer_get_stats(NULL, &stats), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_get_stats(renderer, NULL), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_get_stats(no_renderer, &stats), KAGE_RESULT_INVALID_HANDLE);
+  CHECK(kage_renderer_get_stats(renderer, &stats));
+  REQUIRE(stats.gpu_bytes > 0 && stats.dropped_layers == 0);
+
   uint8_t pixels[8 * 8 * 16];
   size_t passes = 99;
   kage_pass_timing timing;

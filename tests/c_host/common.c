@@ -146,6 +146,7 @@ static void run_frames(kage_context *context, kage_scene *scene, const kage_tech
   float *linear = malloc((size_t)size * size * 16);
   REQUIRE(rgba8 && linear);
   double previous = -1.0;
+  kage_renderer_stats first_stats = {0, 0};
   for (unsigned frame = 0; frame < frames; frame++) {
     float x = -1.0f + 2.0f * frame / (frames > 1 ? frames - 1 : 1);
     kage_transform t = box_at(x);
@@ -186,6 +187,12 @@ static void run_frames(kage_context *context, kage_scene *scene, const kage_tech
     int tamura = technique->technique == KAGE_TECHNIQUE_TAMURA;
     if (tamura) REQUIRE(has_pass(timings, count, "occluder_masks"));
     if (frame == 0) REQUIRE(has_pass(timings, count, "sh_project") && (!tamura || has_pass(timings, count, "self_shadow")));
+    /* Every object a frame needs exists after the first: the device's allocations stay flat. */
+    kage_renderer_stats stats;
+    CHECK(kage_renderer_get_stats(renderer, &stats));
+    REQUIRE(stats.gpu_bytes > 0 && stats.dropped_layers == 0);
+    if (frame == 0) first_stats = stats;
+    REQUIRE(stats.gpu_bytes == first_stats.gpu_bytes);
     printf("frame %u: box at column %.1f, %zu passes, %.3f ms:", frame, column, count, total);
     for (size_t i = 0; i < count; i++) printf(" %s %.3f", timings[i].name, timings[i].milliseconds);
     printf("\n");

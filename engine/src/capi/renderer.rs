@@ -3,7 +3,7 @@ use super::args;
 use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
-use super::scene::{kage_scene, kage_transform};
+use super::scene::{kage_camera_desc, kage_scene, kage_transform};
 use super::technique::kage_technique_desc;
 use crate::imageio::tonemap_srgb8;
 use crate::pass::PassTiming;
@@ -120,6 +120,73 @@ pub unsafe extern "C" fn kage_renderer_set_group_transform(
             unsafe { (handles::get_mut(renderer, "renderer")?, args::value(transform, "transform")?) };
         let transform = transform.validated().map_err(|e| Failure::invalid(format!("group {group}: {e}")))?;
         Ok(r.renderer.set_group_transform(group as usize, transform.matrix())?)
+    })
+}
+
+/// Moves the camera for the next frames (checked as `kage_scene_desc`'s camera is). `camera` is
+/// only read during the call.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread; `camera` NULL or valid.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_set_camera(
+    renderer: *mut kage_renderer,
+    camera: *const kage_camera_desc,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: exclusive use of a live handle (threading rules); camera NULL or valid.
+        let (r, camera) =
+            unsafe { (handles::get_mut(renderer, "renderer")?, args::value(camera, "camera")?) };
+        Ok(r.renderer.set_camera(camera.camera()?)?)
+    })
+}
+
+/// Turns the environment about +Y (counter-clockwise seen from above) by `radians` (finite) for
+/// the next frames, as `kage render --env-rotation` does. Techniques that capture the
+/// environment once (the light probes) keep their captured light.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_set_env_rotation(
+    renderer: *mut kage_renderer,
+    radians: f32,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: exclusive use of a live handle (threading rules).
+        let r = unsafe { handles::get_mut(renderer, "renderer") }?;
+        Ok(r.renderer.set_env_rotation(radians)?)
+    })
+}
+
+/// What a renderer holds and what its last frame had to leave out.
+#[repr(C)]
+#[derive(Clone, Copy, Default)]
+pub struct kage_renderer_stats {
+    /// Bytes of GPU memory the renderer's device has allocated (all of Kage's objects on it).
+    pub gpu_bytes: u64,
+    /// Occluder/receiver/region layers the Tamura technique wanted in the last frame but had
+    /// no room for (its layer limit): their shadows are missing. 0 for other techniques.
+    pub dropped_layers: u32,
+}
+
+/// Writes the renderer's statistics to `*stats`.
+///
+/// # Safety
+/// `renderer` must be NULL or a handle not in use by another thread; `stats` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_get_stats(
+    renderer: *const kage_renderer,
+    stats: *mut kage_renderer_stats,
+) -> kage_result {
+    boundary(|| {
+        // SAFETY: the host does not destroy the handle during the call; stats NULL or writable.
+        let (r, stats) = unsafe { (handles::get(renderer, "renderer")?, args::out(stats, "stats")?) };
+        *stats = kage_renderer_stats {
+            gpu_bytes: r.ctx.allocated_bytes(),
+            dropped_layers: u32::try_from(r.renderer.dropped_layers()).unwrap_or(u32::MAX),
+        };
+        Ok(())
     })
 }
 

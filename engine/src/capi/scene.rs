@@ -82,6 +82,12 @@ pub struct kage_camera_desc {
     pub fov_y_deg: f32,
 }
 
+impl kage_camera_desc {
+    pub(crate) fn camera(&self) -> Result<Camera, Failure> {
+        Camera::from_arrays(self.position, self.target, self.up, self.fov_y_deg).map_err(invalid)
+    }
+}
+
 /// A whole scene from the host's memory, no files involved.
 #[repr(C)]
 pub struct kage_scene_desc {
@@ -161,8 +167,7 @@ unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
     // SAFETY: the caller promises width × height RGB pixels.
     let pixels = unsafe { args::chunks::<3>(env.pixels, texels, "desc->environment.pixels") }?;
     let environment = EnvMap::from_pixels(env.width, env.height, pixels.to_vec()).map_err(invalid)?;
-    let c = &desc.camera;
-    let camera = Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg).map_err(invalid)?;
+    let camera = desc.camera.camera()?;
     Ok(Scene {
         name: "host".into(),
         groups,
