@@ -157,14 +157,57 @@ pub fn run(args: &AsmBenchArgs) -> Result<()> {
         .or_else(|| kage::techniques::prt::cache::default_dir().map(|d| d.join("references")));
     let mut references = references::References::new(&ctx, &scene, args.size, cache.clone())?;
 
+    let (series, rows) = walk(&plan, &mut renderers, &mut references, args)?;
+
+    let device = ctx.info().name.clone();
+    println!(
+        "scene {}: {} frames ({} walkthrough samples; {} held and {} leaving slowly at each of {} keyframes) at {}x{}, {device}; references: {} ray cast, {} from {}",
+        scene.name,
+        plan.len(),
+        args.frames,
+        args.rest,
+        args.slow,
+        scene.walkthrough.len(),
+        args.size,
+        args.size,
+        references.computed,
+        references.loaded,
+        cache.map_or_else(|| "nowhere (no cache folder)".to_string(), |d| d.display().to_string()),
+    );
+    let memory: Vec<Option<u64>> = renderers.iter().map(Renderer::shadow_memory_bytes).collect();
+    let summaries: Vec<report::Summary> =
+        series.iter().zip(&memory).map(|(s, &bytes)| s.summary(bytes, args.converge_tolerance)).collect();
+    report::print(&configs, &summaries, args.slow_px);
+    let written = report::write(&args.out, &scene.name, &configs, &summaries, &rows)?;
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    let title = format!("{}: {} frames at {}², {device}", scene.name, plan.len(), args.size);
+    let path = args.out.join("error-time.png");
+    if report::chart(&path, &title, &configs, &summaries)? {
+        println!("wrote {}", path.display());
+    }
+    args.gpu.finish(&ctx)
+}
+
+/// Renders every frame of `plan` with every renderer in turn and measures it against the
+/// frame's reference: each configuration's series, and one row per frame and configuration.
+fn walk(
+    plan: &[frames::Frame],
+    renderers: &mut [Renderer],
+    references: &mut references::References,
+    args: &AsmBenchArgs,
+) -> Result<(Vec<Series>, Vec<FrameRow>)> {
     let bar = ProgressBar::new(plan.len() as u64).with_style(
         ProgressStyle::with_template("{msg:24} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
             .expect("static template"),
     );
     bar.set_draw_target(ProgressDrawTarget::hidden());
     let start = Instant::now();
-    let mut series: Vec<Series> = configs.iter().map(|_| Series::default()).collect();
+    let n = renderers.len();
+    let mut series: Vec<Series> = (0..n).map(|_| Series::default()).collect();
     let mut rows = Vec::new();
+    // The last frame's reference and renders, for the flips.
     let mut previous: Option<(RgbaF32Image, Vec<RgbaF32Image>)> = None;
     for (i, frame) in plan.iter().enumerate() {
         bar.set_message(format!("frame {i}: reference"));
@@ -172,9 +215,9 @@ pub fn run(args: &AsmBenchArgs) -> Result<()> {
         let motion = (i > 0).then(|| frames::motion_px(&plan[i - 1].camera, &frame.camera, args.size));
         let slow = motion.is_some_and(|m| m > 0.0 && m <= args.slow_px);
         bar.set_message(format!("frame {i}: rendering"));
-        let mut timings = vec![Vec::new(); configs.len()];
-        for k in 0..configs.len() {
-            let c = (i + k) % configs.len();
+        let mut timings = vec![Vec::new(); n];
+        for k in 0..n {
+            let c = (i + k) % n;
             renderers[c].set_camera(frame.camera)?;
             timings[c] = renderers[c].render()?;
         }
@@ -211,36 +254,7 @@ pub fn run(args: &AsmBenchArgs) -> Result<()> {
         }
     }
     bar.finish_and_clear();
-
-    let device = ctx.info().name.clone();
-    println!(
-        "scene {}: {} frames ({} walkthrough samples; {} held and {} leaving slowly at each of {} keyframes) at {}x{}, {device}; references: {} ray cast, {} from {}",
-        scene.name,
-        plan.len(),
-        args.frames,
-        args.rest,
-        args.slow,
-        scene.walkthrough.len(),
-        args.size,
-        args.size,
-        references.computed,
-        references.loaded,
-        cache.map_or_else(|| "nowhere (no cache folder)".to_string(), |d| d.display().to_string()),
-    );
-    let memory: Vec<Option<u64>> = renderers.iter().map(Renderer::shadow_memory_bytes).collect();
-    let summaries: Vec<report::Summary> =
-        series.iter().zip(&memory).map(|(s, &bytes)| s.summary(bytes, args.converge_tolerance)).collect();
-    report::print(&configs, &summaries, args.slow_px);
-    let written = report::write(&args.out, &scene.name, &configs, &summaries, &rows)?;
-    for path in written {
-        println!("wrote {}", path.display());
-    }
-    let title = format!("{}: {} frames at {}², {device}", scene.name, plan.len(), args.size);
-    let path = args.out.join("error-time.png");
-    if report::chart(&path, &title, &configs, &summaries)? {
-        println!("wrote {}", path.display());
-    }
-    args.gpu.finish(&ctx)
+    Ok((series, rows))
 }
 
 #[cfg(test)]
