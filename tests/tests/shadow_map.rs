@@ -131,7 +131,8 @@ fn shadows_match_the_reference_within_the_texel_bound() {
 /// A light moved at run time (`Renderer::set_light`) re-renders its map: the frame after the move
 /// matches the reference of the moved light within the texel bound, and is the frame a renderer
 /// built with the light there from the start draws. The shadow moves far enough that the old
-/// reference would not pass (so the test can fail). Bad light updates are clear errors.
+/// reference would not pass (so the test can fail). Bad light updates are clear errors. The
+/// renderer reports the map's bytes (what `kage bench asm` compares techniques' memory by).
 #[test]
 fn a_moved_light_re_renders_its_shadow() {
     let ctx = Validated::new();
@@ -161,6 +162,12 @@ fn a_moved_light_re_renders_its_shadow() {
     assert!(stale.differing > bound, "the light should have moved the shadow: {}", stale.differing);
     let fresh = render(&ctx, &after, TechniqueChoice::ShadowMap { size: 512 });
     assert_eq!(shadow_mismatch(&image, &fresh, SHADOW_THRESHOLD).unwrap().differing, 0);
+
+    // One D32 map of 512² texels for the one light; a technique without shadow maps has none.
+    assert_eq!(renderer.shadow_memory_bytes(), Some(512 * 512 * 4));
+    let unshadowed =
+        Renderer::new(&ctx, &after, &RenderOptions { width: 16, height: 16, ..Default::default() });
+    assert_eq!(unshadowed.unwrap().shadow_memory_bytes(), None);
 
     let err = renderer.set_light(1, spot_at(moved)).unwrap_err().to_string();
     assert!(err.contains("light 1 does not exist (the scene has 1)"), "{err}");
