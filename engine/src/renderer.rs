@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
-use crate::scene::Scene;
+use crate::scene::{Light, Scene};
 use crate::techniques::background::Background;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
@@ -177,6 +177,7 @@ pub struct Renderer {
     ctx: Arc<Context>,
     scene: GpuScene,
     camera: crate::scene::Camera,
+    lights: Vec<Light>,
     env: GpuEnvironment,
     env_sh: ShProjection,
     env_dirty: bool,
@@ -207,6 +208,7 @@ impl Renderer {
             ctx: ctx.clone(),
             scene: gpu,
             camera: scene.camera,
+            lights: scene.lights.clone(),
             env: GpuEnvironment::new(ctx, &scene.environment)?,
             env_sh: ShProjection::environment(ctx, &scene.environment)?,
             env_dirty: true,
@@ -242,6 +244,18 @@ impl Renderer {
         Ok(())
     }
 
+    /// Replaces the scene's light `index` (checked as a scene file's light is, a point light
+    /// may become a spot light and back); techniques light the next frame with it and redo
+    /// whatever they derived from it (shadow maps).
+    pub fn set_light(&mut self, index: usize, light: Light) -> Result<()> {
+        let count = self.lights.len();
+        let slot = self.lights.get_mut(index).ok_or_else(|| {
+            Error::InvalidArgument(format!("light {index} does not exist (the scene has {count})"))
+        })?;
+        *slot = light.validated().map_err(|e| e.within(&format!("light {index}")))?;
+        Ok(())
+    }
+
     /// Moves a group (a rigid transform: rotation, translation, uniform scale).
     pub fn set_group_transform(&mut self, group: usize, transform: Mat4) -> Result<()> {
         let count = self.scene.transforms.len();
@@ -267,8 +281,11 @@ impl Renderer {
         };
         self.frame_uniforms.write(0, bytes_of(&uniforms))?;
 
-        self.technique
-            .update(&FrameState { transforms: &self.scene.transforms, env_rotation: self.env_rotation })?;
+        self.technique.update(&FrameState {
+            transforms: &self.scene.transforms,
+            env_rotation: self.env_rotation,
+            lights: &self.lights,
+        })?;
 
         let inputs = FrameInputs {
             ctx: &self.ctx,
@@ -303,6 +320,12 @@ impl Renderer {
     /// were left out.
     pub fn dropped_layers(&self) -> usize {
         self.technique.dropped_layers()
+    }
+
+    /// Bytes the technique keeps for the local lights' shadows (see
+    /// `Technique::shadow_memory_bytes`); `None` when it has no shadow storage.
+    pub fn shadow_memory_bytes(&self) -> Option<u64> {
+        self.technique.shadow_memory_bytes()
     }
 
     /// The last rendered frame: linear radiance, row 0 at the top.

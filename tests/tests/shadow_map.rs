@@ -14,6 +14,14 @@ const LIGHT: Vec3 = Vec3::new(0.3, 3.0, 0.2);
 /// A box (1 × 0.5 × 1, floating 0.5 above the floor) over a 6 × 6 floor, one spot light straight
 /// down from 3 above the floor, no environment light (the reference's local mode has none).
 fn box_over_floor() -> Scene {
+    box_over_floor_lit_from(LIGHT)
+}
+
+fn spot_at(position: Vec3) -> Light {
+    Light::Spot { position, direction: Vec3::NEG_Y, fov_deg: FOV_DEG, intensity: [8.0; 3] }
+}
+
+fn box_over_floor_lit_from(light: Vec3) -> Scene {
     let cube = shapes::boxes("box", &[([-0.5, 0.5, -0.5], [0.5, 1.0, 0.5])], [0.8; 3]).unwrap();
     let floor = shapes::plane("floor", [6.0, 6.0], [2, 2], [0.6; 3]).unwrap();
     let group =
@@ -22,12 +30,7 @@ fn box_over_floor() -> Scene {
         name: "box-over-floor".into(),
         groups: vec![group("box", cube), group("floor", floor)],
         environment: EnvMap::constant([0.0; 3]),
-        lights: vec![Light::Spot {
-            position: LIGHT,
-            direction: Vec3::NEG_Y,
-            fov_deg: FOV_DEG,
-            intensity: [8.0; 3],
-        }],
+        lights: vec![spot_at(light)],
         walkthrough: vec![],
         camera: Camera {
             position: Vec3::new(0.0, 2.5, 3.5),
@@ -77,11 +80,20 @@ fn boundary_pixels(image: &kage::imageio::RgbaF32Image, threshold: f64) -> usize
 /// both images agree, so the bound is loose (measured: 9 pixels at S = 512 against a bound of
 /// 1107, 252 against 8082 at S = 32).
 fn texel_bound(scene: &Scene, map_size: u32, boundary: usize) -> usize {
-    let depth = LIGHT.y; // the floor is y = 0, the light looks straight down
+    let Light::Spot { position: light, .. } = scene.lights[0] else { unreachable!("a spot light") };
+    let depth = light.y; // the floor is y = 0, the light looks straight down
     let texel = depth * 2.0 * (0.5 * FOV_DEG.to_radians()).tan() / map_size as f32;
-    // The camera's nearest point of the shadow region (|x|, |z| < 1 around the box) is the
-    // closest, where a pixel is smallest and a texel spans the most pixels.
-    let nearest = scene.camera.position.distance(Vec3::new(0.0, 0.0, 1.0));
+    // The camera's nearest point of the shadow region is the closest, where a pixel is smallest
+    // and a texel spans the most pixels: the shadow lies within the rectangle around the box's
+    // corners projected from the light onto the floor, so the rectangle's nearest point is at
+    // most as far.
+    let corners = [-0.5f32, 0.5].into_iter().flat_map(|x| {
+        [-0.5f32, 0.5].into_iter().flat_map(move |z| [0.5f32, 1.0].map(|y| Vec3::new(x, y, z)))
+    });
+    let on_floor: Vec<Vec3> = corners.map(|c| light + (c - light) * (light.y / (light.y - c.y))).collect();
+    let lo = on_floor.iter().copied().reduce(Vec3::min).unwrap();
+    let hi = on_floor.iter().copied().reduce(Vec3::max).unwrap();
+    let nearest = scene.camera.position.distance(scene.camera.position.clamp(lo, hi));
     let pixel = nearest * 2.0 * (0.5 * scene.camera.fov_y_deg.to_radians()).tan() / SIZE as f32;
     let t = std::f32::consts::FRAC_1_SQRT_2 * texel / pixel;
     (boundary as f32 * (2.0 * t + 1.0)).ceil() as usize
@@ -114,6 +126,53 @@ fn shadows_match_the_reference_within_the_texel_bound() {
             assert!((a[1] - b[1]).abs() <= 1e-3 * b[1].max(1e-3), "{a:?} against {b:?}");
         }
     }
+}
+
+/// A light moved at run time (`Renderer::set_light`) re-renders its map: the frame after the move
+/// matches the reference of the moved light within the texel bound, and is the frame a renderer
+/// built with the light there from the start draws. The shadow moves far enough that the old
+/// reference would not pass (so the test can fail). Bad light updates are clear errors. The
+/// renderer reports the map's bytes (what `kage bench asm` compares techniques' memory by).
+#[test]
+fn a_moved_light_re_renders_its_shadow() {
+    let ctx = Validated::new();
+    let moved = Vec3::new(-1.0, 2.5, -0.6);
+    let (before, after) = (box_over_floor(), box_over_floor_lit_from(moved));
+    let mut renderer = Renderer::new(
+        &ctx,
+        &before,
+        &RenderOptions { width: SIZE, height: SIZE, technique: TechniqueChoice::ShadowMap { size: 512 } },
+    )
+    .unwrap();
+    renderer.render().unwrap();
+    renderer.set_light(0, spot_at(moved)).unwrap();
+    renderer.render().unwrap();
+    let image = renderer.image().unwrap();
+
+    let truth = reference(&ctx, &after);
+    let max = truth.pixels.iter().map(|p| f64::from(p[1])).fold(0.0, f64::max);
+    let bound = texel_bound(&after, 512, boundary_pixels(&truth, SHADOW_THRESHOLD * max));
+    let m = shadow_mismatch(&image, &truth, SHADOW_THRESHOLD).unwrap();
+    let stale = shadow_mismatch(&image, &reference(&ctx, &before), SHADOW_THRESHOLD).unwrap();
+    eprintln!(
+        "moved light: {} pixels misclassified (bound {bound}), {} against the old light",
+        m.differing, stale.differing
+    );
+    assert!(m.differing <= bound, "{} pixels misclassified, bound {bound}", m.differing);
+    assert!(stale.differing > bound, "the light should have moved the shadow: {}", stale.differing);
+    let fresh = render(&ctx, &after, TechniqueChoice::ShadowMap { size: 512 });
+    assert_eq!(shadow_mismatch(&image, &fresh, SHADOW_THRESHOLD).unwrap().differing, 0);
+
+    // One D32 map of 512² texels for the one light; a technique without shadow maps has none.
+    assert_eq!(renderer.shadow_memory_bytes(), Some(512 * 512 * 4));
+    let unshadowed =
+        Renderer::new(&ctx, &after, &RenderOptions { width: 16, height: 16, ..Default::default() });
+    assert_eq!(unshadowed.unwrap().shadow_memory_bytes(), None);
+
+    let err = renderer.set_light(1, spot_at(moved)).unwrap_err().to_string();
+    assert!(err.contains("light 1 does not exist (the scene has 1)"), "{err}");
+    let err = renderer.set_light(0, spot_at(Vec3::new(f32::NAN, 1.0, 0.0))).unwrap_err().to_string();
+    assert!(err.contains("light 0") && err.contains("not finite"), "{err}");
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU; `kage bench
-//! probes` (in bench_probes.rs): how fast probe sets are tetrahedralized and looked up.
+//! probes` (in bench_probes.rs): how fast probe sets are tetrahedralized and looked up; `kage bench
+//! asm` (in bench_asm/): shadow-map techniques measured over a camera walkthrough.
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Subcommand};
@@ -18,6 +19,10 @@ pub enum BenchCommand {
     /// Tetrahedralization time of random probe sets, and lookups per second, coherent (a moving
     /// object) and cold (each from the first tetrahedron).
     Probes(crate::bench_probes::ProbesBenchArgs),
+    /// Shadow-map techniques over a scene's camera walkthrough: pixels shadowed unlike the
+    /// ray-traced reference, GPU ms per pass and frame side by side, shadow memory, flicker
+    /// while the camera moves slowly, frames to converge at rest.
+    Asm(crate::bench_asm::AsmBenchArgs),
 }
 
 #[derive(Args)]
@@ -40,6 +45,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
         BenchCommand::Rays(args) => rays(args),
         BenchCommand::Probes(args) => crate::bench_probes::run(args),
+        BenchCommand::Asm(args) => crate::bench_asm::run(args),
     }
 }
 

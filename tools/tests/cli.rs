@@ -401,3 +401,73 @@ fn probes_bench_runs_small_sets() {
         assert!(first_row.trim_start().starts_with(if grid { "125" } else { "100" }), "{stdout}");
     }
 }
+
+/// `kage bench asm` end to end at a tiny size: two walkthrough samples, one frame held and one
+/// leaving slowly at each keyframe, a coarse and a finer conventional map. What any working run
+/// gives: one summary row per configuration with the map's bytes (side² × 4), errors that are
+/// fractions and fall with the finer map (a 64² map's texels over the 122° cone are 22 cm on the
+/// floor, a 512²'s under 3 cm), the first configuration's ratio 1, a conventional map's error
+/// constant at rest (converged after 0 frames), flips measured over the slow pairs; a second run
+/// takes every reference from the cache. Bad configurations and a scene without a walkthrough
+/// are clear errors.
+#[test]
+fn bench_asm_measures_every_configuration_over_the_walkthrough() {
+    let dir = scratch_dir("cli-bench-asm");
+    let (cache, out) = (dir.join("cache"), dir.join("out"));
+    let args = [
+        "bench",
+        "asm",
+        "--configs",
+        "shadowmap:64,shadowmap:512",
+        "--frames",
+        "2",
+        "--rest",
+        "1",
+        "--slow",
+        "1",
+        "--size",
+        "32",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--validate",
+    ];
+    let first = kage(&args);
+    assert!(first.status.success(), "{}", text(&first));
+    let stdout = String::from_utf8_lossy(&first.stdout);
+    assert!(stdout.contains("references: ") && !stdout.contains("references: 0 ray cast"), "{stdout}");
+    for pass in ["shadow_maps", "scene"] {
+        assert!(stdout.lines().any(|l| l.starts_with("shadowmap:512") && l.contains(pass)), "{stdout}");
+    }
+    assert_eq!(&std::fs::read(out.join("error-time.png")).unwrap()[1..4], b"PNG");
+    let summary = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let lines: Vec<&str> = summary.lines().collect();
+    assert!(lines[0].starts_with(
+        "scene,config,technique,value,shadow_bytes,error_mean,error_max,error_at_rest,frame_ms,ratio,flips_mean,slow_pairs,converged_after,ms_"
+    ));
+    assert_eq!(lines.len(), 3, "{summary}");
+    let rows: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split(',').collect()).collect();
+    let number = |row: &[&str], column: usize| row[column].parse::<f64>().unwrap();
+    assert_eq!((rows[0][4], rows[1][4]), ("16384", "1048576"));
+    for row in &rows {
+        assert!((0.0..1.0).contains(&number(row, 5)) && number(row, 6) >= number(row, 5), "{row:?}");
+        assert!(number(row, 8) > 0.0 && number(row, 11) > 0.0, "{row:?}");
+        assert_eq!(row[12], "0", "a conventional map's error does not change at rest: {row:?}");
+    }
+    assert!(number(&rows[1], 5) < number(&rows[0], 5), "{summary}");
+    assert_eq!(number(&rows[0], 9), 1.0);
+    let frames = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    assert_eq!((frames.lines().count() - 1) % 2, 0, "two rows per frame: {frames}");
+
+    let second = kage(&args);
+    assert!(second.status.success(), "{}", text(&second));
+    assert!(String::from_utf8_lossy(&second.stdout).contains("references: 0 ray cast"), "{}", text(&second));
+
+    let out = out.to_str().unwrap();
+    assert_clear_errors(&[
+        (&["bench", "asm", "--configs", "cube:4", "--out", out], "no technique \"cube\""),
+        (&["bench", "asm", "--configs", "shadowmap:8", "--size", "8", "--out", out], "shadow map size 8"),
+        (&["bench", "asm", "--scene", "teapot", "--out", out], "no camera walkthrough"),
+    ]);
+}

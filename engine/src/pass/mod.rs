@@ -17,7 +17,7 @@
 //! catches passes recorded in the wrong order.
 mod timings;
 
-pub use timings::{TimingRow, TimingTable};
+pub use timings::{median, TimingRow, TimingTable};
 
 use crate::backend::{Context, TimestampPool};
 use crate::error::{Error, Result};

@@ -101,16 +101,9 @@ pub fn shadow_mismatch(
     relative_threshold: f64,
 ) -> Result<ShadowMismatch> {
     check_sizes(a, b)?;
-    if !(relative_threshold > 0.0 && relative_threshold < 1.0) {
-        return Err(Error::InvalidArgument(format!(
-            "shadow threshold {relative_threshold} must be between 0 and 1 (a fraction of the reference's brightest pixel)"
-        )));
-    }
-    let y = |p: &[f32; 4]| f64::from(luminance([p[0], p[1], p[2]]));
-    let threshold = relative_threshold * b.pixels.iter().map(y).fold(0.0, f64::max);
+    let threshold = lit_threshold(b, relative_threshold)?;
     let (mut differing, mut lit_in_render_only) = (0, 0);
-    for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
-        let (lit_a, lit_b) = (y(pa) > threshold, y(pb) > threshold);
+    for (lit_a, lit_b) in lit_states(a, threshold).zip(lit_states(b, threshold)) {
         differing += usize::from(lit_a != lit_b);
         lit_in_render_only += usize::from(lit_a && !lit_b);
     }
@@ -120,6 +113,89 @@ pub fn shadow_mismatch(
         lit_in_render_only,
         threshold,
     })
+}
+
+/// The luminance above which a pixel counts as lit: `relative_threshold` in (0, 1) times the
+/// reference's brightest pixel.
+fn lit_threshold(reference: &RgbaF32Image, relative_threshold: f64) -> Result<f64> {
+    if !(relative_threshold > 0.0 && relative_threshold < 1.0) {
+        return Err(Error::InvalidArgument(format!(
+            "shadow threshold {relative_threshold} must be between 0 and 1 (a fraction of the reference's brightest pixel)"
+        )));
+    }
+    let brightest = reference.pixels.iter().map(pixel_luminance).fold(0.0, f64::max);
+    Ok(relative_threshold * brightest)
+}
+
+fn pixel_luminance(p: &[f32; 4]) -> f64 {
+    f64::from(luminance([p[0], p[1], p[2]]))
+}
+
+/// Lit (true) or shadowed per pixel, row-major.
+fn lit_states(image: &RgbaF32Image, threshold: f64) -> impl Iterator<Item = bool> + '_ {
+    image.pixels.iter().map(move |p| pixel_luminance(p) > threshold)
+}
+
+/// Pixels whose lit/shadowed state changes from one frame to the next (temporal stability):
+/// in a render and in its reference over the same two cameras. Each frame is classified as
+/// [`shadow_mismatch`] classifies it, against that frame's reference. Where the camera moves, the
+/// reference's shadow edges move across the screen too; the render's flips that the reference
+/// does not make are the instability (shimmering edges, shadows popping as they are refined).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ShadowFlips {
+    /// Pixels whose state changes in the render.
+    pub render: usize,
+    /// Pixels whose state changes in the reference.
+    pub reference: usize,
+    /// Pixels whose state changes in the render but not in the reference.
+    pub spurious: usize,
+    /// `spurious` / all pixels.
+    pub fraction: f64,
+}
+
+/// The flips of `render` from frame 0 to frame 1 against those of `reference` (see
+/// [`ShadowFlips`]); `relative_threshold` as for [`shadow_mismatch`]. All four images must have
+/// one size.
+pub fn shadow_flips(
+    render: [&RgbaF32Image; 2],
+    reference: [&RgbaF32Image; 2],
+    relative_threshold: f64,
+) -> Result<ShadowFlips> {
+    check_sizes(render[0], reference[0])?;
+    check_sizes(render[1], reference[1])?;
+    check_sizes(render[0], render[1])?;
+    let states = |k: usize| -> Result<(Vec<bool>, Vec<bool>)> {
+        let threshold = lit_threshold(reference[k], relative_threshold)?;
+        Ok((lit_states(render[k], threshold).collect(), lit_states(reference[k], threshold).collect()))
+    };
+    let ((render_0, reference_0), (render_1, reference_1)) = (states(0)?, states(1)?);
+    let (mut flips, mut reference_flips, mut spurious) = (0, 0, 0);
+    for i in 0..render_0.len() {
+        let (a, b) = (render_0[i] != render_1[i], reference_0[i] != reference_1[i]);
+        flips += usize::from(a);
+        reference_flips += usize::from(b);
+        spurious += usize::from(a && !b);
+    }
+    Ok(ShadowFlips {
+        render: flips,
+        reference: reference_flips,
+        spurious,
+        fraction: spurious as f64 / render_0.len() as f64,
+    })
+}
+
+/// Frames until an error stops falling once the camera has stopped (`errors[0]` the frame it
+/// stopped at): the first frame k from which no later frame's error is below errors[k] −
+/// `tolerance`. `None` when the last frame was still more than `tolerance` below an earlier
+/// one (the error was still falling when the series ended) or the series is empty.
+pub fn frames_to_converge(errors: &[f64], tolerance: f64) -> Option<usize> {
+    // The lowest error from each frame on, to the end.
+    let mut lowest_after = vec![f64::INFINITY; errors.len()];
+    for k in (0..errors.len().saturating_sub(1)).rev() {
+        lowest_after[k] = lowest_after[k + 1].min(errors[k + 1]);
+    }
+    let k = (0..errors.len()).find(|&k| lowest_after[k] >= errors[k] - tolerance)?;
+    (k + 1 < errors.len() || k == 0).then_some(k)
 }
 
 /// The false-colour difference picture: per pixel |Y(a) − Y(b)| (luminance), divided by
@@ -140,10 +216,7 @@ pub fn diff_image(a: &RgbaF32Image, b: &RgbaF32Image) -> Result<DiffImage> {
         .pixels
         .iter()
         .zip(&b.pixels)
-        .map(|(pa, pb)| {
-            let y = |p: &[f32; 4]| f64::from(luminance([p[0], p[1], p[2]]));
-            (y(pa) - y(pb)).abs()
-        })
+        .map(|(pa, pb)| (pixel_luminance(pa) - pixel_luminance(pb)).abs())
         .collect();
     let mut sorted = errors.clone();
     sorted.sort_by(f64::total_cmp);
@@ -230,6 +303,45 @@ mod tests {
             assert!(err.contains("between 0 and 1"), "{bad}: {err}");
         }
         assert!(shadow_mismatch(&image(2, 1, &[0.0; 2]), &reference, 0.25).is_err());
+    }
+
+    #[test]
+    fn shadow_flips_count_the_render_flips_the_reference_does_not_make() {
+        // Both references have brightest 2.0: lit above 0.5 at the threshold 0.25.
+        let reference_0 = image(4, 1, &[2.0, 2.0, 0.0, 0.0]);
+        let reference_1 = image(4, 1, &[2.0, 0.0, 0.0, 2.0]);
+        // Pixel 1 flips in both (an edge moving with the camera); pixel 2 flips in the render
+        // only (popping); pixel 3 flips in the reference only (the render lags).
+        let render_0 = image(4, 1, &[1.0, 1.0, 0.0, 0.0]);
+        let render_1 = image(4, 1, &[1.0, 0.0, 0.9, 0.0]);
+        let f = shadow_flips([&render_0, &render_1], [&reference_0, &reference_1], 0.25).unwrap();
+        assert_eq!((f.render, f.reference, f.spurious), (2, 2, 1));
+        assert_eq!(f.fraction, 0.25);
+        // Each frame has its own threshold: a frame twice as bright overall flips nothing.
+        let brighter = image(4, 1, &[4.0, 4.0, 0.0, 0.0]);
+        let f = shadow_flips([&render_0, &brighter], [&reference_0, &brighter], 0.25).unwrap();
+        assert_eq!((f.render, f.spurious), (0, 0));
+        let small = image(2, 1, &[0.0; 2]);
+        assert!(shadow_flips([&render_0, &small], [&reference_0, &reference_1], 0.25).is_err());
+        assert!(shadow_flips([&render_0, &render_1], [&reference_0, &reference_1], 0.0).is_err());
+    }
+
+    #[test]
+    fn convergence_is_the_frame_after_which_the_error_no_longer_falls() {
+        // A constant error (a conventional map at rest) has converged when the camera stops.
+        assert_eq!(frames_to_converge(&[0.02; 5], 1e-4), Some(0));
+        // Refinement: falls for three frames, then stays within the tolerance.
+        let refining = [0.05, 0.03, 0.021, 0.0205, 0.0207, 0.0204];
+        assert_eq!(frames_to_converge(&refining, 1e-3), Some(2));
+        assert_eq!(frames_to_converge(&refining, 1e-5), None, "still falling by more than 1e-5");
+        // A later drop counts even after a plateau: not converged before it.
+        assert_eq!(frames_to_converge(&[0.05, 0.05, 0.05, 0.01, 0.01], 1e-3), Some(3));
+        // A rise does not reset convergence.
+        assert_eq!(frames_to_converge(&[0.04, 0.02, 0.03, 0.025], 1e-3), Some(1));
+        // Still falling at the end, or nothing to judge.
+        assert_eq!(frames_to_converge(&[0.05, 0.04, 0.03], 1e-3), None);
+        assert_eq!(frames_to_converge(&[], 1e-3), None);
+        assert_eq!(frames_to_converge(&[0.3], 1e-3), Some(0));
     }
 
     #[test]

@@ -21,7 +21,10 @@ pub mod render;
 pub mod statistics;
 
 pub use irradiance::{IrradianceFile, IrradianceReference, PointsFile};
-pub use metrics::{compare, diff_image, shadow_mismatch, ImageMetrics, ShadowMismatch, SHADOW_THRESHOLD};
+pub use metrics::{
+    compare, diff_image, frames_to_converge, shadow_flips, shadow_mismatch, ImageMetrics, ShadowFlips,
+    ShadowMismatch, SHADOW_THRESHOLD,
+};
 pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
 pub use statistics::Statistics;
 

@@ -111,6 +111,14 @@ impl ReferenceRenderer {
         Ok(())
     }
 
+    /// Moves the camera (checked as a scene file's camera is) and starts the image over: the
+    /// next batch replaces what was accumulated.
+    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        self.camera = camera.validated()?;
+        self.samples = 0;
+        Ok(())
+    }
+
     /// Samples per pixel accumulated so far.
     pub fn samples(&self) -> u32 {
         self.samples

@@ -19,6 +19,7 @@ use crate::backend::{Buffer, Context};
 use crate::error::Result;
 use crate::pass::Pass;
 use crate::renderer::{GpuScene, Targets};
+use crate::scene::Light;
 use environment::GpuEnvironment;
 use glam::Mat4;
 use std::sync::Arc;
@@ -41,6 +42,8 @@ pub struct FrameState<'a> {
     pub transforms: &'a [Mat4],
     /// The environment's rotation about +Y, in radians (counter-clockwise seen from above).
     pub env_rotation: f32,
+    /// The scene's point and spot lights as they are this frame (`Renderer::set_light`).
+    pub lights: &'a [Light],
 }
 
 /// A lighting technique: host-side updates, then the passes that draw the scene over the
@@ -57,5 +60,10 @@ pub trait Technique {
     /// unshadowed): 0 for techniques without a layer budget.
     fn dropped_layers(&self) -> usize {
         0
+    }
+    /// Bytes of the shadow storage of the scene's local lights (maps, tile pools), what the
+    /// memory comparisons of shadow-map techniques count; `None` for techniques without one.
+    fn shadow_memory_bytes(&self) -> Option<u64> {
+        None
     }
 }

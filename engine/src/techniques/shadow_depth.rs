@@ -53,6 +53,11 @@ impl ShadowMaps {
         })
     }
 
+    /// Bytes of the maps: side² × 4 (D32) per layer.
+    pub fn byte_size(&self) -> Result<u64> {
+        self.maps.byte_size()
+    }
+
     /// The maps as a scene shader samples them (`sampler2DArray`, nearest texel).
     pub fn binding(&self) -> Binding<'_> {
         Binding::Sampled(&self.maps, &self.nearest)

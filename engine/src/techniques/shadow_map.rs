@@ -48,7 +48,6 @@ const SLOPE_BIAS_TEXELS: f32 = 1.0;
 const MAX_SLOPE: f32 = 10.0;
 
 pub struct ShadowMap {
-    lights: Vec<Light>,
     bounds: Vec<GroupBounds>,
     size: u32,
     /// One map per light.
@@ -93,7 +92,6 @@ impl ShadowMap {
             },
         )?;
         Ok(ShadowMap {
-            lights: scene.lights.clone(),
             bounds: group_bounds(scene),
             size,
             shadow_maps: ShadowMaps::new(ctx, "shadow_map", size, scene.lights.len() as u32)?,
@@ -134,8 +132,10 @@ fn shadow_light(light: &Light, centre: Vec3, radius: f32, size: u32) -> ShadowLi
 impl Technique for ShadowMap {
     fn update(&mut self, state: &FrameState) -> Result<()> {
         let (centre, radius) = scene_sphere(&self.bounds, state.transforms);
+        // The records (and so the maps) are redone from the lights every frame: a moved light
+        // needs nothing else.
         let records: Vec<ShadowLight> =
-            self.lights.iter().map(|l| shadow_light(l, centre, radius, self.size)).collect();
+            state.lights.iter().map(|l| shadow_light(l, centre, radius, self.size)).collect();
         self.shadow_maps.view_projs =
             records.iter().map(|r| Mat4::from_cols_array_2d(&r.view_proj)).collect();
         self.records.write(0, bytes_of_slice(&records))
@@ -159,5 +159,10 @@ impl Technique for ShadowMap {
                 }
             });
         vec![shadow_maps, scene_pass]
+    }
+
+    fn shadow_memory_bytes(&self) -> Option<u64> {
+        // D32 has a texel size, so this never fails.
+        self.shadow_maps.byte_size().ok()
     }
 }

@@ -1,4 +1,5 @@
-//! `pareto.png`: GPU time against error on log scales, one series per technique, the Pareto
+//! GPU time against error on log scales (`kage sweep`'s `pareto.png`, `kage bench asm`'s
+//! `error-time.png`), one series per technique, the Pareto
 //! front drawn through the settings nothing beats.
 use super::pick::{pareto_front, Point};
 use anyhow::{anyhow, Context as _, Result};
@@ -27,8 +28,9 @@ fn font() -> Result<()> {
         .map_err(|e| anyhow!(e))
 }
 
-/// Draws `points` (all with a time and an error above 0) to the PNG at `path`.
-pub fn write(path: &Path, title: &str, points: &[Point]) -> Result<()> {
+/// Draws `points` (all with a time and an error above 0) to the PNG at `path`; `error` names
+/// the y axis (what the points' errors measure).
+pub fn write(path: &Path, title: &str, error: &str, points: &[Point]) -> Result<()> {
     font()?;
     let range = |values: Vec<f64>| {
         let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
@@ -38,7 +40,8 @@ pub fn write(path: &Path, title: &str, points: &[Point]) -> Result<()> {
     let xs = range(points.iter().map(|p| p.ms).collect());
     let ys = range(points.iter().map(|p| p.error).collect());
     let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    draw(&mut pixels, title, points, xs, ys).map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+    draw(&mut pixels, title, error, points, xs, ys)
+        .map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
     image::RgbImage::from_raw(SIZE.0, SIZE.1, pixels)
         .expect("the buffer holds SIZE.0 × SIZE.1 RGB pixels")
         .save(path)
@@ -48,6 +51,7 @@ pub fn write(path: &Path, title: &str, points: &[Point]) -> Result<()> {
 fn draw(
     pixels: &mut [u8],
     title: &str,
+    error: &str,
     points: &[Point],
     xs: std::ops::Range<f64>,
     ys: std::ops::Range<f64>,
@@ -66,7 +70,9 @@ fn draw(
     chart
         .configure_mesh()
         .x_desc("GPU ms per frame (median)")
-        .y_desc("relative RMSE against the reference")
+        .y_desc(error)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
         .label_style(("sans-serif", 14))
         .draw()?;
     let front: Vec<(f64, f64)> =
@@ -97,6 +103,13 @@ fn draw(
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// A tick's value as written: the ticks are one digit times a power of ten, so one significant
+/// digit is exact (and hides the float's rounding: 0.009, not 0.009000000000001).
+fn tick_label(value: &f64) -> String {
+    let exponent = (value.log10() + 1e-9).floor() as i32;
+    format!("{value:.*}", (-exponent).max(0) as usize)
 }
 
 /// Labelled values of a log axis: 1, 2 and 5 times the powers of ten within `range`, and every

@@ -2,8 +2,8 @@
 //! against the ray-traced reference at several poses of the animation, its GPU time per frame
 //! while the scene moves, its precomputation time and its device memory, in `DIR/sweep.csv`;
 //! time against error in `DIR/pareto.png`; and, asked, the setting to pick under a bound.
-mod chart;
-mod pick;
+pub(crate) mod chart;
+pub(crate) mod pick;
 
 use crate::transfer_source::PrtArgs;
 use crate::GpuArgs;
@@ -311,7 +311,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             "{} under {lit_by}: {} frames at {}², error at {}²",
             scene.name, args.frames, args.time_size, args.size
         );
-        chart::write(&args.out.join(&file), &title, &points)?;
+        chart::write(&args.out.join(&file), &title, "relative RMSE against the reference", &points)?;
         println!("wrote {}", args.out.join(&file).display());
         if args.pick {
             print_picks(env, &points, args.max_error, args.max_ms);

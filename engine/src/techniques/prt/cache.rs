@@ -339,19 +339,27 @@ impl Fnv128 {
     }
 }
 
-struct Fnv64(u64);
+/// 64-bit FNV-1a, for file names keyed by their contents (this cache's, the benchmarks' cached
+/// references).
+pub struct Fnv64(u64);
 
 impl Fnv64 {
-    fn new() -> Self {
+    pub fn new() -> Self {
         Fnv64(0xcbf29ce484222325)
     }
-    fn write(&mut self, bytes: &[u8]) {
+    pub fn write(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x100000001b3);
         }
     }
-    fn finish(&self) -> u64 {
+    pub fn finish(&self) -> u64 {
         self.0
+    }
+}
+
+impl Default for Fnv64 {
+    fn default() -> Self {
+        Fnv64::new()
     }
 }
 
