@@ -67,5 +67,7 @@
 // The deepest quadtree level: 2^16 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 16
+// Workgroup of the ASM refinement analysis: 8x8 eye pixels.
+#define KAGE_ASM_ANALYSIS_GROUP 8
 
 #endif

@@ -58,4 +58,8 @@ pub trait Technique {
     fn dropped_layers(&self) -> usize {
         0
     }
+    /// The adaptive shadow map's hierarchy after the last update; `None` for other techniques.
+    fn asm_stats(&self) -> Option<asm::AsmStats> {
+        None
+    }
 }
