@@ -74,10 +74,11 @@ void main() {
     if (tile.y >= uint(KAGE_ASM_MAX_LEVEL)) return;
     // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
     // level L has texels of 1 / (TILE 2^L) a side, so it matches the pixel where
-    // 2^L = 1 / (TILE sqrt(area)).
+    // 2^L = 1 / (TILE sqrt(area)); KAGE_ASM_EXTRA_LEVELS finer.
     vec2 ux = light_uv(s, p + dx) - m.xy, uy = light_uv(s, p + dy) - m.xy;
     float area = abs(ux.x * uy.y - ux.y * uy.x);
     float needed = area > 0.0 ? -log2(float(KAGE_ASM_TILE_TEXELS) * sqrt(area)) : float(KAGE_ASM_MAX_LEVEL);
+    needed += float(KAGE_ASM_EXTRA_LEVELS);
     float missing = min(ceil(needed), float(KAGE_ASM_MAX_LEVEL)) - float(tile.y);
     if (missing < 1.0) return;
     // On a shadow edge: the receiver's visibility against its texel and the 8 around it
