@@ -121,6 +121,12 @@ enum kage_technique
    * `shadow_map_size`² texels per light (1 to 8 lights).
    */
   KAGE_TECHNIQUE_SHADOW_MAP = 5,
+  /**
+   * Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light:
+   * a quadtree of tiles in a page pool of `asm_budget_mb`, refined where the eye sees shadow
+   * edges coarser than its pixels, `asm_time_ms` of tile rendering per frame.
+   */
+  KAGE_TECHNIQUE_ASM = 6,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -184,6 +190,11 @@ typedef uint32_t kage_pixel_format;
  * What to precompute.
  */
 typedef struct PrtParams PrtParams;
+
+/**
+ * A rectangle of the light's view uv (u right, v down, the unit square the whole view).
+ */
+typedef struct UvRect UvRect;
 
 /**
  * A Vulkan device, queue and memory allocator that scenes are precomputed and rendered with.
@@ -299,6 +310,14 @@ typedef struct {
    * A `kage_probe_light` value; default sky and walls.
    */
   uint32_t probe_light;
+  /**
+   * Adaptive shadow maps: the page pool's budget in MB (MiB), never exceeded; default 16.
+   */
+  double asm_budget_mb;
+  /**
+   * Adaptive shadow maps: tile rendering time per frame in ms; default 8.
+   */
+  double asm_time_ms;
 } kage_technique_desc;
 
 /**

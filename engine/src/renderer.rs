@@ -6,6 +6,8 @@ use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::{Light, Scene};
+use crate::techniques::asm::technique::Asm;
+use crate::techniques::asm::{AsmSettings, AsmStats};
 use crate::techniques::background::Background;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
@@ -123,7 +125,8 @@ impl Targets {
                 layers: 1,
                 array: false,
                 format: DEPTH_FORMAT,
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                // Sampled: the ASM refinement analysis reads the visible surfaces back.
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
             },
         )?;
         let readback = Buffer::new(
@@ -157,6 +160,8 @@ pub enum TechniqueChoice {
     /// The scene's point and spot lights with hard shadows from one conventional shadow map of
     /// `size`² texels per light (the baseline of adaptive shadow maps).
     ShadowMap { size: u32 },
+    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light.
+    Asm(AsmSettings),
 }
 
 /// What to render and how large.
@@ -203,6 +208,7 @@ impl Renderer {
             }
             TechniqueChoice::Probes(settings) => Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings)?),
             TechniqueChoice::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
+            TechniqueChoice::Asm(settings) => Box::new(Asm::new(ctx, scene, &gpu, *settings)?),
         };
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -326,6 +332,12 @@ impl Renderer {
     /// `Technique::shadow_memory_bytes`); `None` when it has no shadow storage.
     pub fn shadow_memory_bytes(&self) -> Option<u64> {
         self.technique.shadow_memory_bytes()
+    }
+
+    /// The adaptive shadow map's hierarchy after the last frame (`None` unless the technique
+    /// is `Asm`): bytes against the budget, resident tiles, deepest level, tiles rendered.
+    pub fn asm_stats(&self) -> Option<AsmStats> {
+        self.technique.asm_stats()
     }
 
     /// The last rendered frame: linear radiance, row 0 at the top.

@@ -67,5 +67,11 @@
 // The deepest quadtree level: 2^16 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 16
+// Levels the ASM refinement asks for beyond the one whose texels match the eye pixel's
+// footprint: a nearest-texel edge lies up to ~0.7 texel off, so texels a quarter of the pixel
+// keep the lit/shadowed state of pixel centres right but within ~0.2 pixel of an edge.
+#define KAGE_ASM_EXTRA_LEVELS 2
+// Workgroup of the ASM refinement analysis: 8x8 eye pixels.
+#define KAGE_ASM_ANALYSIS_GROUP 8
 
 #endif

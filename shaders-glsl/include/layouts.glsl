@@ -235,4 +235,12 @@ struct AsmNode {
     uvec4 tile; // x: physical page (layer of the tile array), y: level, z, w: tile x, y at that level
 };
 
+// Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer holds
+// three uint arrays of `size.z` (page table nodes) blocks: a used flag per node, then per node
+// and quadrant the edge pixels asking for that child tile and the sum of their missing levels.
+struct AsmAnalysisPush {
+    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: unused
+    vec4 bias; // as LocalDrawPush.bias
+};
+
 #endif

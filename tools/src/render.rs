@@ -7,6 +7,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
+use kage::techniques::asm::technique::MB;
+use kage::techniques::asm::AsmSettings;
 use kage::techniques::probes::{CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings};
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
@@ -28,6 +30,8 @@ pub enum TechniqueName {
     Shadowmap,
     /// Morishige 2014: light probes captured as SH light the moving group (the first).
     Probes,
+    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light.
+    Asm,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,6 +65,13 @@ pub struct RenderArgs {
     /// Side of a shadow map, texels: parallel-lights 16 to 2048, shadowmap 16 to 8192.
     #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
+    /// Adaptive shadow maps: the page pool's budget, MB (MiB); never exceeded.
+    #[arg(long, default_value_t = AsmSettings::default().budget_mb)]
+    asm_budget_mb: f64,
+    /// Adaptive shadow maps: tile rendering time per frame, ms, as the start-up calibration
+    /// predicts it.
+    #[arg(long, default_value_t = AsmSettings::default().time_ms)]
+    asm_time_ms: f64,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each) or a file {"positions": [[x,y,z], ...]}.
     #[arg(long, default_value = "grid:3,2,3")]
@@ -129,6 +140,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
             TechniqueName::Probes => TechniqueKind::Probes,
             TechniqueName::Shadowmap => TechniqueKind::ShadowMap,
+            TechniqueName::Asm => TechniqueKind::Asm,
         },
         prt: args.prt.params()?,
         regions: args.regions,
@@ -148,6 +160,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 },
             },
         },
+        asm: AsmSettings { budget_mb: args.asm_budget_mb, time_ms: args.asm_time_ms },
     }
     .validated()?;
     let transfer = match settings.precomputation() {
@@ -197,6 +210,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     bar.finish_and_clear();
+    if let Some(stats) = renderer.asm_stats() {
+        println!(
+            "asm: {} tiles resident, {:.2} of {:.2} MB, deepest level {}, {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",
+            stats.resident_tiles,
+            stats.bytes_used as f64 / MB as f64,
+            stats.budget_bytes as f64 / MB as f64,
+            stats.deepest_level,
+            stats.rendered.len(),
+            stats.cost.0,
+            stats.cost.1
+        );
+    }
     if dropped > 0 {
         eprintln!(
             "kage: note: up to {dropped} occlusion layer(s) per frame did not fit the {} Kage keeps; the least energetic regions' shadows between groups were left out",

@@ -148,6 +148,12 @@ impl Buffer {
         })
     }
 
+    /// Records filling the whole buffer with zeros (it needs `TRANSFER_DST` usage).
+    pub fn record_zero(&self, cmd: vk::CommandBuffer) {
+        // SAFETY: recording command buffer of this device; the buffer outlives the submission.
+        unsafe { self.ctx.device.cmd_fill_buffer(cmd, self.raw, 0, vk::WHOLE_SIZE, 0) };
+    }
+
     /// Reads the whole buffer back to the host (waits for the GPU).
     pub fn read(&self) -> Result<Vec<u8>> {
         if let Some(mapped) = self.mapped() {

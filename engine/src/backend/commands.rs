@@ -109,4 +109,21 @@ impl Context {
             )
         };
     }
+
+    /// Opens a debug label (a named region debuggers show) when debug utils are on.
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        let Some(debug) = &self.debug else { return };
+        let Ok(name) = std::ffi::CString::new(name) else { return };
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
+        // SAFETY: recording command buffer; the label string outlives the call.
+        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+
+    /// Closes the label `begin_label` opened.
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(debug) = &self.debug {
+            // SAFETY: matches a begin_label before it in the same command buffer.
+            unsafe { debug.cmd_end_debug_utils_label(cmd) };
+        }
+    }
 }

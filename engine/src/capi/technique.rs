@@ -4,6 +4,7 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
+use crate::techniques::asm::AsmSettings;
 use crate::techniques::probes::{
     CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings, DEFAULT_GRID,
 };
@@ -33,6 +34,10 @@ pub enum kage_technique {
     /// The scene's point and spot lights with hard shadows from one conventional shadow map of
     /// `shadow_map_size`² texels per light (1 to 8 lights).
     ShadowMap = 5,
+    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light:
+    /// a quadtree of tiles in a page pool of `asm_budget_mb`, refined where the eye sees shadow
+    /// edges coarser than its pixels, `asm_time_ms` of tile rendering per frame.
+    Asm = 6,
 }
 
 /// What the light probes capture (the values of `kage_technique_desc.probe_light`).
@@ -85,6 +90,10 @@ pub struct kage_technique_desc {
     pub probe_cube_size: u32,
     /// A `kage_probe_light` value; default sky and walls.
     pub probe_light: u32,
+    /// Adaptive shadow maps: the page pool's budget in MB (MiB), never exceeded; default 16.
+    pub asm_budget_mb: f64,
+    /// Adaptive shadow maps: tile rendering time per frame in ms; default 8.
+    pub asm_time_ms: f64,
 }
 
 impl kage_technique_desc {
@@ -100,6 +109,7 @@ impl kage_technique_desc {
                 (T::ParallelLights as u32, TechniqueKind::ParallelLights),
                 (T::ShadowMap as u32, TechniqueKind::ShadowMap),
                 (T::Probes as u32, TechniqueKind::Probes),
+                (T::Asm as u32, TechniqueKind::Asm),
             ],
         )?;
         let probe_light = args::enumeration(
@@ -129,6 +139,7 @@ impl kage_technique_desc {
                 placement: ProbePlacement::Grid(self.probe_grid),
                 capture: CaptureSettings { cube_size: self.probe_cube_size, light: probe_light },
             },
+            asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms },
         }
         .validated()?)
     }
@@ -158,6 +169,8 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_grid: DEFAULT_GRID,
             probe_cube_size: d.probes.capture.cube_size,
             probe_light: kage_probe_light::SkyAndWalls as u32,
+            asm_budget_mb: d.asm.budget_mb,
+            asm_time_ms: d.asm.time_ms,
         };
         // An unknown technique is reported here already, not at the first use.
         filled.settings()?;

@@ -22,7 +22,6 @@ pub use timings::{median, TimingRow, TimingTable};
 use crate::backend::{Context, TimestampPool};
 use crate::error::{Error, Result};
 use ash::vk;
-use std::ffi::CString;
 use std::sync::Arc;
 
 /// One pass of a frame.
@@ -94,7 +93,7 @@ impl FrameExecutor {
             if i > 0 {
                 self.ctx.full_barrier(cmd);
             }
-            self.begin_label(cmd, pass.name);
+            self.ctx.begin_label(cmd, pass.name);
             if let Some(t) = timestamps {
                 t.write(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, 2 * i as u32);
             }
@@ -102,7 +101,7 @@ impl FrameExecutor {
             if let Some(t) = timestamps {
                 t.write(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * i as u32 + 1);
             }
-            self.end_label(cmd);
+            self.ctx.end_label(cmd);
         }
         if let Err(e) = self.ctx.submit_and_wait(recorder) {
             // The command buffer may still be pending after a timeout or device loss: never
@@ -125,21 +124,6 @@ impl FrameExecutor {
                     .map(|(t, period)| t[2 * i + 1].saturating_sub(t[2 * i]) as f64 * period * 1e-6),
             })
             .collect())
-    }
-
-    fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
-        let Some(debug) = &self.ctx.debug else { return };
-        let Ok(name) = CString::new(name) else { return };
-        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
-        // SAFETY: recording command buffer; the label string outlives the call.
-        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
-    }
-
-    fn end_label(&self, cmd: vk::CommandBuffer) {
-        if let Some(debug) = &self.ctx.debug {
-            // SAFETY: matches the begin_label just before.
-            unsafe { debug.cmd_end_debug_utils_label(cmd) };
-        }
     }
 }
 

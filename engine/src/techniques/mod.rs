@@ -66,4 +66,8 @@ pub trait Technique {
     fn shadow_memory_bytes(&self) -> Option<u64> {
         None
     }
+    /// The adaptive shadow map's hierarchy after the last update; `None` for other techniques.
+    fn asm_stats(&self) -> Option<asm::AsmStats> {
+        None
+    }
 }

@@ -1,6 +1,7 @@
 //! A technique named with all its parameters: what the command line's options and the C ABI's
 //! `kage_technique_desc` both turn into, checked in one place, and turned into the renderer's
 //! [`TechniqueChoice`] once the precomputation it needs is done.
+use super::asm::AsmSettings;
 use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use super::probes::ProbeSettings;
 use super::prt::{PrtParams, TransferSet};
@@ -25,6 +26,8 @@ pub enum TechniqueKind {
     /// The scene's point and spot lights with hard shadows from one conventional shadow map
     /// per light.
     ShadowMap,
+    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light.
+    Asm,
 }
 
 /// Every parameter of every technique; each technique reads the ones it uses.
@@ -42,6 +45,8 @@ pub struct TechniqueSettings {
     pub shadow_map_size: u32,
     /// Placement and capture of the light probes.
     pub probes: ProbeSettings,
+    /// Adaptive shadow maps: memory and time budgets.
+    pub asm: AsmSettings,
 }
 
 impl Default for TechniqueSettings {
@@ -55,6 +60,7 @@ impl Default for TechniqueSettings {
             penumbra: occlusion.penumbra,
             shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
             probes: ProbeSettings::default(),
+            asm: AsmSettings::default(),
         }
     }
 }
@@ -73,6 +79,9 @@ impl TechniqueSettings {
         }
         if self.kind == TechniqueKind::Probes {
             self.probes = self.probes.validated()?;
+        }
+        if self.kind == TechniqueKind::Asm {
+            self.asm = self.asm.validated()?;
         }
         // Zero regions would quietly be Sloan's technique (see `TechniqueChoice::Prt`).
         if self.kind == TechniqueKind::Tamura && self.regions == 0 {
@@ -116,6 +125,7 @@ impl TechniqueSettings {
             }),
             TechniqueKind::Probes => Ok(TechniqueChoice::Probes(settings.probes)),
             TechniqueKind::ShadowMap => Ok(TechniqueChoice::ShadowMap { size: settings.shadow_map_size }),
+            TechniqueKind::Asm => Ok(TechniqueChoice::Asm(settings.asm)),
         }
     }
 }
@@ -147,6 +157,11 @@ mod tests {
         assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
         assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
         assert!(matches!(of(TechniqueKind::Probes).choice(None), Ok(TechniqueChoice::Probes(_))));
+        let asm =
+            TechniqueSettings { asm: AsmSettings { budget_mb: 4.0, time_ms: 2.0 }, ..of(TechniqueKind::Asm) };
+        assert!(
+            matches!(asm.choice(None), Ok(TechniqueChoice::Asm(s)) if s.budget_mb == 4.0 && s.time_ms == 2.0)
+        );
         assert_eq!(of(TechniqueKind::Probes).precomputation(), None);
     }
 
@@ -164,5 +179,10 @@ mod tests {
         probes.probes = ProbeSettings::default();
         probes.probes.capture.cube_size = 512;
         assert!(error(probes, None).contains("cube map size 512"));
+        let mut asm = TechniqueSettings { kind: TechniqueKind::Asm, ..Default::default() };
+        asm.asm.budget_mb = 0.01;
+        assert!(error(asm.clone(), None).contains("holds no tile"));
+        asm.asm = AsmSettings { time_ms: 0.0, ..AsmSettings::default() };
+        assert!(error(asm, None).contains("time budget"));
     }
 }

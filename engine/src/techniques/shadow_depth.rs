@@ -1,7 +1,8 @@
 //! What every shadow-map technique keeps and records first: a D32 array of square maps, one
 //! layer per light, each rendered depth-only with every mesh of the scene from that light's
 //! view, and read back with nearest-texel lookups. Shared by the parallel-lights baseline
-//! (orthographic maps) and the shadowmap technique (perspective maps of local lights).
+//! (orthographic maps), the shadowmap technique (perspective maps of local lights) and adaptive
+//! shadow maps (its page pool: one tile per layer).
 use super::unshadowed::MESH_POSITIONS;
 use crate::backend::{
     vk, Binding, Context, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, Target,
@@ -9,7 +10,7 @@ use crate::backend::{
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
 use crate::pass::Pass;
-use crate::renderer::{GpuScene, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene, DEPTH_FORMAT};
 use glam::Mat4;
 use std::sync::Arc;
 
@@ -67,25 +68,25 @@ impl ShadowMaps {
     pub fn pass<'a>(&'a self, ctx: &'a Context, scene: &'a GpuScene) -> Pass<'a> {
         Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
             for (layer, view_proj) in self.view_projs.iter().enumerate() {
-                let target = Target { image: &self.maps, layer: layer as u32 };
-                self.record(ctx, cmd, scene, target, view_proj);
+                self.record(ctx, cmd, scene, layer as u32, view_proj, |_| true);
             }
         })
     }
 
-    /// Records one rendering scope that clears `target` and draws every mesh of `scene` with
-    /// `view_proj` (world to the map's clip space).
-    fn record(
+    /// Records one rendering scope that clears map `layer` and draws the meshes of `scene` that
+    /// `draws` keeps with `view_proj` (world to the map's clip space).
+    pub fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        target: Target,
+        layer: u32,
         view_proj: &Mat4,
+        draws: impl Fn(&GpuMesh) -> bool,
     ) {
-        ctx.begin_rendering(cmd, None, None, Some(target));
+        ctx.begin_rendering(cmd, None, None, Some(Target { image: &self.maps, layer }));
         self.pipeline.bind(cmd, &[]);
-        for mesh in &scene.meshes {
+        for mesh in scene.meshes.iter().filter(|m| draws(m)) {
             let push = ShadowDepthPush {
                 model: scene.transforms[mesh.group].to_cols_array_2d(),
                 view_proj: view_proj.to_cols_array_2d(),

@@ -46,6 +46,9 @@ const CONSTANT_BIAS_TEXELS: f32 = 0.5;
 const SLOPE_BIAS_TEXELS: f32 = 1.0;
 /// tan θ beyond which the bias stops growing (θ ≈ 84°).
 const MAX_SLOPE: f32 = 10.0;
+/// `LocalDrawPush.bias`: the slope-scaled depth bias of every local-light shadow map (this
+/// technique's and adaptive shadow maps' tiles).
+pub(crate) const DEPTH_BIAS: [f32; 4] = [CONSTANT_BIAS_TEXELS, SLOPE_BIAS_TEXELS, MAX_SLOPE, 0.0];
 
 pub struct ShadowMap {
     bounds: Vec<GroupBounds>,
@@ -110,8 +113,9 @@ fn map_view(light: &Light) -> (Vec3, Vec3, f32) {
 }
 
 /// The record of one light for this frame's scene sphere (`centre`, `radius`): the map's
-/// view-projection with near and far planes around the sphere.
-fn shadow_light(light: &Light, centre: Vec3, radius: f32, size: u32) -> ShadowLight {
+/// view-projection with near and far planes around the sphere, for a map of `size`² texels
+/// (adaptive shadow maps: the root tile's).
+pub(crate) fn shadow_light(light: &Light, centre: Vec3, radius: f32, size: u32) -> ShadowLight {
     let (position, axis, fov_deg) = map_view(light);
     let distance = position.distance(centre);
     // A light inside the sphere still gets a near plane in front of it: 1/1000 of the scene
@@ -155,7 +159,7 @@ impl Technique for ShadowMap {
                     model: model.to_cols_array_2d(),
                     albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
                     params: [count, 0, 0, 0],
-                    bias: [CONSTANT_BIAS_TEXELS, SLOPE_BIAS_TEXELS, MAX_SLOPE, 0.0],
+                    bias: DEPTH_BIAS,
                 }
             });
         vec![shadow_maps, scene_pass]

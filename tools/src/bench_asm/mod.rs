@@ -20,6 +20,7 @@ use kage::imageio::RgbaF32Image;
 use kage::reference::{shadow_flips, shadow_mismatch, SHADOW_THRESHOLD};
 use kage::renderer::{RenderOptions, Renderer, MAX_SIZE};
 use kage::scene::Scene;
+use kage::techniques::asm::AsmSettings;
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use report::{FrameRow, Series};
 use std::path::PathBuf;
@@ -31,8 +32,8 @@ pub struct AsmBenchArgs {
     #[arg(long, default_value = "asm")]
     scene: String,
     /// The configurations, `KIND:VALUE` each: `shadowmap:SIDE` (a conventional map of SIDE²
-    /// texels per light). The first is the one the others' frame times are divided by.
-    #[arg(long, value_delimiter = ',', default_values_t = ["shadowmap:1024".to_string(), "shadowmap:2048".into(), "shadowmap:4096".into()])]
+    /// texels per light), `asm:MB` (an adaptive shadow map within MB megabytes). The first is the one the others' frame times are divided by.
+    #[arg(long, value_delimiter = ',', default_values_t = ["shadowmap:1024".to_string(), "shadowmap:2048".into(), "shadowmap:4096".into(), "asm:4".into(), "asm:8".into(), "asm:16".into()])]
     configs: Vec<String>,
     /// Frames sampling the walkthrough (t = i / frames, as `kage render --animate`).
     #[arg(long, default_value_t = 40)]
@@ -76,12 +77,20 @@ struct ConfigKind {
     settings: fn(&str) -> Result<TechniqueSettings>,
 }
 
-const KINDS: &[ConfigKind] =
-    &[ConfigKind { name: "shadowmap", series: "shadow map (side, texels)", settings: shadowmap }];
+const KINDS: &[ConfigKind] = &[
+    ConfigKind { name: "shadowmap", series: "shadow map (side, texels)", settings: shadowmap },
+    ConfigKind { name: "asm", series: "adaptive shadow map (budget, MB)", settings: asm },
+];
 
 fn shadowmap(value: &str) -> Result<TechniqueSettings> {
     let size = value.parse().with_context(|| format!("{value:?} is not a whole number of texels"))?;
     Ok(TechniqueSettings { kind: TechniqueKind::ShadowMap, shadow_map_size: size, ..Default::default() })
+}
+
+fn asm(value: &str) -> Result<TechniqueSettings> {
+    let budget_mb = value.parse().with_context(|| format!("{value:?} is not a number of MB"))?;
+    let asm = AsmSettings { budget_mb, ..AsmSettings::default() };
+    Ok(TechniqueSettings { kind: TechniqueKind::Asm, asm, ..Default::default() })
 }
 
 /// One configuration of the run.

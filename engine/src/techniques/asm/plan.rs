@@ -1,0 +1,139 @@
+//! The refinement planner (Fernando et al. 2001, section 4.2): which requested tiles to render
+//! this frame. A request is a child tile (a quadrant of a resident tile) that the analysis found
+//! eye pixels on a shadow edge in, whose shadow resolution is coarser than the eye's.
+//!
+//! - Benefit: edge pixels × resolution deficit, the deficit being the mean number of levels
+//!   (factors of two in texel size) those pixels lack.
+//! - Cost: a·N + b milliseconds, N the triangles drawn for the tile (the groups whose light-uv
+//!   bounds overlap it), a and b fitted by least squares to timed tile renders on the running
+//!   device ([`CostModel::fit`]).
+//! - Requests are taken by benefit/cost, best first, until their summed cost would pass the
+//!   per-frame time budget; the best one is always taken, so that the refinement progresses on
+//!   a device slower than the budget assumes.
+use super::tile::TileKey;
+
+/// A child tile the analysis asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Request {
+    pub key: TileKey,
+    /// Eye pixels on a shadow edge inside it, short of resolution.
+    pub edge_pixels: u32,
+    /// Their missing levels, summed.
+    pub missing_levels: u32,
+    /// Triangles a render of the tile draws.
+    pub triangles: u64,
+}
+
+impl Request {
+    pub fn benefit(&self) -> f64 {
+        // edge pixels × mean deficit = the sum of the pixels' deficits.
+        f64::from(self.missing_levels)
+    }
+}
+
+/// Milliseconds to render a tile of N triangles: a·N + b.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostModel {
+    pub ms_per_triangle: f64,
+    pub ms_per_tile: f64,
+}
+
+impl CostModel {
+    pub fn cost_ms(&self, triangles: u64) -> f64 {
+        self.ms_per_triangle * triangles as f64 + self.ms_per_tile
+    }
+
+    /// The least-squares line through (triangles, ms) samples. Both coefficients are kept
+    /// positive (a timing can only grow with work; a tile is never free): with samples that
+    /// all draw the same N, or noise that tilts the line below zero, the model falls back to a
+    /// per-tile mean with a at 0, or to the line through the origin.
+    pub fn fit(samples: &[(u64, f64)]) -> CostModel {
+        const FLOOR_MS: f64 = 1e-3;
+        let n = samples.len() as f64;
+        if samples.is_empty() {
+            return CostModel { ms_per_triangle: 0.0, ms_per_tile: FLOOR_MS };
+        }
+        let mean_x = samples.iter().map(|s| s.0 as f64).sum::<f64>() / n;
+        let mean_y = samples.iter().map(|s| s.1).sum::<f64>() / n;
+        let sxx: f64 = samples.iter().map(|s| (s.0 as f64 - mean_x).powi(2)).sum();
+        let sxy: f64 = samples.iter().map(|s| (s.0 as f64 - mean_x) * (s.1 - mean_y)).sum();
+        let flat = CostModel { ms_per_triangle: 0.0, ms_per_tile: mean_y.max(FLOOR_MS) };
+        if sxx <= 0.0 || sxy <= 0.0 {
+            return flat;
+        }
+        let a = sxy / sxx;
+        let b = mean_y - a * mean_x;
+        if b >= FLOOR_MS {
+            return CostModel { ms_per_triangle: a, ms_per_tile: b };
+        }
+        let sx2: f64 = samples.iter().map(|s| (s.0 as f64).powi(2)).sum();
+        let sxy0: f64 = samples.iter().map(|s| s.0 as f64 * s.1).sum();
+        CostModel { ms_per_triangle: (sxy0 / sx2).max(0.0), ms_per_tile: FLOOR_MS }
+    }
+}
+
+/// The requests to render this frame, best benefit/cost first, each with that ratio, within
+/// `budget_ms` (the best always).
+pub fn plan(mut requests: Vec<Request>, model: &CostModel, budget_ms: f64) -> Vec<(Request, f32)> {
+    let ratio = |r: &Request| r.benefit() / model.cost_ms(r.triangles);
+    requests.retain(|r| r.benefit() > 0.0);
+    requests.sort_by(|a, b| ratio(b).total_cmp(&ratio(a)).then(a.key.cmp(&b.key)));
+    let mut spent = 0.0;
+    let mut chosen = Vec::new();
+    for r in requests {
+        let cost = model.cost_ms(r.triangles);
+        if !chosen.is_empty() && spent + cost > budget_ms {
+            break;
+        }
+        spent += cost;
+        chosen.push((r, ratio(&r) as f32));
+    }
+    chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request(x: u32, edge_pixels: u32, missing_levels: u32, triangles: u64) -> Request {
+        Request { key: TileKey { level: 1, x, y: 0 }, edge_pixels, missing_levels, triangles }
+    }
+
+    #[test]
+    fn the_fit_recovers_a_line_and_stays_positive() {
+        let line: Vec<(u64, f64)> = [100, 1000, 5000].iter().map(|&n| (n, 0.002 * n as f64 + 0.5)).collect();
+        let m = CostModel::fit(&line);
+        assert!((m.ms_per_triangle - 0.002).abs() < 1e-9 && (m.ms_per_tile - 0.5).abs() < 1e-9, "{m:?}");
+        // Same N everywhere: the mean.
+        let m = CostModel::fit(&[(10, 1.0), (10, 3.0)]);
+        assert_eq!(m, CostModel { ms_per_triangle: 0.0, ms_per_tile: 2.0 });
+        // Falling with N (noise): no negative slope.
+        assert_eq!(CostModel::fit(&[(10, 3.0), (20, 1.0)]).ms_per_triangle, 0.0);
+        // Steep through the origin: the intercept would be negative; kept at the floor.
+        let m = CostModel::fit(&[(10, 0.5), (20, 2.0)]);
+        assert!(m.ms_per_triangle > 0.0 && m.ms_per_tile > 0.0, "{m:?}");
+        assert!(CostModel::fit(&[]).ms_per_tile > 0.0);
+    }
+
+    #[test]
+    fn requests_are_taken_by_benefit_over_cost_within_the_budget() {
+        let model = CostModel { ms_per_triangle: 0.001, ms_per_tile: 1.0 };
+        // Costs: 2 ms, 2 ms, 11 ms, 2 ms; benefits 10, 40, 1000, 0.
+        let requests = vec![
+            request(0, 5, 10, 1000),
+            request(1, 20, 40, 1000),
+            request(2, 400, 1000, 10_000),
+            request(3, 0, 0, 1000),
+        ];
+        let keys = |chosen: &[(Request, f32)]| chosen.iter().map(|(r, _)| r.key.x).collect::<Vec<_>>();
+        // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
+        assert_eq!(keys(&plan(requests.clone(), &model, 15.0)), vec![2, 1, 0]);
+        assert_eq!(keys(&plan(requests.clone(), &model, 13.0)), vec![2, 1]);
+        // The best is taken even when it alone is over budget; nothing after it then.
+        assert_eq!(keys(&plan(requests.clone(), &model, 1.0)), vec![2]);
+        // No benefit, no request.
+        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0).is_empty());
+        let chosen = plan(requests, &model, 100.0);
+        assert!(chosen.windows(2).all(|w| w[0].1 >= w[1].1));
+    }
+}

@@ -1,0 +1,485 @@
+//! The adaptive shadow maps technique (`--technique asm`): one spot or point light, its view a
+//! quadtree of tiles in a page pool under a byte budget, refined every frame where the eye sees
+//! shadow edges at a coarser resolution than its pixels.
+//!
+//! A frame, after the host's update (planning from the last frame's analysis):
+//! 1. `asm_tiles`: the tiles planned this frame, each rendered depth-only into its page with
+//!    the light's projection cropped to its square (one debug label per tile);
+//! 2. `scene`: the shared local-light shading, each point's visibility looked up in the finest
+//!    resident tile holding it (the page table's descent);
+//! 3. `asm_analysis`: per visible eye pixel, the tile it used, and on shadow edges short of
+//!    resolution the child tile it asks for, counted in a buffer the host reads next frame.
+//!
+//! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
+//! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
+//! the scene's depth range did) drops every tile and renders the root again; a group moving
+//! drops the tiles its old or new light-uv bounds overlap, with their descendants, and renders
+//! the root again if it is one of them.
+use super::light_view::{tile_view_proj, UvRect};
+use super::page_table;
+use super::plan::{plan, CostModel, Request};
+use super::pool::{Insert, PagePool, PAGE_BYTES};
+use super::tile::TileKey;
+use crate::backend::{
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsPipeline,
+    MemoryLocation, Sampler,
+};
+use crate::error::{Error, Result};
+use crate::layouts::{
+    bytes_of, bytes_of_slice, constants, spirv, AsmAnalysisPush, AsmNode, LocalDrawPush, ShadowLight,
+};
+use crate::pass::{FrameExecutor, Pass};
+use crate::renderer::GpuScene;
+use crate::scene::{Light, Scene};
+use crate::techniques::parallel_lights::scene_sphere;
+use crate::techniques::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use crate::techniques::shadow_depth::ShadowMaps;
+use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
+use crate::techniques::tamura::occlusion::{group_bounds, GroupBounds};
+use crate::techniques::{FrameInputs, FrameState, Technique};
+use glam::{Mat4, Vec3};
+use std::sync::Arc;
+
+/// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
+pub const MB: u64 = 1 << 20;
+
+/// The technique's parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AsmSettings {
+    /// The page pool's budget, MB: it never holds more tiles than fit.
+    pub budget_mb: f64,
+    /// Per-frame time budget of tile rendering, ms, against the calibrated cost model.
+    pub time_ms: f64,
+}
+
+impl Default for AsmSettings {
+    fn default() -> Self {
+        // 8 ms: a few 128² tiles per frame on lavapipe, with the scene's 5,000 triangles.
+        AsmSettings { budget_mb: 16.0, time_ms: 8.0 }
+    }
+}
+
+impl AsmSettings {
+    pub fn validated(self) -> Result<AsmSettings> {
+        let bytes = self.budget_mb * MB as f64;
+        if !(bytes >= PAGE_BYTES as f64 && bytes.is_finite()) {
+            return Err(Error::InvalidArgument(format!(
+                "an ASM budget of {} MB holds no tile: a tile takes {} KiB",
+                self.budget_mb,
+                PAGE_BYTES / 1024
+            )));
+        }
+        if !(self.time_ms > 0.0 && self.time_ms.is_finite()) {
+            return Err(Error::InvalidArgument(format!(
+                "the ASM time budget {} ms must be positive",
+                self.time_ms
+            )));
+        }
+        Ok(self)
+    }
+
+    pub fn budget_bytes(&self) -> u64 {
+        (self.budget_mb * MB as f64) as u64
+    }
+}
+
+/// What the hierarchy holds after a frame's update, for measurements.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AsmStats {
+    pub budget_bytes: u64,
+    /// Bytes of the resident tiles' pages (never above the budget).
+    pub bytes_used: u64,
+    pub resident_tiles: usize,
+    /// The finest resident level (0: the root alone).
+    pub deepest_level: u32,
+    /// Tiles rendered this frame, in render order.
+    pub rendered: Vec<TileKey>,
+    /// The cost model fitted at start-up: ms per triangle and per tile.
+    pub cost: (f64, f64),
+}
+
+/// A tile to render this frame.
+struct TileRender {
+    key: TileKey,
+    page: u32,
+    view_proj: Mat4,
+    /// Per group: whether its light-uv bounds overlap the tile (else it is not drawn).
+    groups: Vec<bool>,
+}
+
+pub struct Asm {
+    light: Light,
+    bounds: Vec<GroupBounds>,
+    /// Triangles of each group.
+    triangles: Vec<u64>,
+    settings: AsmSettings,
+    pool: PagePool,
+    /// The page pool: one D32 layer of `ASM_TILE_TEXELS`² per page.
+    tiles: ShadowMaps,
+    scene_pipeline: GraphicsPipeline,
+    analysis: ComputePipeline,
+    nearest: Sampler,
+    /// `ShadowLight` records (the light in record 0), as the shadowmap technique's.
+    records: Buffer,
+    /// The page table: `AsmNode` per resident tile, root first.
+    table: Buffer,
+    /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by the next update.
+    requests: Buffer,
+    cost: CostModel,
+    frame: u64,
+    /// Last frame's light record, group transforms and group light-uv bounds.
+    record: Option<ShadowLight>,
+    transforms: Vec<Mat4>,
+    group_rects: Vec<UvRect>,
+    /// The tile of each page-table node the last analysis used.
+    table_keys: Vec<TileKey>,
+    analysed: bool,
+    render: Vec<TileRender>,
+    stats: AsmStats,
+}
+
+/// Uints of the analysis output per page-table node: a used flag, 4 quadrant edge counts and
+/// 4 sums of missing levels.
+const REQUEST_WORDS: u64 = 9;
+
+impl Asm {
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, gpu: &GpuScene, settings: AsmSettings) -> Result<Asm> {
+        let settings = settings.validated()?;
+        let [light] = scene.lights[..] else {
+            return Err(Error::InvalidArgument(format!(
+                "the asm technique shadows exactly one point or spot light; scene {} has {}",
+                scene.name,
+                scene.lights.len()
+            )));
+        };
+        let pool = PagePool::new(settings.budget_bytes())?;
+        let capacity = pool.capacity();
+        let tiles = ShadowMaps::new(ctx, "asm", constants::ASM_TILE_TEXELS, capacity)?;
+        let scene_pipeline = scene_pipeline(
+            ctx,
+            "scene_asm_lights",
+            (spirv::LOCAL_LIGHTS_VERT, spirv::ASM_LIGHTS_FRAG),
+            &[
+                BindingKind::UniformBuffer,
+                BindingKind::UniformBuffer,
+                BindingKind::SampledImage,
+                BindingKind::StorageBuffer,
+            ],
+            size_of::<LocalDrawPush>(),
+        )?;
+        let analysis = ComputePipeline::new(
+            ctx,
+            "asm_analysis",
+            spirv::ASM_ANALYSIS_COMP,
+            &[
+                BindingKind::UniformBuffer,
+                BindingKind::UniformBuffer,
+                BindingKind::SampledImage,
+                BindingKind::StorageBuffer,
+                BindingKind::SampledImage,
+                BindingKind::StorageBuffer,
+            ],
+            size_of::<AsmAnalysisPush>() as u32,
+        )?;
+        let buffer =
+            |name, size, usage, location| Buffer::new(ctx, &BufferDesc { name, size, usage, location });
+        let records = buffer(
+            "asm.lights",
+            u64::from(constants::MAX_LOCAL_LIGHTS) * size_of::<ShadowLight>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let table = buffer(
+            "asm.page_table",
+            u64::from(capacity) * size_of::<AsmNode>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let requests = buffer(
+            "asm.requests",
+            REQUEST_WORDS * u64::from(capacity) * 4,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let triangles = (0..scene.groups.len())
+            .map(|g| gpu.meshes.iter().filter(|m| m.group == g).map(|m| u64::from(m.index_count / 3)).sum())
+            .collect();
+        let mut asm = Asm {
+            light,
+            bounds: group_bounds(scene),
+            triangles,
+            settings,
+            pool,
+            tiles,
+            scene_pipeline,
+            analysis,
+            nearest: Sampler::new(ctx, "asm.eye_depth_sampler", false, Edge::Clamp, Edge::Clamp)?,
+            records,
+            table,
+            requests,
+            cost: CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 },
+            frame: 0,
+            record: None,
+            transforms: Vec::new(),
+            group_rects: Vec::new(),
+            table_keys: Vec::new(),
+            analysed: false,
+            render: Vec::new(),
+            stats: AsmStats::default(),
+        };
+        asm.cost = asm.calibrate(ctx, gpu)?;
+        Ok(asm)
+    }
+
+    /// The cost model a·N + b of a tile render, fitted to timed renders of tiles drawing
+    /// different numbers of triangles on this device (the root, and tiles of levels 1 to 3
+    /// along the view's diagonals), each rendered twice and the second timing kept (the first
+    /// pays for cold caches). Without timestamps the model stays at 1 ms per tile.
+    fn calibrate(&mut self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
+        if ctx.info().timestamp_period_ns.is_none() {
+            return Ok(self.cost);
+        }
+        let (centre, radius) = scene_sphere(&self.bounds, &gpu.transforms);
+        let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
+        let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
+        let rects = self.group_rects_for(&view_proj, &gpu.transforms);
+        let mut keys = vec![TileKey::ROOT];
+        for level in 1..=3u32 {
+            let n = 1 << level;
+            keys.extend([(0, 0), (n - 1, n - 1), (n / 2, n / 2 - 1), (0, n - 1)].map(|(x, y)| TileKey {
+                level,
+                x,
+                y,
+            }));
+        }
+        let renders: Vec<TileRender> =
+            keys.iter().map(|&k| self.tile_render(k, 0, &view_proj, &rects)).collect();
+        let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
+        let mut samples = Vec::new();
+        for round in 0..2 {
+            let passes = renders
+                .iter()
+                .map(|t| {
+                    let tiles = &self.tiles;
+                    Pass::new("asm_calibration", &[], &["asm_calibration"], move |cmd| {
+                        tiles.record(ctx, cmd, gpu, t.page, &t.view_proj, |m| t.groups[m.group])
+                    })
+                })
+                .collect();
+            let timings = executor.run(&[], passes)?;
+            if round == 1 {
+                for (t, timing) in renders.iter().zip(timings) {
+                    samples.push((self.tile_triangles(&t.groups), timing.gpu_ms.unwrap_or(0.0)));
+                }
+            }
+        }
+        Ok(CostModel::fit(&samples))
+    }
+
+    /// Each group's light-uv bounds under `transforms`.
+    fn group_rects_for(&self, view_proj: &Mat4, transforms: &[Mat4]) -> Vec<UvRect> {
+        self.bounds
+            .iter()
+            .zip(transforms)
+            .map(|(b, t)| {
+                let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+                for corner in 0..8 {
+                    let pick = |bit: usize, a: f32, b: f32| if corner >> bit & 1 == 0 { a } else { b };
+                    let local = Vec3::new(
+                        pick(0, b.min.x, b.max.x),
+                        pick(1, b.min.y, b.max.y),
+                        pick(2, b.min.z, b.max.z),
+                    );
+                    let world = t.transform_point3(local);
+                    (lo, hi) = (lo.min(world), hi.max(world));
+                }
+                UvRect::of_box(view_proj, lo, hi)
+            })
+            .collect()
+    }
+
+    fn tile_render(&self, key: TileKey, page: u32, view_proj: &Mat4, rects: &[UvRect]) -> TileRender {
+        let square = UvRect::of_tile(key);
+        TileRender {
+            key,
+            page,
+            view_proj: tile_view_proj(view_proj, key),
+            groups: rects.iter().map(|r| r.overlaps(&square)).collect(),
+        }
+    }
+
+    fn tile_triangles(&self, groups: &[bool]) -> u64 {
+        groups.iter().zip(&self.triangles).filter(|(drawn, _)| **drawn).map(|(_, t)| t).sum()
+    }
+
+    /// Marks the tiles the last frame's lookups used, and turns its edge counts into requests.
+    fn read_requests(&mut self) -> Result<Vec<Request>> {
+        let words: Vec<u32> = self
+            .requests
+            .read()?
+            .chunks_exact(4)
+            .map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        let capacity = self.pool.capacity() as usize;
+        let mut requests = Vec::new();
+        for (node, &key) in self.table_keys.iter().enumerate() {
+            if words[node] != 0 {
+                self.pool.touch(key, self.frame);
+            }
+            let Some(children) = key.children() else { continue };
+            for (q, child) in children.into_iter().enumerate() {
+                let slot = 4 * node + q;
+                let edge_pixels = words[capacity + slot];
+                if edge_pixels == 0 || self.pool.page(key).is_none() {
+                    continue;
+                }
+                let square = UvRect::of_tile(child);
+                let groups: Vec<bool> = self.group_rects.iter().map(|r| r.overlaps(&square)).collect();
+                requests.push(Request {
+                    key: child,
+                    edge_pixels,
+                    missing_levels: words[5 * capacity + slot],
+                    triangles: self.tile_triangles(&groups),
+                });
+            }
+        }
+        Ok(requests)
+    }
+
+    /// The hierarchy's state for measurements.
+    pub fn stats(&self) -> AsmStats {
+        self.stats.clone()
+    }
+}
+
+impl Technique for Asm {
+    fn update(&mut self, state: &FrameState) -> Result<()> {
+        self.frame += 1;
+        // The renderer keeps the scene's light count (Renderer::set_light replaces, never adds),
+        // and `new` accepted exactly one.
+        self.light = state.lights[0].clone();
+        let (centre, radius) = scene_sphere(&self.bounds, state.transforms);
+        let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
+        let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
+        let rects = self.group_rects_for(&view_proj, state.transforms);
+        let mut render = Vec::new();
+        let mut read = self.analysed;
+        if self.record.is_none_or(|r| bytes_of(&r) != bytes_of(&record)) {
+            // The light moved (or the depth range changed): every tile's depths are stale.
+            self.pool = PagePool::new(self.settings.budget_bytes())?;
+            render.push(TileKey::ROOT);
+            read = false;
+        } else {
+            let moved: Vec<UvRect> = (0..rects.len())
+                .filter(|&g| self.transforms[g] != state.transforms[g])
+                .flat_map(|g| [self.group_rects[g], rects[g]])
+                .collect();
+            let touched = |key: TileKey| moved.iter().any(|r| r.overlaps(&UvRect::of_tile(key)));
+            self.pool.drop_where(touched);
+            if touched(TileKey::ROOT) {
+                render.push(TileKey::ROOT);
+            }
+        }
+        self.record = Some(record);
+        self.transforms = state.transforms.to_vec();
+        self.group_rects = rects;
+
+        if read {
+            let requests = self.read_requests()?;
+            for (request, ratio) in plan(requests, &self.cost, self.settings.time_ms) {
+                // A parent evicted by an earlier insertion of this frame refuses its child
+                // (an error from the pool): the child waits for a later frame.
+                if let Ok(Insert::Allocated { .. } | Insert::Replaced { .. }) =
+                    self.pool.insert(request.key, self.frame, ratio)
+                {
+                    render.push(request.key);
+                }
+            }
+        }
+        let rects = &self.group_rects;
+        self.render = render
+            .iter()
+            .filter_map(|&key| self.pool.page(key).map(|page| self.tile_render(key, page, &view_proj, rects)))
+            .collect();
+
+        let table = page_table::build(&self.pool);
+        self.table_keys =
+            table.iter().map(|n| TileKey { level: n.tile[1], x: n.tile[2], y: n.tile[3] }).collect();
+        self.table.write(0, bytes_of_slice(&table))?;
+        self.records.write(0, bytes_of(&record))?;
+        self.analysed = true;
+        self.stats = AsmStats {
+            budget_bytes: self.settings.budget_bytes(),
+            bytes_used: self.pool.bytes_in_use(),
+            resident_tiles: table.len(),
+            deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
+            rendered: self.render.iter().map(|t| t.key).collect(),
+            cost: (self.cost.ms_per_triangle, self.cost.ms_per_tile),
+        };
+        Ok(())
+    }
+
+    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        let (ctx, scene) = (inputs.ctx, inputs.scene);
+        let tiles = Pass::new("asm_tiles", &[], &["shadow_maps"], move |cmd| {
+            for t in &self.render {
+                ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", t.key.level, t.key.x, t.key.y));
+                self.tiles.record(ctx, cmd, scene, t.page, &t.view_proj, |m| t.groups[m.group]);
+                ctx.end_label(cmd);
+            }
+        });
+        let bindings = vec![
+            Binding::Uniform(inputs.uniforms),
+            Binding::Uniform(&self.records),
+            self.tiles.binding(),
+            Binding::Storage(&self.table),
+        ];
+        let lighting =
+            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
+                LocalDrawPush {
+                    model: model.to_cols_array_2d(),
+                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                    params: [1, 0, 0, 0],
+                    bias: DEPTH_BIAS,
+                }
+            });
+        let targets = inputs.targets;
+        let uniforms = inputs.uniforms;
+        let (width, height) = (targets.depth.width, targets.depth.height);
+        let analysis = Pass::new(
+            "asm_analysis",
+            &["frame_uniforms", "shadow_maps", "depth"],
+            &["asm_requests"],
+            move |cmd| {
+                self.requests.record_zero(cmd);
+                ctx.full_barrier(cmd);
+                let push =
+                    AsmAnalysisPush { size: [width, height, self.pool.capacity(), 0], bias: DEPTH_BIAS };
+                let group = constants::ASM_ANALYSIS_GROUP;
+                self.analysis.dispatch(
+                    cmd,
+                    &[
+                        Binding::Uniform(uniforms),
+                        Binding::Uniform(&self.records),
+                        self.tiles.binding(),
+                        Binding::Storage(&self.table),
+                        Binding::Sampled(&targets.depth, &self.nearest),
+                        Binding::Storage(&self.requests),
+                    ],
+                    bytes_of(&push),
+                    [width.div_ceil(group), height.div_ceil(group), 1],
+                );
+            },
+        );
+        vec![tiles, lighting, analysis]
+    }
+
+    fn asm_stats(&self) -> Option<AsmStats> {
+        Some(self.stats())
+    }
+
+    /// The whole page pool, allocated up front (within the budget), whatever is resident.
+    fn shadow_memory_bytes(&self) -> Option<u64> {
+        Some(u64::from(self.pool.capacity()) * PAGE_BYTES)
+    }
+}

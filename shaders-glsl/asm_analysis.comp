@@ -1,0 +1,100 @@
+#version 460
+// ASM refinement analysis, per visible eye pixel (Fernando et al. 2001, section 4): where its
+// light uv lands in the finest resident tile, whether it is on a shadow edge, and how many
+// levels finer a tile would have to be for a shadow texel to be no larger than the eye pixel's
+// footprint. Edge pixels short of resolution are counted per requested child tile (a quadrant
+// of their tile) for the host's planner, one frame later.
+//
+// Projected areas from screen-space derivatives of the light uv, taken by finite differences of
+// the world positions reconstructed from the depth target, not from the paper's mip-map trick:
+// a compute pass has no hardware derivatives, the depth target already holds every visible
+// surface (nothing is added to the lighting pass), and picking the smaller of the forward and
+// backward difference keeps a pixel next to a silhouette from taking its neighbour's surface.
+#include "layouts.glsl"
+#include "shadow_test.glsl"
+
+layout(local_size_x = KAGE_ASM_ANALYSIS_GROUP, local_size_y = KAGE_ASM_ANALYSIS_GROUP) in;
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1) uniform Lights { ShadowLight lights[KAGE_MAX_LOCAL_LIGHTS]; };
+layout(set = 0, binding = 2) uniform sampler2DArray asm_pool;
+layout(std430, set = 0, binding = 3) readonly buffer PageTable { AsmNode asm_nodes[]; };
+layout(set = 0, binding = 4) uniform sampler2D eye_depth;
+layout(std430, set = 0, binding = 5) buffer Requests { uint requests[]; };
+layout(push_constant) uniform Push { AsmAnalysisPush push; };
+
+#include "asm_lookup.glsl"
+
+// The world position seen at pixel q, or w = 0 where the pixel shows no surface.
+vec4 surface(ivec2 q) {
+    ivec2 size = ivec2(push.size.xy);
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) return vec4(0.0);
+    float d = texelFetch(eye_depth, q, 0).r;
+    if (d >= 1.0) return vec4(0.0);
+    vec2 ndc = (vec2(q) + 0.5) / vec2(size) * 2.0 - 1.0;
+    vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
+    return vec4(world.xyz / world.w, 1.0);
+}
+
+// The smaller of the differences to the neighbours at q - step and q + step (0 where neither
+// shows a surface).
+vec3 difference(vec3 p, ivec2 q, ivec2 step) {
+    vec4 back = surface(q - step), ahead = surface(q + step);
+    vec3 db = p - back.xyz, da = ahead.xyz - p;
+    if (back.w == 0.0) return ahead.w == 0.0 ? vec3(0.0) : da;
+    if (ahead.w == 0.0) return db;
+    return dot(db, db) < dot(da, da) ? db : da;
+}
+
+vec2 light_uv(ShadowLight s, vec3 p) {
+    vec4 clip = s.view_proj * vec4(p, 1.0);
+    return clip.xy / clip.w * 0.5 + 0.5;
+}
+
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    vec4 here = surface(q);
+    if (here.w == 0.0) return;
+    vec3 p = here.xyz;
+    ShadowLight s = lights[0];
+    vec4 m = shadow_map_coords(s, p);
+    if (m.w < 0.0) return;
+    vec3 dx = difference(p, q, ivec2(1, 0)), dy = difference(p, q, ivec2(0, 1));
+    vec3 ng = cross(dx, dy);
+    if (dot(ng, ng) == 0.0) return;
+    ng = normalize(ng);
+    if (dot(ng, frame.camera_pos.xyz - p) < 0.0) ng = -ng;
+    // Shadow edges matter only where the light reaches: facing it and inside a spot's cone.
+    vec3 l = normalize(s.light.position.xyz - p);
+    if (dot(ng, l) <= 0.0) return;
+    if (s.light.position.w > 0.5 && dot(-l, s.light.direction.xyz) < s.light.direction.w) return;
+
+    uint node = asm_descend(m.xy);
+    requests[node] = 1u;
+    uvec4 tile = asm_nodes[node].tile;
+    if (tile.y >= uint(KAGE_ASM_MAX_LEVEL)) return;
+    // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
+    // level L has texels of 1 / (TILE 2^L) a side, so it matches the pixel where
+    // 2^L = 1 / (TILE sqrt(area)); KAGE_ASM_EXTRA_LEVELS finer.
+    vec2 ux = light_uv(s, p + dx) - m.xy, uy = light_uv(s, p + dy) - m.xy;
+    float area = abs(ux.x * uy.y - ux.y * uy.x);
+    float needed = area > 0.0 ? -log2(float(KAGE_ASM_TILE_TEXELS) * sqrt(area)) : float(KAGE_ASM_MAX_LEVEL);
+    needed += float(KAGE_ASM_EXTRA_LEVELS);
+    float missing = min(ceil(needed), float(KAGE_ASM_MAX_LEVEL)) - float(tile.y);
+    if (missing < 1.0) return;
+    // On a shadow edge: the receiver's visibility against its texel and the 8 around it
+    // disagrees (an occluder's silhouette, a depth discontinuity in the light's view, passes
+    // within a texel). Neighbours lie up to 1 + sqrt(2) texels from p: the slope term grows so.
+    vec4 bias = vec4(push.bias.x, push.bias.y * 2.5, push.bias.z, 0.0);
+    bool centre = asm_visible(s, m, p, ng, tile, ivec2(0), bias);
+    bool edge = false;
+    for (int j = -1; j <= 1; ++j) {
+        for (int i = -1; i <= 1; ++i) {
+            edge = edge || asm_visible(s, m, p, ng, tile, ivec2(i, j), bias) != centre;
+        }
+    }
+    if (!edge) return;
+    uvec2 cell = min(uvec2(m.xy * float(1u << (tile.y + 1u))), uvec2((1u << (tile.y + 1u)) - 1u));
+    uint slot = 4u * node + 2u * (cell.y & 1u) + (cell.x & 1u);
+    atomicAdd(requests[push.size.z + slot], 1u);
+    atomicAdd(requests[5u * push.size.z + slot], uint(missing));
+}

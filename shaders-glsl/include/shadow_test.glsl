@@ -1,0 +1,37 @@
+// The depth comparison of a local light's shadow map (shadowmap and ASM techniques, and the ASM
+// refinement analysis): the stored depth linearized, compared with the receiver's view depth
+// less a slope-scaled bias.
+#ifndef KAGE_SHADOW_TEST_GLSL
+#define KAGE_SHADOW_TEST_GLSL
+
+#include "layouts.glsl"
+
+// The light's map coordinates of p: xy in [0, 1) inside the map (rows downward, as texels),
+// z the view depth along the light's axis (clip w); w < 0 where p is outside the map.
+vec4 shadow_map_coords(ShadowLight s, vec3 p) {
+    vec4 clip = s.view_proj * vec4(p, 1.0);
+    vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+    bool inside = clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) && all(lessThan(uv, vec2(1.0)));
+    return vec4(uv, clip.w, inside ? 1.0 : -1.0);
+}
+
+// Whether a receiver at view depth w (point p, geometric normal ng) is lit past a texel that
+// stores Vulkan depth `stored`, for texels of world size `texel` at unit depth. bias: x constant
+// and y slope-scaled bias in texels, z the largest slope (tan) the bias follows.
+bool shadow_depth_visible(ShadowLight s, float stored, float w, vec3 p, vec3 ng, float texel, vec4 bias) {
+    // Vulkan depth of a right-handed perspective projection back to view depth:
+    // z = near * far / (far - d * (far - near)).
+    float near = s.map.x, far = s.map.y;
+    float occluder = near * far / (far - stored * (far - near));
+    // The depth a surface spans inside one texel grows with the texel (w * texel in world
+    // units) and with tan of the light's angle to the surface: the slope-scaled bias.
+    vec3 l = normalize(s.light.position.xyz - p);
+    float c = max(dot(ng, l), 1e-4);
+    float slope = min(sqrt(max(1.0 - c * c, 0.0)) / c, bias.z);
+    // Fine texels (deep ASM tiles) fall below the D32 depth's own resolution near the far plane:
+    // d(z)/d(d) = z^2 (far - near) / (near far), times 4 ulps of a depth near 1 (2^-24 each).
+    float resolution = w * w * (far - near) / (near * far) * 2.4e-7;
+    return w - w * texel * (bias.x + bias.y * slope) - resolution <= occluder;
+}
+
+#endif
