@@ -271,6 +271,48 @@ fn sweep_writes_one_csv_row_per_setting() {
     assert!(number(&fields[1], 9) > 0.0 && fields[0][9].is_empty(), "precompute seconds only for PRT: {csv}");
 }
 
+#[test]
+fn sweep_asm_compares_budgets_with_map_sizes() {
+    let dir = scratch_dir("cli-sweep-asm");
+    let out = kage(&[
+        "sweep",
+        "--technique",
+        "asm",
+        "--only",
+        "shadowmap:256,asm:1",
+        "--frames",
+        "2",
+        "--size",
+        "32",
+        "--validate",
+        "--out",
+        dir.to_str().unwrap(),
+        "--pick",
+        "--max-error",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("asm: cheapest within mismatch 1: "), "{stdout}");
+    assert_eq!(&std::fs::read(dir.join("pareto.png")).unwrap()[1..4], b"PNG");
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        lines[0],
+        "scene,technique,parameter,value,error_mean,error_max,error_at_rest,flips_mean,frame_ms,ratio,memory_mb"
+    );
+    assert_eq!(lines.len(), 3, "{csv}");
+    let rows: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split(',').collect()).collect();
+    assert_eq!((rows[0][1], rows[0][3], rows[1][1], rows[1][2]), ("shadowmap", "256", "asm", "budget_mb"));
+    let number = |row: &[&str], column: usize| row[column].parse::<f64>().unwrap();
+    // 256² D32 texels: 0.25 MiB; the ASM pool: at most its 1 MB (MiB) budget.
+    assert_eq!(number(&rows[0], 10), 0.25);
+    assert!(number(&rows[1], 10) > 0.0 && number(&rows[1], 10) <= 1.0, "{csv}");
+    for row in &rows {
+        assert!((0.0..1.0).contains(&number(row, 4)) && number(row, 8) > 0.0, "{row:?}");
+    }
+}
+
 /// A 3×3×3 grid over [0, 2]³ (every cube's corners cospherical) and two duplicates.
 fn probe_file(dir: &std::path::Path) -> std::path::PathBuf {
     let mut positions = Vec::new();

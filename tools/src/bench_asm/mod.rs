@@ -10,7 +10,7 @@
 //! median of those ratios is reported beside the ratio of the medians.
 mod frames;
 mod references;
-mod report;
+pub mod report;
 
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
@@ -26,6 +26,10 @@ use report::{FrameRow, Series};
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// What the benchmark compares unless told: the conventional maps and ASM budgets.
+pub const DEFAULT_CONFIGS: [&str; 6] =
+    ["shadowmap:1024", "shadowmap:2048", "shadowmap:4096", "asm:4", "asm:8", "asm:16"];
+
 #[derive(Args)]
 pub struct AsmBenchArgs {
     /// A built-in scene name or a scene file (.json) with local lights and a `walkthrough`.
@@ -33,7 +37,7 @@ pub struct AsmBenchArgs {
     scene: String,
     /// The configurations, `KIND:VALUE` each: `shadowmap:SIDE` (a conventional map of SIDE²
     /// texels per light), `asm:MB` (an adaptive shadow map within MB megabytes). The first is the one the others' frame times are divided by.
-    #[arg(long, value_delimiter = ',', default_values_t = ["shadowmap:1024".to_string(), "shadowmap:2048".into(), "shadowmap:4096".into(), "asm:4".into(), "asm:8".into(), "asm:16".into()])]
+    #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_CONFIGS.map(String::from))]
     configs: Vec<String>,
     /// Frames sampling the walkthrough (t = i / frames, as `kage render --animate`).
     #[arg(long, default_value_t = 40)]
@@ -72,14 +76,26 @@ pub struct AsmBenchArgs {
 /// technique's settings. Adding a technique to the benchmark is adding one entry.
 struct ConfigKind {
     name: &'static str,
+    /// What VALUE is.
+    parameter: &'static str,
     /// The chart's series, naming what the values count.
     series: &'static str,
     settings: fn(&str) -> Result<TechniqueSettings>,
 }
 
 const KINDS: &[ConfigKind] = &[
-    ConfigKind { name: "shadowmap", series: "shadow map (side, texels)", settings: shadowmap },
-    ConfigKind { name: "asm", series: "adaptive shadow map (budget, MB)", settings: asm },
+    ConfigKind {
+        name: "shadowmap",
+        parameter: "side",
+        series: "shadow map (side, texels)",
+        settings: shadowmap,
+    },
+    ConfigKind {
+        name: "asm",
+        parameter: "budget_mb",
+        series: "adaptive shadow map (budget, MB)",
+        settings: asm,
+    },
 ];
 
 fn shadowmap(value: &str) -> Result<TechniqueSettings> {
@@ -98,6 +114,7 @@ pub struct Config {
     /// As given: `shadowmap:1024`.
     pub name: String,
     pub kind: &'static str,
+    pub parameter: &'static str,
     pub series: &'static str,
     pub value: String,
     settings: TechniqueSettings,
@@ -115,13 +132,67 @@ fn parse_config(arg: &str) -> Result<Config> {
     Ok(Config {
         name: arg.to_string(),
         kind: kind.name,
+        parameter: kind.parameter,
         series: kind.series,
         value: value.to_string(),
         settings,
     })
 }
 
+/// A run's configurations and what was measured of each.
+pub struct Measured {
+    pub scene: String,
+    pub configs: Vec<Config>,
+    pub summaries: Vec<report::Summary>,
+    rows: Vec<FrameRow>,
+    /// The chart's title: scene, frames, image size, device.
+    pub title: String,
+}
+
+impl AsmBenchArgs {
+    /// The arguments `kage sweep --technique asm` runs the benchmark with: its defaults but
+    /// for these.
+    pub fn for_sweep(
+        scene: &str,
+        configs: Vec<String>,
+        frames: u32,
+        size: u32,
+        out: PathBuf,
+        gpu: GpuArgs,
+    ) -> Self {
+        AsmBenchArgs {
+            scene: scene.to_string(),
+            configs,
+            frames,
+            rest: 4,
+            slow: 4,
+            size,
+            slow_px: 4.0,
+            converge_tolerance: 1e-4,
+            cache: None,
+            out,
+            gpu,
+        }
+    }
+}
+
 pub fn run(args: &AsmBenchArgs) -> Result<()> {
+    let measured = measure(args)?;
+    report::print(&measured.configs, &measured.summaries, args.slow_px);
+    let written =
+        report::write(&args.out, &measured.scene, &measured.configs, &measured.summaries, &measured.rows)?;
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    let path = args.out.join("error-time.png");
+    if report::chart(&path, &measured.title, &measured.configs, &measured.summaries)? {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Renders the walkthrough with every configuration and measures each against the reference.
+pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
@@ -186,17 +257,9 @@ pub fn run(args: &AsmBenchArgs) -> Result<()> {
     let memory: Vec<Option<u64>> = renderers.iter().map(Renderer::shadow_memory_bytes).collect();
     let summaries: Vec<report::Summary> =
         series.iter().zip(&memory).map(|(s, &bytes)| s.summary(bytes, args.converge_tolerance)).collect();
-    report::print(&configs, &summaries, args.slow_px);
-    let written = report::write(&args.out, &scene.name, &configs, &summaries, &rows)?;
-    for path in written {
-        println!("wrote {}", path.display());
-    }
     let title = format!("{}: {} frames at {}², {device}", scene.name, plan.len(), args.size);
-    let path = args.out.join("error-time.png");
-    if report::chart(&path, &title, &configs, &summaries)? {
-        println!("wrote {}", path.display());
-    }
-    args.gpu.finish(&ctx)
+    args.gpu.finish(&ctx)?;
+    Ok(Measured { scene: scene.name.clone(), configs, summaries, rows, title })
 }
 
 /// Renders every frame of `plan` with every renderer in turn and measures it against the

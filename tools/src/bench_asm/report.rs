@@ -238,10 +238,10 @@ pub fn write(
     Ok(written)
 }
 
-/// The chart of mean error against median frame time, one series per technique; `false` when
-/// no configuration has both above 0 (log scales), so there is nothing to draw.
-pub fn chart(path: &Path, title: &str, configs: &[Config], summaries: &[Summary]) -> Result<bool> {
-    let points: Vec<Point> = configs
+/// The configurations on the chart: those with a frame time and a mean error above 0 (log
+/// scales).
+pub fn points(configs: &[Config], summaries: &[Summary]) -> Vec<Point> {
+    configs
         .iter()
         .zip(summaries)
         .filter(|(_, s)| s.frame_ms > 0.0 && s.error_mean > 0.0)
@@ -252,10 +252,19 @@ pub fn chart(path: &Path, title: &str, configs: &[Config], summaries: &[Summary]
             ms: s.frame_ms,
             error: s.error_mean,
         })
-        .collect();
+        .collect()
+}
+
+/// What the charts' error axis measures.
+pub const ERROR_AXIS: &str = "fraction of pixels shadowed unlike the reference (mean)";
+
+/// The chart of mean error against median frame time, one series per technique; `false` when
+/// no configuration is on it, so there is nothing to draw.
+pub fn chart(path: &Path, title: &str, configs: &[Config], summaries: &[Summary]) -> Result<bool> {
+    let points = points(configs, summaries);
     if points.is_empty() {
         return Ok(false);
     }
-    chart::write(path, title, "fraction of pixels shadowed unlike the reference (mean)", &points)?;
+    chart::write(path, title, ERROR_AXIS, &points)?;
     Ok(true)
 }

@@ -2,6 +2,7 @@
 //! against the ray-traced reference at several poses of the animation, its GPU time per frame
 //! while the scene moves, its precomputation time and its device memory, in `DIR/sweep.csv`;
 //! time against error in `DIR/pareto.png`; and, asked, the setting to pick under a bound.
+mod asm;
 pub(crate) mod chart;
 pub(crate) mod pick;
 
@@ -30,15 +31,18 @@ pub enum SweptTechnique {
     /// Unshadowed SH irradiance; Sloan's PRT at 2 to 5 bands; Tamura at q = 4 to 64;
     /// parallel lights at q = 32, 64, 128 (the paper's Fig. 3).
     Prt,
+    /// Adaptive shadow maps at 4, 8, 16 MB against conventional maps of 1024², 2048², 4096²
+    /// over the scene's camera walkthrough (`kage bench asm`'s measurement).
+    Asm,
 }
 
 #[derive(Args)]
 pub struct SweepArgs {
     #[arg(long, value_enum)]
     technique: SweptTechnique,
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
-    #[arg(long, default_value = "teapot")]
-    scene: String,
+    /// A built-in scene name or a scene file (.json); default: teapot (prt), asm (asm).
+    #[arg(long)]
+    scene: Option<String>,
     /// Environment maps to sweep over, each replacing the scene's (default: the scene's own).
     #[arg(long = "env")]
     envs: Vec<PathBuf>,
@@ -46,16 +50,18 @@ pub struct SweepArgs {
     /// 0 is the scene pose (the teapot standing on the floor: contact).
     #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.125, 0.6])]
     poses: Vec<f32>,
-    /// Only these settings, e.g. `unshadowed,sloan:3,tamura:32,parallel-lights:64`.
+    /// Only these settings, e.g. `unshadowed,sloan:3,tamura:32,parallel-lights:64` (prt) or
+    /// `shadowmap:2048,asm:8` (asm).
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
-    /// Side of the images compared with the reference, pixels.
+    /// Side of the images compared with the reference, pixels (asm: also of the timed frames).
     #[arg(long, default_value_t = 128)]
     size: u32,
     /// Reference samples per pixel.
     #[arg(long, default_value_t = 512)]
     spp: u32,
-    /// Frames timed per setting while the scene moves (the median is reported); 0: no timing.
+    /// prt: frames timed per setting while the scene moves (the median is reported; 0: no
+    /// timing). asm: samples of the walkthrough (each also timed).
     #[arg(long, default_value_t = 100)]
     frames: u32,
     /// Side of the timed frames, pixels.
@@ -94,14 +100,13 @@ enum Setting {
 }
 
 impl Setting {
-    fn all(technique: SweptTechnique) -> Vec<Setting> {
-        match technique {
-            SweptTechnique::Prt => std::iter::once(Setting::Unshadowed)
-                .chain((2..=5).map(|bands| Setting::Sloan { bands }))
-                .chain([4, 8, 16, 32, 64].map(|regions| Setting::Tamura { regions }))
-                .chain([32, 64, 128].map(|regions| Setting::ParallelLights { regions }))
-                .collect(),
-        }
+    /// The PRT sweep's settings.
+    fn all() -> Vec<Setting> {
+        std::iter::once(Setting::Unshadowed)
+            .chain((2..=5).map(|bands| Setting::Sloan { bands }))
+            .chain([4, 8, 16, 32, 64].map(|regions| Setting::Tamura { regions }))
+            .chain([32, 64, 128].map(|regions| Setting::ParallelLights { regions }))
+            .collect()
     }
 
     /// (technique, parameter, value): the CSV's columns and the `--only` spelling.
@@ -141,8 +146,8 @@ impl Setting {
 
 /// The settings `--only` names, in the sweep's order; an unknown name is an error that lists
 /// the known ones.
-fn chosen(technique: SweptTechnique, only: &[String]) -> Result<Vec<Setting>> {
-    let all = Setting::all(technique);
+fn chosen(only: &[String]) -> Result<Vec<Setting>> {
+    let all = Setting::all();
     for name in only {
         if !all.iter().any(|s| s.name() == *name) {
             let known: Vec<String> = all.iter().map(|s| s.name()).collect();
@@ -197,8 +202,15 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     if args.pick && args.frames == 0 {
         bail!("--pick compares frame times: it needs --frames of at least 1");
     }
-    let settings = chosen(args.technique, &args.only)?;
-    let scene = Scene::from_arg(&args.scene)?;
+    match args.technique {
+        SweptTechnique::Prt => run_prt(args),
+        SweptTechnique::Asm => asm::run(args),
+    }
+}
+
+fn run_prt(args: &SweepArgs) -> Result<()> {
+    let settings = chosen(&args.only)?;
+    let scene = Scene::from_arg(args.scene.as_deref().unwrap_or("teapot"))?;
     if scene.groups.is_empty() {
         bail!("scene {} has no groups to move", scene.name);
     }
@@ -314,20 +326,27 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         chart::write(&args.out.join(&file), &title, "relative RMSE against the reference", &points)?;
         println!("wrote {}", args.out.join(&file).display());
         if args.pick {
-            print_picks(env, &points, args.max_error, args.max_ms);
+            print_picks(env, &points, args.max_error, args.max_ms, "relative RMSE");
         }
     }
     args.gpu.finish(&ctx)
 }
 
-fn print_picks(env: &str, points: &[Point], max_error: Option<f64>, max_ms: Option<f64>) {
+/// `metric` names what the points' errors are.
+pub(crate) fn print_picks(
+    env: &str,
+    points: &[Point],
+    max_error: Option<f64>,
+    max_ms: Option<f64>,
+    metric: &str,
+) {
     if let Some(bound) = max_error {
         match pick::cheapest_within(points, bound) {
             Some(p) => println!(
-                "{env}: cheapest within relative RMSE {bound}: {} ({:.2} ms, error {:.4})",
+                "{env}: cheapest within {metric} {bound}: {} ({:.2} ms, error {:.4})",
                 p.name, p.ms, p.error
             ),
-            None => println!("{env}: no setting reaches relative RMSE {bound}"),
+            None => println!("{env}: no setting reaches {metric} {bound}"),
         }
     }
     if let Some(bound) = max_ms {

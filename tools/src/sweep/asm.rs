@@ -1,0 +1,65 @@
+//! `kage sweep --technique asm`: adaptive shadow maps at several budgets against conventional
+//! maps of several sizes over the scene's camera walkthrough, measured as `kage bench asm`
+//! measures them (error against the ray-traced hard-shadow reference, GPU time side by side,
+//! shadow memory), written as the sweep's CSV and chart, with the picks.
+use super::{print_picks, SweepArgs};
+use crate::bench_asm::report::{points, ERROR_AXIS};
+use crate::bench_asm::{measure, AsmBenchArgs, DEFAULT_CONFIGS};
+use crate::sweep::chart;
+use anyhow::{Context as _, Result};
+use std::fmt::Write as _;
+
+pub fn run(args: &SweepArgs) -> Result<()> {
+    let configs =
+        if args.only.is_empty() { DEFAULT_CONFIGS.map(String::from).to_vec() } else { args.only.clone() };
+    let scene = args.scene.as_deref().unwrap_or("asm");
+    let bench =
+        AsmBenchArgs::for_sweep(scene, configs, args.frames, args.size, args.out.clone(), args.gpu.clone());
+    let measured = measure(&bench)?;
+
+    let mut csv = String::from(
+        "scene,technique,parameter,value,error_mean,error_max,error_at_rest,flips_mean,frame_ms,ratio,memory_mb\n",
+    );
+    let optional = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:.6}"));
+    for (c, s) in measured.configs.iter().zip(&measured.summaries) {
+        writeln!(
+            csv,
+            "{},{},{},{},{:.6},{:.6},{},{},{:.4},{:.4},{}",
+            measured.scene,
+            c.kind,
+            c.parameter,
+            c.value,
+            s.error_mean,
+            s.error_max,
+            optional(s.error_at_rest),
+            optional(s.flips_mean),
+            s.frame_ms,
+            s.ratio,
+            s.shadow_bytes.map_or_else(String::new, |b| format!("{:.2}", b as f64 / (1 << 20) as f64)),
+        )
+        .expect("writing to a String");
+        println!(
+            "{:<16} error {:.5} (at rest {}), {:.2} ms ({:.2}× {}), {} MiB",
+            c.name,
+            s.error_mean,
+            optional(s.error_at_rest),
+            s.frame_ms,
+            s.ratio,
+            measured.configs[0].name,
+            s.shadow_bytes.map_or_else(|| "-".to_string(), |b| format!("{:.2}", b as f64 / (1 << 20) as f64)),
+        );
+    }
+    let path = args.out.join("sweep.csv");
+    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
+    let points = points(&measured.configs, &measured.summaries);
+    if !points.is_empty() {
+        let path = args.out.join("pareto.png");
+        chart::write(&path, &measured.title, ERROR_AXIS, &points)?;
+        println!("wrote {}", path.display());
+    }
+    if args.pick {
+        print_picks(&measured.scene, &points, args.max_error, args.max_ms, "mismatch");
+    }
+    Ok(())
+}
