@@ -1,5 +1,6 @@
 //! `kage`: the command-line front end of the Kage engine.
 mod bench;
+mod bench_probe_count;
 mod bench_probes;
 mod compare;
 mod info;

@@ -42,7 +42,7 @@ pub use input::Merged;
 pub use lookup::{Location, Walker};
 pub use reduce::{reduce, sh_error};
 pub use set::{
-    capture_at, grid_lattice, is_static, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings,
+    bounds, capture_at, grid_lattice, is_static, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings,
     AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
 };
 pub use solids::{Hit, Solids};
