@@ -367,7 +367,7 @@ mod tests {
     use kage_tests::Validated;
 
     #[test]
-    fn the_measurement_runs_at_a_tiny_size_and_denser_grids_do_not_get_worse() {
+    fn the_measurement_runs_at_a_tiny_size() {
         let ctx = Validated::new();
         let scene = Scene::builtin("probe-room").unwrap();
         let params = Params {

@@ -7,13 +7,21 @@
 //! light, and the dark side of a bright one does not blow up). A probe with almost no light
 //! is judged against 1/1000 of the candidates' mean instead.
 //!
-//! The greedy pass: every candidate is first scored by its error against the others (one
-//! tetrahedralization without it each); then, most redundant first, a candidate is dropped when
-//! the set without it reproduces it **and every candidate dropped before it** within the
-//! tolerance (one tetrahedralization per try, then a walk per dropped candidate). So when it
-//! ends every candidate, kept or not, is within the tolerance of the kept set's interpolation.
-//! Re-tetrahedralizing the whole kept set per try costs O(n log n) each, O(n² log n) in all:
-//! a second for a few hundred candidates, small beside their capture.
+//! The greedy passes, in rounds: the kept set is tetrahedralized; every kept probe is scored by
+//! its error against the set without it; then, most redundant first, a probe is dropped when the
+//! set without it reproduces it **and every candidate dropped before whose tetrahedron has it as
+//! a vertex** (the only ones whose interpolation its removal changes) within the tolerance.
+//! Rounds repeat until one drops nothing. So when it ends every candidate, kept or not, is within
+//! the tolerance of the kept set's interpolation.
+//!
+//! The set without a probe is not re-tetrahedralized whole (O(n log n) per try, hours for a
+//! thousand lattice candidates): removing a probe changes only its star, whose cavity the
+//! Delaunay tetrahedra of its neighbours alone fill (see `reduce`), so each try tetrahedralizes
+//! its 10–30 neighbours. Within a round, a probe whose neighbour was dropped waits for the next
+//! round, when its star is current again. Two approximations remain, both small: ties between
+//! cospherical probes (every lattice) may be broken differently in the small tetrahedralization
+//! than in the whole; and on the hull the extrapolation is from the neighbours' hull, not the
+//! whole set's.
 use super::lookup::Walker;
 use super::solids::directions;
 use super::tetmesh::TetMesh;
@@ -67,51 +75,83 @@ pub fn sh_error(approx: &ShRgb9, exact: &ShRgb9, floor: f32) -> f32 {
 pub fn reduce(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<Vec<usize>> {
     let n = positions.len();
     let floor = 1e-3 * sh.iter().map(mean_irradiance).sum::<f32>() / n.max(1) as f32;
-    // The error of candidate `i` against the interpolation of `kept` (a mask), or `None` when
-    // those cannot be tetrahedralized (too few, or flat).
-    let build = |kept: &[bool]| -> Option<(TetMesh, Vec<usize>)> {
+    let mut kept = vec![true; n];
+    let mut dropped: Vec<usize> = Vec::new();
+    loop {
         let index: Vec<usize> = (0..n).filter(|&j| kept[j]).collect();
         let points: Vec<DVec3> = index.iter().map(|&j| positions[j]).collect();
-        TetMesh::build(&points).ok().map(|mesh| (mesh, index))
-    };
-    let errors = |mesh: &TetMesh, index: &[usize], probes: &[usize]| -> Result<f32> {
-        let kept_sh: Vec<&ShRgb9> = index.iter().map(|&j| &sh[j]).collect();
+        let Ok(mesh) = TetMesh::build(&points) else { break };
+        // Each kept probe's neighbours (the other vertices of its tetrahedra), and the dropped
+        // candidates whose tetrahedron it is a vertex of: removing it changes exactly those
+        // tetrahedra, so it changes the interpolation at exactly those candidates.
+        let mut link: Vec<Vec<u32>> = vec![Vec::new(); index.len()];
+        for tet in mesh.tets() {
+            for &a in tet {
+                link[a as usize].extend(tet.iter().filter(|&&b| b != a));
+            }
+        }
+        for l in &mut link {
+            l.sort_unstable();
+            l.dedup();
+        }
+        let mut affected: Vec<Vec<usize>> = vec![Vec::new(); index.len()];
         let mut walker = Walker::default();
-        let mut worst = 0.0f32;
-        for &i in probes {
-            let approx = interpolate(mesh, &kept_sh, &mut walker, positions[i])?;
-            worst = worst.max(sh_error(&approx, &sh[i], floor));
+        for &j in &dropped {
+            for a in walker.locate(&mesh, positions[j])?.probes {
+                affected[a as usize].push(j);
+            }
         }
-        Ok(worst)
-    };
-
-    let mut kept = vec![true; n];
-    let mut score = Vec::with_capacity(n);
-    for i in 0..n {
-        kept[i] = false;
-        if let Some((mesh, index)) = build(&kept) {
-            score.push((errors(&mesh, &index, &[i])?, i));
-        }
-        kept[i] = true;
-    }
-    score.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-
-    let mut dropped = Vec::new();
-    for (first_error, i) in score {
-        // Dropping more probes can make a candidate's error smaller as well as larger, but
-        // one over the tolerance against all the others is rarely saved: skip it.
-        if first_error > tolerance {
-            break;
-        }
-        kept[i] = false;
-        dropped.push(i);
-        let within = match build(&kept) {
-            Some((mesh, index)) => errors(&mesh, &index, &dropped)? <= tolerance,
-            None => false,
+        // The interpolation at `probes` from the set without kept probe `k`: the Delaunay
+        // tetrahedra of its neighbours alone, which include those that fill its star's cavity
+        // in the tetrahedralization without it (their circumspheres are empty of every probe).
+        // `None` when the neighbours are flat.
+        let error_without = |k: usize, probes: &[usize]| -> Result<Option<f32>> {
+            let around: Vec<usize> = link[k].iter().map(|&a| index[a as usize]).collect();
+            let Ok(local) = TetMesh::build(&around.iter().map(|&a| positions[a]).collect::<Vec<_>>()) else {
+                return Ok(None);
+            };
+            let local_sh: Vec<&ShRgb9> = around.iter().map(|&a| &sh[a]).collect();
+            let mut walker = Walker::default();
+            let mut worst = 0.0f32;
+            for &j in probes {
+                let approx = interpolate(&local, &local_sh, &mut walker, positions[j])?;
+                worst = worst.max(sh_error(&approx, &sh[j], floor));
+            }
+            Ok(Some(worst))
         };
-        if !within {
-            kept[i] = true;
-            dropped.pop();
+        let mut score = Vec::new();
+        for k in 0..index.len() {
+            if let Some(e) = error_without(k, &[index[k]])? {
+                if e <= tolerance {
+                    score.push((e, k));
+                }
+            }
+        }
+        score.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        // Most redundant first, those whose stars do not touch a star changed in this round:
+        // for them this round's tetrahedralization is still the current one.
+        let mut touched = vec![false; index.len()];
+        let mut left = index.len();
+        let mut removed = false;
+        for (_, k) in score {
+            if touched[k] || left <= 4 {
+                continue;
+            }
+            let mut check = affected[k].clone();
+            check.push(index[k]);
+            if error_without(k, &check)?.is_some_and(|e| e <= tolerance) {
+                kept[index[k]] = false;
+                dropped.push(index[k]);
+                touched[k] = true;
+                for &a in &link[k] {
+                    touched[a as usize] = true;
+                }
+                left -= 1;
+                removed = true;
+            }
+        }
+        if !removed {
+            break;
         }
     }
     Ok((0..n).filter(|&j| kept[j]).collect())
