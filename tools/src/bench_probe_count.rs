@@ -74,7 +74,7 @@ pub struct ProbeCountArgs {
 /// One measurement of the sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
-    pub method: &'static str,
+    pub method: String,
     /// The grid's counts, or the tolerance.
     pub setting: String,
     pub probes: usize,
@@ -83,6 +83,8 @@ pub struct Row {
 
 pub struct Measurement {
     pub rows: Vec<Row>,
+    /// The box the moving group sweeps, within the static box.
+    pub path: (Vec3, Vec3),
     pub test_points: usize,
     /// RMS standard error of the reference relative to the RMS of E: the noise floor.
     pub reference_noise: f64,
@@ -129,54 +131,97 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
             m.reference_seconds,
             m.capture_ms_per_probe
         );
-        println!("{:<26} {:>12} {:>8} {:>10}", "method", "setting", "probes", "rel. RMS");
-        for row in &m.rows {
-            println!("{:<26} {:>12} {:>8} {:>10.4}", row.method, row.setting, row.probes, row.error);
-        }
-        let targets: Vec<f64> = match args.target {
-            Some(t) => vec![t],
-            None => m.rows.iter().filter(|r| r.method == TRILINEAR).map(|r| r.error).collect(),
-        };
-        println!("{:>10} {:>14} {:>14} {:>8}", "target", "grid probes", "tetra probes", "ratio");
-        let mut ratios = Vec::new();
-        for target in targets {
-            let fewest = |method| {
-                m.rows.iter().filter(|r| r.method == method && r.error <= target).map(|r| r.probes).min()
-            };
-            let (grid, tetra) = (fewest(TRILINEAR), fewest(AUTO));
-            let show = |n: Option<usize>| n.map_or("not reached".to_string(), |n| n.to_string());
-            let ratio = grid.zip(tetra).map(|(g, t)| t as f64 / g as f64);
-            println!(
-                "{target:>10.4} {:>14} {:>14} {:>8}",
-                show(grid),
-                show(tetra),
-                ratio.map_or("-".to_string(), |r| format!("{r:.2}"))
-            );
-            ratios.push(ratio);
-        }
-        let reached: Vec<f64> = ratios.iter().flatten().copied().collect();
-        let worst = reached.iter().copied().fold(0.0, f64::max);
         println!(
-            "bar (tetrahedral reaches the grid's error with at most 30 % of its probes): {} at {} of {} targets (largest ratio {worst:.2}); {} targets not reached by one method",
-            if worst <= 0.3 && !reached.is_empty() { "met" } else { "not met" },
-            reached.len(),
-            ratios.len(),
-            ratios.len() - reached.len()
+            "path region {:.2?} to {:.2?}\n{:<32} {:>12} {:>8} {:>10}",
+            m.path.0, m.path.1, "method", "setting", "probes", "rel. RMS"
         );
+        for row in &m.rows {
+            println!("{:<32} {:>12} {:>8} {:>10.4}", row.method, row.setting, row.probes, row.error);
+        }
+        // Like for like (each region's grid against automatic placement in it), and the
+        // paper's comparison: a grid over the whole box against probes where objects move.
+        for (grid, tetra) in
+            [(Region::Box, Region::Box), (Region::Path, Region::Path), (Region::Box, Region::Path)]
+        {
+            compare(&m.rows, &method(TRILINEAR, grid), &method(AUTO, tetra), args.target);
+        }
     }
     args.gpu.finish(&ctx)
+}
+
+/// For each target error (`target`, or each of `grid`'s errors), the fewest probes with which
+/// `grid` and `tetra` reach it, their ratio, and whether the bar is met.
+fn compare(rows: &[Row], grid: &str, tetra: &str, target: Option<f64>) {
+    let targets: Vec<f64> = match target {
+        Some(t) => vec![t],
+        None => rows.iter().filter(|r| r.method == grid).map(|r| r.error).collect(),
+    };
+    println!("{grid} against {tetra}:");
+    println!("{:>10} {:>14} {:>14} {:>8}", "target", "grid probes", "tetra probes", "ratio");
+    let mut ratios = Vec::new();
+    for target in targets {
+        let fewest = |method: &str| {
+            rows.iter().filter(|r| r.method == method && r.error <= target).map(|r| r.probes).min()
+        };
+        let (g, t) = (fewest(grid), fewest(tetra));
+        let show = |n: Option<usize>| n.map_or("not reached".to_string(), |n| n.to_string());
+        let ratio = g.zip(t).map(|(g, t)| t as f64 / g as f64);
+        let shown = ratio.map_or("-".to_string(), |r| format!("{r:.2}"));
+        println!("{target:>10.4} {:>14} {:>14} {shown:>8}", show(g), show(t));
+        ratios.push(ratio);
+    }
+    let reached: Vec<f64> = ratios.iter().flatten().copied().collect();
+    let worst = reached.iter().copied().fold(0.0, f64::max);
+    println!(
+        "bar (tetrahedral reaches the grid's error with at most 30 % of its probes): {} at {} of {} targets (largest ratio {worst:.2}); {} not reached by one of them",
+        if worst <= 0.3 && !reached.is_empty() { "met" } else { "not met" },
+        reached.len(),
+        ratios.len(),
+        ratios.len() - reached.len()
+    );
 }
 
 const TRILINEAR: &str = "grid, trilinear";
 const GRID_TETRA: &str = "grid, tetrahedral";
 const AUTO: &str = "auto, tetrahedral";
 
-/// The counts of grid `level` over `scene`'s static box: `level` along its longest side.
-fn grid_counts(scene: &Scene, level: u32) -> Result<[u32; 3]> {
-    let unit = grid_lattice(scene, [1; 3])?;
-    let extent = unit.step;
-    let along = |e: f64| ((level as f64 * e / extent.max_element()).round() as u32).clamp(2, MAX_GRID);
-    Ok(extent.to_array().map(along))
+/// Where probes go: the static groups' box (as `kage render --probes grid:` and `auto` place
+/// them), or the part of it that the moving group sweeps (where the test points are).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Region {
+    Box,
+    Path,
+}
+
+/// A method's name in `region`.
+pub fn method(name: &str, region: Region) -> String {
+    format!("{name} ({})", if region == Region::Box { "box" } else { "path" })
+}
+
+/// The counts of grid `level` over a box of `extent`: `level` along its longest side, the
+/// others in proportion, at least 2.
+fn grid_counts(extent: Vec3, level: u32) -> [u32; 3] {
+    let along = |e: f32| ((level as f32 * e / extent.max_element()).round() as u32).clamp(2, MAX_GRID);
+    extent.to_array().map(along)
+}
+
+/// The bounds of the moving group's box over 64 times of its motion, within the static box.
+fn path_bounds(group: &kage::scene::Group, static_box: (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
+    let corners = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
+    let (lo, hi) = bounds(corners)?;
+    let swept = (0..64).flat_map(|s| {
+        let m = animation::pose(group, s as f32 / 64.0).matrix();
+        (0..8).map(move |c| {
+            let corner = Vec3::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            );
+            m.transform_point3(corner)
+        })
+    });
+    let (plo, phi) = bounds(swept)?;
+    Some((plo.max(static_box.0), phi.min(static_box.1)))
 }
 
 pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Measurement> {
@@ -201,48 +246,58 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         Ok((sum / (3 * truth.len()) as f64).sqrt() / rms_truth)
     };
 
+    let unit = grid_lattice(scene, [1; 3])?;
+    let static_box = ((unit.first - 0.5 * unit.step).as_vec3(), (unit.first + 0.5 * unit.step).as_vec3());
+    let path = path_bounds(&scene.groups[MOVING_GROUP], static_box)
+        .filter(|(lo, hi)| (*hi - *lo).min_element() > 0.0)
+        .context("the moving group's path has no volume inside the static box")?;
+
     let mut rows = Vec::new();
     let mut captured = 0usize;
     let start = Instant::now();
-    let mut finest_grid = None;
-    for &level in params.grids {
-        let counts = grid_counts(scene, level)?;
-        let lattice: Lattice = grid_lattice(scene, counts)?;
-        let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
-        captured += sh.len();
-        let setting = format!("{}x{}x{}", counts[0], counts[1], counts[2]);
-        let trilinear = ProbeSet::trilinear(lattice, sh.clone())?;
-        rows.push(Row {
-            method: TRILINEAR,
-            setting: setting.clone(),
-            probes: sh.len(),
-            error: error(&trilinear)?,
-        });
-        let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
-        rows.push(Row { method: GRID_TETRA, setting, probes: sh.len(), error: error(&tetra)? });
-        if level == finest {
-            finest_grid = Some((lattice, sh));
+    for (region, (lo, hi)) in [(Region::Box, static_box), (Region::Path, path)] {
+        let mut finest_grid = None;
+        for &level in params.grids {
+            let counts = grid_counts(hi - lo, level);
+            let lattice = Lattice::cell_centres(lo, hi, counts);
+            let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
+            captured += sh.len();
+            let setting = format!("{}x{}x{}", counts[0], counts[1], counts[2]);
+            let trilinear = ProbeSet::trilinear(lattice, sh.clone())?;
+            let probes = sh.len();
+            rows.push(Row {
+                method: method(TRILINEAR, region),
+                setting: setting.clone(),
+                probes,
+                error: error(&trilinear)?,
+            });
+            let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
+            rows.push(Row { method: method(GRID_TETRA, region), setting, probes, error: error(&tetra)? });
+            if level == finest {
+                finest_grid = Some((lattice, sh));
+            }
         }
-    }
-    let Some((lattice, sh)) = finest_grid else { unreachable!("the finest level is one of the levels") };
-    let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) =
-        lattice.positions().into_iter().zip(sh).filter(|(p, _)| !solids.contains(p.as_vec3())).unzip();
-    for &tolerance in params.tolerances {
-        let set = ProbeSet::reduced(&positions, &sh, tolerance)?;
+        let Some((lattice, sh)) = finest_grid else { unreachable!("the finest level is one of the levels") };
+        let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) =
+            lattice.positions().into_iter().zip(sh).filter(|(p, _)| !solids.contains(p.as_vec3())).unzip();
+        for &tolerance in params.tolerances {
+            let set = ProbeSet::reduced(&positions, &sh, tolerance)?;
+            let (probes, error) = (set.probe_count(), error(&set)?);
+            rows.push(Row {
+                method: method(AUTO, region),
+                setting: format!("tol {tolerance}"),
+                probes,
+                error,
+            });
+        }
+        let all = ProbeSet::tetrahedral(&positions, sh)?;
         rows.push(Row {
-            method: AUTO,
-            setting: format!("tol {tolerance}"),
-            probes: set.probe_count(),
-            error: error(&set)?,
+            method: method(AUTO, region),
+            setting: "all cand.".into(),
+            probes: all.probe_count(),
+            error: error(&all)?,
         });
     }
-    let all = ProbeSet::tetrahedral(&positions, sh)?;
-    rows.push(Row {
-        method: AUTO,
-        setting: "all cand.".into(),
-        probes: all.probe_count(),
-        error: error(&all)?,
-    });
 
     // A probe at every test point: what interpolation cannot improve on.
     let at: Vec<DVec3> = points.iter().map(|p| Vec3::from(p.position).as_dvec3()).collect();
@@ -253,6 +308,7 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         points.iter().zip(&truth).zip(&direct).map(|((p, e), sh)| squared_error(sh, p, e)).sum::<f64>();
     Ok(Measurement {
         rows,
+        path,
         test_points: points.len() / params.normals,
         reference_noise: noise / rms_truth,
         capture_floor: (floor / (3 * truth.len()) as f64).sqrt() / rms_truth,
@@ -381,15 +437,23 @@ mod tests {
         };
         let m = measure(&ctx, &scene, &params).unwrap();
         assert_eq!(m.test_points, 4);
-        let rows: Vec<_> = m.rows.iter().map(|r| (r.method, r.probes)).collect();
+        let rows: Vec<_> = m.rows.iter().map(|r| (r.method.as_str(), r.probes)).collect();
+        let (tri, tet) = (method(TRILINEAR, Region::Box), method(GRID_TETRA, Region::Box));
         // probe-room's box is 4 × 2.5 × 4: level 4 is 4 × 3 × 4.
-        assert_eq!(&rows[..4], &[(TRILINEAR, 8), (GRID_TETRA, 8), (TRILINEAR, 48), (GRID_TETRA, 48)]);
+        assert_eq!(
+            &rows[..4],
+            &[(tri.as_str(), 8), (tet.as_str(), 8), (tri.as_str(), 48), (tet.as_str(), 48)]
+        );
         assert!(m.rows.iter().all(|r| r.error.is_finite() && r.error >= 0.0));
-        let auto: Vec<_> = m.rows.iter().filter(|r| r.method == AUTO).collect();
-        assert_eq!(auto.len(), 2);
-        // Automatic placement keeps at most the candidates (those of the finest grid outside
-        // solids; probe-room has none inside).
-        assert!(auto[0].probes >= 4 && auto[0].probes <= auto[1].probes && auto[1].probes == 48);
+        for region in [Region::Box, Region::Path] {
+            let auto: Vec<_> = m.rows.iter().filter(|r| r.method == method(AUTO, region)).collect();
+            assert_eq!(auto.len(), 2);
+            // Automatic placement keeps at most the candidates (those of the finest grid
+            // outside solids; probe-room has none inside), and at least a tetrahedron.
+            assert!(auto[0].probes >= 4 && auto[0].probes <= auto[1].probes && auto[1].probes == 48);
+        }
+        // The bunny's path lies inside the room, under the opening.
+        assert!(m.path.0.y >= 0.0 && m.path.1.x - m.path.0.x < 4.0);
         assert!(m.capture_floor.is_finite() && m.capture_ms_per_probe > 0.0);
     }
 }

@@ -40,7 +40,7 @@ pub use capture::{CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFA
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
-pub use reduce::{reduce, sh_error};
+pub use reduce::reduce;
 pub use set::{
     bounds, capture_at, grid_lattice, is_static, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings,
     AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,

@@ -3,9 +3,10 @@
 //!
 //! The error of a probe against the SH interpolated at its position: the largest difference of
 //! irradiance over 14 normals (the axes and the diagonals) and the three channels, relative to
-//! the probe's mean irradiance over all normals (so that dark probes are judged by their own
-//! light, and the dark side of a bright one does not blow up). A probe with almost no light
-//! is judged against 1/1000 of the candidates' mean instead.
+//! the larger of the probe's own mean irradiance (over all normals) and the candidates' mean.
+//! Relative to its own light alone, a probe in the shade beside a patch of sun would be "wrong"
+//! by many times its light, and every probe along every shadow's edge would stay; relative to
+//! the scene's mean alone, probes that see the sun would be held to a fraction of their light.
 //!
 //! The greedy passes, in rounds: the kept set is tetrahedralized; every kept probe is scored by
 //! its error against the set without it; then, most redundant first, a probe is dropped when the
@@ -49,16 +50,21 @@ pub fn blend<'a>(weighted: impl IntoIterator<Item = (&'a ShRgb9, f64)>) -> ShRgb
     sum
 }
 
-/// A probe's mean irradiance over all normals, per channel: Â₀ Y₀₀ c₀ = π · (1 / 2√π) · c₀.
+/// A probe's mean irradiance over all normals and channels: Â₀ Y₀₀ c₀ = π · (1 / 2√π) · c₀.
 fn mean_irradiance(sh: &ShRgb9) -> f32 {
-    let c0 = sh.c[0].iter().copied().fold(0.0, f32::max);
-    0.5 * std::f32::consts::PI.sqrt() * c0
+    0.5 * std::f32::consts::PI.sqrt() * sh.c[0].iter().sum::<f32>() / 3.0
 }
 
-/// The relative error of `approx` against `exact` (see the module documentation); `floor`
-/// bounds the divisor from below.
-pub fn sh_error(approx: &ShRgb9, exact: &ShRgb9, floor: f32) -> f32 {
-    let scale = mean_irradiance(exact).max(floor);
+/// The candidates' mean irradiance; the smallest positive number for a set in the dark, where
+/// every error is 0.
+fn mean_scale(sh: &[ShRgb9]) -> f32 {
+    (sh.iter().map(mean_irradiance).sum::<f32>() / sh.len().max(1) as f32).max(f32::MIN_POSITIVE)
+}
+
+/// The error of `approx` against `exact` relative to the larger of `exact`'s mean irradiance
+/// and `scale` (see the module documentation).
+fn sh_error(approx: &ShRgb9, exact: &ShRgb9, scale: f32) -> f32 {
+    let scale = mean_irradiance(exact).max(scale);
     directions()
         .iter()
         .map(|&n| {
@@ -74,7 +80,7 @@ pub fn sh_error(approx: &ShRgb9, exact: &ShRgb9, floor: f32) -> f32 {
 /// module documentation). At least four non-coplanar candidates are always kept.
 pub fn reduce(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<Vec<usize>> {
     let n = positions.len();
-    let floor = 1e-3 * sh.iter().map(mean_irradiance).sum::<f32>() / n.max(1) as f32;
+    let scale = mean_scale(sh);
     let mut kept = vec![true; n];
     let mut dropped: Vec<usize> = Vec::new();
     loop {
@@ -115,7 +121,7 @@ pub fn reduce(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<Vec<
             let mut worst = 0.0f32;
             for &j in probes {
                 let approx = interpolate(&local, &local_sh, &mut walker, positions[j])?;
-                worst = worst.max(sh_error(&approx, &sh[j], floor));
+                worst = worst.max(sh_error(&approx, &sh[j], scale));
             }
             Ok(Some(worst))
         };
@@ -204,11 +210,11 @@ mod tests {
         let points: Vec<DVec3> = kept.iter().map(|&i| positions[i]).collect();
         let mesh = TetMesh::build(&points).unwrap();
         let kept_sh: Vec<&ShRgb9> = kept.iter().map(|&i| &sh[i]).collect();
-        let floor = 1e-3 * sh.iter().map(mean_irradiance).sum::<f32>() / sh.len() as f32;
+        let scale = mean_scale(&sh);
         let mut walker = Walker::default();
         for (p, exact) in positions.iter().zip(&sh) {
             let approx = interpolate(&mesh, &kept_sh, &mut walker, *p).unwrap();
-            assert!(sh_error(&approx, exact, floor) <= tolerance, "{p}");
+            assert!(sh_error(&approx, exact, scale) <= tolerance, "{p}");
         }
     }
 }

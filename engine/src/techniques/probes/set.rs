@@ -44,7 +44,7 @@ pub enum ProbePlacement {
 
 /// Candidates along the longest side of the box in automatic placement.
 pub const AUTO_CANDIDATES: u32 = 8;
-/// Automatic placement's tolerance when none is given: 5% of a probe's mean irradiance.
+/// Automatic placement's tolerance when none is given: 5% of the candidates' mean irradiance.
 pub const DEFAULT_TOLERANCE: f32 = 0.05;
 
 /// How the light between probes is found.
