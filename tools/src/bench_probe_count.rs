@@ -450,7 +450,11 @@ mod tests {
             assert_eq!(auto.len(), 2);
             // Automatic placement keeps at most the candidates (those of the finest grid
             // outside solids; probe-room has none inside), and at least a tetrahedron.
-            assert!(auto[0].probes >= 4 && auto[0].probes <= auto[1].probes && auto[1].probes == 48);
+            let finest =
+                m.rows.iter().filter(|r| r.method == method(TRILINEAR, region)).map(|r| r.probes).max();
+            assert!(
+                auto[0].probes >= 4 && auto[0].probes <= auto[1].probes && Some(auto[1].probes) == finest
+            );
         }
         // The bunny's path lies inside the room, under the opening.
         assert!(m.path.0.y >= 0.0 && m.path.1.x - m.path.0.x < 4.0);
