@@ -126,8 +126,8 @@ pub fn reduce(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<Vec<
             Ok(Some(worst))
         };
         let mut score = Vec::new();
-        for k in 0..index.len() {
-            if let Some(e) = error_without(k, &[index[k]])? {
+        for (k, &probe) in index.iter().enumerate() {
+            if let Some(e) = error_without(k, &[probe])? {
                 if e <= tolerance {
                     score.push((e, k));
                 }
