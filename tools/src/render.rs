@@ -104,7 +104,7 @@ pub struct RenderArgs {
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[arg(long, default_value_t = 512)]
