@@ -22,6 +22,7 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
     let probes = ProbeSettings {
         placement: ProbePlacement::Grid([2, 2, 2]),
         capture: CaptureSettings { cube_size: 8, light: CapturedLight::SkyAndWalls },
+        ..Default::default()
     };
     let options = RenderOptions { width: 48, height: 48, technique: TechniqueChoice::Probes(probes) };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
@@ -67,6 +68,7 @@ fn interpolated_irradiance_matches_the_ray_cast_reference_within_its_derived_bou
     let settings = ProbeSettings {
         placement: ProbePlacement::Grid([3, 3, 3]),
         capture: CaptureSettings { cube_size: 64, light: CapturedLight::Sky },
+        ..Default::default()
     };
     let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings).unwrap();
 

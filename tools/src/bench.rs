@@ -23,6 +23,9 @@ pub enum BenchCommand {
     /// ray-traced reference, GPU ms per pass and frame side by side, shadow memory, flicker
     /// while the camera moves slowly, frames to converge at rest.
     Asm(crate::bench_asm::AsmBenchArgs),
+    /// Light probes' irradiance error against the ray-cast truth as the probe count grows: a
+    /// grid with trilinear interpolation against automatic placement with tetrahedral.
+    ProbeCount(crate::bench_probe_count::ProbeCountArgs),
 }
 
 #[derive(Args)]
@@ -46,6 +49,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Rays(args) => rays(args),
         BenchCommand::Probes(args) => crate::bench_probes::run(args),
         BenchCommand::Asm(args) => crate::bench_asm::run(args),
+        BenchCommand::ProbeCount(args) => crate::bench_probe_count::run(args),
     }
 }
 
@@ -179,10 +183,7 @@ fn surface_rays(scene: &Scene, count: u32) -> Vec<CastRay> {
                 (a, b) = (1.0 - a, 1.0 - b);
             }
             let p = t[0] + a * (t[1] - t[0]) + b * (t[2] - t[0]);
-            let z = 2.0 * rng.next() - 1.0;
-            let phi = std::f32::consts::TAU * rng.next();
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let dir = rng.unit_vector();
             let normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
             let side = if normal.dot(dir) >= 0.0 { normal } else { -normal };
             ray(offset_ray_origin(p, side), dir)
@@ -203,5 +204,13 @@ impl Pcg32 {
         self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
         let x = ((((self.0 >> 18) ^ self.0) >> 27) as u32).rotate_right((self.0 >> 59) as u32);
         (x >> 8) as f32 / (1 << 24) as f32
+    }
+
+    /// Uniform on the unit sphere.
+    pub fn unit_vector(&mut self) -> Vec3 {
+        let z = 2.0 * self.next() - 1.0;
+        let phi = std::f32::consts::TAU * self.next();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
     }
 }

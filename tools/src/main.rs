@@ -1,6 +1,7 @@
 //! `kage`: the command-line front end of the Kage engine.
 mod bench;
 mod bench_asm;
+mod bench_probe_count;
 mod bench_probes;
 mod compare;
 mod info;

@@ -1,9 +1,11 @@
 //! `kage probes tetrahedralize` and `kage probes lookup`: the probe set's tetrahedra, and the
-//! tetrahedron and weights of one point.
+//! tetrahedron and weights of one point; `kage probes place`: automatic placement in a scene.
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
 use glam::DVec3;
-use kage::techniques::probes::{TetMesh, Walker};
+use kage::renderer::GpuScene;
+use kage::scene::Scene;
+use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -16,6 +18,31 @@ pub enum ProbesCommand {
     /// The tetrahedron holding a point and its four barycentric weights (outside the hull: those
     /// of the hull's nearest point).
     Lookup(LookupArgs),
+    /// Automatic placement: candidates on a grid over the scene's static groups (those inside
+    /// solids dropped) are captured, the redundant ones dropped; the kept positions are written
+    /// as a probe file for `kage render --probes FILE`.
+    Place(PlaceArgs),
+}
+
+#[derive(Args)]
+pub struct PlaceArgs {
+    /// A built-in scene name or a scene file (.json).
+    #[arg(long, default_value = "probe-room")]
+    scene: String,
+    /// `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (see `kage render --probes`).
+    #[arg(long, default_value = "auto")]
+    probes: String,
+    /// Texels per side of a probe's cube-map face, 8 to 256.
+    #[arg(long, default_value_t = 32)]
+    probe_cube_size: u32,
+    /// What the probes capture besides the sky they see.
+    #[arg(long, value_enum, default_value_t = crate::render::ProbeLightName::SkyAndWalls)]
+    probe_light: crate::render::ProbeLightName,
+    /// Where to write {"positions": [[x,y,z], ...]}.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    gpu: crate::GpuArgs,
 }
 
 #[derive(Args)]
@@ -38,7 +65,7 @@ pub struct LookupArgs {
     at: [f64; 3],
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct ProbeFile {
     positions: Vec<[f64; 3]>,
@@ -53,7 +80,36 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
     match command {
         ProbesCommand::Tetrahedralize(args) => tetrahedralize(args),
         ProbesCommand::Lookup(args) => lookup(args),
+        ProbesCommand::Place(args) => place(args),
     }
+}
+
+fn place(args: &PlaceArgs) -> Result<()> {
+    let placement = crate::render::probe_placement(&args.probes)?;
+    if !matches!(placement, ProbePlacement::Auto { .. }) {
+        anyhow::bail!("--probes {}: expected auto, auto:TOL or auto:TOL:NX,NY,NZ", args.probes);
+    }
+    let scene = Scene::from_arg(&args.scene)?;
+    let ctx = args.gpu.context()?;
+    let gpu = GpuScene::new(&ctx, &scene)?;
+    let settings = ProbeSettings {
+        placement,
+        capture: CaptureSettings { cube_size: args.probe_cube_size, light: args.probe_light.captured() },
+        ..Default::default()
+    };
+    let start = Instant::now();
+    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings)?;
+    let positions = set.mesh.positions().iter().map(|p| p.to_array()).collect();
+    let json = serde_json::to_string(&ProbeFile { positions })?;
+    std::fs::write(&args.out, json + "\n").with_context(|| format!("writing {}", args.out.display()))?;
+    println!(
+        "{} of {} candidate probes kept in {:.1} s; written to {}",
+        set.probe_count(),
+        set.candidates,
+        start.elapsed().as_secs_f64(),
+        args.out.display()
+    );
+    args.gpu.finish(&ctx)
 }
 
 /// The positions of a probe file.

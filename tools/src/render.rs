@@ -9,7 +9,9 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::MB;
 use kage::techniques::asm::AsmSettings;
-use kage::techniques::probes::{CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings};
+use kage::techniques::probes::{
+    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_TOLERANCE,
+};
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
@@ -40,6 +42,23 @@ pub enum ProbeLightName {
     SkyAndWalls,
     /// The sky where the probe sees it; the static groups only occlude.
     Sky,
+}
+
+impl ProbeLightName {
+    pub fn captured(self) -> CapturedLight {
+        match self {
+            ProbeLightName::SkyAndWalls => CapturedLight::SkyAndWalls,
+            ProbeLightName::Sky => CapturedLight::Sky,
+        }
+    }
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProbeInterpolationName {
+    /// Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
+    Tetrahedral,
+    /// Trilinear weights of the grid cell holding the point (a `grid:` placement only).
+    Trilinear,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,9 +92,14 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = AsmSettings::default().time_ms)]
     asm_time_ms: f64,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
-    /// bounding box, 2 to 64 each) or a file {"positions": [[x,y,z], ...]}.
+    /// bounding box, 2 to 64 each), a file {"positions": [[x,y,z], ...]}, or `auto`,
+    /// `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates on that grid, outside solids, captured; those
+    /// the others reproduce within the relative irradiance error TOL, default 0.05, dropped).
     #[arg(long, default_value = "grid:3,2,3")]
     probes: String,
+    /// How the light between probes is found: `trilinear` needs a `grid:` placement.
+    #[arg(long, value_enum, default_value_t = ProbeInterpolationName::Tetrahedral)]
+    probe_interpolation: ProbeInterpolationName,
     /// Texels per side of a probe's cube-map face, 8 to 256.
     #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_CUBE_SIZE)]
     probe_cube_size: u32,
@@ -91,7 +115,7 @@ pub struct RenderArgs {
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm) or a scene file (.json).
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[arg(long, default_value_t = 512)]
@@ -152,12 +176,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         shadow_map_size: args.shadow_map_size,
         probes: ProbeSettings {
             placement: probe_placement(&args.probes)?,
-            capture: CaptureSettings {
-                cube_size: args.probe_cube_size,
-                light: match args.probe_light {
-                    ProbeLightName::SkyAndWalls => CapturedLight::SkyAndWalls,
-                    ProbeLightName::Sky => CapturedLight::Sky,
-                },
+            capture: CaptureSettings { cube_size: args.probe_cube_size, light: args.probe_light.captured() },
+            interpolation: match args.probe_interpolation {
+                ProbeInterpolationName::Tetrahedral => ProbeInterpolation::Tetrahedral,
+                ProbeInterpolationName::Trilinear => ProbeInterpolation::Trilinear,
             },
         },
         asm: AsmSettings { budget_mb: args.asm_budget_mb, time_ms: args.asm_time_ms },
@@ -260,22 +282,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.gpu.finish(&ctx)
 }
 
-/// `--probes`: `grid:NX,NY,NZ` or a probe file.
-fn probe_placement(arg: &str) -> Result<ProbePlacement> {
-    match arg.strip_prefix("grid:") {
-        Some(counts) => {
-            let counts: Vec<u32> = counts
-                .split(',')
-                .map(|n| n.trim().parse())
-                .collect::<Result<_, _>>()
-                .with_context(|| format!("--probes {arg}: expected grid:NX,NY,NZ with whole numbers"))?;
-            let counts: [u32; 3] = counts
-                .try_into()
-                .map_err(|_| anyhow::anyhow!("--probes {arg}: expected three counts, grid:NX,NY,NZ"))?;
-            Ok(ProbePlacement::Grid(counts))
-        }
-        None => {
-            Ok(ProbePlacement::Positions(crate::probes::read_positions(std::path::Path::new(arg))?.into()))
-        }
+/// `--probes`: `grid:NX,NY,NZ`, `auto[:TOL[:NX,NY,NZ]]` or a probe file.
+pub fn probe_placement(arg: &str) -> Result<ProbePlacement> {
+    let counts = |text: &str, form: &str| -> Result<[u32; 3]> {
+        let counts: Vec<u32> = text
+            .split(',')
+            .map(|n| n.trim().parse())
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("--probes {arg}: expected {form} with whole numbers"))?;
+        counts.try_into().map_err(|_| anyhow::anyhow!("--probes {arg}: expected three counts, {form}"))
+    };
+    if let Some(grid) = arg.strip_prefix("grid:") {
+        return Ok(ProbePlacement::Grid(counts(grid, "grid:NX,NY,NZ")?));
     }
+    if arg == "auto" || arg.starts_with("auto:") {
+        let mut parts = arg.splitn(3, ':').skip(1);
+        let tolerance = match parts.next() {
+            Some(t) => t
+                .trim()
+                .parse()
+                .with_context(|| format!("--probes {arg}: expected auto:TOL with TOL a number"))?,
+            None => DEFAULT_TOLERANCE,
+        };
+        let candidates = parts.next().map(|c| counts(c, "auto:TOL:NX,NY,NZ")).transpose()?;
+        return Ok(ProbePlacement::Auto { tolerance, candidates });
+    }
+    Ok(ProbePlacement::Positions(crate::probes::read_positions(std::path::Path::new(arg))?.into()))
 }

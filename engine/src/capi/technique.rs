@@ -6,7 +6,7 @@ use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
 use crate::techniques::asm::AsmSettings;
 use crate::techniques::probes::{
-    CaptureSettings, CapturedLight, ProbePlacement, ProbeSettings, DEFAULT_GRID,
+    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_GRID,
 };
 use crate::techniques::prt::{transfer, PrtParams};
 use crate::techniques::settings::{TechniqueKind, TechniqueSettings};
@@ -138,6 +138,7 @@ impl kage_technique_desc {
             probes: ProbeSettings {
                 placement: ProbePlacement::Grid(self.probe_grid),
                 capture: CaptureSettings { cube_size: self.probe_cube_size, light: probe_light },
+                interpolation: ProbeInterpolation::Tetrahedral,
             },
             asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms },
         }

@@ -3,7 +3,7 @@
 //! the shared reference assets, embedded so the library needs no file at run time.
 use glam::Vec3;
 
-use super::{obj, probe_room, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
+use super::{atrium, obj, probe_room, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
 
 const TEAPOT_OBJ: &[u8] = include_bytes!("../../assets/teapot.obj");
 const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
@@ -12,11 +12,14 @@ const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
 const TEAPOT_HEIGHT: f32 = 15.75;
 
 /// Names accepted by [`Scene::builtin`]; the first is the default.
-pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room", "asm"];
+pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room", "asm", "atrium"];
 
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     if name == "probe-room" {
         return probe_room_scene(name);
+    }
+    if name == "atrium" {
+        return atrium_scene(name);
     }
     // Floor grid vertices per side: 31×31 is the paper's low-resolution receiver, 111×111 its
     // high-resolution one.
@@ -81,5 +84,19 @@ fn probe_room_scene(name: &str) -> Result<Scene, SceneError> {
             up: Vec3::Y,
             fov_y_deg: 70.0,
         },
+    })
+}
+
+/// See [`atrium`]: a courtyard building under the courtyard sky, the bunny passing from the
+/// courtyard's sun into the gallery's shade.
+fn atrium_scene(name: &str) -> Result<Scene, SceneError> {
+    let context = context(name);
+    Ok(Scene {
+        name: name.to_string(),
+        groups: atrium::groups().map_err(context)?,
+        environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
+        lights: Vec::new(),
+        walkthrough: Vec::new(),
+        camera: atrium::camera(),
     })
 }

@@ -20,6 +20,7 @@ use std::path::Path;
 
 pub mod animation;
 mod asm_room;
+pub mod atrium;
 mod builtin;
 mod camera;
 pub mod envmap;

@@ -4,6 +4,11 @@
 //! [`ProbeSet`]: placement, capture and interpolation; [`technique`]: the moving group lit by
 //! the probes. The geometry:
 //!
+//! Automatic placement ([`ProbePlacement::Auto`], [`reduce`]) captures a dense set of candidates
+//! and keeps those the others cannot reproduce; a regular grid with trilinear interpolation
+//! ([`Lattice`], [`ProbeInterpolation::Trilinear`]) is the baseline it is measured against
+//! (`kage bench probe-count`).
+//!
 //! [`TetMesh::build`] tetrahedralizes the probe positions (3D Delaunay, incremental, with exact
 //! orientation and in-sphere predicates and a symbolic perturbation for cospherical sets such as
 //! grids); a [`Walker`] finds the tetrahedron that holds a point by walking from the previous
@@ -20,17 +25,26 @@ mod extrapolate;
 mod input;
 mod lookup;
 mod predicates;
+mod reduce;
 mod rng;
 mod set;
+mod solids;
 mod spatial_sort;
 pub mod technique;
 #[cfg(test)]
 mod tests;
 mod tetmesh;
+mod trilinear;
 
 pub use capture::{CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE};
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
-pub use set::{is_static, ProbePlacement, ProbeSet, ProbeSettings, DEFAULT_GRID, MAX_GRID, MOVING_GROUP};
+pub use reduce::reduce;
+pub use set::{
+    bounds, capture_at, grid_lattice, is_static, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings,
+    AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
+};
+pub use solids::{Hit, Solids};
 pub use tetmesh::{Across, TetMesh};
+pub use trilinear::Lattice;

@@ -2,6 +2,9 @@
 //! tetrahedralization, each probe's SH, and the SH interpolated at any point with the
 //! tetrahedral weights.
 use super::capture::{CaptureSettings, ProbeCapture};
+use super::reduce::{blend, reduce};
+use super::solids::Solids;
+use super::trilinear::Lattice;
 use super::{TetMesh, Walker};
 use crate::backend::Context;
 use crate::error::{Error, Result};
@@ -31,6 +34,27 @@ pub enum ProbePlacement {
     Grid([u32; 3]),
     /// Explicit world positions (`{"positions": [[x, y, z], ...]}` on the command line).
     Positions(Arc<[DVec3]>),
+    /// Automatic: the cell centres of a `candidates` grid over the static groups' bounding box
+    /// that are not inside a solid ([`Solids`]) are captured, then those that the others
+    /// reproduce by tetrahedral interpolation within `tolerance` are dropped (see
+    /// [`super::reduce`]). `None` candidates: [`AUTO_CANDIDATES`] along the box's longest side,
+    /// proportionally fewer along the others.
+    Auto { tolerance: f32, candidates: Option<[u32; 3]> },
+}
+
+/// Candidates along the longest side of the box in automatic placement.
+pub const AUTO_CANDIDATES: u32 = 8;
+/// Automatic placement's tolerance when none is given: 5% of the candidates' mean irradiance.
+pub const DEFAULT_TOLERANCE: f32 = 0.05;
+
+/// How the light between probes is found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ProbeInterpolation {
+    /// Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
+    #[default]
+    Tetrahedral,
+    /// Trilinear weights of the grid cell holding the point: a [`ProbePlacement::Grid`] only.
+    Trilinear,
 }
 
 /// A small grid for a room: 18 probes, two layers.
@@ -47,46 +71,80 @@ impl Default for ProbePlacement {
 pub struct ProbeSettings {
     pub placement: ProbePlacement,
     pub capture: CaptureSettings,
+    pub interpolation: ProbeInterpolation,
 }
 
 impl ProbeSettings {
     pub fn validated(self) -> Result<ProbeSettings> {
-        if let ProbePlacement::Grid(counts) = self.placement {
+        let grid = match self.placement {
+            ProbePlacement::Grid(counts) => Some(("probe grid", counts)),
+            ProbePlacement::Auto { candidates, .. } => candidates.map(|c| ("probe candidate grid", c)),
+            ProbePlacement::Positions(_) => None,
+        };
+        if let Some((what, counts)) = grid {
             if counts.iter().any(|n| !(2..=MAX_GRID).contains(n)) {
                 return Err(Error::InvalidArgument(format!(
-                    "probe grid {counts:?}: each count must be 2 to {MAX_GRID} (a tetrahedralization needs probes in 3D)"
+                    "{what} {counts:?}: each count must be 2 to {MAX_GRID} (a tetrahedralization needs probes in 3D)"
                 )));
             }
+        }
+        if let ProbePlacement::Auto { tolerance, .. } = self.placement {
+            if !(tolerance.is_finite() && tolerance > 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "automatic probe placement: tolerance {tolerance} must be a positive number (a relative irradiance error, such as 0.05)"
+                )));
+            }
+        }
+        if self.interpolation == ProbeInterpolation::Trilinear
+            && !matches!(self.placement, ProbePlacement::Grid(_))
+        {
+            return Err(Error::InvalidArgument(
+                "trilinear probe interpolation needs a probe grid (grid:NX,NY,NZ)".into(),
+            ));
         }
         self.capture.validated()?;
         Ok(self)
     }
 
-    /// The probe positions in `scene`.
+    /// The probe positions in `scene`; for automatic placement, the candidates.
     pub fn positions(&self, scene: &Scene) -> Result<Vec<DVec3>> {
         match &self.placement {
             ProbePlacement::Positions(positions) => Ok(positions.to_vec()),
-            ProbePlacement::Grid(counts) => {
-                let (lo, hi) = static_bounds(scene).ok_or_else(|| {
-                    Error::InvalidArgument(format!(
-                        "scene \"{}\" has no static group to place a probe grid in (group {MOVING_GROUP} moves)",
-                        scene.name
-                    ))
-                })?;
-                let cell = (hi - lo) / Vec3::from(counts.map(|n| n as f32));
-                let mut positions = Vec::new();
-                for k in 0..counts[2] {
-                    for j in 0..counts[1] {
-                        for i in 0..counts[0] {
-                            let centre = lo + cell * (Vec3::new(i as f32, j as f32, k as f32) + 0.5);
-                            positions.push(centre.as_dvec3());
-                        }
+            ProbePlacement::Grid(counts) => Ok(grid_lattice(scene, *counts)?.positions()),
+            ProbePlacement::Auto { candidates, .. } => {
+                let counts = match candidates {
+                    Some(counts) => *counts,
+                    None => {
+                        let (lo, hi) = static_bounds_of(scene)?;
+                        let extent = hi - lo;
+                        let along = |e: f32| {
+                            ((AUTO_CANDIDATES as f32 * e / extent.max_element()).round() as u32)
+                                .clamp(2, MAX_GRID)
+                        };
+                        extent.to_array().map(along)
                     }
-                }
-                Ok(positions)
+                };
+                let solids = Solids::of_static(scene);
+                let lattice = grid_lattice(scene, counts)?;
+                Ok(lattice.positions().into_iter().filter(|p| !solids.contains(p.as_vec3())).collect())
             }
         }
     }
+}
+
+/// The cell centres of a `counts` grid over the static groups' bounding box.
+pub fn grid_lattice(scene: &Scene, counts: [u32; 3]) -> Result<Lattice> {
+    let (lo, hi) = static_bounds_of(scene)?;
+    Ok(Lattice::cell_centres(lo, hi, counts))
+}
+
+fn static_bounds_of(scene: &Scene) -> Result<(Vec3, Vec3)> {
+    static_bounds(scene).ok_or_else(|| {
+        Error::InvalidArgument(format!(
+            "scene \"{}\" has no static group to place probes in (group {MOVING_GROUP} moves)",
+            scene.name
+        ))
+    })
 }
 
 /// The world bounding box of the static groups' vertices.
@@ -110,6 +168,11 @@ pub struct ProbeSet {
     pub mesh: TetMesh,
     /// Each probe's radiance SH, in the order of the positions.
     pub sh: Vec<ShRgb9>,
+    /// The grid, when the interpolation is trilinear; `None`: tetrahedral.
+    pub trilinear: Option<Lattice>,
+    /// Probes captured before automatic placement dropped the redundant ones (the probe count
+    /// for the other placements).
+    pub candidates: usize,
 }
 
 impl ProbeSet {
@@ -123,25 +186,70 @@ impl ProbeSet {
     ) -> Result<ProbeSet> {
         let settings = settings.clone().validated()?;
         let positions = settings.positions(scene)?;
-        let mesh = TetMesh::build(&positions)?;
-        let mut capture = ProbeCapture::new(ctx, scene, settings.capture)?;
-        let sh =
-            positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect::<Result<_>>()?;
-        Ok(ProbeSet { mesh, sh })
+        let sh = capture_at(ctx, scene, gpu, settings.capture, &positions)?;
+        let candidates = positions.len();
+        let mut set = match (&settings.placement, settings.interpolation) {
+            (ProbePlacement::Auto { tolerance, .. }, _) => ProbeSet::reduced(&positions, &sh, *tolerance)?,
+            (ProbePlacement::Grid(counts), ProbeInterpolation::Trilinear) => {
+                ProbeSet::trilinear(grid_lattice(scene, *counts)?, sh)?
+            }
+            _ => ProbeSet::tetrahedral(&positions, sh)?,
+        };
+        set.candidates = candidates;
+        Ok(set)
     }
 
-    /// The SH at `p`: the probes' SH weighted by the tetrahedral (or, outside the hull,
-    /// extrapolation) weights that `walker` finds from where it last stopped.
-    pub fn interpolate(&self, walker: &mut Walker, p: Vec3) -> Result<ShRgb9> {
-        let location = walker.locate(&self.mesh, p.as_dvec3())?;
-        let mut sum = ShRgb9::default();
-        for (&probe, &w) in location.probes.iter().zip(&location.weights) {
-            for (total, c) in sum.c.iter_mut().zip(&self.sh[probe as usize].c) {
-                for (t, v) in total.iter_mut().zip(c) {
-                    *t += w as f32 * v;
-                }
-            }
-        }
-        Ok(sum)
+    /// Tetrahedral interpolation of the SH captured at `positions`.
+    pub fn tetrahedral(positions: &[DVec3], sh: Vec<ShRgb9>) -> Result<ProbeSet> {
+        let candidates = positions.len();
+        Ok(ProbeSet { mesh: TetMesh::build(positions)?, sh, trilinear: None, candidates })
     }
+
+    /// Trilinear interpolation of the SH captured at the positions of `lattice`.
+    pub fn trilinear(lattice: Lattice, sh: Vec<ShRgb9>) -> Result<ProbeSet> {
+        let mut set = ProbeSet::tetrahedral(&lattice.positions(), sh)?;
+        set.trilinear = Some(lattice);
+        Ok(set)
+    }
+
+    /// Tetrahedral interpolation of those of the SH captured at `positions` that automatic
+    /// placement keeps at `tolerance` ([`reduce`]).
+    pub fn reduced(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<ProbeSet> {
+        let kept = reduce(positions, sh, tolerance)?;
+        let points: Vec<DVec3> = kept.iter().map(|&i| positions[i]).collect();
+        let mut set = ProbeSet::tetrahedral(&points, kept.iter().map(|&i| sh[i]).collect())?;
+        set.candidates = positions.len();
+        Ok(set)
+    }
+
+    /// The probes the set interpolates.
+    pub fn probe_count(&self) -> usize {
+        self.sh.len()
+    }
+
+    /// The SH at `p`: the probes' SH weighted by the trilinear weights of the grid, or by the
+    /// tetrahedral (outside the hull, extrapolation) weights that `walker` finds from where it
+    /// last stopped.
+    pub fn interpolate(&self, walker: &mut Walker, p: Vec3) -> Result<ShRgb9> {
+        if let Some(lattice) = &self.trilinear {
+            let weights = lattice.weights(p.as_dvec3());
+            return Ok(blend(weights.iter().map(|&(probe, w)| (&self.sh[probe as usize], w))));
+        }
+        let location = walker.locate(&self.mesh, p.as_dvec3())?;
+        Ok(blend(
+            location.probes.iter().zip(location.weights).map(|(&probe, w)| (&self.sh[probe as usize], w)),
+        ))
+    }
+}
+
+/// The SH captured at each of `positions` (the static groups of `gpu`, which holds `scene`).
+pub fn capture_at(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    gpu: &GpuScene,
+    settings: CaptureSettings,
+    positions: &[DVec3],
+) -> Result<Vec<ShRgb9>> {
+    let mut capture = ProbeCapture::new(ctx, scene, settings)?;
+    positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect()
 }

@@ -1,7 +1,7 @@
 //! The light-probe technique: the moving group ([`MOVING_GROUP`]) takes its irradiance from
 //! the probes, E(n) = nᵀMn (Ramamoorthi & Hanrahan 2001) with M from the SH interpolated at the
 //! group's centre by a walker that starts where the last frame's lookup ended (one lookup per
-//! object per frame, on the host); negative irradiance is clamped; times albedo / π. The static
+//! object per frame, on the host; with trilinear interpolation, from the grid cell instead); negative irradiance is clamped; times albedo / π. The static
 //! groups keep their own lighting: for now the unshadowed technique's (environment SH, no
 //! shadows). The probes are captured once, when the technique is built, with the environment
 //! unrotated: turning the environment afterwards turns the static groups' light, not the

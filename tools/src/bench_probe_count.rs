@@ -1,0 +1,463 @@
+//! `kage bench probe-count`: the error of probe-interpolated irradiance against the ray-cast
+//! ground truth, as the probe count grows, for a regular grid with trilinear interpolation and
+//! for automatic placement with tetrahedral interpolation (Morishige 2014; issue 6, "Error
+//! against probe count").
+//!
+//! Test points: random points in the moving group's bounding box at random times of its
+//! scripted motion (`--animate`), those inside a solid dropped, each with random normals.
+//! Truth: the reference's irradiance E(p, n) (the moving group moved far away, as the probes
+//! leave it out), cached. Error: the RMS of |E_probes − E| over points, normals and channels
+//! divided by the RMS of E (a relative error that dark normals cannot blow up).
+//!
+//! Captures are shared: the grid levels are captured once each, and automatic placement's
+//! candidates are the finest grid's probes outside solids, reduced at each tolerance on the
+//! host.
+use crate::bench::Pcg32;
+use crate::GpuArgs;
+use anyhow::{bail, Context as _, Result};
+use clap::Args;
+use glam::{DVec3, Vec3};
+use kage::backend::Context;
+use kage::reference::irradiance::{IrradianceFile, Point};
+use kage::reference::IrradianceReference;
+use kage::renderer::GpuScene;
+use kage::scene::{animation, Scene};
+use kage::sh::ShRgb9;
+use kage::techniques::probes::{
+    bounds, capture_at, grid_lattice, CaptureSettings, Lattice, ProbeSet, Solids, Walker, MAX_GRID,
+    MOVING_GROUP,
+};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct ProbeCountArgs {
+    /// Built-in scene names or scene files, each with a moving group 0.
+    #[arg(long, value_delimiter = ',', default_values_t = ["probe-room".to_string(), "atrium".to_string()])]
+    scenes: Vec<String>,
+    /// Grid levels: probes along the static box's longest side (the others in proportion, at
+    /// least 2). The finest level's probes outside solids are automatic placement's candidates.
+    #[arg(long, value_delimiter = ',', default_values_t = [2, 3, 4, 6, 8, 10])]
+    grids: Vec<u32>,
+    /// Tolerances of automatic placement (relative irradiance error at the candidates).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.4, 0.2, 0.1, 0.05, 0.025, 0.0125])]
+    tolerances: Vec<f32>,
+    /// Test positions (before those inside solids are dropped).
+    #[arg(long, default_value_t = 64)]
+    points: usize,
+    /// Random normals per test position.
+    #[arg(long, default_value_t = 6)]
+    normals: usize,
+    /// Reference samples per point.
+    #[arg(long, default_value_t = 8192)]
+    spp: u32,
+    /// Texels per side of a probe's cube-map face.
+    #[arg(long, default_value_t = 32)]
+    cube_size: u32,
+    /// The light the probes capture: `sky` is what the reference integrates today (the
+    /// environment with visibility, no bounce); rerun with the reference's transport when it
+    /// changes.
+    #[arg(long, value_enum, default_value_t = crate::render::ProbeLightName::Sky)]
+    probe_light: crate::render::ProbeLightName,
+    /// The relative error a method must reach; default: each grid level's own error.
+    #[arg(long)]
+    target: Option<f64>,
+    /// Where reference irradiance is cached.
+    #[arg(long, default_value = "target/probe-count")]
+    cache: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+/// One measurement of the sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub method: String,
+    /// The grid's counts, or the tolerance.
+    pub setting: String,
+    pub probes: usize,
+    pub error: f64,
+}
+
+pub struct Measurement {
+    pub rows: Vec<Row>,
+    /// The box the moving group sweeps, within the static box.
+    pub path: (Vec3, Vec3),
+    pub test_points: usize,
+    /// RMS standard error of the reference relative to the RMS of E: the noise floor.
+    pub reference_noise: f64,
+    /// The error of a probe captured at each test point: the floor of any interpolation.
+    pub capture_floor: f64,
+    pub capture_ms_per_probe: f64,
+    pub reference_seconds: f64,
+}
+
+pub struct Params<'a> {
+    pub grids: &'a [u32],
+    pub tolerances: &'a [f32],
+    pub points: usize,
+    pub normals: usize,
+    pub spp: u32,
+    pub capture: CaptureSettings,
+    pub cache: Option<&'a Path>,
+}
+
+pub fn run(args: &ProbeCountArgs) -> Result<()> {
+    let ctx = args.gpu.context()?;
+    let params = Params {
+        grids: &args.grids,
+        tolerances: &args.tolerances,
+        points: args.points,
+        normals: args.normals,
+        spp: args.spp,
+        capture: CaptureSettings { cube_size: args.cube_size, light: args.probe_light.captured() },
+        cache: Some(&args.cache),
+    };
+    println!(
+        "probe count against error: {} test positions x {} normals (in the moving group's box along its path), reference {} spp, cube faces {}², capture {:?}, {}",
+        args.points, args.normals, args.spp, args.cube_size, params.capture.light, ctx.info().name
+    );
+    for name in &args.scenes {
+        let scene = Scene::from_arg(name)?;
+        let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {name}"))?;
+        println!(
+            "\nscene {}: {} test points; reference noise {:.4}, capture-at-the-point floor {:.4}; reference {:.1} s; capture {:.1} ms per probe",
+            scene.name,
+            m.test_points,
+            m.reference_noise,
+            m.capture_floor,
+            m.reference_seconds,
+            m.capture_ms_per_probe
+        );
+        println!(
+            "path region {:.2?} to {:.2?}\n{:<32} {:>12} {:>8} {:>10}",
+            m.path.0, m.path.1, "method", "setting", "probes", "rel. RMS"
+        );
+        for row in &m.rows {
+            println!("{:<32} {:>12} {:>8} {:>10.4}", row.method, row.setting, row.probes, row.error);
+        }
+        // Like for like (each region's grid against automatic placement in it), and the
+        // paper's comparison: a grid over the whole box against probes where objects move.
+        for (grid, tetra) in
+            [(Region::Box, Region::Box), (Region::Path, Region::Path), (Region::Box, Region::Path)]
+        {
+            compare(&m.rows, &method(TRILINEAR, grid), &method(AUTO, tetra), args.target);
+        }
+    }
+    args.gpu.finish(&ctx)
+}
+
+/// For each target error (`target`, or each of `grid`'s errors), the fewest probes with which
+/// `grid` and `tetra` reach it, their ratio, and whether the issue's bar is met.
+fn compare(rows: &[Row], grid: &str, tetra: &str, target: Option<f64>) {
+    let targets: Vec<f64> = match target {
+        Some(t) => vec![t],
+        None => rows.iter().filter(|r| r.method == grid).map(|r| r.error).collect(),
+    };
+    println!("{grid} against {tetra}:");
+    println!("{:>10} {:>14} {:>14} {:>8}", "target", "grid probes", "tetra probes", "ratio");
+    let mut ratios = Vec::new();
+    for target in targets {
+        let fewest = |method: &str| {
+            rows.iter().filter(|r| r.method == method && r.error <= target).map(|r| r.probes).min()
+        };
+        let (g, t) = (fewest(grid), fewest(tetra));
+        let show = |n: Option<usize>| n.map_or("not reached".to_string(), |n| n.to_string());
+        let ratio = g.zip(t).map(|(g, t)| t as f64 / g as f64);
+        let shown = ratio.map_or("-".to_string(), |r| format!("{r:.2}"));
+        println!("{target:>10.4} {:>14} {:>14} {shown:>8}", show(g), show(t));
+        ratios.push(ratio);
+    }
+    let reached: Vec<f64> = ratios.iter().flatten().copied().collect();
+    let worst = reached.iter().copied().fold(0.0, f64::max);
+    println!(
+        "bar (tetrahedral reaches the grid's error with at most 30 % of its probes): {} at {} of {} targets (largest ratio {worst:.2}); {} not reached by one of them",
+        if worst <= 0.3 && !reached.is_empty() { "met" } else { "not met" },
+        reached.len(),
+        ratios.len(),
+        ratios.len() - reached.len()
+    );
+}
+
+const TRILINEAR: &str = "grid, trilinear";
+const GRID_TETRA: &str = "grid, tetrahedral";
+const AUTO: &str = "auto, tetrahedral";
+
+/// Where probes go: the static groups' box (as `kage render --probes grid:` and `auto` place
+/// them), or the part of it that the moving group sweeps (where the test points are).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Region {
+    Box,
+    Path,
+}
+
+/// A method's name in `region`.
+pub fn method(name: &str, region: Region) -> String {
+    format!("{name} ({})", if region == Region::Box { "box" } else { "path" })
+}
+
+/// The counts of grid `level` over a box of `extent`: `level` along its longest side, the
+/// others in proportion, at least 2.
+fn grid_counts(extent: Vec3, level: u32) -> [u32; 3] {
+    let along = |e: f32| ((level as f32 * e / extent.max_element()).round() as u32).clamp(2, MAX_GRID);
+    extent.to_array().map(along)
+}
+
+/// The bounds of the moving group's box over 64 times of its motion, within the static box.
+fn path_bounds(group: &kage::scene::Group, static_box: (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
+    let corners = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
+    let (lo, hi) = bounds(corners)?;
+    let swept = (0..64).flat_map(|s| {
+        let m = animation::pose(group, s as f32 / 64.0).matrix();
+        (0..8).map(move |c| {
+            let corner = Vec3::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            );
+            m.transform_point3(corner)
+        })
+    });
+    let (plo, phi) = bounds(swept)?;
+    Some((plo.max(static_box.0), phi.min(static_box.1)))
+}
+
+pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Measurement> {
+    let Some(&finest) = params.grids.iter().max() else { bail!("--grids: give at least one level") };
+    if params.points == 0 || params.normals == 0 {
+        bail!("--points and --normals must be at least 1");
+    }
+    let solids = Solids::of_static(scene);
+    let points = test_points(scene, &solids, params.points, params.normals)?;
+    let (truth, noise, reference_seconds) = reference(ctx, scene, &points, params)?;
+
+    // The probes leave the moving group out of their captures; it stays where it is.
+    let gpu = GpuScene::new(ctx, scene)?;
+    let rms_truth = (truth.iter().flatten().map(|&e| e * e).sum::<f64>() / (3 * truth.len()) as f64).sqrt();
+    let error = |set: &ProbeSet| -> Result<f64> {
+        let mut walker = Walker::default();
+        let mut sum = 0.0;
+        for (point, exact) in points.iter().zip(&truth) {
+            let sh = set.interpolate(&mut walker, Vec3::from(point.position))?;
+            sum += squared_error(&sh, point, exact);
+        }
+        Ok((sum / (3 * truth.len()) as f64).sqrt() / rms_truth)
+    };
+
+    let unit = grid_lattice(scene, [1; 3])?;
+    let static_box = ((unit.first - 0.5 * unit.step).as_vec3(), (unit.first + 0.5 * unit.step).as_vec3());
+    let path = path_bounds(&scene.groups[MOVING_GROUP], static_box)
+        .filter(|(lo, hi)| (*hi - *lo).min_element() > 0.0)
+        .context("the moving group's path has no volume inside the static box")?;
+
+    let mut rows = Vec::new();
+    let mut captured = 0usize;
+    let start = Instant::now();
+    for (region, (lo, hi)) in [(Region::Box, static_box), (Region::Path, path)] {
+        let mut finest_grid = None;
+        for &level in params.grids {
+            let counts = grid_counts(hi - lo, level);
+            let lattice = Lattice::cell_centres(lo, hi, counts);
+            let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
+            captured += sh.len();
+            let setting = format!("{}x{}x{}", counts[0], counts[1], counts[2]);
+            let trilinear = ProbeSet::trilinear(lattice, sh.clone())?;
+            let probes = sh.len();
+            rows.push(Row {
+                method: method(TRILINEAR, region),
+                setting: setting.clone(),
+                probes,
+                error: error(&trilinear)?,
+            });
+            let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
+            rows.push(Row { method: method(GRID_TETRA, region), setting, probes, error: error(&tetra)? });
+            if level == finest {
+                finest_grid = Some((lattice, sh));
+            }
+        }
+        let Some((lattice, sh)) = finest_grid else { unreachable!("the finest level is one of the levels") };
+        let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) =
+            lattice.positions().into_iter().zip(sh).filter(|(p, _)| !solids.contains(p.as_vec3())).unzip();
+        for &tolerance in params.tolerances {
+            let set = ProbeSet::reduced(&positions, &sh, tolerance)?;
+            let (probes, error) = (set.probe_count(), error(&set)?);
+            rows.push(Row {
+                method: method(AUTO, region),
+                setting: format!("tol {tolerance}"),
+                probes,
+                error,
+            });
+        }
+        let all = ProbeSet::tetrahedral(&positions, sh)?;
+        rows.push(Row {
+            method: method(AUTO, region),
+            setting: "all cand.".into(),
+            probes: all.probe_count(),
+            error: error(&all)?,
+        });
+    }
+
+    // A probe at every test point: what interpolation cannot improve on.
+    let at: Vec<DVec3> = points.iter().map(|p| Vec3::from(p.position).as_dvec3()).collect();
+    let direct = capture_at(ctx, scene, &gpu, params.capture, &at)?;
+    captured += direct.len();
+    let capture_ms_per_probe = start.elapsed().as_secs_f64() * 1e3 / captured as f64;
+    let floor =
+        points.iter().zip(&truth).zip(&direct).map(|((p, e), sh)| squared_error(sh, p, e)).sum::<f64>();
+    Ok(Measurement {
+        rows,
+        path,
+        test_points: points.len() / params.normals,
+        reference_noise: noise / rms_truth,
+        capture_floor: (floor / (3 * truth.len()) as f64).sqrt() / rms_truth,
+        capture_ms_per_probe,
+        reference_seconds,
+    })
+}
+
+/// Σ over channels of (E_sh(n), clamped at 0 as the renderer does, − E)².
+fn squared_error(sh: &ShRgb9, point: &Point, exact: &[f64; 3]) -> f64 {
+    let e = sh.irradiance(Vec3::from(point.normal));
+    (0..3).map(|k| (f64::from(e[k].max(0.0)) - exact[k]).powi(2)).sum()
+}
+
+/// `normals` points per position: random positions in the moving group's bounding box at
+/// random times of its motion, outside solids, each with random normals.
+fn test_points(scene: &Scene, solids: &Solids, positions: usize, normals: usize) -> Result<Vec<Point>> {
+    let Some(group) = scene.groups.get(MOVING_GROUP) else {
+        bail!("scene {} has no moving group (group {MOVING_GROUP}) to take a path from", scene.name)
+    };
+    let corners = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
+    let Some((lo, hi)) = bounds(corners) else {
+        bail!("the moving group of scene {} has no vertices", scene.name)
+    };
+    let mut rng = Pcg32(0x2545_f491_4f6c_dd1d);
+    let mut points = Vec::new();
+    // Positions inside solids are redrawn, up to a bound so that a moving group buried in
+    // geometry is an error, not a hang.
+    for _ in 0..positions * 20 {
+        if points.len() == positions * normals {
+            break;
+        }
+        let t = rng.next();
+        let local = lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next());
+        let p = animation::pose(group, t).matrix().transform_point3(local);
+        if solids.contains(p) {
+            continue;
+        }
+        for _ in 0..normals {
+            points.push(Point { position: p.to_array(), normal: rng.unit_vector().to_array() });
+        }
+    }
+    if points.len() < positions * normals {
+        bail!(
+            "only {} of {positions} test positions along the moving group's path are outside solids",
+            points.len() / normals
+        );
+    }
+    Ok(points)
+}
+
+#[derive(Serialize, Deserialize)]
+struct Cached {
+    scene: String,
+    points: Vec<Point>,
+    irradiance: IrradianceFile,
+}
+
+/// The reference irradiance at `points` (from the cache when it holds these points at this
+/// spp), the RMS of its standard error, and the seconds it took (0 when cached).
+fn reference(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    points: &[Point],
+    params: &Params,
+) -> Result<(Vec<[f64; 3]>, f64, f64)> {
+    let path =
+        params.cache.map(|dir| dir.join(format!("{}-{}-{}spp.json", scene.name, points.len(), params.spp)));
+    let cached = path.as_ref().and_then(|p| std::fs::read_to_string(p).ok()).and_then(|text| {
+        serde_json::from_str::<Cached>(&text).ok().filter(|c| c.scene == scene.name && c.points == points)
+    });
+    let start = Instant::now();
+    let file = match cached {
+        Some(c) => c.irradiance,
+        None => {
+            let mut away = scene.clone();
+            away.groups[MOVING_GROUP].transform.translation += Vec3::new(0.0, -1e4, 0.0);
+            let mut reference = IrradianceReference::new(ctx, &away, points, 11)?;
+            let batch = 512;
+            let mut left = params.spp;
+            while left > 0 {
+                reference.run_batch(left.min(batch))?;
+                left -= left.min(batch);
+            }
+            let irradiance = IrradianceFile::from_statistics(&reference.statistics()?);
+            let cached = Cached { scene: scene.name.clone(), points: points.to_vec(), irradiance };
+            if let Some(path) = &path {
+                if let Some(dir) = path.parent() {
+                    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+                }
+                std::fs::write(path, serde_json::to_string(&cached)?)
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+            cached.irradiance
+        }
+    };
+    reference_values(&file, start.elapsed().as_secs_f64())
+}
+
+fn reference_values(file: &IrradianceFile, seconds: f64) -> Result<(Vec<[f64; 3]>, f64, f64)> {
+    let truth = file.irradiance.iter().map(|e| e.map(f64::from)).collect::<Vec<_>>();
+    let n = file.standard_error.len().max(1) * 3;
+    let noise =
+        (file.standard_error.iter().flatten().map(|&s| f64::from(s).powi(2)).sum::<f64>() / n as f64).sqrt();
+    Ok((truth, noise, seconds))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kage::techniques::probes::CapturedLight;
+    use kage_tests::Validated;
+
+    #[test]
+    fn the_measurement_runs_at_a_tiny_size() {
+        let ctx = Validated::new();
+        let scene = Scene::builtin("probe-room").unwrap();
+        let params = Params {
+            grids: &[2, 4],
+            tolerances: &[0.2],
+            points: 4,
+            normals: 2,
+            spp: 64,
+            capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky },
+            cache: None,
+        };
+        let m = measure(&ctx, &scene, &params).unwrap();
+        assert_eq!(m.test_points, 4);
+        let rows: Vec<_> = m.rows.iter().map(|r| (r.method.as_str(), r.probes)).collect();
+        let (tri, tet) = (method(TRILINEAR, Region::Box), method(GRID_TETRA, Region::Box));
+        // probe-room's box is 4 × 2.5 × 4: level 4 is 4 × 3 × 4.
+        assert_eq!(
+            &rows[..4],
+            &[(tri.as_str(), 8), (tet.as_str(), 8), (tri.as_str(), 48), (tet.as_str(), 48)]
+        );
+        assert!(m.rows.iter().all(|r| r.error.is_finite() && r.error >= 0.0));
+        for region in [Region::Box, Region::Path] {
+            let auto: Vec<_> = m.rows.iter().filter(|r| r.method == method(AUTO, region)).collect();
+            assert_eq!(auto.len(), 2);
+            // Automatic placement keeps at most the candidates (those of the finest grid
+            // outside solids; probe-room has none inside), and at least a tetrahedron.
+            let finest =
+                m.rows.iter().filter(|r| r.method == method(TRILINEAR, region)).map(|r| r.probes).max();
+            assert!(
+                auto[0].probes >= 4 && auto[0].probes <= auto[1].probes && Some(auto[1].probes) == finest
+            );
+        }
+        // The bunny's path lies inside the room, under the opening.
+        assert!(m.path.0.y >= 0.0 && m.path.1.x - m.path.0.x < 4.0);
+        assert!(m.capture_floor.is_finite() && m.capture_ms_per_probe > 0.0);
+    }
+}
