@@ -32,6 +32,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+/// Grid levels and placement tolerances measured unless told (`kage sweep --technique probes`
+/// measures these too).
+pub const DEFAULT_GRIDS: [u32; 6] = [2, 3, 4, 6, 8, 10];
+pub const DEFAULT_TOLERANCES: [f32; 6] = [0.4, 0.2, 0.1, 0.05, 0.025, 0.0125];
+
 #[derive(Args)]
 pub struct ProbeCountArgs {
     /// Built-in scene names or scene files, each with a moving group 0.
@@ -39,10 +44,10 @@ pub struct ProbeCountArgs {
     scenes: Vec<String>,
     /// Grid levels: probes along the static box's longest side (the others in proportion, at
     /// least 2). The finest level's probes outside solids are automatic placement's candidates.
-    #[arg(long, value_delimiter = ',', default_values_t = [2, 3, 4, 6, 8, 10])]
+    #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_GRIDS)]
     grids: Vec<u32>,
     /// Tolerances of automatic placement (relative irradiance error at the candidates).
-    #[arg(long, value_delimiter = ',', default_values_t = [0.4, 0.2, 0.1, 0.05, 0.025, 0.0125])]
+    #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_TOLERANCES)]
     tolerances: Vec<f32>,
     /// Test positions (before those inside solids are dropped).
     #[arg(long, default_value_t = 64)]

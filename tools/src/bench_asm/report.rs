@@ -246,7 +246,7 @@ pub fn points(configs: &[Config], summaries: &[Summary]) -> Vec<Point> {
         .zip(summaries)
         .filter(|(_, s)| s.frame_ms > 0.0 && s.error_mean > 0.0)
         .map(|(c, s)| Point {
-            series: c.series,
+            series: c.series.into(),
             name: c.name.clone(),
             label: c.value.clone(),
             ms: s.frame_ms,
@@ -265,6 +265,6 @@ pub fn chart(path: &Path, title: &str, configs: &[Config], summaries: &[Summary]
     if points.is_empty() {
         return Ok(false);
     }
-    chart::write(path, title, ERROR_AXIS, &points)?;
+    chart::write(path, title, &chart::frame_time_against(ERROR_AXIS), &points)?;
     Ok(true)
 }

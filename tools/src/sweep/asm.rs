@@ -2,7 +2,7 @@
 //! maps of several sizes over the scene's camera walkthrough, measured as `kage bench asm`
 //! measures them (error against the ray-traced hard-shadow reference, GPU time side by side,
 //! shadow memory), written as the sweep's CSV and chart, with the picks.
-use super::{print_picks, SweepArgs};
+use super::{print_picks, SweepArgs, Terms, FRAME_TIME};
 use crate::bench_asm::report::{points, ERROR_AXIS};
 use crate::bench_asm::{measure, AsmBenchArgs, DEFAULT_CONFIGS};
 use crate::sweep::chart;
@@ -55,11 +55,17 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let points = points(&measured.configs, &measured.summaries);
     if !points.is_empty() {
         let path = args.out.join("pareto.png");
-        chart::write(&path, &measured.title, ERROR_AXIS, &points)?;
+        chart::write(&path, &measured.title, &chart::frame_time_against(ERROR_AXIS), &points)?;
         println!("wrote {}", path.display());
     }
     if args.pick {
-        print_picks(&measured.scene, &points, args.max_error, args.max_ms, "mismatch");
+        print_picks(
+            &measured.scene,
+            &points,
+            args.max_error,
+            args.max_ms,
+            &Terms { metric: "mismatch", unit: FRAME_TIME },
+        );
     }
     Ok(())
 }

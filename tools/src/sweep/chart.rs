@@ -28,9 +28,19 @@ fn font() -> Result<()> {
         .map_err(|e| anyhow!(e))
 }
 
-/// Draws `points` (all with a time and an error above 0) to the PNG at `path`; `error` names
-/// the y axis (what the points' errors measure).
-pub fn write(path: &Path, title: &str, error: &str, points: &[Point]) -> Result<()> {
+/// What the chart's axes measure: the points' cost (`Point::ms`) and error.
+pub struct Axes<'a> {
+    pub cost: &'a str,
+    pub error: &'a str,
+}
+
+/// The axes of a frame-time sweep, with `error` on y.
+pub fn frame_time_against(error: &str) -> Axes<'_> {
+    Axes { cost: "GPU ms per frame (median)", error }
+}
+
+/// Draws `points` (all with a cost and an error above 0) to the PNG at `path`.
+pub fn write(path: &Path, title: &str, axes: &Axes, points: &[Point]) -> Result<()> {
     font()?;
     let range = |values: Vec<f64>| {
         let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
@@ -40,8 +50,7 @@ pub fn write(path: &Path, title: &str, error: &str, points: &[Point]) -> Result<
     let xs = range(points.iter().map(|p| p.ms).collect());
     let ys = range(points.iter().map(|p| p.error).collect());
     let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    draw(&mut pixels, title, error, points, xs, ys)
-        .map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+    draw(&mut pixels, title, axes, points, xs, ys).map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
     image::RgbImage::from_raw(SIZE.0, SIZE.1, pixels)
         .expect("the buffer holds SIZE.0 × SIZE.1 RGB pixels")
         .save(path)
@@ -51,7 +60,7 @@ pub fn write(path: &Path, title: &str, error: &str, points: &[Point]) -> Result<
 fn draw(
     pixels: &mut [u8],
     title: &str,
-    error: &str,
+    axes: &Axes,
     points: &[Point],
     xs: std::ops::Range<f64>,
     ys: std::ops::Range<f64>,
@@ -69,8 +78,8 @@ fn draw(
         )?;
     chart
         .configure_mesh()
-        .x_desc("GPU ms per frame (median)")
-        .y_desc(error)
+        .x_desc(axes.cost)
+        .y_desc(axes.error)
         .x_label_formatter(&tick_label)
         .y_label_formatter(&tick_label)
         .label_style(("sans-serif", 14))
@@ -81,7 +90,7 @@ fn draw(
         .draw_series(LineSeries::new(front, BLACK.stroke_width(2)))?
         .label("Pareto front")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-    let mut names: Vec<&str> = points.iter().map(|p| p.series).collect();
+    let mut names: Vec<&str> = points.iter().map(|p| p.series.as_str()).collect();
     names.dedup();
     for (i, name) in names.into_iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();

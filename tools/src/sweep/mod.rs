@@ -5,6 +5,7 @@
 mod asm;
 pub(crate) mod chart;
 pub(crate) mod pick;
+mod probes;
 
 use crate::transfer_source::PrtArgs;
 use crate::GpuArgs;
@@ -34,13 +35,17 @@ pub enum SweptTechnique {
     /// Adaptive shadow maps at 4, 8, 16 MB against conventional maps of 1024², 2048², 4096²
     /// over the scene's camera walkthrough (`kage bench asm`'s measurement).
     Asm,
+    /// Light probes: grids (trilinear and tetrahedral) against automatic placement
+    /// (tetrahedral), error against probe count (`kage bench probe-count`'s measurement).
+    Probes,
 }
 
 #[derive(Args)]
 pub struct SweepArgs {
     #[arg(long, value_enum)]
     technique: SweptTechnique,
-    /// A built-in scene name or a scene file (.json); default: teapot (prt), asm (asm).
+    /// A built-in scene name or a scene file (.json); default: teapot (prt), asm (asm),
+    /// probe-room (probes).
     #[arg(long)]
     scene: Option<String>,
     /// Environment maps to sweep over, each replacing the scene's (default: the scene's own).
@@ -83,9 +88,12 @@ pub struct SweepArgs {
     /// With `--pick`: the largest acceptable relative RMSE (mean over the poses).
     #[arg(long, requires = "pick")]
     max_error: Option<f64>,
-    /// With `--pick`: the largest acceptable GPU time per frame, ms.
+    /// With `--pick`: the largest acceptable GPU time per frame, ms (prt, asm).
     #[arg(long, requires = "pick")]
     max_ms: Option<f64>,
+    /// With `--pick` (probes): the most probes acceptable.
+    #[arg(long, requires = "pick")]
+    max_probes: Option<u32>,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -182,7 +190,7 @@ impl Row {
             Setting::ParallelLights { .. } => "parallel lights (q)",
         };
         let label = self.setting.describe().2;
-        Some(Point { series, name: self.setting.name(), label, ms, error })
+        Some(Point { series: series.into(), name: self.setting.name(), label, ms, error })
     }
 }
 
@@ -193,18 +201,25 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     if args.size == 0 || args.time_size == 0 || args.spp == 0 {
         bail!("--size, --time-size and --spp must be at least 1");
     }
-    if args.pick && args.max_error.is_none() && args.max_ms.is_none() {
-        bail!("--pick needs a bound: --max-error E, --max-ms T, or both");
+    if args.pick && args.max_error.is_none() && args.max_ms.is_none() && args.max_probes.is_none() {
+        bail!("--pick needs a bound: --max-error E, --max-ms T (--max-probes N for probes), or both");
+    }
+    if args.max_probes.is_some() && args.technique != SweptTechnique::Probes {
+        bail!(
+            "--max-probes bounds the probe sweep's cost; the {:?} sweep's is frame time: --max-ms",
+            args.technique
+        );
     }
     if args.max_error.into_iter().chain(args.max_ms).any(|b| !(b.is_finite() && b > 0.0)) {
         bail!("--max-error and --max-ms must be positive numbers");
     }
-    if args.pick && args.frames == 0 {
+    if args.pick && args.frames == 0 && args.technique != SweptTechnique::Probes {
         bail!("--pick compares frame times: it needs --frames of at least 1");
     }
     match args.technique {
         SweptTechnique::Prt => run_prt(args),
         SweptTechnique::Asm => asm::run(args),
+        SweptTechnique::Probes => probes::run(args),
     }
 }
 
@@ -323,39 +338,64 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             "{} under {lit_by}: {} frames at {}², error at {}²",
             scene.name, args.frames, args.time_size, args.size
         );
-        chart::write(&args.out.join(&file), &title, "relative RMSE against the reference", &points)?;
+        chart::write(
+            &args.out.join(&file),
+            &title,
+            &chart::frame_time_against("relative RMSE against the reference"),
+            &points,
+        )?;
         println!("wrote {}", args.out.join(&file).display());
         if args.pick {
-            print_picks(env, &points, args.max_error, args.max_ms, "relative RMSE");
+            print_picks(
+                env,
+                &points,
+                args.max_error,
+                args.max_ms,
+                &Terms { metric: "relative RMSE", unit: FRAME_TIME },
+            );
         }
     }
     args.gpu.finish(&ctx)
 }
 
-/// `metric` names what the points' errors are.
+/// How a sweep's picks name what they compare: the error metric, and the cost's unit (`ms`, or
+/// `probes` where the probe count is the cost).
+pub(crate) struct Terms<'a> {
+    pub metric: &'a str,
+    pub unit: &'a str,
+}
+
+pub(crate) const FRAME_TIME: &str = "ms";
+
 pub(crate) fn print_picks(
     env: &str,
     points: &[Point],
     max_error: Option<f64>,
-    max_ms: Option<f64>,
-    metric: &str,
+    max_cost: Option<f64>,
+    terms: &Terms,
 ) {
+    let (metric, unit) = (terms.metric, terms.unit);
+    let cost = |v: f64| if unit == FRAME_TIME { format!("{v:.2} {unit}") } else { format!("{v} {unit}") };
     if let Some(bound) = max_error {
         match pick::cheapest_within(points, bound) {
             Some(p) => println!(
-                "{env}: cheapest within {metric} {bound}: {} ({:.2} ms, error {:.4})",
-                p.name, p.ms, p.error
+                "{env}: cheapest within {metric} {bound}: {} ({}, error {:.4})",
+                p.name,
+                cost(p.ms),
+                p.error
             ),
             None => println!("{env}: no setting reaches {metric} {bound}"),
         }
     }
-    if let Some(bound) = max_ms {
+    if let Some(bound) = max_cost {
         match pick::most_accurate_within(points, bound) {
             Some(p) => println!(
-                "{env}: most accurate within {bound} ms: {} ({:.2} ms, error {:.4})",
-                p.name, p.ms, p.error
+                "{env}: most accurate within {bound} {unit}: {} ({}, error {:.4})",
+                p.name,
+                cost(p.ms),
+                p.error
             ),
-            None => println!("{env}: no setting runs within {bound} ms"),
+            None => println!("{env}: no setting runs within {bound} {unit}"),
         }
     }
 }

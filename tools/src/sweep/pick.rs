@@ -5,7 +5,7 @@
 #[derive(Clone, Debug, PartialEq)]
 pub struct Point {
     /// The chart's series: the technique and what its labels count (`tamura (q)`).
-    pub series: &'static str,
+    pub series: String,
     /// The setting's name (`tamura:32`).
     pub name: String,
     /// Its label on the chart (`32`).
@@ -49,7 +49,7 @@ mod tests {
         [("a", 1.0, 0.5), ("b", 2.0, 0.2), ("c", 3.0, 0.3), ("d", 4.0, 0.1), ("e", 2.0, 0.4)]
             .into_iter()
             .map(|(name, ms, error)| Point {
-                series: "t",
+                series: "t".into(),
                 name: name.into(),
                 label: String::new(),
                 ms,

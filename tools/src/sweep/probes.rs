@@ -1,0 +1,109 @@
+//! `kage sweep --technique probes`: light probes on regular grids (trilinear and tetrahedral
+//! interpolation) against automatic placement (tetrahedral), each in the static groups' box and
+//! in the box the moving group sweeps, measured as `kage bench probe-count` measures them: the
+//! relative RMS error of interpolated irradiance against the ray-cast truth at test points
+//! along the moving group's path, against the number of probes. The probe count is the cost
+//! here (SH storage and captures; the per-frame lookup is one walk per object whatever the
+//! count), so the chart's x axis counts probes and `--pick` takes `--max-probes`.
+use super::{print_picks, SweepArgs, Terms};
+use crate::bench_probe_count::{measure, Params, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
+use crate::render::ProbeLightName;
+use crate::sweep::chart::{self, Axes};
+use crate::sweep::pick::Point;
+use anyhow::{bail, Context as _, Result};
+use kage::scene::Scene;
+use kage::sh::ShRgb9;
+use kage::techniques::probes::CaptureSettings;
+use std::fmt::Write as _;
+
+/// Test positions along the path, and random normals at each.
+const POINTS: usize = 64;
+const NORMALS: usize = 4;
+/// Cube-map faces of the captures, texels: the error floor of a probe captured at a test point
+/// is the same at 32² as at 128² on these scenes (bench probe-count's floor), at 1/16 the time.
+const CUBE_SIZE: u32 = 32;
+
+pub fn run(args: &SweepArgs) -> Result<()> {
+    if args.max_ms.is_some() {
+        bail!("--max-ms: the probe sweep's cost is its probe count, not frame time: use --max-probes N");
+    }
+    if !args.only.is_empty() {
+        bail!("--only: the probe sweep measures every grid level and tolerance together (the automatic placement starts from the finest grid)");
+    }
+    let scene = Scene::from_arg(args.scene.as_deref().unwrap_or("probe-room"))?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let ctx = args.gpu.context()?;
+    let cache = args.out.join("reference-cache");
+    let params = Params {
+        grids: &DEFAULT_GRIDS,
+        tolerances: &DEFAULT_TOLERANCES,
+        points: POINTS,
+        normals: NORMALS,
+        spp: args.spp,
+        capture: CaptureSettings { cube_size: CUBE_SIZE, light: ProbeLightName::Sky.captured() },
+        cache: Some(&cache),
+    };
+    let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {}", scene.name))?;
+    println!(
+        "scene {}: {} test points x {NORMALS} normals, reference {} spp (noise {:.4} of the RMS irradiance), a probe at each point {:.4}, capture {:.1} ms per probe, {}",
+        scene.name,
+        m.test_points,
+        args.spp,
+        m.reference_noise,
+        m.capture_floor,
+        m.capture_ms_per_probe,
+        ctx.info().name
+    );
+    let mut csv = String::from("scene,technique,parameter,value,probes,error,capture_s,memory_mb\n");
+    let mut points = Vec::new();
+    for row in &m.rows {
+        let parameter = if row.setting.starts_with("tol") || row.setting.starts_with("all") {
+            "tolerance"
+        } else {
+            "grid"
+        };
+        let value = row.setting.trim_start_matches("tol ");
+        let capture_s = row.probes as f64 * m.capture_ms_per_probe / 1e3;
+        let memory_mb = (row.probes * size_of::<ShRgb9>()) as f64 / (1 << 20) as f64;
+        writeln!(
+            csv,
+            "{},\"{}\",{parameter},{value},{},{:.6},{capture_s:.3},{memory_mb:.4}",
+            scene.name, row.method, row.probes, row.error
+        )
+        .expect("writing to a String");
+        println!(
+            "{:<32} {:>12} {:>6} probes, relative RMS error {:.4}",
+            row.method, row.setting, row.probes, row.error
+        );
+        if row.error > 0.0 && row.probes > 0 {
+            points.push(Point {
+                series: row.method.clone(),
+                name: format!("{} {}", row.method, row.setting),
+                label: row.probes.to_string(),
+                ms: row.probes as f64,
+                error: row.error,
+            });
+        }
+    }
+    let path = args.out.join("sweep.csv");
+    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
+    if !points.is_empty() {
+        let path = args.out.join("pareto.png");
+        let title =
+            format!("{}: {} test points x {NORMALS} normals, {}", scene.name, m.test_points, ctx.info().name);
+        let axes = Axes { cost: "probes", error: "relative RMS irradiance error against the reference" };
+        chart::write(&path, &title, &axes, &points)?;
+        println!("wrote {}", path.display());
+    }
+    if args.pick {
+        print_picks(
+            &scene.name,
+            &points,
+            args.max_error,
+            args.max_probes.map(f64::from),
+            &Terms { metric: "relative RMS error", unit: "probes" },
+        );
+    }
+    args.gpu.finish(&ctx)
+}
