@@ -23,7 +23,12 @@ fn constant_environment_with_no_walls_captures_its_own_sh() {
         camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
     };
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
-    let settings = CaptureSettings { cube_size: SIDE, light: CapturedLight::SkyAndWalls };
+    let settings = CaptureSettings {
+        cube_size: SIDE,
+        light: CapturedLight::SkyAndWalls,
+        samples: 32,
+        ..Default::default()
+    };
     let mut capture = ProbeCapture::new(&ctx, &scene, settings).unwrap();
     let sh = capture.capture(&gpu, |_| true, Vec3::new(0.3, -2.0, 7.0)).unwrap();
     // A constant L has c0 = L·Y0·4π = 2√π·L and nothing else. The texel solid angles telescope
@@ -46,19 +51,25 @@ fn a_probe_near_the_red_wall_sees_red_on_its_side() {
     let ctx = Validated::new();
     let scene = Scene::builtin("probe-room").unwrap();
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
-    let settings = CaptureSettings { cube_size: SIDE, light: CapturedLight::SkyAndWalls };
+    let settings = CaptureSettings {
+        cube_size: SIDE,
+        light: CapturedLight::SkyAndWalls,
+        samples: 32,
+        ..Default::default()
+    };
     let mut capture = ProbeCapture::new(&ctx, &scene, settings).unwrap();
     // The bunny (group 0) moves: probes capture the room alone.
     let sh = capture.capture(&gpu, |group| group != 0, Vec3::new(-1.2, 1.2, 0.5)).unwrap();
-    // The linear band (c1, c2, c3) ∝ (y, z, x) points where the light comes from: red from −X,
-    // green from +X (the green wall), each relative to its channel's average (c0).
+    // The linear band (c1, c2, c3) ∝ (y, z, x) points where the light comes from, relative to
+    // its channel's average (c0). The grey sky through the opening (up, towards +X from here)
+    // outshines the walls, which it lights only through the opening; on it the red wall adds
+    // red from −X, the green wall green from +X.
     let x = |channel: usize| sh.c[3][channel] / sh.c[0][channel];
-    assert!(x(0) < 0.0, "red's linear band points to {}", x(0));
     assert!(x(0) < x(1) && x(0) < x(2), "red {} green {} blue {}", x(0), x(1), x(2));
     assert!(x(1) > x(2), "green {} blue {}", x(1), x(2));
 
     // With black walls only the sky through the ceiling's opening is left: light from above
-    // (c1 ∝ y). With lit walls it is not, as the unshadowed floor outshines the opening.
+    // (c1 ∝ y).
     let settings = CaptureSettings { light: CapturedLight::Sky, ..settings };
     let sky = ProbeCapture::new(&ctx, &scene, settings).unwrap().capture(&gpu, |g| g != 0, Vec3::Y).unwrap();
     assert!((0..3).all(|k| sky.c[1][k] > 0.5 * sky.c[0][k]), "{:?} {:?}", sky.c[0], sky.c[1]);

@@ -32,7 +32,8 @@ pub enum TechniqueName {
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProbeLightName {
-    /// The sky where the probe sees it, and the static groups lit without shadows.
+    /// The sky where the probe sees it, and the static groups as the ray caster lights them
+    /// (environment and local lights with shadows, --probe-bounces).
     SkyAndWalls,
     /// The sky where the probe sees it; the static groups only occlude.
     Sky,
@@ -71,6 +72,13 @@ pub struct RenderArgs {
     /// What the probes capture besides the sky they see.
     #[arg(long, value_enum, default_value_t = ProbeLightName::SkyAndWalls)]
     probe_light: ProbeLightName,
+    /// Reflections of the walls' light the probes capture: 1 (walls lit directly) or 2 (and
+    /// by each other once).
+    #[arg(long, default_value_t = kage::reference::MAX_BOUNCES)]
+    probe_bounces: u32,
+    /// Monte Carlo samples per wall vertex and bounce for the probes' capture.
+    #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_SAMPLES)]
+    probe_samples: u32,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
@@ -146,6 +154,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     ProbeLightName::SkyAndWalls => CapturedLight::SkyAndWalls,
                     ProbeLightName::Sky => CapturedLight::Sky,
                 },
+                bounces: args.probe_bounces,
+                samples: args.probe_samples,
             },
         },
     }

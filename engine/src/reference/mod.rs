@@ -20,7 +20,7 @@ pub mod metrics;
 pub mod render;
 pub mod statistics;
 
-pub use irradiance::{IrradianceFile, IrradianceReference, PointsFile};
+pub use irradiance::{surface_radiance, IrradianceFile, IrradianceReference, PointsFile, MAX_BOUNCES};
 pub use metrics::{compare, diff_image, shadow_mismatch, ImageMetrics, ShadowMismatch, SHADOW_THRESHOLD};
 pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
 pub use statistics::Statistics;

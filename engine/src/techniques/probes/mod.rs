@@ -28,7 +28,10 @@ pub mod technique;
 mod tests;
 mod tetmesh;
 
-pub use capture::{CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE};
+pub use capture::{
+    CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES,
+    RADIANCE_SEED,
+};
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
