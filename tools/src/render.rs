@@ -79,6 +79,10 @@ pub struct RenderArgs {
     /// Monte Carlo samples per wall vertex and bounce for the probes' capture.
     #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_SAMPLES)]
     probe_samples: u32,
+    /// Window on the probes' SH against ringing: off, nonnegative (irradiance never negative),
+    /// hanning:W or lanczos:W (Sloan 2008).
+    #[arg(long, default_value = "off")]
+    probe_dering: String,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
@@ -156,6 +160,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 },
                 bounces: args.probe_bounces,
                 samples: args.probe_samples,
+                dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
             },
         },
     }

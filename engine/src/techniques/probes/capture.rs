@@ -13,6 +13,7 @@
 //! spot lights have no area for the cube map to see: each one visible from the probe (a shadow
 //! ray through the static groups, on the CPU) is added to the SH as the delta of radiance it is,
 //! (I / d²) δ(ω − l): coefficients (I / d²) y_i(l).
+use super::dering::Dering;
 use super::set::is_static;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsDesc, GraphicsPipeline, Image,
@@ -62,7 +63,7 @@ pub enum CapturedLight {
     SkyAndWalls,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaptureSettings {
     /// Texels per side of a cube face, within [`CUBE_SIZES`].
     pub cube_size: u32,
@@ -73,6 +74,8 @@ pub struct CaptureSettings {
     pub bounces: u32,
     /// Monte Carlo samples per wall vertex and bounce.
     pub samples: u32,
+    /// The window applied to each probe's SH ([`Dering`]; off by default).
+    pub dering: Dering,
 }
 
 /// Each bounce's samples per vertex: about 3% noise per vertex on probe-room's walls.
@@ -87,6 +90,7 @@ impl Default for CaptureSettings {
             light: CapturedLight::default(),
             bounces: crate::reference::MAX_BOUNCES,
             samples: DEFAULT_SAMPLES,
+            dering: Dering::Off,
         }
     }
 }
@@ -282,7 +286,7 @@ impl ProbeCapture {
         for light in &self.lights {
             self.add_light(&mut sh, light, position);
         }
-        Ok(sh)
+        Ok(self.settings.dering.apply(&sh))
     }
 
     /// Adds `light`'s delta of radiance to `sh` where the probe at `p` sees it (see the module

@@ -15,6 +15,7 @@
 //! lower-dimensional fallback.
 mod capture;
 mod delaunay;
+mod dering;
 mod error;
 mod extrapolate;
 mod input;
@@ -32,6 +33,7 @@ pub use capture::{
     CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES,
     RADIANCE_SEED,
 };
+pub use dering::Dering;
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
