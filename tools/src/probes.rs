@@ -16,6 +16,9 @@ pub enum ProbesCommand {
     /// The tetrahedron holding a point and its four barycentric weights (outside the hull: those
     /// of the hull's nearest point).
     Lookup(LookupArgs),
+    /// A probe from an equirectangular photograph or HDR image: its 9 SH coefficients per
+    /// channel and the irradiance at the six axis normals.
+    CaptureImage(crate::probe_image::CaptureImageArgs),
 }
 
 #[derive(Args)]
@@ -53,6 +56,7 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
     match command {
         ProbesCommand::Tetrahedralize(args) => tetrahedralize(args),
         ProbesCommand::Lookup(args) => lookup(args),
+        ProbesCommand::CaptureImage(args) => crate::probe_image::run(args),
     }
 }
 
