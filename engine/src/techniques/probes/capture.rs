@@ -13,6 +13,14 @@
 //! spot lights have no area for the cube map to see: each one visible from the probe (a shadow
 //! ray through the static groups, on the CPU) is added to the SH as the delta of radiance it is,
 //! (I / d²) δ(ω − l): coefficients (I / d²) y_i(l).
+//!
+//! A probe inside a wall, a column or under a floor sees the back of the static surfaces
+//! around it, and its light is meaningless. [`ProbeCapture::back_faces`] casts rays in
+//! [`BACK_FACE_RAYS`] directions from the probe through the static groups and counts those
+//! whose first hit is a back face (the side the triangle's counter-clockwise winding faces away
+//! from); [`ProbeCapture::keep_valid`] leaves out, with a warning naming the probe, those where
+//! more than [`MAX_BACK_FACES`] of the directions do. A probe in open space sees no back face;
+//! one just behind a single-sided wall sees its back over about half the sphere.
 use super::dering::Dering;
 use super::set::is_static;
 use crate::backend::{
@@ -32,7 +40,7 @@ use crate::techniques::background::Background;
 use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::sh_projection::{Mapping, ProjectionNames, ShProjection};
 use crate::techniques::unshadowed::MESH_POSITIONS;
-use glam::Vec3;
+use glam::{DVec3, Mat3, Vec3};
 use std::ops::RangeInclusive;
 use std::sync::Arc;
 
@@ -114,6 +122,20 @@ impl CaptureSettings {
         }
         Ok(self)
     }
+}
+
+/// Directions cast by [`ProbeCapture::back_faces`]: a Fibonacci lattice, each about 0.05 sr.
+pub const BACK_FACE_RAYS: u32 = 256;
+/// The fraction of directions seeing back faces above which a probe is inside geometry.
+pub const MAX_BACK_FACES: f32 = 0.25;
+
+/// A probe left out of the set: its index in the positions given, where it is, and the
+/// fraction of its directions that see back faces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InvalidProbe {
+    pub index: usize,
+    pub position: DVec3,
+    pub back_faces: f32,
 }
 
 /// Per-vertex radiance as a second vertex buffer (location 1).
@@ -287,6 +309,45 @@ impl ProbeCapture {
             self.add_light(&mut sh, light, position);
         }
         Ok(self.settings.dering.apply(&sh))
+    }
+
+    /// The fraction of [`BACK_FACE_RAYS`] directions from `p` whose first static surface is
+    /// met from behind.
+    pub fn back_faces(&self, p: Vec3) -> f32 {
+        let n = BACK_FACE_RAYS;
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        let back = (0..n)
+            .filter(|&i| {
+                let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+                let r = (1.0 - y * y).max(0.0).sqrt();
+                let dir = Vec3::new(r * (golden * i as f32).cos(), y, r * (golden * i as f32).sin());
+                self.statics.closest_hit(p, dir, f32::INFINITY).is_some_and(|hit| {
+                    let v = self.statics.triangles()[hit.triangle as usize];
+                    let [a, b, c] = [v.v0, v.v1, v.v2].map(|v| Vec3::from_slice(&v[..3]));
+                    let to_world = self.statics.instances()[hit.instance as usize].object_to_world;
+                    let face =
+                        Mat3::from_mat4(glam::Mat4::from_cols_array_2d(&to_world)) * (b - a).cross(c - a);
+                    face.dot(dir) > 0.0
+                })
+            })
+            .count();
+        back as f32 / n as f32
+    }
+
+    /// The positions of probes not inside geometry ([`ProbeCapture::back_faces`] at most
+    /// [`MAX_BACK_FACES`]), and those left out.
+    pub fn keep_valid(&self, positions: &[DVec3]) -> (Vec<DVec3>, Vec<InvalidProbe>) {
+        let mut kept = Vec::with_capacity(positions.len());
+        let mut invalid = Vec::new();
+        for (index, &position) in positions.iter().enumerate() {
+            let back_faces = self.back_faces(position.as_vec3());
+            if back_faces > MAX_BACK_FACES {
+                invalid.push(InvalidProbe { index, position, back_faces });
+            } else {
+                kept.push(position);
+            }
+        }
+        (kept, invalid)
     }
 
     /// Adds `light`'s delta of radiance to `sh` where the probe at `p` sees it (see the module

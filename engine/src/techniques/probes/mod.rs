@@ -30,8 +30,8 @@ mod tests;
 mod tetmesh;
 
 pub use capture::{
-    CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES,
-    RADIANCE_SEED,
+    CaptureSettings, CapturedLight, InvalidProbe, ProbeCapture, BACK_FACE_RAYS, CUBE_SIZES,
+    DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES, MAX_BACK_FACES, RADIANCE_SEED,
 };
 pub use dering::Dering;
 pub use error::ProbeError;

@@ -1,7 +1,7 @@
 //! A captured probe set (Morishige 2014, steps 1–5): where the probes are, their
 //! tetrahedralization, each probe's SH, and the SH interpolated at any point with the
 //! tetrahedral weights.
-use super::capture::{CaptureSettings, ProbeCapture};
+use super::capture::{CaptureSettings, InvalidProbe, ProbeCapture};
 use super::{TetMesh, Walker};
 use crate::backend::Context;
 use crate::error::{Error, Result};
@@ -108,13 +108,16 @@ pub fn bounds(points: impl Iterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
 
 pub struct ProbeSet {
     pub mesh: TetMesh,
-    /// Each probe's radiance SH, in the order of the positions.
+    /// Each probe's radiance SH, in the order of the mesh's positions.
     pub sh: Vec<ShRgb9>,
+    /// The probes left out because they are inside geometry ([`ProbeCapture::keep_valid`]): the
+    /// mesh holds the others, in their order.
+    pub invalid: Vec<InvalidProbe>,
 }
 
 impl ProbeSet {
-    /// Places the probes, tetrahedralizes them and captures each (the static groups of `gpu`,
-    /// which holds `scene`).
+    /// Places the probes, leaves out those inside geometry, tetrahedralizes the others and
+    /// captures each (the static groups of `gpu`, which holds `scene`).
     pub fn capture(
         ctx: &Arc<Context>,
         scene: &Scene,
@@ -122,12 +125,24 @@ impl ProbeSet {
         settings: &ProbeSettings,
     ) -> Result<ProbeSet> {
         let settings = settings.clone().validated()?;
-        let positions = settings.positions(scene)?;
-        let mesh = TetMesh::build(&positions)?;
         let mut capture = ProbeCapture::new(ctx, scene, settings.capture)?;
+        let (positions, invalid) = capture.keep_valid(&settings.positions(scene)?);
+        // A warning, not an error: the set still lights the scene without them.
+        for probe in &invalid {
+            let p = probe.position;
+            eprintln!(
+                "kage: warning: probe {} at ({}, {}, {}) is inside geometry ({:.0}% of its directions see back faces): left out",
+                probe.index,
+                p.x,
+                p.y,
+                p.z,
+                100.0 * probe.back_faces
+            );
+        }
+        let mesh = TetMesh::build(&positions)?;
         let sh =
             positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect::<Result<_>>()?;
-        Ok(ProbeSet { mesh, sh })
+        Ok(ProbeSet { mesh, sh, invalid })
     }
 
     /// The SH at `p`: the probes' SH weighted by the tetrahedral (or, outside the hull,
