@@ -145,8 +145,13 @@ fn captured_scene_light_matches_the_reference_with_bounces() {
     scene.groups[MOVING_GROUP].meshes.clear();
     scene.lights.push(Light::Point { position: Vec3::new(1.2, 2.2, -1.0), intensity: [0.02, 0.015, 0.01] });
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
-    let capture =
-        CaptureSettings { cube_size: 16, light: CapturedLight::SkyAndWalls, bounces: 2, samples: 64 };
+    let capture = CaptureSettings {
+        cube_size: 16,
+        light: CapturedLight::SkyAndWalls,
+        bounces: 2,
+        samples: 64,
+        ..Default::default()
+    };
     let radiance = surface_radiance(&ctx, &scene, capture.bounces, capture.samples, RADIANCE_SEED).unwrap();
     let points: Vec<Point> =
         POINTS[..3].iter().map(|&(position, normal)| Point { position, normal }).collect();
