@@ -20,6 +20,7 @@ fn constant_environment_with_no_walls_captures_its_own_sh() {
         environment: EnvMap::constant(radiance),
         lights: vec![],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
     };
     let gpu = GpuScene::new(&ctx, &scene).unwrap();

@@ -33,6 +33,7 @@ fn sun_scene() -> Scene {
         environment: sun_map(),
         lights: vec![],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: Camera { position: Vec3::new(0.0, 1.0, 3.0), target: Vec3::Y, up: Vec3::Y, fov_y_deg: 40.0 },
     }
 }

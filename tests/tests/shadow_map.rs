@@ -29,6 +29,7 @@ fn box_over_floor() -> Scene {
             intensity: [8.0; 3],
         }],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 2.5, 3.5),
             target: Vec3::ZERO,

@@ -63,7 +63,8 @@ pub struct RenderArgs {
     #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
-    /// bounding box, 2 to 64 each) or a file {"positions": [[x,y,z], ...]}.
+    /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`) or a file
+    /// {"positions": [[x,y,z], ...]}.
     #[arg(long, default_value = "grid:3,2,3")]
     probes: String,
     /// Texels per side of a probe's cube-map face, 8 to 256.
@@ -151,7 +152,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
         shadow_map_size: args.shadow_map_size,
         probes: ProbeSettings {
-            placement: probe_placement(&args.probes)?,
+            placement: probe_placement(&args.probes, &scene)?,
             capture: CaptureSettings {
                 cube_size: args.probe_cube_size,
                 light: match args.probe_light {
@@ -251,7 +252,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 /// `--probes`: `grid:NX,NY,NZ` or a probe file.
-fn probe_placement(arg: &str) -> Result<ProbePlacement> {
+fn probe_placement(arg: &str, scene: &Scene) -> Result<ProbePlacement> {
+    if arg == "scene" {
+        if scene.probes.is_empty() {
+            anyhow::bail!(
+                "--probes scene: scene \"{}\" places no probes (its file has no \"probes\")",
+                scene.name
+            );
+        }
+        let positions: Vec<glam::DVec3> = scene.probes.iter().map(|p| p.position.as_dvec3()).collect();
+        return Ok(ProbePlacement::Positions(positions.into()));
+    }
     match arg.strip_prefix("grid:") {
         Some(counts) => {
             let counts: Vec<u32> = counts
