@@ -433,3 +433,24 @@ fn probes_capture_image_matches_kage_sh() {
     let odd = 2.0 * (2.0 * std::f64::consts::PI / 3.0) * 0.488603 * c1;
     assert!((e("+y") - e("-y") - odd).abs() < 1e-4 * odd.abs(), "{} {} {odd}", e("+y"), e("-y"));
 }
+
+/// The probe capture's own options: bad values are clear errors.
+#[test]
+fn probe_capture_options_are_checked() {
+    let probes = ["render", "--technique", "probes", "--width", "8", "--height", "8"];
+    let with =
+        |extra: &[&'static str]| -> Vec<&'static str> { probes.iter().chain(extra).copied().collect() };
+    let (dering, scene, bounces) = (
+        with(&["--scene", "probe-room", "--probe-dering", "gauss:2"]),
+        with(&["--probes", "scene"]),
+        with(&["--scene", "probe-room", "--probe-bounces", "3"]),
+    );
+    let cases: [(&[&str], &str); 5] = [
+        (&dering, "deringing window \"gauss:2\""),
+        (&scene, "places no probes"),
+        (&bounces, "3 bounces: at most 2"),
+        (&["probes", "capture-image", "/nonexistent/photo.exr"], "/nonexistent/photo.exr"),
+        (&["probes", "capture-image", "/nonexistent/photo.exr", "--dering", "lanczos:0"], "lanczos:0"),
+    ];
+    assert_clear_errors(&cases);
+}
