@@ -2,7 +2,7 @@
 //! the maths says.
 use glam::Vec3;
 use kage::renderer::GpuScene;
-use kage::scene::{Camera, EnvMap, Scene};
+use kage::scene::{Camera, EnvMap, Light, Scene};
 use kage::techniques::probes::{CaptureSettings, CapturedLight, ProbeCapture};
 use kage_tests::Validated;
 use std::f32::consts::PI;
@@ -82,4 +82,38 @@ fn bad_cube_sizes_are_named() {
         let error = CaptureSettings { cube_size: size, ..Default::default() }.validated().unwrap_err();
         assert!(error.to_string().contains(&format!("cube map size {size} must be 8 to 256")), "{error}");
     }
+}
+
+/// A point light is added to a probe's SH as the delta of radiance it is, (I / d²) y_i(l), where
+/// the probe sees it, and not at all where the static groups hide it: above probe-room's ceiling
+/// it reaches the probe only through the opening.
+#[test]
+fn a_point_light_is_captured_where_the_probe_sees_it() {
+    let ctx = Validated::new();
+    let base = Scene::builtin("probe-room").unwrap();
+    let gpu = GpuScene::new(&ctx, &base).unwrap();
+    let settings = CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() };
+    let probe = Vec3::new(0.0, 1.0, 0.0);
+    let capture = |light: Option<Vec3>| {
+        let mut scene = base.clone();
+        scene.lights.extend(light.map(|position| Light::Point { position, intensity: [2.0, 1.0, 0.5] }));
+        ProbeCapture::new(&ctx, &scene, settings).unwrap().capture(&gpu, |g| g != 0, probe).unwrap()
+    };
+    let dark = capture(None);
+    // Through the opening: the line to it crosses the ceiling's plane at x = 0.2, z = 0.15,
+    // inside the opening's ±0.6.
+    let seen = Vec3::new(0.4, 4.0, 0.3);
+    let lit = capture(Some(seen));
+    let to = seen - probe;
+    let (d2, l) = (to.length_squared(), to.normalize());
+    let y = [0.282095, 0.488603 * l.y, 0.488603 * l.z, 0.488603 * l.x];
+    for (i, y) in y.into_iter().enumerate() {
+        for (k, intensity) in [2.0, 1.0, 0.5].into_iter().enumerate() {
+            let expected = dark.c[i][k] + intensity / d2 * y;
+            // The same cube map both times: only f32 rounding of the sum differs.
+            assert!((lit.c[i][k] - expected).abs() <= 1e-5 * expected.abs().max(1.0), "c{i}[{k}]");
+        }
+    }
+    // Behind the ceiling: nothing added, bit for bit.
+    assert_eq!(capture(Some(Vec3::new(1.5, 3.0, 1.5))), dark);
 }
