@@ -19,16 +19,9 @@ layout(push_constant) uniform Push { ReferencePush p; };
 
 // Point and spot lights (local_light.glsl), one shadow ray each.
 vec3 local_lighting(SurfacePoint s) {
-    vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
     vec3 sum = vec3(0.0);
     for (uint k = 0u; k < p.params.y; ++k) {
-        ReferenceLight light = lights[k];
-        vec3 e = local_light_unshadowed(light, s.position, s.shading_normal, s.geometric_normal);
-        if (all(equal(e, vec3(0.0)))) continue;
-        vec3 to_light_from_origin = light.position.xyz - origin;
-        float tmax = length(to_light_from_origin);
-        if (bvh_occluded(origin, to_light_from_origin / tmax, tmax)) continue;
-        sum += e;
+        sum += local_light_shadowed(lights[k], s.position, s.shading_normal, s.geometric_normal);
     }
     return s.albedo / REFERENCE_PI * sum;
 }

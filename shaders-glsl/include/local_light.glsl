@@ -21,4 +21,17 @@ vec3 local_light_unshadowed(ReferenceLight light, vec3 p, vec3 ns, vec3 ng) {
     return light.intensity.rgb * (cos_n / d2);
 }
 
+#ifdef KAGE_BVH_GLSL
+// The same with one shadow ray from p (offset along ng) to the light: the reference's hard
+// shadows, shared by its image and irradiance modes.
+vec3 local_light_shadowed(ReferenceLight light, vec3 p, vec3 ns, vec3 ng) {
+    vec3 e = local_light_unshadowed(light, p, ns, ng);
+    if (all(equal(e, vec3(0.0)))) return e;
+    vec3 origin = offset_ray_origin(p, ng);
+    vec3 to_light = light.position.xyz - origin;
+    float tmax = length(to_light);
+    return bvh_occluded(origin, to_light / tmax, tmax) ? vec3(0.0) : e;
+}
+#endif
+
 #endif

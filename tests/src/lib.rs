@@ -47,6 +47,7 @@ pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Sce
         environment,
         lights: vec![],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera,
     }
 }

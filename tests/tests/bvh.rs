@@ -54,6 +54,7 @@ fn scene(groups: Vec<Group>) -> Scene {
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

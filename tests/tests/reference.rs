@@ -114,6 +114,7 @@ fn tilted_planes_under_a_real_map_match_cpu_integration() {
             environment: map.clone(),
             lights: vec![],
             walkthrough: vec![],
+            probes: Vec::new(),
             camera: Camera { position: 2.0 * n, target: Vec3::ZERO, up, fov_y_deg: 40.0 },
         };
         let stats = render(&ctx, &scene, 16, LightMode::Environment, 10 + k as u32, 256);
@@ -182,6 +183,7 @@ fn a_blocker_darkens_the_floor_by_its_form_factor() {
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: side_camera(),
     };
     let size = 33;
@@ -206,6 +208,7 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
         environment: EnvMap::constant([1.0; 3]),
         lights,
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: side_camera(),
     };
     let size = 33;
@@ -246,6 +249,7 @@ fn spot_light_lights_only_inside_its_cone() {
             environment: EnvMap::constant([1.0; 3]),
             lights: vec![spot(direction).validated().unwrap()],
             walkthrough: vec![],
+            probes: Vec::new(),
             camera: side_camera(),
         };
         let stats = render(&ctx, &scene, size, LightMode::Local, 0, 1);

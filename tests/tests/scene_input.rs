@@ -2,7 +2,7 @@
 //! panic), and an exported scene reads back identical. No GPU needed.
 use std::path::{Path, PathBuf};
 
-use kage::scene::{Scene, BUILTIN};
+use kage::scene::{ProbeRole, Scene, BUILTIN};
 
 /// A fresh, empty folder under the system temp dir, unique to this process and test.
 fn temp_dir(test: &str) -> PathBuf {
@@ -303,5 +303,42 @@ fn exported_builtins_read_back_identical() {
         }
         assert!(back.environment == scene.environment, "environment pixels differ");
         assert!(back == scene);
+    }
+}
+
+/// Probes placed in a scene file, with and without a role, read in and export back identical;
+/// an unknown role, an unknown field and a non-finite position are errors that say so.
+#[test]
+fn scene_file_probes_round_trip_and_bad_ones_are_named() {
+    let dir = temp_dir("probes");
+    write(&dir, "tri.obj", TRIANGLE_OBJ);
+    let probes = r#", "probes": [{"position": [0, 1, 0], "role": "sky"}, {"position": [1, 0.5, -1]},
+        {"position": [-1, 0.5, 1], "role": "bounce"}, {"position": [0, 0.2, 0], "role": "bleed"}]"#;
+    let path = write(
+        &dir,
+        "scene.json",
+        &scene_json("", r#"{"obj": "tri.obj", "albedo": [0.5, 0.5, 0.5]}"#, probes),
+    );
+    let scene = Scene::load(&path).unwrap();
+    let roles: Vec<_> = scene.probes.iter().map(|p| p.role).collect();
+    assert_eq!(roles, [Some(ProbeRole::Sky), None, Some(ProbeRole::Bounce), Some(ProbeRole::Bleed)]);
+    assert_eq!(scene.probes[1].position, glam::Vec3::new(1.0, 0.5, -1.0));
+    let out = dir.join("export");
+    scene.export(&out).unwrap();
+    let back = Scene::load(&out.join(kage::scene::SCENE_FILE)).unwrap();
+    assert_eq!(back.probes, scene.probes);
+
+    for (extra, expected) in [
+        (r#", "probes": [{"position": [0, 1, 0], "role": "fill"}]"#, "unknown variant `fill`"),
+        (r#", "probes": [{"position": [0, 1, 0], "radius": 2}]"#, "unknown field `radius`"),
+        (r#", "probes": [{"position": [0, 1e39, 0]}]"#, "probe 0"),
+    ] {
+        let path = write(
+            &dir,
+            "bad.json",
+            &scene_json("", r#"{"obj": "tri.obj", "albedo": [0.5, 0.5, 0.5]}"#, extra),
+        );
+        let error = Scene::load(&path).unwrap_err().to_string();
+        assert!(error.contains(expected), "{extra}: {error}");
     }
 }

@@ -32,6 +32,7 @@ fn box_over_floor_lit_from(light: Vec3) -> Scene {
         environment: EnvMap::constant([0.0; 3]),
         lights: vec![spot_at(light)],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 2.5, 3.5),
             target: Vec3::ZERO,

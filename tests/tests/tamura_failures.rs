@@ -203,6 +203,7 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![],
         walkthrough: vec![],
+        probes: Vec::new(),
         camera: base.camera,
     };
     let lower = sphere_group("lower", radius, Vec3::new(0.0, low, 0.0));

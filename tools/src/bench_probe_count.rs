@@ -117,7 +117,11 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         points: args.points,
         normals: args.normals,
         spp: args.spp,
-        capture: CaptureSettings { cube_size: args.cube_size, light: args.probe_light.captured() },
+        capture: CaptureSettings {
+            cube_size: args.cube_size,
+            light: args.probe_light.captured(),
+            ..Default::default()
+        },
         cache: Some(&args.cache),
     };
     println!(

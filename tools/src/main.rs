@@ -6,6 +6,7 @@ mod bench_probes;
 mod compare;
 mod info;
 mod precompute;
+mod probe_image;
 mod probes;
 mod reference;
 mod render;

@@ -18,6 +18,9 @@ pub enum ProbesCommand {
     /// The tetrahedron holding a point and its four barycentric weights (outside the hull: those
     /// of the hull's nearest point).
     Lookup(LookupArgs),
+    /// A probe from an equirectangular photograph or HDR image: its 9 SH coefficients per
+    /// channel and the irradiance at the six axis normals.
+    CaptureImage(crate::probe_image::CaptureImageArgs),
     /// Automatic placement: candidates on a grid over the scene's static groups (those inside
     /// solids dropped) are captured, the redundant ones dropped; the kept positions are written
     /// as a probe file for `kage render --probes FILE`.
@@ -81,20 +84,25 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
         ProbesCommand::Tetrahedralize(args) => tetrahedralize(args),
         ProbesCommand::Lookup(args) => lookup(args),
         ProbesCommand::Place(args) => place(args),
+        ProbesCommand::CaptureImage(args) => crate::probe_image::run(args),
     }
 }
 
 fn place(args: &PlaceArgs) -> Result<()> {
-    let placement = crate::render::probe_placement(&args.probes)?;
+    let scene = Scene::from_arg(&args.scene)?;
+    let placement = crate::render::probe_placement(&args.probes, &scene)?;
     if !matches!(placement, ProbePlacement::Auto { .. }) {
         anyhow::bail!("--probes {}: expected auto, auto:TOL or auto:TOL:NX,NY,NZ", args.probes);
     }
-    let scene = Scene::from_arg(&args.scene)?;
     let ctx = args.gpu.context()?;
     let gpu = GpuScene::new(&ctx, &scene)?;
     let settings = ProbeSettings {
         placement,
-        capture: CaptureSettings { cube_size: args.probe_cube_size, light: args.probe_light.captured() },
+        capture: CaptureSettings {
+            cube_size: args.probe_cube_size,
+            light: args.probe_light.captured(),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let start = Instant::now();

@@ -42,6 +42,16 @@ pub struct ReferenceArgs {
     /// {"points": [{"position": [x, y, z], "normal": [x, y, z]}, ...]}.
     #[arg(long, conflicts_with = "light")]
     irradiance: Option<PathBuf>,
+    /// With --irradiance: light arriving after up to this many reflections off the surfaces
+    /// (0: the environment and the point and spot lights, with shadows; 1: and the surfaces lit by
+    /// them; 2: and lit by each other once). The surfaces' radiance is computed per vertex and
+    /// interpolated across triangles, exactly as light probes capture it (`--bounces 2` is what
+    /// `--technique probes` captures by default; the reference's scene keeps its moving group).
+    #[arg(long, default_value_t = 0, requires = "irradiance")]
+    bounces: u32,
+    /// Samples per vertex and bounce for the surfaces' radiance (that of the probes by default).
+    #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_SAMPLES, requires = "irradiance")]
+    bounce_samples: u32,
     /// Picks the random sequence; references with different seeds are independent.
     #[arg(long, default_value_t = 0)]
     seed: u32,
@@ -183,8 +193,17 @@ fn run_irradiance(
     scene: &Scene,
     points: &PointsFile,
 ) -> Result<()> {
-    let mut reference = IrradianceReference::new(ctx, scene, &points.points, args.seed)
-        .context("setting up the irradiance reference")?;
+    let radiance = kage::reference::surface_radiance(
+        ctx,
+        scene,
+        args.bounces,
+        args.bounce_samples,
+        kage::techniques::probes::RADIANCE_SEED,
+    )
+    .context("computing the surfaces' radiance")?;
+    let mut reference =
+        IrradianceReference::with_radiance(ctx, scene, &points.points, args.seed, radiance.as_deref())
+            .context("setting up the irradiance reference")?;
     let start = Instant::now();
     let statistics = progressive(&mut reference, args.spp, args.time_budget, "point")?;
     let file = IrradianceFile::from_statistics(&statistics);

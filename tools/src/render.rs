@@ -38,7 +38,8 @@ pub enum TechniqueName {
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProbeLightName {
-    /// The sky where the probe sees it, and the static groups lit without shadows.
+    /// The sky where the probe sees it, and the static groups as the ray caster lights them
+    /// (environment and local lights with shadows, --probe-bounces).
     SkyAndWalls,
     /// The sky where the probe sees it; the static groups only occlude.
     Sky,
@@ -92,9 +93,10 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = AsmSettings::default().time_ms)]
     asm_time_ms: f64,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
-    /// bounding box, 2 to 64 each), a file {"positions": [[x,y,z], ...]}, or `auto`,
-    /// `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates on that grid, outside solids, captured; those
-    /// the others reproduce within the relative irradiance error TOL, default 0.05, dropped).
+    /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`), a file
+    /// {"positions": [[x,y,z], ...]}, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
+    /// on that grid, outside solids, captured; those the others reproduce within the relative
+    /// irradiance error TOL, default 0.05, dropped).
     #[arg(long, default_value = "grid:3,2,3")]
     probes: String,
     /// How the light between probes is found: `trilinear` needs a `grid:` placement.
@@ -106,6 +108,17 @@ pub struct RenderArgs {
     /// What the probes capture besides the sky they see.
     #[arg(long, value_enum, default_value_t = ProbeLightName::SkyAndWalls)]
     probe_light: ProbeLightName,
+    /// Reflections of the walls' light the probes capture: 1 (walls lit directly) or 2 (and
+    /// by each other once).
+    #[arg(long, default_value_t = kage::reference::MAX_BOUNCES)]
+    probe_bounces: u32,
+    /// Monte Carlo samples per wall vertex and bounce for the probes' capture.
+    #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_SAMPLES)]
+    probe_samples: u32,
+    /// Window on the probes' SH against ringing: off, nonnegative (irradiance never negative),
+    /// hanning:W or lanczos:W (Sloan 2008).
+    #[arg(long, default_value = "off")]
+    probe_dering: String,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
@@ -175,8 +188,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
         shadow_map_size: args.shadow_map_size,
         probes: ProbeSettings {
-            placement: probe_placement(&args.probes)?,
-            capture: CaptureSettings { cube_size: args.probe_cube_size, light: args.probe_light.captured() },
+            placement: probe_placement(&args.probes, &scene)?,
+            capture: CaptureSettings {
+                cube_size: args.probe_cube_size,
+                light: args.probe_light.captured(),
+                bounces: args.probe_bounces,
+                samples: args.probe_samples,
+                dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
+            },
             interpolation: match args.probe_interpolation {
                 ProbeInterpolationName::Tetrahedral => ProbeInterpolation::Tetrahedral,
                 ProbeInterpolationName::Trilinear => ProbeInterpolation::Trilinear,
@@ -282,8 +301,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.gpu.finish(&ctx)
 }
 
-/// `--probes`: `grid:NX,NY,NZ`, `auto[:TOL[:NX,NY,NZ]]` or a probe file.
-pub fn probe_placement(arg: &str) -> Result<ProbePlacement> {
+/// `--probes`: `grid:NX,NY,NZ`, `auto[:TOL[:NX,NY,NZ]]`, `scene` or a probe file.
+pub fn probe_placement(arg: &str, scene: &Scene) -> Result<ProbePlacement> {
+    if arg == "scene" {
+        if scene.probes.is_empty() {
+            anyhow::bail!(
+                "--probes scene: scene \"{}\" places no probes (its file has no \"probes\")",
+                scene.name
+            );
+        }
+        let positions: Vec<glam::DVec3> = scene.probes.iter().map(|p| p.position.as_dvec3()).collect();
+        return Ok(ProbePlacement::Positions(positions.into()));
+    }
     let counts = |text: &str, form: &str| -> Result<[u32; 3]> {
         let counts: Vec<u32> = text
             .split(',')

@@ -513,3 +513,56 @@ fn bench_asm_measures_every_configuration_over_the_walkthrough() {
         (&["bench", "asm", "--scene", "teapot", "--out", out], "no camera walkthrough"),
     ]);
 }
+
+/// A probe captured from a photograph (city.exr) has exactly the coefficients `kage sh` gives
+/// for the same map (one projection serves both), and its file holds them and the irradiance
+/// the SH gives at the six axis normals.
+#[test]
+fn probes_capture_image_matches_kage_sh() {
+    let dir = scratch_dir("cli-capture-image");
+    let map = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/city.exr");
+    let json = dir.join("probe.json");
+    let probe = kage(&["probes", "capture-image", map, "--out", json.to_str().unwrap(), "--validate"]);
+    assert!(probe.status.success(), "{}", text(&probe));
+    let sh = kage(&["sh", map, "--validate"]);
+    assert!(sh.status.success(), "{}", text(&sh));
+    let coefficients = |out: &Output| -> Vec<String> {
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter(|l| l.starts_with("  "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(coefficients(&probe).len(), 9);
+    assert_eq!(coefficients(&probe), coefficients(&sh));
+    let file: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let c0 = file["sh"][0][0].as_f64().unwrap();
+    let printed: f64 = coefficients(&sh)[0].split_whitespace().nth(3).unwrap().parse().unwrap();
+    assert!((c0 - printed).abs() <= 1e-6 * c0, "{c0} against {printed}");
+    // E(+y) − E(−y) = 2 Â₁ y₁ c₁ (the odd band alone), for each channel.
+    let e = |axis: &str| file["irradiance"][axis][0].as_f64().unwrap();
+    let c1 = file["sh"][1][0].as_f64().unwrap();
+    let odd = 2.0 * (2.0 * std::f64::consts::PI / 3.0) * 0.488603 * c1;
+    assert!((e("+y") - e("-y") - odd).abs() < 1e-4 * odd.abs(), "{} {} {odd}", e("+y"), e("-y"));
+}
+
+/// The probe capture's own options: bad values are clear errors.
+#[test]
+fn probe_capture_options_are_checked() {
+    let probes = ["render", "--technique", "probes", "--width", "8", "--height", "8"];
+    let with =
+        |extra: &[&'static str]| -> Vec<&'static str> { probes.iter().chain(extra).copied().collect() };
+    let (dering, scene, bounces) = (
+        with(&["--scene", "probe-room", "--probe-dering", "gauss:2"]),
+        with(&["--probes", "scene"]),
+        with(&["--scene", "probe-room", "--probe-bounces", "3"]),
+    );
+    let cases: [(&[&str], &str); 5] = [
+        (&dering, "deringing window \"gauss:2\""),
+        (&scene, "places no probes"),
+        (&bounces, "3 bounces: at most 2"),
+        (&["probes", "capture-image", "/nonexistent/photo.exr"], "/nonexistent/photo.exr"),
+        (&["probes", "capture-image", "/nonexistent/photo.exr", "--dering", "lanczos:0"], "lanczos:0"),
+    ];
+    assert_clear_errors(&cases);
+}

@@ -175,6 +175,7 @@ unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
         lights: Vec::new(),
         camera,
         walkthrough: Vec::new(),
+        probes: Vec::new(),
     })
 }
 

@@ -44,8 +44,8 @@ pub enum kage_technique {
 #[repr(u32)]
 #[derive(Clone, Copy)]
 pub enum kage_probe_light {
-    /// The environment where the probe sees it, plus the static groups lit directly by the
-    /// environment without shadows.
+    /// The environment where the probe sees it, plus the static groups as Kage's ray caster
+    /// lights them (environment and local lights with shadows, one bounce between them).
     SkyAndWalls = 0,
     /// The environment where the probe sees it; the static groups only occlude it.
     Sky = 1,
@@ -137,7 +137,11 @@ impl kage_technique_desc {
             shadow_map_size: self.shadow_map_size,
             probes: ProbeSettings {
                 placement: ProbePlacement::Grid(self.probe_grid),
-                capture: CaptureSettings { cube_size: self.probe_cube_size, light: probe_light },
+                capture: CaptureSettings {
+                    cube_size: self.probe_cube_size,
+                    light: probe_light,
+                    ..Default::default()
+                },
                 interpolation: ProbeInterpolation::Tetrahedral,
             },
             asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms },

@@ -221,6 +221,7 @@ mod tests {
             environment: EnvMap::constant([1.0; 3]),
             lights: vec![],
             walkthrough: vec![],
+            probes: Vec::new(),
             camera: Camera { position: Vec3::Z * 5.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
         }
     }

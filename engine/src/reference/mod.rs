@@ -20,7 +20,7 @@ pub mod metrics;
 pub mod render;
 pub mod statistics;
 
-pub use irradiance::{IrradianceFile, IrradianceReference, PointsFile};
+pub use irradiance::{surface_radiance, IrradianceFile, IrradianceReference, PointsFile, MAX_BOUNCES};
 pub use metrics::{
     compare, diff_image, frames_to_converge, shadow_flips, shadow_mismatch, ImageMetrics, ShadowFlips,
     ShadowMismatch, SHADOW_THRESHOLD,

@@ -6,10 +6,10 @@
 //! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
 use super::lighting::{ReferenceLighting, IMPORTS};
 use super::statistics::{accum_buffer, samples_after, Statistics};
-use crate::backend::{vk, BindingKind, Buffer, ComputePipeline, Context};
+use crate::backend::{BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::imageio::RgbaF32Image;
-use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, ReferenceLight, ReferencePush};
+use crate::layouts::{bytes_of, constants, spirv, ReferenceLight, ReferencePush};
 use crate::pass::{FrameExecutor, Pass};
 use crate::renderer::MAX_SIZE;
 use crate::scene::{Camera, Light, Scene};
@@ -38,8 +38,6 @@ pub struct ReferenceRenderer {
     lighting: ReferenceLighting,
     pipeline: ComputePipeline,
     accum: Buffer,
-    lights: Buffer,
-    light_count: u32,
     camera: Camera,
     options: ReferenceOptions,
     samples: u32,
@@ -54,12 +52,6 @@ impl ReferenceRenderer {
                 "image size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
             )));
         }
-        let mut lights: Vec<ReferenceLight> = scene.lights.iter().map(reference_light).collect();
-        let light_count = lights.len() as u32;
-        // A storage buffer may not be empty: a scene without lights binds one unused entry.
-        if lights.is_empty() {
-            lights.push(ReferenceLight::default());
-        }
         Ok(ReferenceRenderer {
             lighting: ReferenceLighting::new(ctx, scene)?,
             pipeline: ComputePipeline::new(
@@ -70,13 +62,6 @@ impl ReferenceRenderer {
                 size_of::<ReferencePush>() as u32,
             )?,
             accum: accum_buffer(ctx, "reference_accum", width as usize * height as usize)?,
-            lights: Buffer::with_data(
-                ctx,
-                "reference_lights",
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                bytes_of_slice(&lights),
-            )?,
-            light_count,
             camera: scene.camera,
             options: options.clone(),
             samples: 0,
@@ -93,11 +78,15 @@ impl ReferenceRenderer {
         let group = constants::REFERENCE_GROUP;
         let groups = [width.div_ceil(group), height.div_ceil(group), 1];
         let pipeline = &self.pipeline;
-        let (lighting, accum, lights) = (&self.lighting, &self.accum, &self.lights);
+        let (lighting, accum, lights) = (&self.lighting, &self.accum, &self.lighting.lights);
         let inv_view_proj = view_proj.inverse().to_cols_array_2d();
         let camera_pos = self.camera.position.extend(self.lighting.env_total).to_array();
-        let params =
-            [(self.options.light == LightMode::Local) as u32, self.light_count, self.options.seed, 0];
+        let params = [
+            (self.options.light == LightMode::Local) as u32,
+            self.lighting.light_count,
+            self.options.seed,
+            0,
+        ];
         let passes = super::sample_passes(spp, self.samples, |first, count| {
             let push =
                 ReferencePush { inv_view_proj, camera_pos, frame: [width, height, first, count], params };

@@ -54,6 +54,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         environment,
         lights: Vec::new(),
         walkthrough: Vec::new(),
+        probes: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 2.2, 4.2),
             target: Vec3::new(0.0, 0.4, 0.0),
@@ -78,6 +79,7 @@ fn probe_room_scene(name: &str) -> Result<Scene, SceneError> {
         environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
         lights: Vec::new(),
         walkthrough: Vec::new(),
+        probes: Vec::new(),
         camera: Camera {
             position: Vec3::new(0.0, 1.4, 1.9),
             target: Vec3::new(0.0, 0.5, 0.0),
@@ -97,6 +99,7 @@ fn atrium_scene(name: &str) -> Result<Scene, SceneError> {
         environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
         lights: Vec::new(),
         walkthrough: Vec::new(),
+        probes: Vec::new(),
         camera: atrium::camera(),
     })
 }

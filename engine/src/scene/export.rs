@@ -4,7 +4,7 @@ use std::collections::HashSet;
 use std::path::Path;
 
 use super::file::{
-    CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, PointDesc, SceneFile, SpotDesc,
+    CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, PointDesc, ProbeDesc, SceneFile, SpotDesc,
 };
 use super::{obj, Camera, Light, Scene, SceneError};
 
@@ -56,6 +56,11 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
         groups,
         lights: scene.lights.iter().map(light).collect(),
         walkthrough: scene.walkthrough.iter().map(camera).collect(),
+        probes: scene
+            .probes
+            .iter()
+            .map(|p| ProbeDesc { position: p.position.to_array(), role: p.role })
+            .collect(),
     };
     let path = dir.join(SCENE_FILE);
     let json = serde_json::to_string_pretty(&file)

@@ -24,6 +24,8 @@
 //! - `name` defaults to the scene file's stem; `camera.up` defaults to +Y; `lights` defaults to none.
 //! - `walkthrough` (optional): cameras, in the form of `camera`, that `kage render --animate`
 //!   visits in order.
+//! - `probes` (optional): light probes placed by hand, `{"position": [x, y, z], "role": "sky"}`
+//!   with `role` optional, one of `sky`, `bounce`, `bleed` ([`super::ProbeRole`]).
 //! - Relative paths are relative to the folder of the scene file.
 use serde::{Deserialize, Serialize};
 
@@ -39,6 +41,16 @@ pub struct SceneFile {
     pub lights: Vec<LightDesc>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub walkthrough: Vec<CameraDesc>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub probes: Vec<ProbeDesc>,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeDesc {
+    pub position: [f32; 3],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub role: Option<super::ProbeRole>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use glam::{Quat, Vec3};
 
 use super::file::{EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, SceneFile};
-use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
+use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, SceneProbe, Transform};
 
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let text =
@@ -48,7 +48,19 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .enumerate()
         .map(|(at, l)| light(l).map_err(|e| e.within(&format!("light {at}"))))
         .collect::<Result<_, _>>()?;
-    Ok(Scene { name, groups, environment, lights, camera, walkthrough })
+    let probes = file
+        .probes
+        .iter()
+        .enumerate()
+        .map(|(at, p)| {
+            let position = Vec3::from(p.position);
+            if !position.is_finite() {
+                return Err(SceneError::invalid(format!("probe {at}: position {position} is not finite")));
+            }
+            Ok(SceneProbe { position, role: p.role })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Scene { name, groups, environment, lights, camera, walkthrough, probes })
 }
 
 fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneError> {

@@ -31,6 +31,7 @@ mod light;
 mod load;
 mod mesh;
 mod obj;
+mod probe;
 mod probe_room;
 pub mod shapes;
 mod transform;
@@ -43,6 +44,7 @@ pub use export::{ENVIRONMENT_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
 pub use mesh::Mesh;
 pub use obj::{load_obj, parse_obj, write_obj};
+pub use probe::{ProbeRole, SceneProbe};
 pub use transform::Transform;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -55,6 +57,8 @@ pub struct Scene {
     /// Camera keyframes of the scripted walkthrough (`kage render --animate`), visited in order
     /// and back to the first; empty for a scene without one (see [`animation::camera_at`]).
     pub walkthrough: Vec<Camera>,
+    /// Light probes placed by hand (`probes` in a scene file); empty for most scenes.
+    pub probes: Vec<SceneProbe>,
 }
 
 /// Meshes that move together.

@@ -40,7 +40,11 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         points: POINTS,
         normals: NORMALS,
         spp: args.spp,
-        capture: CaptureSettings { cube_size: CUBE_SIZE, light: ProbeLightName::Sky.captured() },
+        capture: CaptureSettings {
+            cube_size: CUBE_SIZE,
+            light: ProbeLightName::Sky.captured(),
+            ..Default::default()
+        },
         cache: Some(&cache),
     };
     let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {}", scene.name))?;

@@ -5,22 +5,42 @@
 //!
 //! Light paths captured ([`CapturedLight`]): the environment wherever the probe sees it (the
 //! rasterized cube map gives the visibility: walls hide the sky), and, with
-//! [`CapturedLight::SkyAndWalls`], the static surfaces lit directly by the environment's SH
-//! irradiance without shadows (Kage's unshadowed technique: a wall inside a closed room is lit
-//! as if nothing stood between it and the sky). Not captured yet: shadowed light on the
-//! surfaces, local lights, and further bounces.
-use crate::backend::{vk, Buffer, BufferDesc, Context, Edge, Image, ImageDesc, MemoryLocation, Sampler};
+//! [`CapturedLight::SkyAndWalls`], the static surfaces as Kage lights them: their outgoing
+//! radiance computed once per vertex by the BVH ray caster (environment light with shadows,
+//! point and spot lights with shadows, and one bounce between the surfaces:
+//! [`crate::reference::surface_radiance`]) and interpolated across each triangle by the
+//! rasterizer, the same radiance `kage reference --irradiance --bounces` integrates. Point and
+//! spot lights have no area for the cube map to see: each one visible from the probe (a shadow
+//! ray through the static groups, on the CPU) is added to the SH as the delta of radiance it is,
+//! (I / d²) δ(ω − l): coefficients (I / d²) y_i(l).
+//!
+//! A probe inside a wall, a column or under a floor sees the back of the static surfaces
+//! around it, and its light is meaningless. [`ProbeCapture::back_faces`] casts rays in
+//! [`BACK_FACE_RAYS`] directions from the probe through the static groups and counts those
+//! whose first hit is a back face (the side the triangle's counter-clockwise winding faces away
+//! from); [`ProbeCapture::keep_valid`] leaves out, with a warning naming the probe, those where
+//! more than [`MAX_BACK_FACES`] of the directions do. A probe in open space sees no back face;
+//! one just behind a single-sided wall sees its back over about half the sphere.
+use super::dering::Dering;
+use super::set::is_static;
+use crate::backend::{
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsDesc, GraphicsPipeline, Image,
+    ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
+};
 use crate::error::{Error, Result};
-use crate::layouts::{bytes_of, FrameUniforms};
+use crate::layouts::ReferenceLight;
+use crate::layouts::{bytes_of, spirv, DrawPush, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass};
-use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::raycast::SceneBvh;
+use crate::reference::{irradiance::check_bounces, surface_radiance};
+use crate::renderer::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::scene::{Camera, Scene};
-use crate::sh::ShRgb9;
+use crate::sh::{eval_basis, ShRgb9};
 use crate::techniques::background::Background;
 use crate::techniques::environment::GpuEnvironment;
-use crate::techniques::sh_projection::{Mapping, ProjectionNames, ShProjection, ENVIRONMENT};
-use crate::techniques::unshadowed::Unshadowed;
-use glam::Vec3;
+use crate::techniques::sh_projection::{Mapping, ProjectionNames, ShProjection};
+use crate::techniques::unshadowed::MESH_POSITIONS;
+use glam::{DVec3, Mat3, Vec3};
 use std::ops::RangeInclusive;
 use std::sync::Arc;
 
@@ -42,24 +62,45 @@ const CUBE_FACES: [(Vec3, Vec3); 6] = [
 /// Which light the cube maps hold (see the module documentation).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum CapturedLight {
-    /// The environment where the probe sees it; static surfaces drawn black, so they only
-    /// occlude. The light the reference's irradiance mode integrates.
+    /// The environment and the scene's lights where the probe sees them; static surfaces drawn
+    /// black, so they only occlude: `kage reference --irradiance --bounces 0`.
     Sky,
-    /// The sky, plus the static surfaces lit directly by the environment without shadows.
+    /// The sky, plus the static surfaces with the radiance the ray caster computes for them
+    /// ([`CaptureSettings::bounces`]).
     #[default]
     SkyAndWalls,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaptureSettings {
     /// Texels per side of a cube face, within [`CUBE_SIZES`].
     pub cube_size: u32,
     pub light: CapturedLight,
+    /// With [`CapturedLight::SkyAndWalls`]: how many times light reaching the probe from the
+    /// walls has reflected, 1 (the walls lit directly) or 2 (and by each other once, the
+    /// default); the reference's `--bounces`.
+    pub bounces: u32,
+    /// Monte Carlo samples per wall vertex and bounce.
+    pub samples: u32,
+    /// The window applied to each probe's SH ([`Dering`]; off by default).
+    pub dering: Dering,
 }
+
+/// Each bounce's samples per vertex: seconds on lavapipe for probe-room's 729 wall vertices,
+/// though their direct light keeps a relative standard error of about 47% (BENCHMARKS.md).
+pub const DEFAULT_SAMPLES: u32 = 256;
+/// The seed of the walls' radiance: one scene, one radiance.
+pub const RADIANCE_SEED: u32 = 0x5eed;
 
 impl Default for CaptureSettings {
     fn default() -> Self {
-        CaptureSettings { cube_size: DEFAULT_CUBE_SIZE, light: CapturedLight::default() }
+        CaptureSettings {
+            cube_size: DEFAULT_CUBE_SIZE,
+            light: CapturedLight::default(),
+            bounces: crate::reference::MAX_BOUNCES,
+            samples: DEFAULT_SAMPLES,
+            dering: Dering::Off,
+        }
     }
 }
 
@@ -73,14 +114,42 @@ impl CaptureSettings {
                 CUBE_SIZES.end()
             )));
         }
+        check_bounces(self.bounces)?;
+        if self.light == CapturedLight::SkyAndWalls && (self.bounces == 0 || self.samples == 0) {
+            return Err(Error::InvalidArgument(format!(
+                "probes capturing the walls need at least 1 bounce and 1 sample per vertex (got {} and {})",
+                self.bounces, self.samples
+            )));
+        }
         Ok(self)
     }
 }
 
+/// Directions cast by [`ProbeCapture::back_faces`]: a Fibonacci lattice, each about 0.05 sr.
+pub const BACK_FACE_RAYS: u32 = 256;
+/// The fraction of directions seeing back faces above which a probe is inside geometry.
+pub const MAX_BACK_FACES: f32 = 0.25;
+
+/// A probe left out of the set: its index in the positions given, where it is, and the
+/// fraction of its directions that see back faces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InvalidProbe {
+    pub index: usize,
+    pub position: DVec3,
+    pub back_faces: f32,
+}
+
+/// Per-vertex radiance as a second vertex buffer (location 1).
+const RADIANCE_ATTRIBUTES: [VertexAttribute; 1] =
+    [VertexAttribute { location: 1, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }];
+const RADIANCE_VERTICES: VertexBuffer<'static> =
+    VertexBuffer { stride: 16, attributes: &RADIANCE_ATTRIBUTES };
+
 const PROBE_CUBE: ProjectionNames =
     ProjectionNames { source: "probe_cube", partials: "probe_sh_partials", result: "probe_sh" };
-/// What every capture reads without writing it: the faces' cameras, the environment and its SH.
-const IMPORTS: [&str; 3] = ["probe_faces", ENVIRONMENT.source, ENVIRONMENT.result];
+/// What every capture reads without writing it: the faces' cameras, the environment and the
+/// walls' radiance.
+const IMPORTS: [&str; 3] = ["probe_faces", "environment", "probe_radiance"];
 
 /// Captures probes of one scene, one after another, reusing its cube map and pipelines.
 pub struct ProbeCapture {
@@ -92,18 +161,24 @@ pub struct ProbeCapture {
     /// One `FrameUniforms` per face.
     faces: Vec<Buffer>,
     env: GpuEnvironment,
-    env_sh: ShProjection,
     background: Background,
-    surfaces: Unshadowed,
+    surfaces: GraphicsPipeline,
+    /// `[group][mesh]`: the radiance vertex buffer of each static mesh (`None` for the others).
+    radiance: Vec<Vec<Option<Buffer>>>,
+    /// The scene's point and spot lights, and the static groups that may hide them.
+    lights: Vec<ReferenceLight>,
+    statics: SceneBvh,
     projection: ShProjection,
     executor: FrameExecutor,
 }
 
 impl ProbeCapture {
-    /// Uploads `scene`'s environment and projects it (the walls' light) once.
+    /// Uploads `scene`'s environment and computes the radiance of its static groups ([`is_static`])
+    /// once, lit by everything static (the moving group casts no shadow on them).
     pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: CaptureSettings) -> Result<ProbeCapture> {
         let settings = settings.validated()?;
         let side = settings.cube_size;
+        let statics = static_scene(scene);
         let image = |name, format, usage| {
             Image::new(
                 ctx,
@@ -123,10 +198,6 @@ impl ProbeCapture {
                 )
             })
             .collect::<Result<_>>()?;
-        let env = GpuEnvironment::new(ctx, &scene.environment)?;
-        let env_sh = ShProjection::environment(ctx, &scene.environment)?;
-        let mut executor = FrameExecutor::new(ctx, "probe_capture")?;
-        executor.run(&[ENVIRONMENT.source], env_sh.passes(&env.image, &env.sampler).into())?;
         Ok(ProbeCapture {
             ctx: ctx.clone(),
             settings,
@@ -139,17 +210,36 @@ impl ProbeCapture {
             // The projection reads texels with texelFetch: the filter never applies.
             sampler: Sampler::new(ctx, "probe_cube.sampler", false, Edge::Clamp, Edge::Clamp)?,
             faces,
-            env,
-            env_sh,
+            env: GpuEnvironment::new(ctx, &scene.environment)?,
             background: Background::new(ctx)?,
-            surfaces: Unshadowed::new(ctx)?,
+            surfaces: GraphicsPipeline::new(
+                ctx,
+                &GraphicsDesc {
+                    name: "probe_surfaces",
+                    vertex_spirv: spirv::PROBE_SURFACE_VERT,
+                    fragment_spirv: spirv::PROBE_SURFACE_FRAG,
+                    bindings: &[BindingKind::UniformBuffer],
+                    push_size: size_of::<DrawPush>() as u32,
+                    vertex_buffers: &[MESH_POSITIONS, RADIANCE_VERTICES],
+                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                    color_formats: &[COLOR_FORMAT],
+                    depth_format: Some(DEPTH_FORMAT),
+                    depth_test: true,
+                    additive: false,
+                    constants: &[],
+                },
+            )?,
+            radiance: static_radiance(ctx, &statics, settings)?,
+            lights: scene.lights.iter().map(crate::reference::render::reference_light).collect(),
+            statics: SceneBvh::build(&statics)?,
             projection: ShProjection::new(ctx, Mapping::Cube { side }, PROBE_CUBE)?,
-            executor,
+            executor: FrameExecutor::new(ctx, "probe_capture")?,
         })
     }
 
     /// The SH of the radiance arriving at `position`: the meshes of `scene` whose group
-    /// `is_static` accepts, and the environment (not rotated) behind them.
+    /// `is_static` accepts, and the environment (not rotated) behind them. A mesh of the
+    /// module's moving group that `is_static` accepts has no radiance and is drawn black.
     pub fn capture(
         &mut self,
         scene: &GpuScene,
@@ -170,16 +260,14 @@ impl ProbeCapture {
             };
             buffer.write(0, bytes_of(&uniforms))?;
         }
-        let lit = self.settings.light == CapturedLight::SkyAndWalls;
-        let albedo =
-            |mesh: &GpuMesh| is_static(mesh.group).then_some(if lit { mesh.albedo } else { [0.0; 3] });
         let (ctx, cube, depth, faces, side) =
             (&self.ctx, &self.cube, &self.depth, &self.faces, self.settings.cube_size);
         let face_area = |f: u32| vk::Rect2D {
             offset: vk::Offset2D { x: 0, y: (f * side) as i32 },
             extent: vk::Extent2D { width: side, height: side },
         };
-        let (background, surfaces, env, env_sh) = (&self.background, &self.surfaces, &self.env, &self.env_sh);
+        let (background, surfaces, env, radiance) =
+            (&self.background, &self.surfaces, &self.env, &self.radiance);
         let mut passes = vec![
             Pass::new("probe_background", &["probe_faces", "environment"], &["probe_cube"], move |cmd| {
                 ctx.begin_rendering(cmd, Some(cube.into()), Some([0.0; 4]), None);
@@ -191,13 +279,25 @@ impl ProbeCapture {
             }),
             Pass::new(
                 "probe_surfaces",
-                &["probe_faces", "env_sh", "probe_cube"],
+                &["probe_faces", "probe_radiance", "probe_cube"],
                 &["probe_cube", "probe_depth"],
                 move |cmd| {
                     ctx.begin_rendering(cmd, Some(cube.into()), None, Some(depth.into()));
                     for (f, uniforms) in faces.iter().enumerate() {
                         ctx.set_viewport(cmd, face_area(f as u32));
-                        surfaces.draw(ctx, cmd, uniforms, &env_sh.coefficients, scene, albedo);
+                        surfaces.bind(cmd, &[Binding::Uniform(uniforms)]);
+                        for mesh in scene.meshes.iter().filter(|m| is_static(m.group)) {
+                            let Some(Some(r)) = radiance.get(mesh.group).and_then(|g| g.get(mesh.mesh))
+                            else {
+                                continue;
+                            };
+                            let push = DrawPush {
+                                model: scene.transforms[mesh.group].to_cols_array_2d(),
+                                albedo: [0.0; 4],
+                            };
+                            surfaces.push(cmd, bytes_of(&push));
+                            ctx.draw_indexed(cmd, &[&mesh.vertices, r], &mesh.indices, mesh.index_count);
+                        }
                     }
                     ctx.end_rendering(cmd);
                 },
@@ -205,6 +305,120 @@ impl ProbeCapture {
         ];
         passes.extend(self.projection.passes(&self.cube, &self.sampler));
         self.executor.run(&IMPORTS, passes)?;
-        self.projection.read()
+        let mut sh = self.projection.read()?;
+        for light in &self.lights {
+            self.add_light(&mut sh, light, position);
+        }
+        Ok(self.settings.dering.apply(&sh))
     }
+
+    /// The fraction of [`BACK_FACE_RAYS`] directions from `p` whose first static surface is
+    /// met from behind.
+    pub fn back_faces(&self, p: Vec3) -> f32 {
+        let n = BACK_FACE_RAYS;
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        let back = (0..n)
+            .filter(|&i| {
+                let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+                let r = (1.0 - y * y).max(0.0).sqrt();
+                let dir = Vec3::new(r * (golden * i as f32).cos(), y, r * (golden * i as f32).sin());
+                self.statics.closest_hit(p, dir, f32::INFINITY).is_some_and(|hit| {
+                    let v = self.statics.triangles()[hit.triangle as usize];
+                    let [a, b, c] = [v.v0, v.v1, v.v2].map(|v| Vec3::from_slice(&v[..3]));
+                    let to_world = self.statics.instances()[hit.instance as usize].object_to_world;
+                    let face =
+                        Mat3::from_mat4(glam::Mat4::from_cols_array_2d(&to_world)) * (b - a).cross(c - a);
+                    face.dot(dir) > 0.0
+                })
+            })
+            .count();
+        back as f32 / n as f32
+    }
+
+    /// The positions of probes not inside geometry ([`ProbeCapture::back_faces`] at most
+    /// [`MAX_BACK_FACES`]), and those left out.
+    pub fn keep_valid(&self, positions: &[DVec3]) -> (Vec<DVec3>, Vec<InvalidProbe>) {
+        let mut kept = Vec::with_capacity(positions.len());
+        let mut invalid = Vec::new();
+        for (index, &position) in positions.iter().enumerate() {
+            let back_faces = self.back_faces(position.as_vec3());
+            if back_faces > MAX_BACK_FACES {
+                invalid.push(InvalidProbe { index, position, back_faces });
+            } else {
+                kept.push(position);
+            }
+        }
+        (kept, invalid)
+    }
+
+    /// Adds `light`'s delta of radiance to `sh` where the probe at `p` sees it (see the module
+    /// documentation); the same cone and falloff as local_light.glsl.
+    fn add_light(&self, sh: &mut ShRgb9, light: &ReferenceLight, p: Vec3) {
+        let to_light = Vec3::from_slice(&light.position[..3]) - p;
+        let d = to_light.length();
+        if d <= 0.0 {
+            return;
+        }
+        let l = to_light / d;
+        let spot = light.position[3] > 0.5;
+        if spot && (-l).dot(Vec3::from_slice(&light.direction[..3])) < light.direction[3] {
+            return;
+        }
+        if self.statics.occluded(p, l, d) {
+            return;
+        }
+        let mut y = [0.0; 9];
+        eval_basis(3, l, &mut y);
+        for (c, y) in sh.c.iter_mut().zip(y) {
+            for (v, intensity) in c.iter_mut().zip(&light.intensity) {
+                *v += intensity / (d * d) * y;
+            }
+        }
+    }
+}
+
+/// A copy of `scene` without the meshes of its moving group (the group stays, empty, so that
+/// group indices do not change).
+fn static_scene(scene: &Scene) -> Scene {
+    let mut statics = scene.clone();
+    for (g, group) in statics.groups.iter_mut().enumerate() {
+        if !is_static(g) {
+            group.meshes.clear();
+        }
+    }
+    statics
+}
+
+/// The radiance vertex buffers of [`ProbeCapture::radiance`] for the static scene `statics`:
+/// zero with [`CapturedLight::Sky`].
+fn static_radiance(
+    ctx: &Arc<Context>,
+    statics: &Scene,
+    settings: CaptureSettings,
+) -> Result<Vec<Vec<Option<Buffer>>>> {
+    let radiance = match settings.light {
+        CapturedLight::Sky => None,
+        CapturedLight::SkyAndWalls => {
+            surface_radiance(ctx, statics, settings.bounces, settings.samples, RADIANCE_SEED)?
+        }
+    };
+    let mut next = 0;
+    let mut buffers = Vec::new();
+    for group in &statics.groups {
+        let mut meshes = Vec::new();
+        for mesh in &group.meshes {
+            let count = mesh.positions.len();
+            let values = radiance.as_ref().map_or(vec![[0.0; 4]; count], |r| r[next..next + count].to_vec());
+            next += count;
+            let bytes: Vec<u8> = values.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect();
+            let name = format!("{}.{}.probe_radiance", group.name, mesh.name);
+            meshes.push(
+                (count > 0)
+                    .then(|| Buffer::with_data(ctx, &name, vk::BufferUsageFlags::VERTEX_BUFFER, &bytes))
+                    .transpose()?,
+            );
+        }
+        buffers.push(meshes);
+    }
+    Ok(buffers)
 }

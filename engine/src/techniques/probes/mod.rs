@@ -20,6 +20,7 @@
 //! lower-dimensional fallback.
 mod capture;
 mod delaunay;
+mod dering;
 mod error;
 mod extrapolate;
 mod input;
@@ -36,7 +37,11 @@ mod tests;
 mod tetmesh;
 mod trilinear;
 
-pub use capture::{CaptureSettings, CapturedLight, ProbeCapture, CUBE_SIZES, DEFAULT_CUBE_SIZE};
+pub use capture::{
+    CaptureSettings, CapturedLight, InvalidProbe, ProbeCapture, BACK_FACE_RAYS, CUBE_SIZES,
+    DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES, MAX_BACK_FACES, RADIANCE_SEED,
+};
+pub use dering::Dering;
 pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};

@@ -1,7 +1,7 @@
 //! A captured probe set (Morishige 2014, steps 1–5): where the probes are, their
 //! tetrahedralization, each probe's SH, and the SH interpolated at any point with the
 //! tetrahedral weights.
-use super::capture::{CaptureSettings, ProbeCapture};
+use super::capture::{CaptureSettings, InvalidProbe, ProbeCapture};
 use super::reduce::{blend, reduce};
 use super::solids::Solids;
 use super::trilinear::Lattice;
@@ -166,18 +166,21 @@ pub fn bounds(points: impl Iterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
 
 pub struct ProbeSet {
     pub mesh: TetMesh,
-    /// Each probe's radiance SH, in the order of the positions.
+    /// Each probe's radiance SH, in the order of the mesh's positions.
     pub sh: Vec<ShRgb9>,
     /// The grid, when the interpolation is trilinear; `None`: tetrahedral.
     pub trilinear: Option<Lattice>,
     /// Probes captured before automatic placement dropped the redundant ones (the probe count
     /// for the other placements).
     pub candidates: usize,
+    /// The probes left out because they are inside geometry ([`ProbeCapture::keep_valid`]): the
+    /// mesh holds the others, in their order.
+    pub invalid: Vec<InvalidProbe>,
 }
 
 impl ProbeSet {
-    /// Places the probes, tetrahedralizes them and captures each (the static groups of `gpu`,
-    /// which holds `scene`).
+    /// Places the probes, leaves out those inside geometry, tetrahedralizes the others and
+    /// captures each (the static groups of `gpu`, which holds `scene`).
     pub fn capture(
         ctx: &Arc<Context>,
         scene: &Scene,
@@ -185,24 +188,52 @@ impl ProbeSet {
         settings: &ProbeSettings,
     ) -> Result<ProbeSet> {
         let settings = settings.clone().validated()?;
-        let positions = settings.positions(scene)?;
-        let sh = capture_at(ctx, scene, gpu, settings.capture, &positions)?;
+        let mut capture = ProbeCapture::new(ctx, scene, settings.capture)?;
+        let (positions, invalid) = capture.keep_valid(&settings.positions(scene)?);
+        // A warning, not an error: the set still lights the scene without them.
+        for probe in &invalid {
+            let p = probe.position;
+            eprintln!(
+                "kage: warning: probe {} at ({}, {}, {}) is inside geometry ({:.0}% of its directions see back faces): left out",
+                probe.index,
+                p.x,
+                p.y,
+                p.z,
+                100.0 * probe.back_faces
+            );
+        }
+        let sh: Vec<ShRgb9> =
+            positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect::<Result<_>>()?;
         let candidates = positions.len();
         let mut set = match (&settings.placement, settings.interpolation) {
             (ProbePlacement::Auto { tolerance, .. }, _) => ProbeSet::reduced(&positions, &sh, *tolerance)?,
             (ProbePlacement::Grid(counts), ProbeInterpolation::Trilinear) => {
+                // A lattice needs every corner: a probe left out leaves a hole no weight fills.
+                if let Some(probe) = invalid.first() {
+                    return Err(Error::InvalidArgument(format!(
+                        "trilinear interpolation needs every grid probe, and probe {} at {} is inside geometry: use tetrahedral interpolation",
+                        probe.index, probe.position
+                    )));
+                }
                 ProbeSet::trilinear(grid_lattice(scene, *counts)?, sh)?
             }
             _ => ProbeSet::tetrahedral(&positions, sh)?,
         };
         set.candidates = candidates;
+        set.invalid = invalid;
         Ok(set)
     }
 
     /// Tetrahedral interpolation of the SH captured at `positions`.
     pub fn tetrahedral(positions: &[DVec3], sh: Vec<ShRgb9>) -> Result<ProbeSet> {
         let candidates = positions.len();
-        Ok(ProbeSet { mesh: TetMesh::build(positions)?, sh, trilinear: None, candidates })
+        Ok(ProbeSet {
+            mesh: TetMesh::build(positions)?,
+            sh,
+            trilinear: None,
+            candidates,
+            invalid: Vec::new(),
+        })
     }
 
     /// Trilinear interpolation of the SH captured at the positions of `lattice`.
