@@ -502,7 +502,8 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
 /// (capi::result's unit tests map every error class to its code). Lavapipe cannot be made to
 /// lose its device on demand: it has no GPU to reset and no watchdog (a shader that never ends
 /// just occupies a CPU thread until the 10-minute fence timeout), so the mapping of the
-/// `vk::Result` every call site goes through is what is tested here.
+/// `vk::Result` every call site goes through is what is tested here, and pass's unit tests check
+/// that every frame after a loss still reports the loss.
 #[test]
 fn device_loss_and_out_of_memory_results_keep_their_class() {
     let map = |result| Error::vk("vkQueueSubmit")(result);
