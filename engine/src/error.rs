@@ -16,6 +16,10 @@ pub enum Error {
     OutOfDeviceMemory { call: &'static str },
     #[error("out of host memory in {call}")]
     OutOfHostMemory { call: &'static str },
+    /// One resource that the device cannot hold: beyond its size limit for the format, or no
+    /// memory left for it. Like the two above, a request to retry with smaller settings.
+    #[error("out of device memory for {name} ({bytes} bytes): {reason}")]
+    OutOfDeviceMemoryFor { name: String, bytes: u64, reason: String },
     #[error("the Vulkan device was lost in {call}")]
     DeviceLost { call: &'static str },
     #[error("{call} failed: {result:?}")]

@@ -196,6 +196,7 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, options: &RenderOptions) -> Result<Renderer> {
+        scene.validate()?;
         let targets = Targets::new(ctx, options.width, options.height)?;
         let gpu = GpuScene::new(ctx, scene)?;
         let technique: Box<dyn Technique> = match &options.technique {

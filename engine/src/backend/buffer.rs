@@ -48,7 +48,7 @@ impl Buffer {
             Err(e) => {
                 // SAFETY: the buffer is unbound and unused.
                 unsafe { ctx.device.destroy_buffer(raw, None) };
-                return Err(allocation_error(desc.name, e));
+                return Err(allocation_error(desc.name, requirements.size, e));
             }
         };
         // SAFETY: the allocation satisfies the buffer's requirements and is not bound elsewhere.
@@ -180,11 +180,15 @@ impl Buffer {
     }
 }
 
-pub(crate) fn allocation_error(name: &str, e: gpu_allocator::AllocationError) -> Error {
+/// A failed allocation of `bytes` for the resource `name`: running out of memory names the
+/// resource and its size, so that a host knows which setting to turn down.
+pub(crate) fn allocation_error(name: &str, bytes: u64, e: gpu_allocator::AllocationError) -> Error {
     match e {
-        gpu_allocator::AllocationError::OutOfMemory => {
-            Error::OutOfDeviceMemory { call: "gpu-allocator allocate" }
-        }
+        gpu_allocator::AllocationError::OutOfMemory => Error::OutOfDeviceMemoryFor {
+            name: name.to_owned(),
+            bytes,
+            reason: "no device memory block can hold it".into(),
+        },
         e => Error::Allocation { name: name.to_owned(), message: e.to_string() },
     }
 }

@@ -45,7 +45,7 @@ impl Context {
         unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
     }
 
-    pub(crate) fn destroy_recorder(&self, recorder: CommandRecorder) {
+    pub(crate) fn destroy_recorder(&self, recorder: &CommandRecorder) {
         self.free_command_buffer(recorder.cmd);
         // SAFETY: the fence is not in use once the last submission was waited for.
         unsafe { self.device.destroy_fence(recorder.fence, None) };
@@ -86,7 +86,7 @@ impl Context {
         });
         // After a failed submission the buffer may still be pending: free it only once idle.
         if result.is_ok() || self.wait_idle().is_ok() {
-            self.destroy_recorder(recorder);
+            self.destroy_recorder(&recorder);
         }
         result
     }

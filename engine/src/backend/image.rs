@@ -71,24 +71,57 @@ fn texel_bytes(format: vk::Format) -> Option<u64> {
 
 impl Image {
     pub fn new(ctx: &Arc<Context>, desc: &ImageDesc) -> Result<Image> {
+        // The limits of this format and usage (finer than the device-wide ones): an image
+        // beyond them is invalid to create, so it is refused before vkCreateImage.
         // SAFETY: plain property query.
-        let limits = unsafe { ctx.instance.get_physical_device_properties(ctx.physical) }.limits;
+        let limits = unsafe {
+            ctx.instance.get_physical_device_image_format_properties(
+                ctx.physical,
+                desc.format,
+                vk::ImageType::TYPE_2D,
+                vk::ImageTiling::OPTIMAL,
+                desc.usage,
+                vk::ImageCreateFlags::empty(),
+            )
+        }
+        .map_err(|e| match e {
+            vk::Result::ERROR_FORMAT_NOT_SUPPORTED => Error::Unsupported(format!(
+                "{:?} images with usage {:?} (for {})",
+                desc.format, desc.usage, desc.name
+            )),
+            e => Error::vk("vkGetPhysicalDeviceImageFormatProperties")(e),
+        })?;
+        let max = limits.max_extent;
         if desc.width == 0
             || desc.height == 0
             || desc.layers == 0
-            || desc.width > limits.max_image_dimension2_d
-            || desc.height > limits.max_image_dimension2_d
-            || desc.layers > limits.max_image_array_layers
+            || desc.width > max.width
+            || desc.height > max.height
+            || desc.layers > limits.max_array_layers
         {
             return Err(Error::InvalidArgument(format!(
-                "image {} of {}x{}x{} is outside the device limits (1..={} per side, {} layers)",
+                "image {} of {}x{}x{} is outside the device limits (1..={}x{}, {} layers)",
                 desc.name,
                 desc.width,
                 desc.height,
                 desc.layers,
-                limits.max_image_dimension2_d,
-                limits.max_image_array_layers
+                max.width,
+                max.height,
+                limits.max_array_layers
             )));
+        }
+        if let Some(texel) = texel_bytes(desc.format) {
+            let bytes = u64::from(desc.width) * u64::from(desc.height) * u64::from(desc.layers) * texel;
+            if bytes > limits.max_resource_size {
+                return Err(Error::OutOfDeviceMemoryFor {
+                    name: desc.name.to_owned(),
+                    bytes,
+                    reason: format!(
+                        "the device's largest image of this format is {} bytes",
+                        limits.max_resource_size
+                    ),
+                });
+            }
         }
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
@@ -116,7 +149,7 @@ impl Image {
             Err(e) => {
                 // SAFETY: unbound, unused image.
                 unsafe { ctx.device.destroy_image(raw, None) };
-                return Err(allocation_error(desc.name, e));
+                return Err(allocation_error(desc.name, requirements.size, e));
             }
         };
         let mut image = Image {

@@ -68,9 +68,10 @@ fn code_of(error: &Error) -> kage_result {
     match error {
         Error::Loader(_) | Error::NoDevice(_) => kage_result::NoDevice,
         Error::Unsupported(_) => kage_result::Unsupported,
-        Error::OutOfDeviceMemory { .. } | Error::OutOfHostMemory { .. } | Error::Allocation { .. } => {
-            kage_result::OutOfMemory
-        }
+        Error::OutOfDeviceMemory { .. }
+        | Error::OutOfHostMemory { .. }
+        | Error::OutOfDeviceMemoryFor { .. }
+        | Error::Allocation { .. } => kage_result::OutOfMemory,
         Error::DeviceLost { .. } => kage_result::DeviceLost,
         Error::Vulkan { .. } | Error::Timeout(_) => kage_result::Vulkan,
         // A scene error names a file when one was read; otherwise the host's data is at fault.
@@ -167,6 +168,15 @@ mod tests {
         assert_eq!(boundary(|| Ok(())), kage_result::Ok);
         // Success leaves the last failure's message in place.
         assert_eq!(last_message(), "out of host memory in vkX");
+        // Device loss and one resource too large keep their own codes.
+        assert_eq!(
+            boundary(|| Err(Error::DeviceLost { call: "vkQueueSubmit" }.into())),
+            kage_result::DeviceLost
+        );
+        let too_large =
+            Error::OutOfDeviceMemoryFor { name: "mask".into(), bytes: 1 << 32, reason: "limit".into() };
+        assert_eq!(boundary(|| Err(too_large.into())), kage_result::OutOfMemory);
+        assert_eq!(last_message(), "out of device memory for mask (4294967296 bytes): limit");
     }
 
     #[test]

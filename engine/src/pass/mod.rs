@@ -54,8 +54,34 @@ pub struct PassTiming {
 pub struct FrameExecutor {
     ctx: Arc<Context>,
     name: String,
-    recorder: Option<crate::backend::CommandRecorder>,
+    /// The command buffer, or the failed submission that left it pending for good.
+    recorder: std::result::Result<crate::backend::CommandRecorder, Failed>,
     timestamps: Option<TimestampPool>,
+}
+
+/// The failed submission that left an executor unusable, kept to answer every later frame.
+struct Failed {
+    device_lost: bool,
+    message: String,
+}
+
+impl Failed {
+    fn new(error: &Error) -> Failed {
+        Failed { device_lost: matches!(error, Error::DeviceLost { .. }), message: error.to_string() }
+    }
+
+    /// A lost device stays a lost device for every later frame, so that a host's handling of
+    /// it (rebuild everything) is triggered however many frames it renders before it looks;
+    /// any other failure is named.
+    fn error(&self) -> Error {
+        match self.device_lost {
+            true => Error::DeviceLost { call: "a frame after the device was lost" },
+            false => Error::InvalidArgument(format!(
+                "the frame executor cannot run after an earlier failure: {}",
+                self.message
+            )),
+        }
+    }
 }
 
 impl FrameExecutor {
@@ -64,7 +90,7 @@ impl FrameExecutor {
         Ok(FrameExecutor {
             ctx: ctx.clone(),
             name: name.to_owned(),
-            recorder: Some(recorder),
+            recorder: Ok(recorder),
             timestamps: None,
         })
     }
@@ -78,10 +104,10 @@ impl FrameExecutor {
             self.timestamps =
                 Some(TimestampPool::new(&self.ctx, &format!("{}.timestamps", self.name), count.max(16))?);
         }
-        let recorder = self
-            .recorder
-            .as_ref()
-            .ok_or(Error::InvalidArgument("frame executor was poisoned by an earlier failure".into()))?;
+        let recorder = match &self.recorder {
+            Ok(recorder) => recorder,
+            Err(failed) => return Err(failed.error()),
+        };
         let cmd = recorder.cmd;
         let timestamps = self.timestamps.as_ref().filter(|_| period_ns.is_some());
         self.ctx.begin(recorder)?;
@@ -106,7 +132,7 @@ impl FrameExecutor {
         if let Err(e) = self.ctx.submit_and_wait(recorder) {
             // The command buffer may still be pending after a timeout or device loss: never
             // reuse it.
-            self.recorder = None;
+            self.recorder = Err(Failed::new(&e));
             return Err(e);
         }
         let ticks = match timestamps {
@@ -129,7 +155,7 @@ impl FrameExecutor {
 
 impl Drop for FrameExecutor {
     fn drop(&mut self) {
-        if let Some(recorder) = self.recorder.take() {
+        if let Ok(recorder) = &self.recorder {
             self.ctx.destroy_recorder(recorder);
         }
     }
@@ -147,4 +173,20 @@ fn check_data_flow(imports: &[&'static str], passes: &[Pass<'_>]) -> Result<()> 
         available.extend_from_slice(pass.outputs);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lavapipe cannot lose its device on demand, so the answer to the frames after a failure
+    /// is tested on its own.
+    #[test]
+    fn frames_after_a_device_loss_report_the_loss() {
+        let lost = Failed::new(&Error::DeviceLost { call: "vkQueueSubmit" });
+        assert!(matches!(lost.error(), Error::DeviceLost { .. }));
+        let timeout = Failed::new(&Error::Timeout("vkWaitForFences"));
+        let message = timeout.error().to_string();
+        assert!(message.contains("earlier failure") && message.contains("vkWaitForFences"), "{message}");
+    }
 }

@@ -33,6 +33,7 @@ pub struct SceneBvh {
 
 impl SceneBvh {
     pub fn build(scene: &Scene) -> Result<SceneBvh> {
+        scene.validate()?;
         let mut bvh = SceneBvh {
             blas_nodes: Vec::new(),
             tlas_nodes: Vec::new(),

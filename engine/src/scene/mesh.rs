@@ -32,36 +32,29 @@ impl Mesh {
         albedo: [f32; 3],
     ) -> Result<Mesh, SceneError> {
         let name = name.into();
-        if indices.is_empty() {
-            return Err(SceneError::invalid(format!("mesh \"{name}\" is empty: it has no triangles")));
-        }
-        if indices.len() % 3 != 0 {
-            return Err(SceneError::invalid(format!(
-                "mesh \"{name}\" has {} indices, not a whole number of triangles",
-                indices.len()
-            )));
-        }
-        if let Some((at, index)) = indices.iter().enumerate().find(|(_, i)| **i as usize >= positions.len()) {
-            return Err(SceneError::invalid(format!(
-                "mesh \"{name}\": triangle {} uses vertex index {index}, out of range for {} vertices",
-                at / 3,
-                positions.len()
-            )));
-        }
-        if let Some((at, p)) = positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite())) {
-            return Err(SceneError::invalid(format!(
-                "mesh \"{name}\": vertex {at} is NaN or infinite: {p:?}"
-            )));
-        }
-        if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
-            return Err(SceneError::invalid(format!("mesh \"{name}\": albedo {albedo:?} is outside [0, 1]")));
-        }
+        check_geometry(&name, &positions, &indices, albedo)?;
         let normals = match normals {
             Some(normals) if normals.len() == positions.len() => unit_normals(&name, normals)?,
             _ => area_weighted_normals(&positions, &indices),
         };
         let (positions, normals, indices) = in_first_use_order(positions, normals, indices);
         Ok(Mesh { name, positions, normals, indices, albedo })
+    }
+
+    /// Checks what [`Mesh::new`] guarantees, for a mesh whose public fields were filled or
+    /// changed by hand: triangles, indices in range, finite positions, one finite non-zero
+    /// normal per position, albedo in [0, 1]. The error names the mesh and the first fault.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let name = &self.name;
+        check_geometry(name, &self.positions, &self.indices, self.albedo)?;
+        if self.normals.len() != self.positions.len() {
+            return Err(SceneError::invalid(format!(
+                "mesh \"{name}\" has {} normals for {} positions",
+                self.normals.len(),
+                self.positions.len()
+            )));
+        }
+        self.normals.iter().enumerate().try_for_each(|(at, n)| checked_normal(name, at, *n).map(|_| ()))
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -73,17 +66,54 @@ impl Mesh {
     }
 }
 
+/// The checks of [`Mesh::new`] and [`Mesh::validate`] that do not involve normals.
+fn check_geometry(
+    name: &str,
+    positions: &[[f32; 3]],
+    indices: &[u32],
+    albedo: [f32; 3],
+) -> Result<(), SceneError> {
+    if indices.is_empty() {
+        return Err(SceneError::invalid(format!("mesh \"{name}\" is empty: it has no triangles")));
+    }
+    if indices.len() % 3 != 0 {
+        return Err(SceneError::invalid(format!(
+            "mesh \"{name}\" has {} indices, not a whole number of triangles",
+            indices.len()
+        )));
+    }
+    if let Some((at, index)) = indices.iter().enumerate().find(|(_, i)| **i as usize >= positions.len()) {
+        return Err(SceneError::invalid(format!(
+            "mesh \"{name}\": triangle {} uses vertex index {index}, out of range for {} vertices",
+            at / 3,
+            positions.len()
+        )));
+    }
+    if let Some((at, p)) = positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite())) {
+        return Err(SceneError::invalid(format!("mesh \"{name}\": vertex {at} is NaN or infinite: {p:?}")));
+    }
+    if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
+        return Err(SceneError::invalid(format!("mesh \"{name}\": albedo {albedo:?} is outside [0, 1]")));
+    }
+    Ok(())
+}
+
+fn checked_normal(name: &str, at: usize, n: [f32; 3]) -> Result<Vec3, SceneError> {
+    let v = Vec3::from(n);
+    if !v.is_finite() || v.length_squared() == 0.0 {
+        return Err(SceneError::invalid(format!(
+            "mesh \"{name}\": normal {at} is {n:?}; normals must be finite and non-zero"
+        )));
+    }
+    Ok(v)
+}
+
 fn unit_normals(name: &str, normals: Vec<[f32; 3]>) -> Result<Vec<[f32; 3]>, SceneError> {
     normals
         .into_iter()
         .enumerate()
         .map(|(at, n)| {
-            let v = Vec3::from(n);
-            if !v.is_finite() || v.length_squared() == 0.0 {
-                return Err(SceneError::invalid(format!(
-                    "mesh \"{name}\": normal {at} is {n:?}; normals must be finite and non-zero"
-                )));
-            }
+            let v = checked_normal(name, at, n)?;
             // Already-unit normals stay bit-identical (see `Mesh`'s round-trip promise).
             Ok(if v.is_normalized() { n } else { v.normalize().to_array() })
         })

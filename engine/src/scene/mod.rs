@@ -98,6 +98,26 @@ impl Scene {
         export::export(self, dir)
     }
 
+    /// Checks what loading guarantees, for a scene built or changed in code (its fields are
+    /// public, so nothing else does): every mesh as [`Mesh::validate`], every group transform,
+    /// light and camera as their `validated`. The error names the group and mesh at fault.
+    /// Groups without meshes, and scenes without groups, are allowed here: they draw nothing
+    /// and cast no shadow (scene files and the C ABI refuse them as likely mistakes).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        for (g, group) in self.groups.iter().enumerate() {
+            let place = format!("scene \"{}\": group {g} (\"{}\")", self.name, group.name);
+            group.transform.validated().map_err(|e| e.within(&place))?;
+            for (m, mesh) in group.meshes.iter().enumerate() {
+                mesh.validate().map_err(|e| e.within(&format!("{place}: mesh {m}")))?;
+            }
+        }
+        for (l, light) in self.lights.iter().enumerate() {
+            light.validated().map_err(|e| e.within(&format!("scene \"{}\": light {l}", self.name)))?;
+        }
+        self.camera.validated().map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
+        Ok(())
+    }
+
     pub fn meshes(&self) -> impl Iterator<Item = (&Group, &Mesh)> {
         self.groups.iter().flat_map(|g| g.meshes.iter().map(move |m| (g, m)))
     }

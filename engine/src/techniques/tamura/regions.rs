@@ -155,8 +155,8 @@ fn relax(samples: &[Sample], mut sites: Vec<DVec3>) -> Vec<DVec3> {
 
 /// Assigns every texel (direction, solid angle, radiance) to its nearest site. While a site has
 /// no texel, it moves to the texel farthest (in angle, weighted by solid angle) from the site
-/// that holds it, which is where another region helps most; a map has far more texels than
-/// [`MAX_REGIONS`], so this ends after a few rounds.
+/// that holds it, which is where another region helps most; [`Regions::new`] asks for no more
+/// sites than there are texels, so this ends after a few rounds.
 fn assign_without_empty_regions(
     texels: &[(DVec3, f64, [f64; 3])],
     mut sites: Vec<DVec3>,
@@ -187,6 +187,15 @@ impl Regions {
     pub fn new(map: &EnvMap, q: usize) -> Result<Regions> {
         if !(1..=MAX_REGIONS).contains(&q) {
             return Err(Error::InvalidArgument(format!("regions: q = {q}, must be 1 to {MAX_REGIONS}")));
+        }
+        // Every region needs a texel of its own (a 2x1 map cannot be split in 64).
+        let texel_count = map.width() as usize * map.height() as usize;
+        if q > texel_count {
+            return Err(Error::InvalidArgument(format!(
+                "regions: q = {q} regions need at least {q} texels, but the {}x{} environment map has {texel_count}",
+                map.width(),
+                map.height()
+            )));
         }
         let samples = relaxation_samples(map);
         let sites = relax(&samples, initial_sites(&samples, q));
