@@ -441,7 +441,7 @@ mod tests {
             points: 4,
             normals: 2,
             spp: 64,
-            capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky },
+            capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
             cache: None,
         };
         let m = measure(&ctx, &scene, &params).unwrap();

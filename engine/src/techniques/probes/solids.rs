@@ -102,6 +102,7 @@ mod tests {
             environment: EnvMap::constant([1.0; 3]),
             lights: vec![],
             walkthrough: vec![],
+            probes: vec![],
             camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
         }
     }
