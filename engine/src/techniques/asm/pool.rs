@@ -11,8 +11,10 @@ use crate::error::{Error, Result};
 use crate::layouts::constants::ASM_TILE_TEXELS;
 use std::collections::HashMap;
 
-/// Bytes of one page: a tile of D32 depth texels.
-pub const PAGE_BYTES: u64 = 4 * ASM_TILE_TEXELS as u64 * ASM_TILE_TEXELS as u64;
+/// Bytes of one page for the depth test with bias: a tile of D32 depth texels.
+pub const DEPTH_PAGE_BYTES: u64 = 4 * ASM_TILE_TEXELS as u64 * ASM_TILE_TEXELS as u64;
+/// Bytes of one page for the polygon-ID test: D32 depth and an R32_UINT polygon ID per texel.
+pub const ID_PAGE_BYTES: u64 = 2 * DEPTH_PAGE_BYTES;
 
 #[derive(Clone, Copy, Debug)]
 struct Resident {
@@ -37,21 +39,23 @@ pub enum Insert {
 #[derive(Debug)]
 pub struct PagePool {
     capacity: u32,
+    page_bytes: u64,
     free: Vec<u32>,
     tiles: HashMap<TileKey, Resident>,
 }
 
 impl PagePool {
-    /// A pool within `budget_bytes`, with the root resident (used at frame 0); the budget
-    /// must hold at least the root's page.
-    pub fn new(budget_bytes: u64) -> Result<PagePool> {
-        let capacity = u32::try_from(budget_bytes / PAGE_BYTES).unwrap_or(u32::MAX);
+    /// A pool of pages of `page_bytes` within `budget_bytes`, with the root resident (used at
+    /// frame 0); the budget must hold at least the root's page.
+    pub fn new(budget_bytes: u64, page_bytes: u64) -> Result<PagePool> {
+        let capacity = u32::try_from(budget_bytes / page_bytes.max(1)).unwrap_or(u32::MAX);
         if capacity == 0 {
             return Err(Error::InvalidArgument(format!(
-                "an ASM budget of {budget_bytes} bytes holds no tile: a tile takes {PAGE_BYTES} bytes"
+                "an ASM budget of {budget_bytes} bytes holds no tile: a tile takes {page_bytes} bytes"
             )));
         }
-        let mut pool = PagePool { capacity, free: (0..capacity).rev().collect(), tiles: HashMap::new() };
+        let mut pool =
+            PagePool { capacity, page_bytes, free: (0..capacity).rev().collect(), tiles: HashMap::new() };
         pool.insert(TileKey::ROOT, 0, f32::INFINITY)?;
         Ok(pool)
     }
@@ -62,7 +66,7 @@ impl PagePool {
     }
 
     pub fn bytes_in_use(&self) -> u64 {
-        self.tiles.len() as u64 * PAGE_BYTES
+        self.tiles.len() as u64 * self.page_bytes
     }
 
     /// The page of a resident tile.
@@ -142,6 +146,7 @@ impl PagePool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    const PAGE_BYTES: u64 = DEPTH_PAGE_BYTES;
 
     fn child(key: TileKey, q: usize) -> TileKey {
         key.children().unwrap()[q]
@@ -149,14 +154,14 @@ mod tests {
 
     #[test]
     fn a_budget_below_one_page_is_an_error() {
-        assert!(PagePool::new(PAGE_BYTES - 1).unwrap_err().to_string().contains("holds no tile"));
-        let pool = PagePool::new(PAGE_BYTES).unwrap();
+        assert!(PagePool::new(PAGE_BYTES - 1, PAGE_BYTES).unwrap_err().to_string().contains("holds no tile"));
+        let pool = PagePool::new(PAGE_BYTES, PAGE_BYTES).unwrap();
         assert_eq!((pool.capacity(), pool.page(TileKey::ROOT)), (1, Some(0)));
     }
 
     #[test]
     fn tiles_grow_from_the_root_and_evict_least_recently_used_leaves() {
-        let mut pool = PagePool::new(3 * PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(3 * PAGE_BYTES, PAGE_BYTES).unwrap();
         let (a, b) = (child(TileKey::ROOT, 0), child(TileKey::ROOT, 3));
         assert!(pool.insert(child(a, 0), 1, 1.0).is_err(), "parent missing");
         assert!(matches!(pool.insert(a, 1, 1.0).unwrap(), Insert::Allocated { .. }));
@@ -178,7 +183,7 @@ mod tests {
 
     #[test]
     fn dropping_a_tile_drops_its_descendants_and_frees_their_pages() {
-        let mut pool = PagePool::new(8 * PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(8 * PAGE_BYTES, PAGE_BYTES).unwrap();
         let a = child(TileKey::ROOT, 0);
         let (a0, b) = (child(a, 0), child(TileKey::ROOT, 1));
         for key in [a, a0, child(a0, 3), b] {
@@ -200,7 +205,7 @@ mod tests {
     #[test]
     fn the_budget_is_never_exceeded() {
         let budget = 10 * PAGE_BYTES + PAGE_BYTES / 2;
-        let mut pool = PagePool::new(budget).unwrap();
+        let mut pool = PagePool::new(budget, PAGE_BYTES).unwrap();
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = || {
             state ^= state << 13;
