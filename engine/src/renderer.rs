@@ -186,6 +186,7 @@ pub struct Renderer {
     env_sh: ShProjection,
     env_dirty: bool,
     env_rotation: f32,
+    lights: Vec<crate::scene::Light>,
     background: Background,
     technique: Box<dyn Technique>,
     frame_uniforms: Buffer,
@@ -217,6 +218,7 @@ impl Renderer {
             env_sh: ShProjection::environment(ctx, &scene.environment)?,
             env_dirty: true,
             env_rotation: 0.0,
+            lights: scene.lights.clone(),
             background: Background::new(ctx)?,
             technique,
             frame_uniforms: Buffer::new(
@@ -248,6 +250,17 @@ impl Renderer {
         Ok(())
     }
 
+    /// Moves or changes light `index` of the scene (checked as a scene file's light is). The
+    /// techniques that follow moving lights read it each frame (adaptive shadow maps).
+    pub fn set_light(&mut self, index: usize, light: crate::scene::Light) -> Result<()> {
+        let count = self.lights.len();
+        let slot = self.lights.get_mut(index).ok_or_else(|| {
+            Error::InvalidArgument(format!("light {index} does not exist (the scene has {count})"))
+        })?;
+        *slot = light.validated()?;
+        Ok(())
+    }
+
     /// Moves a group (a rigid transform: rotation, translation, uniform scale).
     pub fn set_group_transform(&mut self, group: usize, transform: Mat4) -> Result<()> {
         let count = self.scene.transforms.len();
@@ -273,8 +286,11 @@ impl Renderer {
         };
         self.frame_uniforms.write(0, bytes_of(&uniforms))?;
 
-        self.technique
-            .update(&FrameState { transforms: &self.scene.transforms, env_rotation: self.env_rotation })?;
+        self.technique.update(&FrameState {
+            transforms: &self.scene.transforms,
+            env_rotation: self.env_rotation,
+            lights: &self.lights,
+        })?;
 
         let inputs = FrameInputs {
             ctx: &self.ctx,

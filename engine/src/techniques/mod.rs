@@ -41,6 +41,8 @@ pub struct FrameState<'a> {
     pub transforms: &'a [Mat4],
     /// The environment's rotation about +Y, in radians (counter-clockwise seen from above).
     pub env_rotation: f32,
+    /// The scene's point and spot lights as they are this frame.
+    pub lights: &'a [crate::scene::Light],
 }
 
 /// A lighting technique: host-side updates, then the passes that draw the scene over the

@@ -109,21 +109,6 @@ impl PagePool {
         Ok(Insert::Replaced { page, evicted })
     }
 
-    /// Drops every resident tile `stale` picks, but the root, with all its descendants (their
-    /// parent gone, the lookup's descent could no longer reach them); returns the dropped tiles.
-    pub fn drop_where(&mut self, stale: impl Fn(TileKey) -> bool) -> Vec<TileKey> {
-        let picked: Vec<TileKey> =
-            self.tiles.keys().copied().filter(|k| *k != TileKey::ROOT && stale(*k)).collect();
-        let dropped: Vec<TileKey> =
-            self.tiles.keys().copied().filter(|k| picked.iter().any(|p| p.covers(*k))).collect();
-        for key in &dropped {
-            if let Some(r) = self.tiles.remove(key) {
-                self.free.push(r.page);
-            }
-        }
-        dropped
-    }
-
     /// The tile to evict for `key`, if any may go.
     fn victim(&self, key: TileKey, frame: u64, benefit: f32) -> Option<TileKey> {
         let evictable = self.tiles.iter().filter(|(k, _)| {
@@ -179,25 +164,6 @@ mod tests {
         );
         assert!(pool.touch(a, 4) && !pool.touch(child(a, 1), 4));
         assert_eq!(pool.page(TileKey::ROOT), Some(0), "the root is never evicted");
-    }
-
-    #[test]
-    fn dropping_a_tile_drops_its_descendants_and_frees_their_pages() {
-        let mut pool = PagePool::new(8 * PAGE_BYTES, PAGE_BYTES).unwrap();
-        let a = child(TileKey::ROOT, 0);
-        let (a0, b) = (child(a, 0), child(TileKey::ROOT, 1));
-        for key in [a, a0, child(a0, 3), b] {
-            pool.insert(key, 1, 1.0).unwrap();
-        }
-        let mut dropped = pool.drop_where(|k| k == a || k == TileKey::ROOT);
-        dropped.sort();
-        assert_eq!(dropped, vec![a, a0, child(a0, 3)]);
-        assert_eq!(pool.resident().count(), 2, "the root and b stay");
-        assert!(pool.page(b).is_some() && pool.page(TileKey::ROOT).is_some());
-        // The freed pages serve new tiles: 6 free again.
-        for q in 0..4 {
-            assert!(matches!(pool.insert(child(b, q), 2, 1.0).unwrap(), Insert::Allocated { .. }));
-        }
     }
 
     /// Random requests over many frames: the pool never holds more than its budget, the root

@@ -13,8 +13,10 @@
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
 //! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
 //! the scene's depth range did) drops every tile and renders the root again; a group moving
-//! drops the tiles its old or new light-uv bounds overlap, with their descendants, and renders
-//! the root again if it is one of them.
+//! re-renders the resident tiles its old or new light-uv bounds overlap (outside the time
+//! budget: a stale tile would show the group where it was), and keeps the others as they are.
+//! Dropping them instead would cut the quadtree: every ancestor of a refined tile overlaps a
+//! group somewhere in its square.
 use super::light_view::{tile_view_proj, UvRect};
 use super::page_table;
 use super::plan::{plan, CostModel, Request};
@@ -467,6 +469,9 @@ impl TileIds {
 impl Technique for Asm {
     fn update(&mut self, state: &FrameState) -> Result<()> {
         self.frame += 1;
+        if let Some(&light) = state.lights.first() {
+            self.light = light;
+        }
         let (centre, radius) = scene_sphere(&self.bounds, state.transforms);
         let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
         let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
@@ -484,10 +489,9 @@ impl Technique for Asm {
                 .flat_map(|g| [self.group_rects[g], rects[g]])
                 .collect();
             let touched = |key: TileKey| moved.iter().any(|r| r.overlaps(&UvRect::of_tile(key)));
-            self.pool.drop_where(touched);
-            if touched(TileKey::ROOT) {
-                render.push(TileKey::ROOT);
-            }
+            render.extend(self.pool.resident().map(|(key, _)| key).filter(|&key| touched(key)));
+            // Coarse levels first: the root leads.
+            render.sort();
         }
         self.record = Some(record);
         self.transforms = state.transforms.to_vec();
