@@ -245,7 +245,7 @@ struct AsmTilePush {
 // three uint arrays of `size.z` (page table nodes) blocks: a used flag per node, then per node
 // and quadrant the edge pixels asking for that child tile and the sum of their missing levels.
 struct AsmAnalysisPush {
-    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: unused
+    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: the pixel of each 2x2 block analysed this frame (x + 2y)
     vec4 bias; // as LocalDrawPush.bias
 };
 

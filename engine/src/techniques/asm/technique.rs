@@ -7,7 +7,7 @@
 //!    the light's projection cropped to its square (one debug label per tile);
 //! 2. `scene`: the shared local-light shading, each point's visibility looked up in the finest
 //!    resident tile holding it (the page table's descent);
-//! 3. `asm_analysis`: per visible eye pixel, the tile it used, and on shadow edges short of
+//! 3. `asm_analysis`: per visible eye pixel (one of each 2×2 block per frame, in turn), the tile it used, and on shadow edges short of
 //!    resolution the child tile it asks for, counted in a buffer the host reads next frame.
 //!
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
@@ -570,8 +570,10 @@ impl Technique for Asm {
             move |cmd| {
                 self.requests.record_zero(cmd);
                 ctx.full_barrier(cmd);
-                let push =
-                    AsmAnalysisPush { size: [width, height, self.pool.capacity(), 0], bias: DEPTH_BIAS };
+                let push = AsmAnalysisPush {
+                    size: [width, height, self.pool.capacity(), (self.frame % 4) as u32],
+                    bias: DEPTH_BIAS,
+                };
                 let group = constants::ASM_ANALYSIS_GROUP;
                 self.analysis.dispatch(
                     cmd,
@@ -584,7 +586,7 @@ impl Technique for Asm {
                         Binding::Storage(&self.requests),
                     ],
                     bytes_of(&push),
-                    [width.div_ceil(group), height.div_ceil(group), 1],
+                    [width.div_ceil(2 * group), height.div_ceil(2 * group), 1],
                 );
             },
         );
