@@ -47,7 +47,9 @@ use std::sync::Arc;
 /// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
 pub const MB: u64 = 1 << 20;
 
-/// The shadow test of the lookup.
+/// The shadow test of the lookup. The bias test is the default: at equal memory it holds twice
+/// the tiles, and over the `asm` walkthrough's close-ups it misclassified fewer pixels (IDs
+/// only won on the bunny, whose surfaces turn away from the light; BENCHMARKS.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AsmTest {
     /// The paper's: a tile texel holding the receiver's own polygon is lit; otherwise the
