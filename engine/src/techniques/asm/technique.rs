@@ -194,7 +194,14 @@ impl Asm {
         };
         let pool = PagePool::new(settings.budget_bytes(), settings.test.page_bytes())?;
         let capacity = pool.capacity();
-        let tiles = ShadowMaps::new(ctx, "asm", constants::ASM_TILE_TEXELS, capacity)?;
+        let tiles =
+            ShadowMaps::new(ctx, "asm", constants::ASM_TILE_TEXELS, capacity).map_err(|e| match e {
+                Error::InvalidArgument(e) => Error::InvalidArgument(format!(
+                    "an ASM budget of {} MB is {capacity} pages, one image layer each: {e}",
+                    settings.budget_mb
+                )),
+                e => e,
+            })?;
         let ids = match settings.test {
             AsmTest::Bias => None,
             AsmTest::Id => Some(TileIds::new(ctx, gpu, capacity)?),
