@@ -318,6 +318,10 @@ typedef struct {
    * Adaptive shadow maps: tile rendering time per frame in ms; default 8.
    */
   double asm_time_ms;
+  /**
+   * A `kage_asm_test` value; default bias.
+   */
+  uint32_t asm_test;
 } kage_technique_desc;
 
 /**

@@ -224,7 +224,7 @@ struct ShadowLight {
 struct LocalDrawPush {
     mat4 model;
     vec4 albedo; // rgb: diffuse albedo, a: unused
-    uvec4 params; // x: light count, y, z, w: unused
+    uvec4 params; // x: light count, y: polygon ID of the mesh's first triangle (ASM's ID test), z, w: unused
     vec4 bias; // x: constant depth bias, y: slope-scaled depth bias (both in texels at the receiver's depth), z: the largest slope (tangent) the bias follows, w: unused
 };
 
@@ -236,11 +236,17 @@ struct AsmNode {
     uvec4 tile; // x: physical page (layer of the tile array), y: level, z, w: tile x, y at that level
 };
 
+// Push constants of an ASM tile render with polygon IDs (asm_tile.vert/frag): one draw per mesh.
+struct AsmTilePush {
+    mat4 transform; // object to the tile's clip space (the tile's view-projection times the model)
+    uvec4 ids; // x: polygon ID of the mesh's first triangle (IDs start at 1; 0: no surface), y, z, w: unused
+};
+
 // Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer holds
 // three uint arrays of `size.z` (page table nodes) blocks: a used flag per node, then per node
 // and quadrant the edge pixels asking for that child tile and the sum of their missing levels.
 struct AsmAnalysisPush {
-    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: unused
+    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: the pixel of each 2x2 block analysed this frame (x + 2y)
     vec4 bias; // as LocalDrawPush.bias
 };
 

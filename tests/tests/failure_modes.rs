@@ -18,6 +18,7 @@ use kage::raycast::{closest_hit_brute_force, GpuBvh, GpuRays, Query, RayCaster, 
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice, MAX_SIZE};
 use kage::scene::envmap::MAX_RADIANCE;
 use kage::scene::{shapes, Camera, EnvMap, Group, Light, Mesh, Scene, Transform};
+use kage::techniques::asm::AsmSettings;
 use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSettings};
 use kage::techniques::prt::{transfer, PrtParams};
 use kage::techniques::tamura::technique::OcclusionSettings;
@@ -64,6 +65,7 @@ fn scene(groups: Vec<Group>) -> Scene {
         environment: EnvMap::constant([1.0; 3]),
         lights: vec![spot()],
         walkthrough: vec![],
+        probes: vec![],
         camera: camera(),
     }
 }
@@ -119,9 +121,11 @@ fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, Technique
             "probes",
             TechniqueChoice::Probes(ProbeSettings {
                 placement: ProbePlacement::Grid([2, 2, 2]),
-                capture: CaptureSettings { cube_size: 8, ..Default::default() },
+                capture: CaptureSettings { cube_size: 8, samples: 16, ..Default::default() },
+                ..Default::default()
             }),
         ),
+        ("asm", TechniqueChoice::Asm(AsmSettings { budget_mb: 1.0, ..AsmSettings::default() })),
     ]
 }
 

@@ -48,6 +48,7 @@ fn probes(dering: Dering) -> ProbeSettings {
     ProbeSettings {
         placement: ProbePlacement::Positions(Arc::from(positions)),
         capture: CaptureSettings { cube_size: 16, light: CapturedLight::Sky, dering, ..Default::default() },
+        ..Default::default()
     }
 }
 
@@ -125,6 +126,7 @@ fn a_probe_inside_a_wall_is_detected_and_left_out() {
     let settings = ProbeSettings {
         placement: ProbePlacement::Positions(Arc::from(positions.clone())),
         capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
+        ..Default::default()
     };
     let capture = kage::techniques::probes::ProbeCapture::new(&ctx, &scene, settings.capture).unwrap();
     // Inside the slab nearly every direction meets a back face first: not all, as its bottom

@@ -11,7 +11,7 @@ use kage_tests::Validated;
 fn tiny(placement: ProbePlacement, interpolation: ProbeInterpolation) -> ProbeSettings {
     ProbeSettings {
         placement,
-        capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky },
+        capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
         interpolation,
     }
 }

@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
-use kage::techniques::asm::technique::MB;
+use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_TOLERANCE,
@@ -63,6 +63,12 @@ pub enum ProbeInterpolationName {
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AsmTestName {
+    Id,
+    Bias,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PenumbraName {
     Fixed,
     Adaptive,
@@ -92,6 +98,10 @@ pub struct RenderArgs {
     /// predicts it.
     #[arg(long, default_value_t = AsmSettings::default().time_ms)]
     asm_time_ms: f64,
+    /// Adaptive shadow maps: the shadow test, `id` (the paper's polygon IDs, depth with bias
+    /// as fallback; pages take twice the bytes) or `bias` (depth with slope-scaled bias).
+    #[arg(long, value_enum, default_value_t = AsmTestName::Bias)]
+    asm_test: AsmTestName,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`), a file
     /// {"positions": [[x,y,z], ...]}, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
@@ -201,7 +211,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 ProbeInterpolationName::Trilinear => ProbeInterpolation::Trilinear,
             },
         },
-        asm: AsmSettings { budget_mb: args.asm_budget_mb, time_ms: args.asm_time_ms },
+        asm: AsmSettings {
+            budget_mb: args.asm_budget_mb,
+            time_ms: args.asm_time_ms,
+            test: match args.asm_test {
+                AsmTestName::Id => AsmTest::Id,
+                AsmTestName::Bias => AsmTest::Bias,
+            },
+        },
     }
     .validated()?;
     let transfer = match settings.precomputation() {

@@ -50,6 +50,13 @@ pub struct DeviceInfo {
     pub features: Vec<(&'static str, bool)>,
 }
 
+impl DeviceInfo {
+    /// Whether the device has the feature of that `features` name.
+    pub fn has(&self, feature: &str) -> bool {
+        self.features.iter().any(|(name, present)| *name == feature && *present)
+    }
+}
+
 pub struct Context {
     _entry: ash::Entry,
     pub(crate) instance: ash::Instance,
@@ -171,6 +178,7 @@ impl Context {
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
         let enabled = vk::PhysicalDeviceFeatures::default()
             .shader_clip_distance(true)
+            .geometry_shader(info.has(device::GEOMETRY_SHADER))
             .shader_storage_image_extended_formats(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)

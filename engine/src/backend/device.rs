@@ -91,6 +91,7 @@ pub(crate) fn probe(
                 features.shader_storage_image_extended_formats == vk::TRUE,
             ),
             ("shaderFloat64", features.shader_float64 == vk::TRUE),
+            (GEOMETRY_SHADER, features.geometry_shader == vk::TRUE),
             (
                 "ray query (not used: Kage casts rays through its own BVH)",
                 has_extension(&device_exts, ash::khr::ray_query::NAME),
@@ -104,6 +105,10 @@ pub(crate) fn probe(
     }
     Ok(info)
 }
+
+/// The feature that lets fragment shaders read gl_PrimitiveID (SPIR-V's Geometry capability):
+/// the polygon IDs of adaptive shadow maps. Enabled where the device has it.
+pub const GEOMETRY_SHADER: &str = "geometryShader (ASM polygon IDs: gl_PrimitiveID in fragment shaders)";
 
 /// Chooses a Vulkan 1.2+ device with a graphics+compute queue: by name when asked, otherwise
 /// discrete GPU first, then integrated, virtual, CPU.

@@ -4,6 +4,7 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
+use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
 use crate::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_GRID,
@@ -51,6 +52,16 @@ pub enum kage_probe_light {
     Sky = 1,
 }
 
+/// The shadow test of adaptive shadow maps (the values of `kage_technique_desc.asm_test`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_asm_test {
+    /// The depth comparison with a slope-scaled bias.
+    Bias = 0,
+    /// The paper's polygon-ID comparison, depth with bias as fallback.
+    Id = 1,
+}
+
 /// Width of Tamura's penumbrae (the values of `kage_technique_desc.penumbra`).
 #[repr(u32)]
 #[derive(Clone, Copy)]
@@ -94,6 +105,8 @@ pub struct kage_technique_desc {
     pub asm_budget_mb: f64,
     /// Adaptive shadow maps: tile rendering time per frame in ms; default 8.
     pub asm_time_ms: f64,
+    /// A `kage_asm_test` value; default bias.
+    pub asm_test: u32,
 }
 
 impl kage_technique_desc {
@@ -120,6 +133,11 @@ impl kage_technique_desc {
                 (kage_probe_light::Sky as u32, CapturedLight::Sky),
             ],
         )?;
+        let asm_test = args::enumeration(
+            self.asm_test,
+            "asm_test",
+            &[(kage_asm_test::Bias as u32, AsmTest::Bias), (kage_asm_test::Id as u32, AsmTest::Id)],
+        )?;
         let penumbra = args::enumeration(
             self.penumbra,
             "penumbra",
@@ -144,7 +162,7 @@ impl kage_technique_desc {
                 },
                 interpolation: ProbeInterpolation::Tetrahedral,
             },
-            asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms },
+            asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms, test: asm_test },
         }
         .validated()?)
     }
@@ -176,6 +194,10 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_light: kage_probe_light::SkyAndWalls as u32,
             asm_budget_mb: d.asm.budget_mb,
             asm_time_ms: d.asm.time_ms,
+            asm_test: match d.asm.test {
+                AsmTest::Bias => kage_asm_test::Bias as u32,
+                AsmTest::Id => kage_asm_test::Id as u32,
+            },
         };
         // An unknown technique is reported here already, not at the first use.
         filled.settings()?;

@@ -157,8 +157,10 @@ mod tests {
         assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
         assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
         assert!(matches!(of(TechniqueKind::Probes).choice(None), Ok(TechniqueChoice::Probes(_))));
-        let asm =
-            TechniqueSettings { asm: AsmSettings { budget_mb: 4.0, time_ms: 2.0 }, ..of(TechniqueKind::Asm) };
+        let asm = TechniqueSettings {
+            asm: AsmSettings { budget_mb: 4.0, time_ms: 2.0, ..AsmSettings::default() },
+            ..of(TechniqueKind::Asm)
+        };
         assert!(
             matches!(asm.choice(None), Ok(TechniqueChoice::Asm(s)) if s.budget_mb == 4.0 && s.time_ms == 2.0)
         );

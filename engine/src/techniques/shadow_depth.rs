@@ -64,6 +64,11 @@ impl ShadowMaps {
         Binding::Sampled(&self.maps, &self.nearest)
     }
 
+    /// Map `layer` as a depth attachment.
+    pub fn target(&self, layer: u32) -> Target<'_> {
+        Target { image: &self.maps, layer }
+    }
+
     /// The `shadow_maps` pass: layer i from `view_projs[i]`.
     pub fn pass<'a>(&'a self, ctx: &'a Context, scene: &'a GpuScene) -> Pass<'a> {
         Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
@@ -84,7 +89,7 @@ impl ShadowMaps {
         view_proj: &Mat4,
         draws: impl Fn(&GpuMesh) -> bool,
     ) {
-        ctx.begin_rendering(cmd, None, None, Some(Target { image: &self.maps, layer }));
+        ctx.begin_rendering(cmd, None, None, Some(self.target(layer)));
         self.pipeline.bind(cmd, &[]);
         for mesh in scene.meshes.iter().filter(|m| draws(m)) {
             let push = ShadowDepthPush {

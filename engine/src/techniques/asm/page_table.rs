@@ -29,7 +29,7 @@ pub fn build(pool: &PagePool) -> Vec<AsmNode> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::techniques::asm::pool::PAGE_BYTES;
+    use crate::techniques::asm::pool::DEPTH_PAGE_BYTES as PAGE_BYTES;
 
     /// The GPU's descent (as the lighting shader will do it), on the CPU: from the root, into
     /// the resident child holding `uv`, until there is none. Returns the tile reached.
@@ -48,7 +48,7 @@ mod tests {
 
     #[test]
     fn a_missing_tile_falls_back_to_its_nearest_resident_ancestor() {
-        let mut pool = PagePool::new(8 * PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(8 * PAGE_BYTES, PAGE_BYTES).unwrap();
         // Refine towards uv = (0.3, 0.6) down to level 4.
         let uv = [0.3, 0.6];
         for level in 1..=4 {
@@ -72,7 +72,7 @@ mod tests {
 
     #[test]
     fn children_follow_their_parents_and_point_at_the_right_quadrant() {
-        let mut pool = PagePool::new(16 * PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(16 * PAGE_BYTES, PAGE_BYTES).unwrap();
         for child in TileKey::ROOT.children().unwrap() {
             pool.insert(child, 1, 1.0).unwrap();
         }

@@ -11,8 +11,10 @@ use crate::error::{Error, Result};
 use crate::layouts::constants::ASM_TILE_TEXELS;
 use std::collections::HashMap;
 
-/// Bytes of one page: a tile of D32 depth texels.
-pub const PAGE_BYTES: u64 = 4 * ASM_TILE_TEXELS as u64 * ASM_TILE_TEXELS as u64;
+/// Bytes of one page for the depth test with bias: a tile of D32 depth texels.
+pub const DEPTH_PAGE_BYTES: u64 = 4 * ASM_TILE_TEXELS as u64 * ASM_TILE_TEXELS as u64;
+/// Bytes of one page for the polygon-ID test: D32 depth and an R32_UINT polygon ID per texel.
+pub const ID_PAGE_BYTES: u64 = 2 * DEPTH_PAGE_BYTES;
 
 #[derive(Clone, Copy, Debug)]
 struct Resident {
@@ -37,21 +39,23 @@ pub enum Insert {
 #[derive(Debug)]
 pub struct PagePool {
     capacity: u32,
+    page_bytes: u64,
     free: Vec<u32>,
     tiles: HashMap<TileKey, Resident>,
 }
 
 impl PagePool {
-    /// A pool within `budget_bytes`, with the root resident (used at frame 0); the budget
-    /// must hold at least the root's page.
-    pub fn new(budget_bytes: u64) -> Result<PagePool> {
-        let capacity = u32::try_from(budget_bytes / PAGE_BYTES).unwrap_or(u32::MAX);
+    /// A pool of pages of `page_bytes` within `budget_bytes`, with the root resident (used at
+    /// frame 0); the budget must hold at least the root's page.
+    pub fn new(budget_bytes: u64, page_bytes: u64) -> Result<PagePool> {
+        let capacity = u32::try_from(budget_bytes / page_bytes.max(1)).unwrap_or(u32::MAX);
         if capacity == 0 {
             return Err(Error::InvalidArgument(format!(
-                "an ASM budget of {budget_bytes} bytes holds no tile: a tile takes {PAGE_BYTES} bytes"
+                "an ASM budget of {budget_bytes} bytes holds no tile: a tile takes {page_bytes} bytes"
             )));
         }
-        let mut pool = PagePool { capacity, free: (0..capacity).rev().collect(), tiles: HashMap::new() };
+        let mut pool =
+            PagePool { capacity, page_bytes, free: (0..capacity).rev().collect(), tiles: HashMap::new() };
         pool.insert(TileKey::ROOT, 0, f32::INFINITY)?;
         Ok(pool)
     }
@@ -61,8 +65,13 @@ impl PagePool {
         self.capacity
     }
 
+    /// Bytes of all its pages: what the pool's images take, resident or not.
+    pub fn bytes_allocated(&self) -> u64 {
+        u64::from(self.capacity) * self.page_bytes
+    }
+
     pub fn bytes_in_use(&self) -> u64 {
-        self.tiles.len() as u64 * PAGE_BYTES
+        self.tiles.len() as u64 * self.page_bytes
     }
 
     /// The page of a resident tile.
@@ -105,21 +114,6 @@ impl PagePool {
         Ok(Insert::Replaced { page, evicted })
     }
 
-    /// Drops every resident tile `stale` picks, but the root, with all its descendants (their
-    /// parent gone, the lookup's descent could no longer reach them); returns the dropped tiles.
-    pub fn drop_where(&mut self, stale: impl Fn(TileKey) -> bool) -> Vec<TileKey> {
-        let picked: Vec<TileKey> =
-            self.tiles.keys().copied().filter(|k| *k != TileKey::ROOT && stale(*k)).collect();
-        let dropped: Vec<TileKey> =
-            self.tiles.keys().copied().filter(|k| picked.iter().any(|p| p.covers(*k))).collect();
-        for key in &dropped {
-            if let Some(r) = self.tiles.remove(key) {
-                self.free.push(r.page);
-            }
-        }
-        dropped
-    }
-
     /// The tile to evict for `key`, if any may go.
     fn victim(&self, key: TileKey, frame: u64, benefit: f32) -> Option<TileKey> {
         let evictable = self.tiles.iter().filter(|(k, _)| {
@@ -142,6 +136,7 @@ impl PagePool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    const PAGE_BYTES: u64 = DEPTH_PAGE_BYTES;
 
     fn child(key: TileKey, q: usize) -> TileKey {
         key.children().unwrap()[q]
@@ -149,14 +144,14 @@ mod tests {
 
     #[test]
     fn a_budget_below_one_page_is_an_error() {
-        assert!(PagePool::new(PAGE_BYTES - 1).unwrap_err().to_string().contains("holds no tile"));
-        let pool = PagePool::new(PAGE_BYTES).unwrap();
+        assert!(PagePool::new(PAGE_BYTES - 1, PAGE_BYTES).unwrap_err().to_string().contains("holds no tile"));
+        let pool = PagePool::new(PAGE_BYTES, PAGE_BYTES).unwrap();
         assert_eq!((pool.capacity(), pool.page(TileKey::ROOT)), (1, Some(0)));
     }
 
     #[test]
     fn tiles_grow_from_the_root_and_evict_least_recently_used_leaves() {
-        let mut pool = PagePool::new(3 * PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(3 * PAGE_BYTES, PAGE_BYTES).unwrap();
         let (a, b) = (child(TileKey::ROOT, 0), child(TileKey::ROOT, 3));
         assert!(pool.insert(child(a, 0), 1, 1.0).is_err(), "parent missing");
         assert!(matches!(pool.insert(a, 1, 1.0).unwrap(), Insert::Allocated { .. }));
@@ -176,31 +171,12 @@ mod tests {
         assert_eq!(pool.page(TileKey::ROOT), Some(0), "the root is never evicted");
     }
 
-    #[test]
-    fn dropping_a_tile_drops_its_descendants_and_frees_their_pages() {
-        let mut pool = PagePool::new(8 * PAGE_BYTES).unwrap();
-        let a = child(TileKey::ROOT, 0);
-        let (a0, b) = (child(a, 0), child(TileKey::ROOT, 1));
-        for key in [a, a0, child(a0, 3), b] {
-            pool.insert(key, 1, 1.0).unwrap();
-        }
-        let mut dropped = pool.drop_where(|k| k == a || k == TileKey::ROOT);
-        dropped.sort();
-        assert_eq!(dropped, vec![a, a0, child(a0, 3)]);
-        assert_eq!(pool.resident().count(), 2, "the root and b stay");
-        assert!(pool.page(b).is_some() && pool.page(TileKey::ROOT).is_some());
-        // The freed pages serve new tiles: 6 free again.
-        for q in 0..4 {
-            assert!(matches!(pool.insert(child(b, q), 2, 1.0).unwrap(), Insert::Allocated { .. }));
-        }
-    }
-
     /// Random requests over many frames: the pool never holds more than its budget, the root
     /// stays, and every resident tile's parent is resident (the lookup reaches it).
     #[test]
     fn the_budget_is_never_exceeded() {
         let budget = 10 * PAGE_BYTES + PAGE_BYTES / 2;
-        let mut pool = PagePool::new(budget).unwrap();
+        let mut pool = PagePool::new(budget, PAGE_BYTES).unwrap();
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = || {
             state ^= state << 13;

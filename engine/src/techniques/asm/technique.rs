@@ -7,41 +7,68 @@
 //!    the light's projection cropped to its square (one debug label per tile);
 //! 2. `scene`: the shared local-light shading, each point's visibility looked up in the finest
 //!    resident tile holding it (the page table's descent);
-//! 3. `asm_analysis`: per visible eye pixel, the tile it used, and on shadow edges short of
+//! 3. `asm_analysis`: per visible eye pixel (one of each 2×2 block per frame, in turn), the tile it used, and on shadow edges short of
 //!    resolution the child tile it asks for, counted in a buffer the host reads next frame.
 //!
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
 //! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
 //! the scene's depth range did) drops every tile and renders the root again; a group moving
-//! drops the tiles its old or new light-uv bounds overlap, with their descendants, and renders
-//! the root again if it is one of them.
+//! re-renders the resident tiles its old or new light-uv bounds overlap (outside the time
+//! budget: a stale tile would show the group where it was), and keeps the others as they are.
+//! Dropping them instead would cut the quadtree: every ancestor of a refined tile overlaps a
+//! group somewhere in its square.
 use super::light_view::{tile_view_proj, UvRect};
 use super::page_table;
 use super::plan::{plan, CostModel, Request};
-use super::pool::{Insert, PagePool, PAGE_BYTES};
+use super::pool::{Insert, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
 use super::tile::TileKey;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsPipeline,
-    MemoryLocation, Sampler,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsDesc,
+    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{
-    bytes_of, bytes_of_slice, constants, spirv, AsmAnalysisPush, AsmNode, LocalDrawPush, ShadowLight,
+    bytes_of, bytes_of_slice, constants, spirv, AsmAnalysisPush, AsmNode, AsmTilePush, LocalDrawPush,
+    ShadowLight,
 };
 use crate::pass::{FrameExecutor, Pass};
-use crate::renderer::GpuScene;
+use crate::renderer::{GpuScene, DEPTH_FORMAT};
 use crate::scene::{Light, Scene};
 use crate::techniques::parallel_lights::scene_sphere;
 use crate::techniques::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
 use crate::techniques::shadow_depth::ShadowMaps;
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
 use crate::techniques::tamura::occlusion::{group_bounds, GroupBounds};
+use crate::techniques::unshadowed::MESH_POSITIONS;
 use crate::techniques::{FrameInputs, FrameState, Technique};
 use glam::{Mat4, Vec3};
 use std::sync::Arc;
 
 /// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
 pub const MB: u64 = 1 << 20;
+
+/// The shadow test of the lookup. The bias test is the default: at equal memory it holds twice
+/// the tiles, and over the `asm` walkthrough's close-ups it misclassified fewer pixels (IDs
+/// only won on the bunny, whose surfaces turn away from the light; BENCHMARKS.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AsmTest {
+    /// The paper's: a tile texel holding the receiver's own polygon is lit; otherwise the
+    /// depth comparison with bias decides. Pages hold an ID per texel beside the depth.
+    Id,
+    /// The depth comparison with the shadowmap technique's slope-scaled bias alone.
+    #[default]
+    Bias,
+}
+
+impl AsmTest {
+    /// Bytes of one page of the pool.
+    pub fn page_bytes(self) -> u64 {
+        match self {
+            AsmTest::Id => ID_PAGE_BYTES,
+            AsmTest::Bias => DEPTH_PAGE_BYTES,
+        }
+    }
+}
 
 /// The technique's parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,23 +77,24 @@ pub struct AsmSettings {
     pub budget_mb: f64,
     /// Per-frame time budget of tile rendering, ms, against the calibrated cost model.
     pub time_ms: f64,
+    pub test: AsmTest,
 }
 
 impl Default for AsmSettings {
     fn default() -> Self {
         // 8 ms: a few 128² tiles per frame on lavapipe, with the scene's 5,000 triangles.
-        AsmSettings { budget_mb: 16.0, time_ms: 8.0 }
+        AsmSettings { budget_mb: 16.0, time_ms: 8.0, test: AsmTest::default() }
     }
 }
 
 impl AsmSettings {
     pub fn validated(self) -> Result<AsmSettings> {
         let bytes = self.budget_mb * MB as f64;
-        if !(bytes >= PAGE_BYTES as f64 && bytes.is_finite()) {
+        if !(bytes >= self.test.page_bytes() as f64 && bytes.is_finite()) {
             return Err(Error::InvalidArgument(format!(
                 "an ASM budget of {} MB holds no tile: a tile takes {} KiB",
                 self.budget_mb,
-                PAGE_BYTES / 1024
+                self.test.page_bytes() / 1024
             )));
         }
         if !(self.time_ms > 0.0 && self.time_ms.is_finite()) {
@@ -98,6 +126,12 @@ pub struct AsmStats {
     pub cost: (f64, f64),
 }
 
+struct TileIds {
+    image: Image,
+    pipeline: GraphicsPipeline,
+    first: Vec<Vec<u32>>,
+}
+
 /// A tile to render this frame.
 struct TileRender {
     key: TileKey,
@@ -116,6 +150,9 @@ pub struct Asm {
     pool: PagePool,
     /// The page pool: one D32 layer of `ASM_TILE_TEXELS`² per page.
     tiles: ShadowMaps,
+    /// The ID test's polygon IDs: an R32_UINT layer per page, the pipeline that renders depth
+    /// and IDs, and each mesh's first ID (by group, then mesh).
+    ids: Option<TileIds>,
     scene_pipeline: GraphicsPipeline,
     analysis: ComputePipeline,
     nearest: Sampler,
@@ -138,6 +175,9 @@ pub struct Asm {
     stats: AsmStats,
 }
 
+/// The ID test's polygon IDs.
+const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
+
 /// Uints of the analysis output per page-table node: a used flag, 4 quadrant edge counts and
 /// 4 sums of missing levels.
 const REQUEST_WORDS: u64 = 9;
@@ -152,19 +192,38 @@ impl Asm {
                 scene.lights.len()
             )));
         };
-        let pool = PagePool::new(settings.budget_bytes())?;
+        let pool = PagePool::new(settings.budget_bytes(), settings.test.page_bytes())?;
         let capacity = pool.capacity();
-        let tiles = ShadowMaps::new(ctx, "asm", constants::ASM_TILE_TEXELS, capacity)?;
+        let tiles =
+            ShadowMaps::new(ctx, "asm", constants::ASM_TILE_TEXELS, capacity).map_err(|e| match e {
+                Error::InvalidArgument(e) => Error::InvalidArgument(format!(
+                    "an ASM budget of {} MB is {capacity} pages, one image layer each: {e}",
+                    settings.budget_mb
+                )),
+                e => e,
+            })?;
+        let ids = match settings.test {
+            AsmTest::Bias => None,
+            AsmTest::Id => Some(TileIds::new(ctx, gpu, capacity)?),
+        };
+        let mut bindings = vec![
+            BindingKind::UniformBuffer,
+            BindingKind::UniformBuffer,
+            BindingKind::SampledImage,
+            BindingKind::StorageBuffer,
+        ];
+        let fragment = match settings.test {
+            AsmTest::Bias => spirv::ASM_LIGHTS_FRAG,
+            AsmTest::Id => {
+                bindings.push(BindingKind::SampledImage);
+                spirv::ASM_LIGHTS_ID_FRAG
+            }
+        };
         let scene_pipeline = scene_pipeline(
             ctx,
             "scene_asm_lights",
-            (spirv::LOCAL_LIGHTS_VERT, spirv::ASM_LIGHTS_FRAG),
-            &[
-                BindingKind::UniformBuffer,
-                BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
-                BindingKind::StorageBuffer,
-            ],
+            (spirv::LOCAL_LIGHTS_VERT, fragment),
+            &bindings,
             size_of::<LocalDrawPush>(),
         )?;
         let analysis = ComputePipeline::new(
@@ -211,6 +270,7 @@ impl Asm {
             settings,
             pool,
             tiles,
+            ids,
             scene_pipeline,
             analysis,
             nearest: Sampler::new(ctx, "asm.eye_depth_sampler", false, Edge::Clamp, Edge::Clamp)?,
@@ -235,7 +295,7 @@ impl Asm {
     /// different numbers of triangles on this device (the root, and tiles of levels 1 to 3
     /// along the view's diagonals), each rendered twice and the second timing kept (the first
     /// pays for cold caches). Without timestamps the model stays at 1 ms per tile.
-    fn calibrate(&mut self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
+    fn calibrate(&self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
         if ctx.info().timestamp_period_ns.is_none() {
             return Ok(self.cost);
         }
@@ -260,9 +320,8 @@ impl Asm {
             let passes = renders
                 .iter()
                 .map(|t| {
-                    let tiles = &self.tiles;
                     Pass::new("asm_calibration", &[], &["asm_calibration"], move |cmd| {
-                        tiles.record(ctx, cmd, gpu, t.page, &t.view_proj, |m| t.groups[m.group])
+                        self.record_tile(ctx, cmd, gpu, t)
                     })
                 })
                 .collect();
@@ -274,6 +333,25 @@ impl Asm {
             }
         }
         Ok(CostModel::fit(&samples))
+    }
+
+    /// Records the render of one tile into its page (and its ID layer for the ID test).
+    fn record_tile(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, t: &TileRender) {
+        let Some(ids) = &self.ids else {
+            return self.tiles.record(ctx, cmd, scene, t.page, &t.view_proj, |m| t.groups[m.group]);
+        };
+        let (color, depth) = (Target { image: &ids.image, layer: t.page }, self.tiles.target(t.page));
+        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(depth));
+        ids.pipeline.bind(cmd, &[]);
+        for mesh in scene.meshes.iter().filter(|m| t.groups[m.group]) {
+            let push = AsmTilePush {
+                transform: (t.view_proj * scene.transforms[mesh.group]).to_cols_array_2d(),
+                ids: [ids.first[mesh.group][mesh.mesh], 0, 0, 0],
+            };
+            ids.pipeline.push(cmd, bytes_of(&push));
+            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        }
+        ctx.end_rendering(cmd);
     }
 
     /// Each group's light-uv bounds under `transforms`.
@@ -352,6 +430,51 @@ impl Asm {
     }
 }
 
+impl TileIds {
+    fn new(ctx: &Arc<Context>, gpu: &GpuScene, capacity: u32) -> Result<TileIds> {
+        if !ctx.info().has(GEOMETRY_SHADER) {
+            return Err(Error::Unsupported(format!(
+                "the ASM polygon-ID test needs {GEOMETRY_SHADER} on {}; use the bias test",
+                ctx.info().name
+            )));
+        }
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let desc = ImageDesc::square_array("asm.ids", constants::ASM_TILE_TEXELS, capacity, ID_FORMAT, usage);
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "asm.tile_ids",
+                vertex_spirv: spirv::ASM_TILE_VERT,
+                fragment_spirv: spirv::ASM_TILE_FRAG,
+                bindings: &[],
+                push_size: size_of::<AsmTilePush>() as u32,
+                vertex_buffers: &[MESH_POSITIONS],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[ID_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                additive: false,
+                constants: &[],
+            },
+        )?;
+        // IDs from 1 (0 is a texel no surface covers), numbered mesh after mesh.
+        let mut next = 1u32;
+        let mut first: Vec<Vec<u32>> = Vec::new();
+        for mesh in &gpu.meshes {
+            if first.len() <= mesh.group {
+                first.resize(mesh.group + 1, Vec::new());
+            }
+            let of_group = &mut first[mesh.group];
+            if of_group.len() <= mesh.mesh {
+                of_group.resize(mesh.mesh + 1, 0);
+            }
+            of_group[mesh.mesh] = next;
+            next += mesh.index_count / 3;
+        }
+        Ok(TileIds { image: Image::new(ctx, &desc)?, pipeline, first })
+    }
+}
+
 impl Technique for Asm {
     fn update(&mut self, state: &FrameState) -> Result<()> {
         self.frame += 1;
@@ -366,7 +489,7 @@ impl Technique for Asm {
         let mut read = self.analysed;
         if self.record.is_none_or(|r| bytes_of(&r) != bytes_of(&record)) {
             // The light moved (or the depth range changed): every tile's depths are stale.
-            self.pool = PagePool::new(self.settings.budget_bytes())?;
+            self.pool = PagePool::new(self.settings.budget_bytes(), self.settings.test.page_bytes())?;
             render.push(TileKey::ROOT);
             read = false;
         } else {
@@ -375,10 +498,9 @@ impl Technique for Asm {
                 .flat_map(|g| [self.group_rects[g], rects[g]])
                 .collect();
             let touched = |key: TileKey| moved.iter().any(|r| r.overlaps(&UvRect::of_tile(key)));
-            self.pool.drop_where(touched);
-            if touched(TileKey::ROOT) {
-                render.push(TileKey::ROOT);
-            }
+            render.extend(self.pool.resident().map(|(key, _)| key).filter(|&key| touched(key)));
+            // Coarse levels first: the root leads.
+            render.sort();
         }
         self.record = Some(record);
         self.transforms = state.transforms.to_vec();
@@ -424,22 +546,26 @@ impl Technique for Asm {
         let tiles = Pass::new("asm_tiles", &[], &["shadow_maps"], move |cmd| {
             for t in &self.render {
                 ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", t.key.level, t.key.x, t.key.y));
-                self.tiles.record(ctx, cmd, scene, t.page, &t.view_proj, |m| t.groups[m.group]);
+                self.record_tile(ctx, cmd, scene, t);
                 ctx.end_label(cmd);
             }
         });
-        let bindings = vec![
+        let mut bindings = vec![
             Binding::Uniform(inputs.uniforms),
             Binding::Uniform(&self.records),
             self.tiles.binding(),
             Binding::Storage(&self.table),
         ];
+        if let Some(ids) = &self.ids {
+            bindings.push(Binding::Sampled(&ids.image, &self.nearest));
+        }
+        let ids = &self.ids;
         let lighting =
             scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
                 LocalDrawPush {
                     model: model.to_cols_array_2d(),
                     albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    params: [1, 0, 0, 0],
+                    params: [1, ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), 0, 0],
                     bias: DEPTH_BIAS,
                 }
             });
@@ -453,8 +579,10 @@ impl Technique for Asm {
             move |cmd| {
                 self.requests.record_zero(cmd);
                 ctx.full_barrier(cmd);
-                let push =
-                    AsmAnalysisPush { size: [width, height, self.pool.capacity(), 0], bias: DEPTH_BIAS };
+                let push = AsmAnalysisPush {
+                    size: [width, height, self.pool.capacity(), (self.frame % 4) as u32],
+                    bias: DEPTH_BIAS,
+                };
                 let group = constants::ASM_ANALYSIS_GROUP;
                 self.analysis.dispatch(
                     cmd,
@@ -467,7 +595,7 @@ impl Technique for Asm {
                         Binding::Storage(&self.requests),
                     ],
                     bytes_of(&push),
-                    [width.div_ceil(group), height.div_ceil(group), 1],
+                    [width.div_ceil(2 * group), height.div_ceil(2 * group), 1],
                 );
             },
         );
@@ -480,6 +608,6 @@ impl Technique for Asm {
 
     /// The whole page pool, allocated up front (within the budget), whatever is resident.
     fn shadow_memory_bytes(&self) -> Option<u64> {
-        Some(u64::from(self.pool.capacity()) * PAGE_BYTES)
+        Some(self.pool.bytes_allocated())
     }
 }

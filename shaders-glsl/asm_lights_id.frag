@@ -1,0 +1,4 @@
+#version 460
+// ASM lighting with the polygon-ID test, depth as fallback (include/asm_lights.glsl).
+#define ASM_ID_TEST
+#include "asm_lights.glsl"

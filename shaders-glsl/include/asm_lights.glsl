@@ -1,0 +1,31 @@
+// ASM technique: V of the shared local-light shading looked up in the finest resident tile of
+// the adaptive shadow map (one light: the page table covers one light's view). With
+// ASM_ID_TEST, the paper's test: lit where the texel's polygon is the receiver's own (no bias
+// needed, so no acne), else the depth comparison with the slope-scaled bias decides.
+#ifndef KAGE_ASM_LIGHTS_GLSL
+#define KAGE_ASM_LIGHTS_GLSL
+
+#include "local_lights_shading.glsl"
+
+layout(set = 0, binding = 2) uniform sampler2DArray asm_pool;
+layout(std430, set = 0, binding = 3) readonly buffer PageTable { AsmNode asm_nodes[]; };
+#ifdef ASM_ID_TEST
+layout(set = 0, binding = 4) uniform usampler2DArray asm_ids;
+#endif
+
+#include "asm_lookup.glsl"
+
+bool visible(uint k, vec3 p, vec3 ng) {
+    ShadowLight s = lights[k];
+    vec4 m = shadow_map_coords(s, p);
+    if (m.w < 0.0) return true;
+    uvec4 tile = asm_nodes[asm_descend(m.xy)].tile;
+#ifdef ASM_ID_TEST
+    if (texelFetch(asm_ids, asm_texel(tile, m.xy, ivec2(0)), 0).r == draw.params.y + uint(gl_PrimitiveID)) {
+        return true;
+    }
+#endif
+    return asm_visible(s, m, p, ng, tile, ivec2(0), draw.bias);
+}
+
+#endif
