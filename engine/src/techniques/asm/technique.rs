@@ -480,7 +480,7 @@ impl Technique for Asm {
         self.frame += 1;
         // The renderer keeps the scene's light count (Renderer::set_light replaces, never adds),
         // and `new` accepted exactly one.
-        self.light = state.lights[0].clone();
+        self.light = state.lights[0];
         let (centre, radius) = scene_sphere(&self.bounds, state.transforms);
         let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
         let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
