@@ -90,8 +90,13 @@ fn draw(
         .draw_series(LineSeries::new(front, BLACK.stroke_width(2)))?
         .label("Pareto front")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-    let mut names: Vec<&str> = points.iter().map(|p| p.series.as_str()).collect();
-    names.dedup();
+    // One series per name, in order of first appearance (rows of several series interleave).
+    let mut names: Vec<&str> = Vec::new();
+    for p in points {
+        if !names.contains(&p.series.as_str()) {
+            names.push(&p.series);
+        }
+    }
     for (i, name) in names.into_iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();
         let series = points.iter().filter(|p| p.series == name);
