@@ -3,7 +3,7 @@
 //! Shared by the unshadowed, parallel-lights and shadowmap techniques.
 use super::unshadowed::MESH_VERTICES;
 use super::FrameInputs;
-use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline};
+use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, VertexBuffer};
 use crate::error::Result;
 use crate::layouts::{bytes_of, Pod};
 use crate::pass::Pass;
@@ -14,13 +14,26 @@ use std::sync::Arc;
 /// What a shadow-map technique's scene pass reads.
 pub const SCENE_READS: [&str; 3] = ["frame_uniforms", "shadow_maps", "color"];
 
-/// A scene pipeline named `name` from its two shaders, resources and push-constant size.
+/// A scene pipeline named `name` from its two shaders, resources and push-constant size, drawing
+/// the meshes' positions and normals.
 pub fn scene_pipeline(
     ctx: &Arc<Context>,
     name: &str,
     shaders: (&[u8], &[u8]),
     bindings: &[BindingKind],
     push_size: usize,
+) -> Result<GraphicsPipeline> {
+    scene_pipeline_with(ctx, name, shaders, bindings, push_size, &[MESH_VERTICES])
+}
+
+/// [`scene_pipeline`] with other vertex buffers (per-vertex data beside the positions).
+pub fn scene_pipeline_with(
+    ctx: &Arc<Context>,
+    name: &str,
+    shaders: (&[u8], &[u8]),
+    bindings: &[BindingKind],
+    push_size: usize,
+    vertex_buffers: &[VertexBuffer],
 ) -> Result<GraphicsPipeline> {
     GraphicsPipeline::new(
         ctx,
@@ -30,7 +43,7 @@ pub fn scene_pipeline(
             fragment_spirv: shaders.1,
             bindings,
             push_size: push_size as u32,
-            vertex_buffers: &[MESH_VERTICES],
+            vertex_buffers,
             topology: vk::PrimitiveTopology::TRIANGLE_LIST,
             color_formats: &[COLOR_FORMAT],
             depth_format: Some(DEPTH_FORMAT),

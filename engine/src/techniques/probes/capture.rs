@@ -24,8 +24,8 @@
 use super::dering::Dering;
 use super::set::is_static;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsDesc, GraphicsPipeline, Image,
-    ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsPipeline, Image, ImageDesc,
+    MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::ReferenceLight;
@@ -38,6 +38,7 @@ use crate::scene::{Camera, Scene};
 use crate::sh::{eval_basis, ShRgb9};
 use crate::techniques::background::Background;
 use crate::techniques::environment::GpuEnvironment;
+use crate::techniques::scene_pass::scene_pipeline_with;
 use crate::techniques::sh_projection::{Mapping, ProjectionNames, ShProjection};
 use crate::techniques::unshadowed::MESH_POSITIONS;
 use glam::{DVec3, Mat3, Vec3};
@@ -212,22 +213,13 @@ impl ProbeCapture {
             faces,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
             background: Background::new(ctx)?,
-            surfaces: GraphicsPipeline::new(
+            surfaces: scene_pipeline_with(
                 ctx,
-                &GraphicsDesc {
-                    name: "probe_surfaces",
-                    vertex_spirv: spirv::PROBE_SURFACE_VERT,
-                    fragment_spirv: spirv::PROBE_SURFACE_FRAG,
-                    bindings: &[BindingKind::UniformBuffer],
-                    push_size: size_of::<DrawPush>() as u32,
-                    vertex_buffers: &[MESH_POSITIONS, RADIANCE_VERTICES],
-                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                    color_formats: &[COLOR_FORMAT],
-                    depth_format: Some(DEPTH_FORMAT),
-                    depth_test: true,
-                    additive: false,
-                    constants: &[],
-                },
+                "probe_surfaces",
+                (spirv::PROBE_SURFACE_VERT, spirv::PROBE_SURFACE_FRAG),
+                &[BindingKind::UniformBuffer],
+                size_of::<DrawPush>(),
+                &[MESH_POSITIONS, RADIANCE_VERTICES],
             )?,
             radiance: static_radiance(ctx, &statics, settings)?,
             lights: scene.lights.iter().map(crate::reference::render::reference_light).collect(),
