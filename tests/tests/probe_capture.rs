@@ -10,6 +10,12 @@ use std::f32::consts::PI;
 /// Small faces keep the tests fast on lavapipe; the maths below holds at any size.
 const SIDE: u32 = 16;
 
+/// Cube faces of SIDE², the walls lit by the ray caster with few samples (these tests look at
+/// the projection and the walls' colours, not the radiance's noise).
+fn sky_and_walls() -> CaptureSettings {
+    CaptureSettings { cube_size: SIDE, light: CapturedLight::SkyAndWalls, samples: 32, ..Default::default() }
+}
+
 #[test]
 fn constant_environment_with_no_walls_captures_its_own_sh() {
     let ctx = Validated::new();
@@ -24,12 +30,7 @@ fn constant_environment_with_no_walls_captures_its_own_sh() {
         camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
     };
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
-    let settings = CaptureSettings {
-        cube_size: SIDE,
-        light: CapturedLight::SkyAndWalls,
-        samples: 32,
-        ..Default::default()
-    };
+    let settings = sky_and_walls();
     let mut capture = ProbeCapture::new(&ctx, &scene, settings).unwrap();
     let sh = capture.capture(&gpu, |_| true, Vec3::new(0.3, -2.0, 7.0)).unwrap();
     // A constant L has c0 = L·Y0·4π = 2√π·L and nothing else. The texel solid angles telescope
@@ -52,12 +53,7 @@ fn a_probe_near_the_red_wall_sees_red_on_its_side() {
     let ctx = Validated::new();
     let scene = Scene::builtin("probe-room").unwrap();
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
-    let settings = CaptureSettings {
-        cube_size: SIDE,
-        light: CapturedLight::SkyAndWalls,
-        samples: 32,
-        ..Default::default()
-    };
+    let settings = sky_and_walls();
     let mut capture = ProbeCapture::new(&ctx, &scene, settings).unwrap();
     // The bunny (group 0) moves: probes capture the room alone.
     let sh = capture.capture(&gpu, |group| group != 0, Vec3::new(-1.2, 1.2, 0.5)).unwrap();

@@ -80,10 +80,40 @@ pub struct ProbeCountArgs {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
     pub method: String,
-    /// The grid's counts, or the tolerance.
-    pub setting: String,
+    pub setting: Setting,
     pub probes: usize,
     pub error: f64,
+}
+
+/// What a row's method was given: a grid's counts, or automatic placement's tolerance (or all
+/// its candidates kept).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Setting {
+    Grid([u32; 3]),
+    Tolerance(f32),
+    AllCandidates,
+}
+
+impl Setting {
+    /// The parameter's name and value, as the sweep's CSV columns.
+    pub fn parameter(self) -> (&'static str, String) {
+        match self {
+            Setting::Grid(c) => ("grid", format!("{}x{}x{}", c[0], c[1], c[2])),
+            Setting::Tolerance(t) => ("tolerance", t.to_string()),
+            Setting::AllCandidates => ("tolerance", "0".into()),
+        }
+    }
+}
+
+impl std::fmt::Display for Setting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = match self {
+            Setting::Grid(_) => self.parameter().1,
+            Setting::Tolerance(t) => format!("tol {t}"),
+            Setting::AllCandidates => "all cand.".into(),
+        };
+        f.pad(&text)
+    }
 }
 
 pub struct Measurement {
@@ -271,15 +301,10 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
             let lattice = Lattice::cell_centres(lo, hi, counts);
             let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
             captured += sh.len();
-            let setting = format!("{}x{}x{}", counts[0], counts[1], counts[2]);
+            let setting = Setting::Grid(counts);
             let trilinear = ProbeSet::trilinear(lattice, sh.clone())?;
             let probes = sh.len();
-            rows.push(Row {
-                method: method(TRILINEAR, region),
-                setting: setting.clone(),
-                probes,
-                error: error(&trilinear)?,
-            });
+            rows.push(Row { method: method(TRILINEAR, region), setting, probes, error: error(&trilinear)? });
             let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
             rows.push(Row { method: method(GRID_TETRA, region), setting, probes, error: error(&tetra)? });
             if level == finest {
@@ -294,7 +319,7 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
             let (probes, error) = (set.probe_count(), error(&set)?);
             rows.push(Row {
                 method: method(AUTO, region),
-                setting: format!("tol {tolerance}"),
+                setting: Setting::Tolerance(tolerance),
                 probes,
                 error,
             });
@@ -302,7 +327,7 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         let all = ProbeSet::tetrahedral(&positions, sh)?;
         rows.push(Row {
             method: method(AUTO, region),
-            setting: "all cand.".into(),
+            setting: Setting::AllCandidates,
             probes: all.probe_count(),
             error: error(&all)?,
         });

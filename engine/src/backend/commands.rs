@@ -77,11 +77,13 @@ impl Context {
         unsafe { self.device.reset_fences(&[recorder.fence]) }.map_err(Error::vk("vkResetFences"))
     }
 
-    /// Records `record` into a fresh command buffer, submits it and waits.
+    /// Records `record` into a fresh command buffer, submits it and waits; its writes are then
+    /// visible to the host.
     pub fn one_shot(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
         let recorder = self.create_recorder(name)?;
         let result = self.begin(&recorder).and_then(|()| {
             record(recorder.cmd);
+            self.host_read_barrier(recorder.cmd);
             self.submit_and_wait(&recorder)
         });
         // After a failed submission the buffer may still be pending: free it only once idle.
@@ -93,15 +95,30 @@ impl Context {
 
     /// A full memory barrier: everything before finishes and is visible to everything after.
     pub fn full_barrier(&self, cmd: vk::CommandBuffer) {
+        self.barrier_to(
+            cmd,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE,
+        );
+    }
+
+    /// Everything before finishes and its writes become visible to host reads once the
+    /// submission's fence is waited for (a fence alone does not make device writes visible to
+    /// the host: mapped memory needs this HOST-stage dependency, coherent or not).
+    pub fn host_read_barrier(&self, cmd: vk::CommandBuffer) {
+        self.barrier_to(cmd, vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ);
+    }
+
+    fn barrier_to(&self, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags, access: vk::AccessFlags) {
         let barrier = vk::MemoryBarrier::default()
             .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-            .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
+            .dst_access_mask(access);
         // SAFETY: recording command buffer of this device.
         unsafe {
             self.device.cmd_pipeline_barrier(
                 cmd,
                 vk::PipelineStageFlags::ALL_COMMANDS,
-                vk::PipelineStageFlags::ALL_COMMANDS,
+                stage,
                 vk::DependencyFlags::empty(),
                 &[barrier],
                 &[],

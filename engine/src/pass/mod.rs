@@ -9,8 +9,9 @@
 //! - Between two consecutive passes the executor records one full memory barrier
 //!   (all commands → all commands, memory writes → memory reads and writes). Within a pass,
 //!   the pass itself is responsible for any hazard between its own commands.
-//! - A frame is one command buffer, submitted and waited for on its fence before `run`
-//!   returns, so the host may read or rewrite any resource afterwards.
+//! - A frame is one command buffer, ending with a barrier that makes every write visible to host
+//!   reads, submitted and waited for on its fence before `run` returns, so the host may read or
+//!   rewrite any resource afterwards (readbacks, the ASM analysis' counts).
 //!
 //! The declared inputs and outputs are checked before recording: a pass may only read what an
 //! earlier pass of the frame wrote or what the frame imports (persistent resources), which
@@ -129,6 +130,7 @@ impl FrameExecutor {
             }
             self.ctx.end_label(cmd);
         }
+        self.ctx.host_read_barrier(cmd);
         if let Err(e) = self.ctx.submit_and_wait(recorder) {
             // The command buffer may still be pending after a timeout or device loss: never
             // reuse it.

@@ -147,6 +147,14 @@ pub struct Measured {
     rows: Vec<FrameRow>,
     /// The chart's title: scene, frames, image size, device.
     pub title: String,
+    slow_px: f32,
+}
+
+impl Measured {
+    /// The table of figures per configuration and the table of passes.
+    pub fn print(&self) {
+        report::print(&self.configs, &self.summaries, self.slow_px);
+    }
 }
 
 impl AsmBenchArgs {
@@ -178,7 +186,7 @@ impl AsmBenchArgs {
 
 pub fn run(args: &AsmBenchArgs) -> Result<()> {
     let measured = measure(args)?;
-    report::print(&measured.configs, &measured.summaries, args.slow_px);
+    measured.print();
     let written =
         report::write(&args.out, &measured.scene, &measured.configs, &measured.summaries, &measured.rows)?;
     for path in written {
@@ -259,7 +267,7 @@ pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
         series.iter().zip(&memory).map(|(s, &bytes)| s.summary(bytes, args.converge_tolerance)).collect();
     let title = format!("{}: {} frames at {}², {device}", scene.name, plan.len(), args.size);
     args.gpu.finish(&ctx)?;
-    Ok(Measured { scene: scene.name.clone(), configs, summaries, rows, title })
+    Ok(Measured { scene: scene.name.clone(), configs, summaries, rows, title, slow_px: args.slow_px })
 }
 
 /// Renders every frame of `plan` with every renderer in turn and measures it against the

@@ -2,11 +2,11 @@
 //! maps of several sizes over the scene's camera walkthrough, measured as `kage bench asm`
 //! measures them (error against the ray-traced hard-shadow reference, GPU time side by side,
 //! shadow memory), written as the sweep's CSV and chart, with the picks.
-use super::{print_picks, SweepArgs, Terms, FRAME_TIME};
+use super::{write_outputs, SweepArgs, Terms, FRAME_TIME};
 use crate::bench_asm::report::{points, ERROR_AXIS};
 use crate::bench_asm::{measure, AsmBenchArgs, DEFAULT_CONFIGS};
 use crate::sweep::chart;
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use std::fmt::Write as _;
 
 pub fn run(args: &SweepArgs) -> Result<()> {
@@ -16,6 +16,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let bench =
         AsmBenchArgs::for_sweep(scene, configs, args.frames, args.size, args.out.clone(), args.gpu.clone());
     let measured = measure(&bench)?;
+    measured.print();
 
     let mut csv = String::from(
         "scene,technique,parameter,value,error_mean,error_max,error_at_rest,flips_mean,frame_ms,ratio,memory_mb\n",
@@ -38,34 +39,14 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             s.shadow_bytes.map_or_else(String::new, |b| format!("{:.2}", b as f64 / (1 << 20) as f64)),
         )
         .expect("writing to a String");
-        println!(
-            "{:<16} error {:.5} (at rest {}), {:.2} ms ({:.2}× {}), {} MiB",
-            c.name,
-            s.error_mean,
-            optional(s.error_at_rest),
-            s.frame_ms,
-            s.ratio,
-            measured.configs[0].name,
-            s.shadow_bytes.map_or_else(|| "-".to_string(), |b| format!("{:.2}", b as f64 / (1 << 20) as f64)),
-        );
     }
-    let path = args.out.join("sweep.csv");
-    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
-    println!("wrote {}", path.display());
-    let points = points(&measured.configs, &measured.summaries);
-    if !points.is_empty() {
-        let path = args.out.join("pareto.png");
-        chart::write(&path, &measured.title, &chart::frame_time_against(ERROR_AXIS), &points)?;
-        println!("wrote {}", path.display());
-    }
-    if args.pick {
-        print_picks(
-            &measured.scene,
-            &points,
-            args.max_error,
-            args.max_ms,
-            &Terms { metric: "mismatch", unit: FRAME_TIME },
-        );
-    }
-    Ok(())
+    write_outputs(
+        args,
+        &measured.scene,
+        &csv,
+        (&measured.title, &chart::frame_time_against(ERROR_AXIS)),
+        &points(&measured.configs, &measured.summaries),
+        args.max_ms,
+        &Terms { metric: "mismatch", unit: FRAME_TIME },
+    )
 }

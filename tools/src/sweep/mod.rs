@@ -358,6 +358,31 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
     args.gpu.finish(&ctx)
 }
 
+/// A sweep's files for one scene: `sweep.csv`, and `pareto.png` when any setting is on the chart;
+/// then the picks `--pick` asks for, `max_cost` bounding the cost the points count.
+pub(crate) fn write_outputs(
+    args: &SweepArgs,
+    scene: &str,
+    csv: &str,
+    chart: (&str, &chart::Axes),
+    points: &[Point],
+    max_cost: Option<f64>,
+    terms: &Terms,
+) -> Result<()> {
+    let path = args.out.join("sweep.csv");
+    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
+    if !points.is_empty() {
+        let path = args.out.join("pareto.png");
+        chart::write(&path, chart.0, chart.1, points)?;
+        println!("wrote {}", path.display());
+    }
+    if args.pick {
+        print_picks(scene, points, args.max_error, max_cost, terms);
+    }
+    Ok(())
+}
+
 /// How a sweep's picks name what they compare: the error metric, and the cost's unit (`ms`, or
 /// `probes` where the probe count is the cost).
 pub(crate) struct Terms<'a> {

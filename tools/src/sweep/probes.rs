@@ -5,10 +5,10 @@
 //! along the moving group's path, against the number of probes. The probe count is the cost
 //! here (SH storage and captures; the per-frame lookup is one walk per object whatever the
 //! count), so the chart's x axis counts probes and `--pick` takes `--max-probes`.
-use super::{print_picks, SweepArgs, Terms};
+use super::{write_outputs, SweepArgs, Terms};
 use crate::bench_probe_count::{measure, Params, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
 use crate::render::ProbeLightName;
-use crate::sweep::chart::{self, Axes};
+use crate::sweep::chart::Axes;
 use crate::sweep::pick::Point;
 use anyhow::{bail, Context as _, Result};
 use kage::scene::Scene;
@@ -61,12 +61,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let mut csv = String::from("scene,technique,parameter,value,probes,error,capture_s,memory_mb\n");
     let mut points = Vec::new();
     for row in &m.rows {
-        let parameter = if row.setting.starts_with("tol") || row.setting.starts_with("all") {
-            "tolerance"
-        } else {
-            "grid"
-        };
-        let value = row.setting.trim_start_matches("tol ");
+        let (parameter, value) = row.setting.parameter();
         let capture_s = row.probes as f64 * m.capture_ms_per_probe / 1e3;
         let memory_mb = (row.probes * size_of::<ShRgb9>()) as f64 / (1 << 20) as f64;
         writeln!(
@@ -89,25 +84,17 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             });
         }
     }
-    let path = args.out.join("sweep.csv");
-    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
-    println!("wrote {}", path.display());
-    if !points.is_empty() {
-        let path = args.out.join("pareto.png");
-        let title =
-            format!("{}: {} test points x {NORMALS} normals, {}", scene.name, m.test_points, ctx.info().name);
-        let axes = Axes { cost: "probes", error: "relative RMS irradiance error against the reference" };
-        chart::write(&path, &title, &axes, &points)?;
-        println!("wrote {}", path.display());
-    }
-    if args.pick {
-        print_picks(
-            &scene.name,
-            &points,
-            args.max_error,
-            args.max_probes.map(f64::from),
-            &Terms { metric: "relative RMS error", unit: "probes" },
-        );
-    }
+    let title =
+        format!("{}: {} test points x {NORMALS} normals, {}", scene.name, m.test_points, ctx.info().name);
+    let axes = Axes { cost: "probes", error: "relative RMS irradiance error against the reference" };
+    write_outputs(
+        args,
+        &scene.name,
+        &csv,
+        (&title, &axes),
+        &points,
+        args.max_probes.map(f64::from),
+        &Terms { metric: "relative RMS error", unit: "probes" },
+    )?;
     args.gpu.finish(&ctx)
 }
