@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the speed-against-accuracy charts shown in README.md (docs/sweep-*.png) with
 # `kage sweep`, and keeps each sweep's CSV beside its chart. Run by hand, not in CI: the PRT
-# sweep takes about 15 minutes on a 2-core lavapipe machine, the ASM sweep about 5 and the
+# sweep takes about 15 minutes on a 2-core lavapipe machine, the ASM sweep about 2 (references cached; 5 more to ray-cast them) and the
 # probe sweeps (probe-room and atrium) about 5 each. Frame times are only as good as the
 # machine is quiet: run it with nothing else busy.
 set -euo pipefail
@@ -19,6 +19,6 @@ sweep() {
   echo "wrote docs/sweep-$name.png docs/sweep-$name.csv"
 }
 sweep prt --technique prt
-sweep asm --technique asm --size 256 --frames 40
+sweep asm --technique asm --size 256 --frames 200
 sweep probes-room --technique probes --scene probe-room --spp 8192
 sweep probes-atrium --technique probes --scene atrium --spp 8192

@@ -2,27 +2,29 @@
 // ASM refinement analysis, per visible eye pixel (Fernando et al. 2001, section 4): where its
 // light uv lands in the finest resident tile, whether it is on a shadow edge, and how many
 // levels finer a tile would have to be for a shadow texel to be no larger than the eye pixel's
-// footprint. Edge pixels short of resolution are counted per requested child tile (a quadrant
-// of their tile) for the host's planner, one frame later.
+// footprint. Edge pixels short of resolution are counted per requested tile (the tiles under
+// theirs towards them, up to KAGE_ASM_CHAIN_LEVELS deep) for the host's planner, which renders
+// the chosen ones before the same frame's lighting.
 //
 // Projected areas from screen-space derivatives of the light uv, taken by finite differences of
 // the world positions reconstructed from the depth target, not from the paper's mip-map trick:
-// a compute pass has no hardware derivatives, the depth target already holds every visible
-// surface (nothing is added to the lighting pass), and picking the smaller of the forward and
-// backward difference keeps a pixel next to a silhouette from taking its neighbour's surface.
+// a compute pass has no hardware derivatives, the eye depth pass already holds every visible
+// surface, and picking the smaller of the forward and backward difference keeps a pixel next
+// to a silhouette from taking its neighbour's surface.
 #include "layouts.glsl"
 #include "shadow_test.glsl"
 
 layout(local_size_x = KAGE_ASM_ANALYSIS_GROUP, local_size_y = KAGE_ASM_ANALYSIS_GROUP) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform Lights { ShadowLight lights[KAGE_MAX_LOCAL_LIGHTS]; };
-layout(set = 0, binding = 2) uniform sampler2DArray asm_pool;
-layout(std430, set = 0, binding = 3) readonly buffer PageTable { AsmNode asm_nodes[]; };
 layout(set = 0, binding = 4) uniform sampler2D eye_depth;
 layout(std430, set = 0, binding = 5) buffer Requests { uint requests[]; };
 layout(push_constant) uniform Push { AsmAnalysisPush push; };
 
 #include "asm_lookup.glsl"
+
+// Request slots per node: 4 + 16 + ... + 4^KAGE_ASM_CHAIN_LEVELS.
+#define ASM_REQUEST_SLOTS (((1u << (2u * uint(KAGE_ASM_CHAIN_LEVELS) + 2u)) - 4u) / 3u)
 
 // The world position seen at pixel q, or w = 0 where the pixel shows no surface.
 vec4 surface(ivec2 q) {
@@ -95,8 +97,14 @@ void main() {
         }
     }
     if (!edge) return;
-    uvec2 cell = min(uvec2(m.xy * float(1u << (tile.y + 1u))), uvec2((1u << (tile.y + 1u)) - 1u));
-    uint slot = 4u * node + 2u * (cell.y & 1u) + (cell.x & 1u);
-    atomicAdd(requests[push.size.z + slot], 1u);
-    atomicAdd(requests[5u * push.size.z + slot], uint(missing));
+    // The chain of tiles under this one towards the pixel, as deep as it lacks levels (at most
+    // KAGE_ASM_CHAIN_LEVELS): slots of depth d start at (4^d - 4) / 3 within the node's block.
+    uint chain = min(uint(missing), uint(KAGE_ASM_CHAIN_LEVELS));
+    for (uint d = 1u; d <= chain; ++d) {
+        uint n = 1u << (tile.y + d);
+        uvec2 cell = min(uvec2(m.xy * float(n)), uvec2(n - 1u)) - (tile.zw << d);
+        uint slot = node * ASM_REQUEST_SLOTS + ((1u << (2u * d)) - 4u) / 3u + (cell.y << d) + cell.x;
+        atomicAdd(requests[push.size.z + slot], 1u);
+        atomicAdd(requests[push.size.z * (1u + ASM_REQUEST_SLOTS) + slot], uint(missing) - d + 1u);
+    }
 }

@@ -289,6 +289,7 @@ impl Renderer {
         self.frame_uniforms.write(0, bytes_of(&uniforms))?;
 
         self.technique.update(&FrameState {
+            view_proj,
             transforms: &self.scene.transforms,
             env_rotation: self.env_rotation,
             lights: &self.lights,
@@ -302,9 +303,19 @@ impl Renderer {
             scene: &self.scene,
             targets: &self.targets,
         };
+        let mut imports = vec!["frame_uniforms", "environment"];
+        imports.extend_from_slice(self.technique.persistent());
+        let analysis = self.technique.analysis_passes(&inputs);
+        let mut timings = Vec::new();
+        if !analysis.is_empty() {
+            timings = self.executor.run(&imports, analysis)?;
+            self.technique.analysed()?;
+        }
         let mut passes: Vec<Pass> = Vec::new();
         if self.env_dirty {
             passes.extend(self.env_sh.passes(&self.env.image, &self.env.sampler));
+        } else {
+            imports.push("env_sh");
         }
         passes.push(self.background.pass(&inputs));
         passes.extend(self.technique.passes(&inputs));
@@ -312,12 +323,7 @@ impl Renderer {
         passes.push(Pass::new("readback", &["color"], &[], move |cmd| {
             targets.color.record_copy_to(cmd, &targets.readback)
         }));
-        let mut imports = vec!["frame_uniforms", "environment"];
-        if !self.env_dirty {
-            imports.push("env_sh");
-        }
-        imports.extend_from_slice(self.technique.persistent());
-        let timings = self.executor.run(&imports, passes)?;
+        timings.extend(self.executor.run(&imports, passes)?);
         self.env_dirty = false;
         Ok(timings)
     }

@@ -7,8 +7,6 @@
 
 #include "local_lights_shading.glsl"
 
-layout(set = 0, binding = 2) uniform sampler2DArray asm_pool;
-layout(std430, set = 0, binding = 3) readonly buffer PageTable { AsmNode asm_nodes[]; };
 #ifdef ASM_ID_TEST
 layout(set = 0, binding = 4) uniform usampler2DArray asm_ids;
 #endif

@@ -1,17 +1,32 @@
-// The adaptive shadow map's page-table descent (engine/src/techniques/asm/page_table.rs), shared
-// by the lighting pass and the refinement analysis. The including shader declares the page table
-// as `asm_nodes` and the page pool as `asm_pool` (sampler2DArray, one tile per layer).
+// The adaptive shadow map's page table and its descent (engine/src/techniques/asm/page_table.rs),
+// shared by the lighting pass and the refinement analysis, with the page pool (one tile per
+// layer). The including shader declares nothing else at set 0, bindings 2 and 3.
 #ifndef KAGE_ASM_LOOKUP_GLSL
 #define KAGE_ASM_LOOKUP_GLSL
 
 #include "layouts.glsl"
 
-// The node of the finest resident tile holding light uv `uv`: from the root, into the child
-// holding uv while it is resident. A missing tile so falls back to its nearest resident ancestor,
-// at worst the root, never to "lit".
+#define ASM_DIRECTORY_SIDE (1u << KAGE_ASM_DIRECTORY_LEVEL)
+
+layout(set = 0, binding = 2) uniform sampler2DArray asm_pool;
+// The directory (rows of ASM_DIRECTORY_SIDE entries: node index | level << 24, the finest
+// resident tile at or above the directory's level over each of its tiles), then the nodes.
+layout(std430, set = 0, binding = 3) readonly buffer PageTable {
+    uint asm_directory[ASM_DIRECTORY_SIDE * ASM_DIRECTORY_SIDE];
+    AsmNode asm_nodes[];
+};
+
+// The node of the finest resident tile holding light uv `uv`: the directory's tile, then into
+// the child holding uv while it is resident. A missing tile so falls back to its nearest
+// resident ancestor, at worst the root, never to "lit".
 uint asm_descend(vec2 uv) {
-    uint at = 0u;
-    for (uint level = 1u; level <= uint(KAGE_ASM_MAX_LEVEL); ++level) {
+    uvec2 entry_cell = min(uvec2(uv * float(ASM_DIRECTORY_SIDE)), uvec2(ASM_DIRECTORY_SIDE - 1u));
+    uint entry = asm_directory[entry_cell.y * ASM_DIRECTORY_SIDE + entry_cell.x];
+    uint at = entry & 0xffffffu;
+    // A tile above the directory's level has no resident child over uv: the directory would
+    // name that child.
+    if ((entry >> 24) < uint(KAGE_ASM_DIRECTORY_LEVEL)) return at;
+    for (uint level = uint(KAGE_ASM_DIRECTORY_LEVEL) + 1u; level <= uint(KAGE_ASM_MAX_LEVEL); ++level) {
         uint n = 1u << level;
         uvec2 cell = min(uvec2(uv * float(n)), uvec2(n - 1u));
         uint next = asm_nodes[at].children[2u * (cell.y & 1u) + (cell.x & 1u)];

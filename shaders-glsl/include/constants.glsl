@@ -68,9 +68,19 @@
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 16
 // Levels the ASM refinement asks for beyond the one whose texels match the eye pixel's
-// footprint: a nearest-texel edge lies up to ~0.7 texel off, so texels a quarter of the pixel
-// keep the lit/shadowed state of pixel centres right but within ~0.2 pixel of an edge.
-#define KAGE_ASM_EXTRA_LEVELS 2
+// footprint: a nearest-texel edge lies up to half a texel off, so texels an eighth of the pixel
+// keep the lit/shadowed state of pixel centres right but within ~1/16 pixel of an edge (a
+// quarter, 2, misclassified a third more pixels of the `asm` walkthrough; 4 no fewer).
+#define KAGE_ASM_EXTRA_LEVELS 3
+// The page table's directory: one entry per tile of this level (128² entries, 64 KiB) naming
+// the finest resident tile at or above it, where the lookup's descent starts. The descent is a
+// chain of dependent reads, one per level, that a CPU rasterizer pays per fragment in full (it
+// was half of the lighting pass on lavapipe); below this level views rarely refine.
+#define KAGE_ASM_DIRECTORY_LEVEL 7
+// Levels below a pixel's finest resident tile the ASM analysis asks for at once (the tiles of
+// its chain, each at most this many levels under the tile): a camera arriving at a new view
+// refines that many levels in one frame instead of one.
+#define KAGE_ASM_CHAIN_LEVELS 3
 // Workgroup of the ASM refinement analysis: 8x8 eye pixels.
 #define KAGE_ASM_ANALYSIS_GROUP 8
 

@@ -244,7 +244,9 @@ struct AsmTilePush {
 
 // Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer holds
 // three uint arrays of `size.z` (page table nodes) blocks: a used flag per node, then per node
-// and quadrant the edge pixels asking for that child tile and the sum of their missing levels.
+// and requested descendant (its 4 children, 16 grandchildren, ... down to
+// KAGE_ASM_CHAIN_LEVELS, row by row within each level) the edge pixels asking for that tile,
+// then the same slots' sums of the levels those pixels still lack at that tile.
 struct AsmAnalysisPush {
     uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: the pixel of each 2x2 block analysed this frame (x + 2y)
     vec4 bias; // as LocalDrawPush.bias

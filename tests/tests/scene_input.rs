@@ -271,6 +271,11 @@ fn built_in_scenes_are_listed_and_unknown_names_rejected() {
     assert_eq!(BUILTIN[0], "teapot");
     let message = Scene::from_arg("no-such-scene").unwrap_err().to_string();
     assert!(BUILTIN.iter().all(|name| message.contains(name)), "{message}");
+    // A folder without a scene file is no scene file: the answer lists the built-ins, never
+    // "is a directory".
+    let empty = temp_dir("no-scene-file");
+    let message = Scene::from_arg(empty.to_str().unwrap()).unwrap_err().to_string();
+    assert!(BUILTIN.iter().all(|name| message.contains(name)), "{message}");
     let hires = Scene::builtin("teapot-hires-floor").unwrap();
     let floor = hires.groups.iter().find(|g| g.name == "floor").unwrap();
     assert_eq!(floor.meshes[0].vertex_count(), 111 * 111);
@@ -286,6 +291,8 @@ fn exported_builtins_read_back_identical() {
         let dir = temp_dir(&format!("export-{}", scene.name));
         scene.export(&dir).unwrap();
         let back = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
+        // The folder as a --scene argument is its scene file.
+        assert!(Scene::from_arg(dir.to_str().unwrap()).unwrap() == back);
         // Field by field first, so a failure says what differs; then everything at once.
         assert_eq!(back.name, scene.name);
         assert_eq!(back.camera, scene.camera);

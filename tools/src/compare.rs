@@ -1,7 +1,7 @@
 //! `kage compare A.exr B.exr`: error metrics of image A against the reference B.
 use anyhow::{Context as _, Result};
 use clap::Args;
-use kage::reference::{compare, diff_image, shadow_mismatch, SHADOW_THRESHOLD};
+use kage::reference::{compare, diff_image, shadow_mismatch, shadow_mismatch_image, SHADOW_THRESHOLD};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -18,7 +18,11 @@ pub struct CompareArgs {
     /// local-light renders against `kage reference --light local`).
     #[arg(long)]
     shadow_mismatch: bool,
-    /// With --shadow-mismatch: a pixel is lit when its luminance exceeds this fraction of B's
+    /// Write where A and B disagree on lit and shadowed (.png: red lit in A only, blue lit in
+    /// B only, light grey lit in both, dark grey shadowed in both).
+    #[arg(long)]
+    mismatch_image: Option<PathBuf>,
+    /// With --shadow-mismatch and --mismatch-image: a pixel is lit when its luminance exceeds this fraction of B's
     /// brightest pixel.
     #[arg(long, default_value_t = SHADOW_THRESHOLD)]
     shadow_threshold: f64,
@@ -47,6 +51,15 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         println!(
             "shadow mismatch  {:.6e}   ({} pixels lit in one image only, {} of them lit in A only; lit above {:.3e} = {relative} x B's brightest)",
             s.fraction, s.differing, s.lit_in_render_only, s.threshold
+        );
+    }
+    if let Some(path) = &args.mismatch_image {
+        let mismatch = shadow_mismatch_image(&a, &b, args.shadow_threshold)?;
+        mismatch.write_png(path)?;
+        println!(
+            "wrote {}: red lit in A only, blue lit in B only (lit above {:.3e})",
+            path.display(),
+            mismatch.scale
         );
     }
     if let Some(path) = &args.diff {

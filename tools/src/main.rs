@@ -110,6 +110,13 @@ enum Command {
 }
 
 fn main() {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`kage render | head -1`) would
+    // panic; the default disposition ends the process quietly, as other command-line tools do.
+    // SAFETY: no other thread exists yet, and SIG_DFL is a valid disposition for SIGPIPE.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL)
+    };
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(&args),

@@ -226,6 +226,28 @@ pub fn diff_image(a: &RgbaF32Image, b: &RgbaF32Image) -> Result<DiffImage> {
     Ok(DiffImage { width: a.width, height: a.height, rgb, scale })
 }
 
+/// Where `a` and the reference `b` disagree on lit and shadowed (as [`shadow_mismatch`]
+/// counts): red where only `a` is lit (a leak), blue where only `b` is, light grey where both
+/// are lit and dark grey where both are shadowed. `scale` is the luminance threshold.
+pub fn shadow_mismatch_image(
+    a: &RgbaF32Image,
+    b: &RgbaF32Image,
+    relative_threshold: f64,
+) -> Result<DiffImage> {
+    check_sizes(a, b)?;
+    let threshold = lit_threshold(b, relative_threshold)?;
+    let rgb = lit_states(a, threshold)
+        .zip(lit_states(b, threshold))
+        .flat_map(|states| match states {
+            (true, false) => [230, 40, 40],
+            (false, true) => [40, 110, 255],
+            (true, true) => [170, 170, 170],
+            (false, false) => [50, 50, 50],
+        })
+        .collect();
+    Ok(DiffImage { width: a.width, height: a.height, rgb, scale: threshold })
+}
+
 impl DiffImage {
     pub fn write_png(&self, path: &Path) -> Result<()> {
         image::save_buffer_with_format(

@@ -22,8 +22,8 @@ pub mod statistics;
 
 pub use irradiance::{surface_radiance, IrradianceFile, IrradianceReference, PointsFile, MAX_BOUNCES};
 pub use metrics::{
-    compare, diff_image, frames_to_converge, shadow_flips, shadow_mismatch, ImageMetrics, ShadowFlips,
-    ShadowMismatch, SHADOW_THRESHOLD,
+    compare, diff_image, frames_to_converge, shadow_flips, shadow_mismatch, shadow_mismatch_image,
+    ImageMetrics, ShadowFlips, ShadowMismatch, SHADOW_THRESHOLD,
 };
 pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
 pub use statistics::Statistics;

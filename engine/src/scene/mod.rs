@@ -80,11 +80,14 @@ impl Scene {
         builtin::builtin(name)
     }
 
-    /// What a `--scene` argument means: an existing path or a name ending in `.json` is a scene
-    /// file, anything else a built-in name.
+    /// What a `--scene` argument means: an existing file or a name ending in `.json` is a scene
+    /// file, a folder holding [`SCENE_FILE`] (as [`Scene::export`] writes it) that file, anything
+    /// else a built-in name (so a folder named like a built-in scene does not hide it).
     pub fn from_arg(arg: &str) -> Result<Scene, SceneError> {
         let path = Path::new(arg);
-        if path.exists() || arg.ends_with(".json") {
+        if path.join(SCENE_FILE).is_file() {
+            Scene::load(&path.join(SCENE_FILE))
+        } else if path.is_file() || arg.ends_with(".json") {
             Scene::load(path)
         } else {
             Scene::builtin(arg)

@@ -38,6 +38,8 @@ pub struct FrameInputs<'a> {
 
 /// The state of the frame about to be recorded.
 pub struct FrameState<'a> {
+    /// World to the camera's clip space.
+    pub view_proj: Mat4,
     /// Object-to-world transform of every group.
     pub transforms: &'a [Mat4],
     /// The environment's rotation about +Y, in radians (counter-clockwise seen from above).
@@ -56,6 +58,17 @@ pub trait Technique {
         &[]
     }
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>>;
+    /// Passes submitted and waited for before the frame's own, whose results the host reads in
+    /// [`Technique::analysed`] before [`Technique::passes`] records the frame: the adaptive
+    /// shadow map's analysis of the eye view, which decides the tiles the same frame renders
+    /// and looks up (the paper's order). None for the other techniques.
+    fn analysis_passes<'a>(&'a self, _inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        Vec::new()
+    }
+    /// Reads what [`Technique::analysis_passes`] wrote, after their submission has completed.
+    fn analysed(&mut self) -> Result<()> {
+        Ok(())
+    }
     /// Occlusion layers the last frame wanted but had no room for (their light was left
     /// unshadowed): 0 for techniques without a layer budget.
     fn dropped_layers(&self) -> usize {

@@ -89,7 +89,21 @@ impl ShadowMaps {
         view_proj: &Mat4,
         draws: impl Fn(&GpuMesh) -> bool,
     ) {
-        ctx.begin_rendering(cmd, None, None, Some(self.target(layer)));
+        self.record_into(ctx, cmd, scene, self.target(layer), view_proj, draws);
+    }
+
+    /// [`ShadowMaps::record`] into another depth target of the same format (the ASM's eye-view
+    /// depth).
+    pub fn record_into(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        target: Target<'_>,
+        view_proj: &Mat4,
+        draws: impl Fn(&GpuMesh) -> bool,
+    ) {
+        ctx.begin_rendering(cmd, None, None, Some(target));
         self.pipeline.bind(cmd, &[]);
         for mesh in scene.meshes.iter().filter(|m| draws(m)) {
             let push = ShadowDepthPush {

@@ -2,18 +2,60 @@
 //! in a buffer, the root at index 0 and every node's children after it (breadth first). A child
 //! index of 0 means "not resident" (the root is no one's child), so the lookup stops there and
 //! uses the last node's page: the finest resident tile over the point.
+//!
+//! A directory comes first in the buffer: one entry per tile of level
+//! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
+//! that the descent starts there instead of at the root.
 use super::pool::PagePool;
 use super::tile::TileKey;
-use crate::layouts::AsmNode;
+use crate::layouts::constants::ASM_DIRECTORY_LEVEL;
+use crate::layouts::{bytes_of_slice, AsmNode};
 use std::collections::VecDeque;
 
+/// Entries of the directory per side.
+pub const DIRECTORY_SIDE: u32 = 1 << ASM_DIRECTORY_LEVEL;
+/// Bytes of the directory at the head of the page-table buffer.
+pub const DIRECTORY_BYTES: u64 = 4 * DIRECTORY_SIDE as u64 * DIRECTORY_SIDE as u64;
+/// A directory entry's level field (the node index below it).
+const LEVEL_SHIFT: u32 = 24;
+
+/// What the page-table buffer holds: the directory (row by row, `node | level << 24`), then
+/// the nodes.
+pub struct PageTable {
+    pub directory: Vec<u32>,
+    pub nodes: Vec<AsmNode>,
+}
+
+impl PageTable {
+    /// The buffer's bytes, as `asm_lookup.glsl`'s `PageTable` block reads them.
+    pub fn bytes(&self) -> Vec<u8> {
+        let directory = self.directory.iter().flat_map(|e| e.to_ne_bytes());
+        directory.chain(bytes_of_slice(&self.nodes).iter().copied()).collect()
+    }
+
+    /// Bytes of a table of up to `nodes` nodes.
+    pub fn buffer_bytes(nodes: u32) -> u64 {
+        DIRECTORY_BYTES + u64::from(nodes) * size_of::<AsmNode>() as u64
+    }
+}
+
 /// The page table of `pool`'s resident tiles, root first.
-pub fn build(pool: &PagePool) -> Vec<AsmNode> {
+pub fn build(pool: &PagePool) -> PageTable {
     let node = |key: TileKey, page: u32| AsmNode { children: [0; 4], tile: [page, key.level, key.x, key.y] };
     let root_page = pool.page(TileKey::ROOT).unwrap_or(0);
     let mut nodes = vec![node(TileKey::ROOT, root_page)];
+    let mut directory = vec![0u32; (DIRECTORY_SIDE * DIRECTORY_SIDE) as usize];
     let mut queue = VecDeque::from([(TileKey::ROOT, 0usize)]);
     while let Some((key, at)) = queue.pop_front() {
+        // Breadth first: a finer tile overwrites its ancestors' entries.
+        if key.level <= ASM_DIRECTORY_LEVEL {
+            let span = 1 << (ASM_DIRECTORY_LEVEL - key.level);
+            let entry = at as u32 | key.level << LEVEL_SHIFT;
+            for y in key.y * span..(key.y + 1) * span {
+                let row = (y * DIRECTORY_SIDE) as usize;
+                directory[row + (key.x * span) as usize..row + ((key.x + 1) * span) as usize].fill(entry);
+            }
+        }
         let Some(children) = key.children() else { continue };
         for (q, child) in children.into_iter().enumerate() {
             if let Some(page) = pool.page(child) {
@@ -23,7 +65,7 @@ pub fn build(pool: &PagePool) -> Vec<AsmNode> {
             }
         }
     }
-    nodes
+    PageTable { directory, nodes }
 }
 
 #[cfg(test)]
@@ -31,19 +73,31 @@ mod tests {
     use super::*;
     use crate::techniques::asm::pool::DEPTH_PAGE_BYTES as PAGE_BYTES;
 
-    /// The GPU's descent (as the lighting shader will do it), on the CPU: from the root, into
-    /// the resident child holding `uv`, until there is none. Returns the tile reached.
-    fn lookup(table: &[AsmNode], uv: [f32; 2]) -> TileKey {
-        let mut at = 0usize;
+    /// From node `at`, into the resident child holding `uv` until there is none.
+    fn descend(table: &PageTable, mut at: usize, uv: [f32; 2]) -> TileKey {
         loop {
-            let [_, level, x, y] = table[at].tile;
+            let [_, level, x, y] = table.nodes[at].tile;
             let here = TileKey { level, x, y };
             let Some(child) = TileKey::containing(uv, level + 1) else { return here };
-            match table[at].children[child.quadrant()] {
+            match table.nodes[at].children[child.quadrant()] {
                 0 => return here,
                 next => at = next as usize,
             }
         }
+    }
+
+    /// The GPU's lookup (asm_lookup.glsl) on the CPU: the directory's tile over `uv`, and on
+    /// from there only where that tile is of the directory's level.
+    fn lookup(table: &PageTable, uv: [f32; 2]) -> TileKey {
+        let cell = |c: f32| ((c * DIRECTORY_SIDE as f32) as u32).min(DIRECTORY_SIDE - 1);
+        let entry = table.directory[(cell(uv[1]) * DIRECTORY_SIDE + cell(uv[0])) as usize];
+        let at = (entry & 0xff_ffff) as usize;
+        assert_eq!(table.nodes[at].tile[1], entry >> LEVEL_SHIFT, "the entry's level is its node's");
+        if entry >> LEVEL_SHIFT < ASM_DIRECTORY_LEVEL {
+            let [_, level, x, y] = table.nodes[at].tile;
+            return TileKey { level, x, y };
+        }
+        descend(table, at, uv)
     }
 
     #[test]
@@ -55,7 +109,7 @@ mod tests {
             pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1.0).unwrap();
         }
         let table = build(&pool);
-        assert_eq!(table.len(), 5);
+        assert_eq!(table.nodes.len(), 5);
         assert_eq!(lookup(&table, uv), TileKey::containing(uv, 4).unwrap());
         // A point in the same level-2 tile but another level-3 one gets the level-2 tile.
         let beside = [0.3 + 0.125, 0.6];
@@ -64,7 +118,7 @@ mod tests {
         // Far away: the root, which every lookup can fall back to; never "no tile".
         assert_eq!(lookup(&table, [0.9, 0.1]), TileKey::ROOT);
         // Each node's page is its tile's page in the pool.
-        for node in &table {
+        for node in &table.nodes {
             let [page, level, x, y] = node.tile;
             assert_eq!(pool.page(TileKey { level, x, y }), Some(page));
         }
@@ -79,15 +133,53 @@ mod tests {
         let grandchild = TileKey::ROOT.children().unwrap()[2].children().unwrap()[1];
         pool.insert(grandchild, 1, 1.0).unwrap();
         let table = build(&pool);
-        assert_eq!(table.len(), 6);
-        for (at, node) in table.iter().enumerate() {
+        assert_eq!(table.nodes.len(), 6);
+        for (at, node) in table.nodes.iter().enumerate() {
             let [_, level, x, y] = node.tile;
             for (q, &child) in node.children.iter().enumerate().filter(|(_, c)| **c != 0) {
                 assert!(child as usize > at);
-                let [_, cl, cx, cy] = table[child as usize].tile;
+                let [_, cl, cx, cy] = table.nodes[child as usize].tile;
                 let key = TileKey { level: cl, x: cx, y: cy };
                 assert_eq!((key.parent(), key.quadrant()), (Some(TileKey { level, x, y }), q));
             }
+        }
+    }
+
+    #[test]
+    fn the_directory_starts_every_descent_where_the_root_would_arrive() {
+        // Chains refined past the directory's level at two points, and a full level 2, so that
+        // the directory holds tiles above, at and (through them) below its level.
+        let deep = ASM_DIRECTORY_LEVEL + 3;
+        let mut pool = PagePool::new(64 * PAGE_BYTES, PAGE_BYTES).unwrap();
+        for uv in [[0.3, 0.6], [0.71, 0.12]] {
+            for level in 1..=deep {
+                pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1.0).unwrap();
+            }
+        }
+        for key in TileKey::ROOT.children().unwrap() {
+            pool.insert(key, 1, 1.0).unwrap();
+            for child in key.children().unwrap() {
+                pool.insert(child, 1, 1.0).unwrap();
+            }
+        }
+        let table = build(&pool);
+        assert_eq!(table.bytes().len() as u64, PageTable::buffer_bytes(table.nodes.len() as u32));
+        // A lattice of points finer than the deepest tiles near the chains, coarser elsewhere.
+        let mut reached_deep = 0;
+        for centre in [[0.3f32, 0.6], [0.71, 0.12], [0.5, 0.5]] {
+            for i in 0..64 {
+                for j in 0..64 {
+                    let step = 1.0 / (1u32 << deep) as f32 / 8.0;
+                    let uv = [centre[0] + (i as f32 - 32.0) * step, centre[1] + (j as f32 - 32.0) * step];
+                    let found = lookup(&table, uv);
+                    assert_eq!(found, descend(&table, 0, uv), "at {uv:?}");
+                    reached_deep += usize::from(found.level == deep);
+                }
+            }
+        }
+        assert!(reached_deep > 0, "the lattice reaches the chains' deepest tiles");
+        for uv in [[0.0, 0.0], [0.999_99, 0.999_99], [0.5, 0.25]] {
+            assert_eq!(lookup(&table, uv), descend(&table, 0, uv));
         }
     }
 }

@@ -9,8 +9,10 @@
 //!   device ([`CostModel::fit`]).
 //! - Requests are taken by benefit/cost, best first, until their summed cost would pass the
 //!   per-frame time budget; the best one is always taken, so that the refinement progresses on
-//!   a device slower than the budget assumes.
+//!   a device slower than the budget assumes. A request under a tile that is not resident
+//!   (the analysis asks for whole chains of tiles) waits until its parent is taken.
 use super::tile::TileKey;
+use std::collections::HashMap;
 
 /// A child tile the analysis asked for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,21 +74,37 @@ impl CostModel {
     }
 }
 
-/// The requests to render this frame, best benefit/cost first, each with that ratio, within
-/// `budget_ms` (the best always).
-pub fn plan(mut requests: Vec<Request>, model: &CostModel, budget_ms: f64) -> Vec<(Request, f32)> {
+/// The requests to render this frame, each with its benefit/cost, within `budget_ms` (the best
+/// always), in an order that takes every tile after its parent: among the requests whose
+/// parent is `resident` or taken already, the best benefit/cost first.
+pub fn plan(
+    requests: Vec<Request>,
+    model: &CostModel,
+    budget_ms: f64,
+    resident: impl Fn(TileKey) -> bool,
+) -> Vec<(Request, f32)> {
     let ratio = |r: &Request| r.benefit() / model.cost_ms(r.triangles);
-    requests.retain(|r| r.benefit() > 0.0);
-    requests.sort_by(|a, b| ratio(b).total_cmp(&ratio(a)).then(a.key.cmp(&b.key)));
+    let mut ready = Vec::new();
+    let mut waiting: HashMap<TileKey, Vec<Request>> = HashMap::new();
+    for r in requests.into_iter().filter(|r| r.benefit() > 0.0) {
+        match r.key.parent().filter(|&p| !resident(p)) {
+            Some(parent) => waiting.entry(parent).or_default().push(r),
+            None => ready.push(r),
+        }
+    }
     let mut spent = 0.0;
     let mut chosen = Vec::new();
-    for r in requests {
+    while let Some(best) = (0..ready.len())
+        .max_by(|&a, &b| ratio(&ready[a]).total_cmp(&ratio(&ready[b])).then(ready[b].key.cmp(&ready[a].key)))
+    {
+        let r = ready.swap_remove(best);
         let cost = model.cost_ms(r.triangles);
         if !chosen.is_empty() && spent + cost > budget_ms {
             break;
         }
         spent += cost;
         chosen.push((r, ratio(&r) as f32));
+        ready.extend(waiting.remove(&r.key).unwrap_or_default());
     }
     chosen
 }
@@ -127,13 +145,35 @@ mod tests {
         ];
         let keys = |chosen: &[(Request, f32)]| chosen.iter().map(|(r, _)| r.key.x).collect::<Vec<_>>();
         // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
-        assert_eq!(keys(&plan(requests.clone(), &model, 15.0)), vec![2, 1, 0]);
-        assert_eq!(keys(&plan(requests.clone(), &model, 13.0)), vec![2, 1]);
+        let root = |_| true;
+        assert_eq!(keys(&plan(requests.clone(), &model, 15.0, root)), vec![2, 1, 0]);
+        assert_eq!(keys(&plan(requests.clone(), &model, 13.0, root)), vec![2, 1]);
         // The best is taken even when it alone is over budget; nothing after it then.
-        assert_eq!(keys(&plan(requests.clone(), &model, 1.0)), vec![2]);
+        assert_eq!(keys(&plan(requests.clone(), &model, 1.0, root)), vec![2]);
         // No benefit, no request.
-        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0).is_empty());
-        let chosen = plan(requests, &model, 100.0);
+        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0, root).is_empty());
+        let chosen = plan(requests, &model, 100.0, root);
         assert!(chosen.windows(2).all(|w| w[0].1 >= w[1].1));
+    }
+
+    #[test]
+    fn a_chain_is_taken_parent_first_and_waits_for_its_parent() {
+        let model = CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 };
+        let child = TileKey { level: 1, x: 1, y: 0 };
+        let grandchild = child.children().unwrap()[2];
+        let beside = TileKey { level: 1, x: 0, y: 1 };
+        let ask = |key, missing_levels| Request { key, edge_pixels: 1, missing_levels, triangles: 10 };
+        // The grandchild has the best ratio, but comes after its parent; the tile beside
+        // comes between them, as its ratio is better than the grandchild's parent's.
+        let requests = vec![ask(grandchild, 50), ask(child, 10), ask(beside, 20)];
+        let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT);
+        let keys: Vec<TileKey> = chosen.iter().map(|(r, _)| r.key).collect();
+        assert_eq!(keys, vec![beside, child, grandchild]);
+        // Within a budget of two tiles the grandchild waits for a later frame.
+        let chosen = plan(requests.clone(), &model, 2.0, |k| k == TileKey::ROOT);
+        assert_eq!(chosen.iter().map(|(r, _)| r.key).collect::<Vec<_>>(), vec![beside, child]);
+        // With its parent resident it is taken first.
+        let chosen = plan(requests, &model, 1.0, |k| k == TileKey::ROOT || k == child);
+        assert_eq!(chosen[0].0.key, grandchild);
     }
 }

@@ -2,13 +2,17 @@
 //! quadtree of tiles in a page pool under a byte budget, refined every frame where the eye sees
 //! shadow edges at a coarser resolution than its pixels.
 //!
-//! A frame, after the host's update (planning from the last frame's analysis):
-//! 1. `asm_tiles`: the tiles planned this frame, each rendered depth-only into its page with
-//!    the light's projection cropped to its square (one debug label per tile);
-//! 2. `scene`: the shared local-light shading, each point's visibility looked up in the finest
-//!    resident tile holding it (the page table's descent);
-//! 3. `asm_analysis`: per visible eye pixel (one of each 2×2 block per frame, in turn), the tile it used, and on shadow edges short of
-//!    resolution the child tile it asks for, counted in a buffer the host reads next frame.
+//! A frame follows the paper's order: the eye view is analysed first, and the tiles it asks for
+//! are rendered before the same frame looks them up. Two submissions:
+//! 1. analysis: `asm_refresh` re-renders the resident tiles a moving group touched (see below),
+//!    `asm_eye_depth` draws the scene's depth from the eye, and `asm_analysis` finds, per eye
+//!    pixel (one of each 2×2 block per frame, in turn), the tile it uses, and on shadow edges
+//!    short of resolution the chain of finer tiles it asks for, counted in a buffer;
+//! 2. the host reads the counts, marks the used tiles, and plans within the time budget
+//!    (`plan`); then the frame: `asm_tiles` renders the planned tiles, each depth-only into its
+//!    page with the light's projection cropped to its square (one debug label per tile), and
+//!    `scene` shades with each point's visibility looked up in the finest resident tile holding
+//!    it (the page table's directory and descent).
 //!
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
 //! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
@@ -27,10 +31,7 @@ use crate::backend::{
     GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
-use crate::layouts::{
-    bytes_of, bytes_of_slice, constants, spirv, AsmAnalysisPush, AsmNode, AsmTilePush, LocalDrawPush,
-    ShadowLight,
-};
+use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, AsmTilePush, LocalDrawPush, ShadowLight};
 use crate::pass::{FrameExecutor, Pass};
 use crate::renderer::{GpuScene, DEPTH_FORMAT};
 use crate::scene::{Light, Scene};
@@ -158,19 +159,23 @@ pub struct Asm {
     nearest: Sampler,
     /// `ShadowLight` records (the light in record 0), as the shadowmap technique's.
     records: Buffer,
-    /// The page table: `AsmNode` per resident tile, root first.
+    /// The page table (page_table::PageTable): the directory, then `AsmNode` per resident tile.
     table: Buffer,
-    /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by the next update.
+    /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by `analysed`.
     requests: Buffer,
     cost: CostModel,
     frame: u64,
-    /// Last frame's light record, group transforms and group light-uv bounds.
+    /// The light record, group transforms and group light-uv bounds of the frame.
     record: Option<ShadowLight>,
     transforms: Vec<Mat4>,
     group_rects: Vec<UvRect>,
-    /// The tile of each page-table node the last analysis used.
+    /// World to the eye's clip space this frame.
+    eye_view_proj: Mat4,
+    /// The tile of each node of the page table the analysis descends.
     table_keys: Vec<TileKey>,
-    analysed: bool,
+    /// Resident tiles a moving group made stale, rendered before the analysis.
+    refresh: Vec<TileRender>,
+    /// Tiles the analysis asked for, rendered before the lighting.
     render: Vec<TileRender>,
     stats: AsmStats,
 }
@@ -178,9 +183,12 @@ pub struct Asm {
 /// The ID test's polygon IDs.
 const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
 
-/// Uints of the analysis output per page-table node: a used flag, 4 quadrant edge counts and
-/// 4 sums of missing levels.
-const REQUEST_WORDS: u64 = 9;
+/// Tiles the analysis may ask for under one page-table node: 4 + 16 + ... down to
+/// `ASM_CHAIN_LEVELS` (as asm_analysis.comp's `ASM_REQUEST_SLOTS`).
+const REQUEST_SLOTS: usize = ((1 << (2 * constants::ASM_CHAIN_LEVELS + 2)) - 4) / 3;
+/// Uints of the analysis output per page-table node: a used flag, an edge count and a sum of
+/// missing levels per slot.
+const REQUEST_WORDS: u64 = 1 + 2 * REQUEST_SLOTS as u64;
 
 impl Asm {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, gpu: &GpuScene, settings: AsmSettings) -> Result<Asm> {
@@ -250,7 +258,7 @@ impl Asm {
         )?;
         let table = buffer(
             "asm.page_table",
-            u64::from(capacity) * size_of::<AsmNode>() as u64,
+            page_table::PageTable::buffer_bytes(capacity),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
@@ -282,8 +290,9 @@ impl Asm {
             record: None,
             transforms: Vec::new(),
             group_rects: Vec::new(),
+            eye_view_proj: Mat4::IDENTITY,
             table_keys: Vec::new(),
-            analysed: false,
+            refresh: Vec::new(),
             render: Vec::new(),
             stats: AsmStats::default(),
         };
@@ -333,6 +342,15 @@ impl Asm {
             }
         }
         Ok(CostModel::fit(&samples))
+    }
+
+    /// Records the renders of `tiles`, one debug label each.
+    fn record_tiles(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, tiles: &[TileRender]) {
+        for t in tiles {
+            ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", t.key.level, t.key.x, t.key.y));
+            self.record_tile(ctx, cmd, scene, t);
+            ctx.end_label(cmd);
+        }
     }
 
     /// Records the render of one tile into its page (and its ID layer for the ID test).
@@ -390,7 +408,8 @@ impl Asm {
         groups.iter().zip(&self.triangles).filter(|(drawn, _)| **drawn).map(|(_, t)| t).sum()
     }
 
-    /// Marks the tiles the last frame's lookups used, and turns its edge counts into requests.
+    /// Marks the tiles this frame's lookups use, and turns the analysis' edge counts into
+    /// requests.
     fn read_requests(&mut self) -> Result<Vec<Request>> {
         let words: Vec<u32> = self
             .requests
@@ -399,29 +418,44 @@ impl Asm {
             .map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
             .collect();
         let capacity = self.pool.capacity() as usize;
+        let (counts, missing) = words[capacity..].split_at(capacity * REQUEST_SLOTS);
         let mut requests = Vec::new();
         for (node, &key) in self.table_keys.iter().enumerate() {
             if words[node] != 0 {
                 self.pool.touch(key, self.frame);
             }
-            let Some(children) = key.children() else { continue };
-            for (q, child) in children.into_iter().enumerate() {
-                let slot = 4 * node + q;
-                let edge_pixels = words[capacity + slot];
-                if edge_pixels == 0 || self.pool.page(key).is_none() {
-                    continue;
+            // Slots row by row within each depth, as the analysis counts them.
+            let mut slot = node * REQUEST_SLOTS;
+            for depth in 1..=constants::ASM_CHAIN_LEVELS {
+                let side = 1u32 << depth;
+                for i in 0..side * side {
+                    let edge_pixels = counts[slot];
+                    let (x, y) = (key.x * side + i % side, key.y * side + i / side);
+                    let tile = TileKey { level: key.level + depth, x, y };
+                    slot += 1;
+                    if edge_pixels == 0 || tile.level > constants::ASM_MAX_LEVEL {
+                        continue;
+                    }
+                    let square = UvRect::of_tile(tile);
+                    let groups: Vec<bool> = self.group_rects.iter().map(|r| r.overlaps(&square)).collect();
+                    requests.push(Request {
+                        key: tile,
+                        edge_pixels,
+                        missing_levels: missing[slot - 1],
+                        triangles: self.tile_triangles(&groups),
+                    });
                 }
-                let square = UvRect::of_tile(child);
-                let groups: Vec<bool> = self.group_rects.iter().map(|r| r.overlaps(&square)).collect();
-                requests.push(Request {
-                    key: child,
-                    edge_pixels,
-                    missing_levels: words[5 * capacity + slot],
-                    triangles: self.tile_triangles(&groups),
-                });
             }
         }
         Ok(requests)
+    }
+
+    /// Rebuilds the page table from the pool and uploads it.
+    fn write_table(&mut self) -> Result<()> {
+        let table = page_table::build(&self.pool);
+        self.table_keys =
+            table.nodes.iter().map(|n| TileKey { level: n.tile[1], x: n.tile[2], y: n.tile[3] }).collect();
+        self.table.write(0, &table.bytes())
     }
 
     /// The hierarchy's state for measurements.
@@ -478,6 +512,7 @@ impl TileIds {
 impl Technique for Asm {
     fn update(&mut self, state: &FrameState) -> Result<()> {
         self.frame += 1;
+        self.eye_view_proj = state.view_proj;
         // The renderer keeps the scene's light count (Renderer::set_light replaces, never adds),
         // and `new` accepted exactly one.
         self.light = state.lights[0];
@@ -485,92 +520,43 @@ impl Technique for Asm {
         let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
         let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
         let rects = self.group_rects_for(&view_proj, state.transforms);
-        let mut render = Vec::new();
-        let mut read = self.analysed;
+        let mut refresh = Vec::new();
         if self.record.is_none_or(|r| bytes_of(&r) != bytes_of(&record)) {
             // The light moved (or the depth range changed): every tile's depths are stale.
             self.pool = PagePool::new(self.settings.budget_bytes(), self.settings.test.page_bytes())?;
-            render.push(TileKey::ROOT);
-            read = false;
+            refresh.push(TileKey::ROOT);
         } else {
             let moved: Vec<UvRect> = (0..rects.len())
                 .filter(|&g| self.transforms[g] != state.transforms[g])
                 .flat_map(|g| [self.group_rects[g], rects[g]])
                 .collect();
             let touched = |key: TileKey| moved.iter().any(|r| r.overlaps(&UvRect::of_tile(key)));
-            render.extend(self.pool.resident().map(|(key, _)| key).filter(|&key| touched(key)));
+            refresh.extend(self.pool.resident().map(|(key, _)| key).filter(|&key| touched(key)));
             // Coarse levels first: the root leads.
-            render.sort();
+            refresh.sort();
         }
         self.record = Some(record);
         self.transforms = state.transforms.to_vec();
         self.group_rects = rects;
-
-        if read {
-            let requests = self.read_requests()?;
-            for (request, ratio) in plan(requests, &self.cost, self.settings.time_ms) {
-                // A parent evicted by an earlier insertion of this frame refuses its child
-                // (an error from the pool): the child waits for a later frame.
-                if let Ok(Insert::Allocated { .. } | Insert::Replaced { .. }) =
-                    self.pool.insert(request.key, self.frame, ratio)
-                {
-                    render.push(request.key);
-                }
-            }
-        }
-        let rects = &self.group_rects;
-        self.render = render
+        self.refresh = refresh
             .iter()
-            .filter_map(|&key| self.pool.page(key).map(|page| self.tile_render(key, page, &view_proj, rects)))
+            .filter_map(|&key| {
+                self.pool.page(key).map(|page| self.tile_render(key, page, &view_proj, &self.group_rects))
+            })
             .collect();
-
-        let table = page_table::build(&self.pool);
-        self.table_keys =
-            table.iter().map(|n| TileKey { level: n.tile[1], x: n.tile[2], y: n.tile[3] }).collect();
-        self.table.write(0, bytes_of_slice(&table))?;
+        self.write_table()?;
         self.records.write(0, bytes_of(&record))?;
-        self.analysed = true;
-        self.stats = AsmStats {
-            budget_bytes: self.settings.budget_bytes(),
-            bytes_used: self.pool.bytes_in_use(),
-            resident_tiles: table.len(),
-            deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
-            rendered: self.render.iter().map(|t| t.key).collect(),
-            cost: (self.cost.ms_per_triangle, self.cost.ms_per_tile),
-        };
         Ok(())
     }
 
-    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
-        let (ctx, scene) = (inputs.ctx, inputs.scene);
-        let tiles = Pass::new("asm_tiles", &[], &["shadow_maps"], move |cmd| {
-            for t in &self.render {
-                ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", t.key.level, t.key.x, t.key.y));
-                self.record_tile(ctx, cmd, scene, t);
-                ctx.end_label(cmd);
-            }
+    fn analysis_passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        let (ctx, scene, targets, uniforms) = (inputs.ctx, inputs.scene, inputs.targets, inputs.uniforms);
+        let refresh = Pass::new("asm_refresh", &[], &["shadow_maps"], move |cmd| {
+            self.record_tiles(ctx, cmd, scene, &self.refresh);
         });
-        let mut bindings = vec![
-            Binding::Uniform(inputs.uniforms),
-            Binding::Uniform(&self.records),
-            self.tiles.binding(),
-            Binding::Storage(&self.table),
-        ];
-        if let Some(ids) = &self.ids {
-            bindings.push(Binding::Sampled(&ids.image, &self.nearest));
-        }
-        let ids = &self.ids;
-        let lighting =
-            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
-                LocalDrawPush {
-                    model: model.to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    params: [1, ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), 0, 0],
-                    bias: DEPTH_BIAS,
-                }
-            });
-        let targets = inputs.targets;
-        let uniforms = inputs.uniforms;
+        let eye_depth = Pass::new("asm_eye_depth", &[], &["depth"], move |cmd| {
+            self.tiles.record_into(ctx, cmd, scene, (&targets.depth).into(), &self.eye_view_proj, |_| true);
+        });
         let (width, height) = (targets.depth.width, targets.depth.height);
         let analysis = Pass::new(
             "asm_analysis",
@@ -599,7 +585,64 @@ impl Technique for Asm {
                 );
             },
         );
-        vec![tiles, lighting, analysis]
+        vec![refresh, eye_depth, analysis]
+    }
+
+    fn analysed(&mut self) -> Result<()> {
+        let requests = self.read_requests()?;
+        let view_proj = Mat4::from_cols_array_2d(&self.record.expect("update sets the record").view_proj);
+        let pool = &self.pool;
+        let chosen = plan(requests, &self.cost, self.settings.time_ms, |key| pool.page(key).is_some());
+        let mut render = Vec::new();
+        for (request, ratio) in chosen {
+            // A parent evicted by an earlier insertion of this frame, or refused a page, refuses
+            // its child (an error from the pool): the child waits for a later frame.
+            if let Ok(Insert::Allocated { page } | Insert::Replaced { page, .. }) =
+                self.pool.insert(request.key, self.frame, ratio)
+            {
+                render.push(self.tile_render(request.key, page, &view_proj, &self.group_rects));
+            }
+        }
+        // A tile whose page a later insertion of this frame took is no longer resident.
+        render.retain(|t| self.pool.page(t.key) == Some(t.page));
+        self.render = render;
+        self.write_table()?;
+        self.stats = AsmStats {
+            budget_bytes: self.settings.budget_bytes(),
+            bytes_used: self.pool.bytes_in_use(),
+            resident_tiles: self.table_keys.len(),
+            deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
+            rendered: self.refresh.iter().chain(&self.render).map(|t| t.key).collect(),
+            cost: (self.cost.ms_per_triangle, self.cost.ms_per_tile),
+        };
+        Ok(())
+    }
+
+    fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
+        let (ctx, scene) = (inputs.ctx, inputs.scene);
+        let tiles = Pass::new("asm_tiles", &[], &["shadow_maps"], move |cmd| {
+            self.record_tiles(ctx, cmd, scene, &self.render);
+        });
+        let mut bindings = vec![
+            Binding::Uniform(inputs.uniforms),
+            Binding::Uniform(&self.records),
+            self.tiles.binding(),
+            Binding::Storage(&self.table),
+        ];
+        if let Some(ids) = &self.ids {
+            bindings.push(Binding::Sampled(&ids.image, &self.nearest));
+        }
+        let ids = &self.ids;
+        let lighting =
+            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
+                LocalDrawPush {
+                    model: model.to_cols_array_2d(),
+                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                    params: [1, ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), 0, 0],
+                    bias: DEPTH_BIAS,
+                }
+            });
+        vec![tiles, lighting]
     }
 
     fn asm_stats(&self) -> Option<AsmStats> {
