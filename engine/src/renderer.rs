@@ -347,6 +347,11 @@ impl Renderer {
         self.technique.asm_stats()
     }
 
+    /// The light probes placed and kept (`None` unless the technique is `Probes`).
+    pub fn probe_counts(&self) -> Option<crate::techniques::probes::ProbeCounts> {
+        self.technique.probe_counts()
+    }
+
     /// The last rendered frame: linear radiance, row 0 at the top.
     pub fn image(&self) -> Result<RgbaF32Image> {
         let bytes = self.targets.readback.read()?;

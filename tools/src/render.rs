@@ -239,8 +239,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut renderer =
         Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height, technique })
             .context("setting up the renderer")?;
-    if settings.kind == TechniqueKind::Probes {
-        eprintln!("probes: captured in {:.2} s", setup.elapsed().as_secs_f64());
+    if let Some(counts) = renderer.probe_counts() {
+        let seconds = setup.elapsed().as_secs_f64();
+        let left_out = match counts.inside_geometry {
+            0 => String::new(),
+            n => format!(", {n} inside geometry left out"),
+        };
+        match counts.kept < counts.candidates {
+            true => eprintln!(
+                "probes: {} of {} candidates kept by automatic placement{left_out}, captured in {seconds:.2} s",
+                counts.kept, counts.candidates
+            ),
+            false => eprintln!("probes: {}{left_out}, captured in {seconds:.2} s", counts.kept),
+        }
     }
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
     let bar = ProgressBar::new(args.frames as u64).with_style(

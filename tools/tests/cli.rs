@@ -349,6 +349,48 @@ fn probe_file(dir: &std::path::Path) -> std::path::PathBuf {
     path
 }
 
+/// `--probes auto` reports how many of its candidates it kept (the issue asks for the count);
+/// a grid reports its probe count.
+#[test]
+fn render_with_probes_reports_what_placement_kept() {
+    let dir = scratch_dir("cli-probes-auto");
+    let out_png = dir.join("probes.png");
+    let run = |probes: &str| {
+        let args = [
+            "render",
+            "--scene",
+            "probe-room",
+            "--technique",
+            "probes",
+            "--probes",
+            probes,
+            "--probe-cube-size",
+            "8",
+            "--probe-light",
+            "sky",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--frames",
+            "1",
+            "--validate",
+            "--out",
+            out_png.to_str().unwrap(),
+        ];
+        let out = kage(&args);
+        assert!(out.status.success(), "{}", text(&out));
+        text(&out)
+    };
+    let auto = run("auto:0.05:4,3,3");
+    let line = auto.lines().find(|l| l.starts_with("probes: ")).unwrap_or_else(|| panic!("{auto}"));
+    let kept: usize = line["probes: ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!(line.contains("of 36 candidates kept by automatic placement"), "{line}");
+    assert!((4..36).contains(&kept), "{line}");
+    let grid = run("grid:3,2,3");
+    assert!(grid.lines().any(|l| l.starts_with("probes: 18, captured in")), "{grid}");
+}
+
 #[test]
 fn probes_tetrahedralize_writes_positive_tetrahedra_filling_the_hull() {
     let dir = scratch_dir("cli-probes");

@@ -83,4 +83,8 @@ pub trait Technique {
     fn asm_stats(&self) -> Option<asm::AsmStats> {
         None
     }
+    /// The light probes placed and kept; `None` for techniques without probes.
+    fn probe_counts(&self) -> Option<probes::ProbeCounts> {
+        None
+    }
 }

@@ -47,8 +47,8 @@ pub use input::Merged;
 pub use lookup::{Location, Walker};
 pub use reduce::reduce;
 pub use set::{
-    bounds, capture_at, grid_lattice, is_static, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings,
-    AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
+    bounds, capture_at, grid_lattice, is_static, ProbeCounts, ProbeInterpolation, ProbePlacement, ProbeSet,
+    ProbeSettings, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
 };
 pub use solids::{Hit, Solids};
 pub use tetmesh::{Across, TetMesh};

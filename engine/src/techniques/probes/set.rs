@@ -164,6 +164,18 @@ pub fn bounds(points: impl Iterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
     points.fold(None, |b, p| Some(b.map_or((p, p), |(lo, hi): (Vec3, Vec3)| (lo.min(p), hi.max(p)))))
 }
 
+/// What a probe set kept of the positions its placement gave.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProbeCounts {
+    /// Probes the set interpolates.
+    pub kept: usize,
+    /// Probes captured (outside geometry): automatic placement keeps `kept` of them, the other
+    /// placements all.
+    pub candidates: usize,
+    /// Positions left out because they lie inside geometry.
+    pub inside_geometry: usize,
+}
+
 pub struct ProbeSet {
     pub mesh: TetMesh,
     /// Each probe's radiance SH, in the order of the mesh's positions.
@@ -256,6 +268,15 @@ impl ProbeSet {
     /// The probes the set interpolates.
     pub fn probe_count(&self) -> usize {
         self.sh.len()
+    }
+
+    /// How many probes were placed, left out and kept.
+    pub fn counts(&self) -> ProbeCounts {
+        ProbeCounts {
+            kept: self.probe_count(),
+            candidates: self.candidates,
+            inside_geometry: self.invalid.len(),
+        }
     }
 
     /// The SH at `p`: the probes' SH weighted by the trilinear weights of the grid, or by the

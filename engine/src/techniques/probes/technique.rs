@@ -83,4 +83,8 @@ impl Technique for ProbeTechnique {
             ctx.end_rendering(cmd);
         })]
     }
+
+    fn probe_counts(&self) -> Option<super::ProbeCounts> {
+        Some(self.set.counts())
+    }
 }
