@@ -263,9 +263,9 @@ typedef struct {
 
 /**
  * A technique and all its parameters; each technique reads the fields it uses and ignores the
- * rest. Start from `kage_technique_desc_default` and change what you need: techniques still to
- * come (adaptive shadow maps: a page budget; light probes: a probe set) will add their fields
- * here, and a host that starts from the default needs no other change than a recompile.
+ * rest. Start from `kage_technique_desc_default` and change what you need: fields added in
+ * later versions come with defaults there, so such a host needs no other change than a
+ * recompile.
  */
 typedef struct {
   /**
@@ -322,6 +322,49 @@ typedef struct {
    * A `kage_asm_test` value; default bias.
    */
   uint32_t asm_test;
+  /**
+   * A `kage_probe_placement` value; default grid.
+   */
+  uint32_t probe_placement;
+  /**
+   * Automatic placement's candidate grid along X, Y and Z (2 to 64 each), or all 0 for its
+   * default; default 0, 0, 0.
+   */
+  uint32_t probe_candidates[3];
+  /**
+   * Automatic placement's tolerance: the relative irradiance error below which a probe the
+   * others reproduce is dropped; default 0.05.
+   */
+  float probe_tolerance;
+  /**
+   * `KAGE_PROBE_PLACEMENT_POSITIONS`: x, y, z of each probe, read during
+   * `kage_renderer_create` only; default NULL.
+   */
+  const float *probe_positions;
+  /**
+   * Probes at `probe_positions`; default 0.
+   */
+  uint32_t probe_position_count;
+  /**
+   * A `kage_probe_interpolation` value; default tetrahedral.
+   */
+  uint32_t probe_interpolation;
+  /**
+   * Reflections of the walls' light the probes capture (sky and walls): 1 or 2; default 2.
+   */
+  uint32_t probe_bounces;
+  /**
+   * Monte Carlo samples per wall vertex and bounce of the probes' capture; default 256.
+   */
+  uint32_t probe_samples;
+  /**
+   * A `kage_probe_dering` value; default off.
+   */
+  uint32_t probe_dering;
+  /**
+   * The Hanning or Lanczos window's width in bands (> 0); default 0 (unused).
+   */
+  float probe_dering_width;
 } kage_technique_desc;
 
 /**
@@ -377,6 +420,19 @@ typedef struct {
    * no room for (its layer limit): their shadows are missing. 0 for other techniques.
    */
   uint32_t dropped_layers;
+  /**
+   * Light probes the probes technique interpolates; 0 for other techniques.
+   */
+  uint32_t probes;
+  /**
+   * Probes captured before automatic placement kept `probes` of them (the same as `probes`
+   * for the other placements); 0 for other techniques.
+   */
+  uint32_t probe_candidates;
+  /**
+   * Probe positions left out because they lie inside geometry; 0 for other techniques.
+   */
+  uint32_t probes_inside_geometry;
 } kage_renderer_stats;
 
 /**

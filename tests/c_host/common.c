@@ -146,7 +146,7 @@ static void run_frames(kage_context *context, kage_scene *scene, const kage_tech
   float *linear = malloc((size_t)size * size * 16);
   REQUIRE(rgba8 && linear);
   double previous = -1.0;
-  kage_renderer_stats first_stats = {0, 0};
+  kage_renderer_stats first_stats = {0};
   for (unsigned frame = 0; frame < frames; frame++) {
     float x = -1.0f + 2.0f * frame / (frames > 1 ? frames - 1 : 1);
     kage_transform t = box_at(x);

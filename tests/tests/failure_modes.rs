@@ -793,3 +793,79 @@ fn c_abi_catches_bad_values_and_calls_after_free() {
         pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
     assert!(linear.iter().all(|c| c.is_finite() && *c >= 0.0), "{linear:?}");
 }
+
+/// The probe technique through the C ABI, as a host drives it: probes at positions it passes,
+/// counted back by `kage_renderer_get_stats`; bad probe values are errors naming the field.
+#[test]
+fn c_abi_places_probes_and_reports_them() {
+    use capi::technique::{kage_probe_dering, kage_probe_interpolation, kage_probe_placement};
+    let _shared = alongside_others();
+    let c = CHost::new();
+    // Around the triangles (the scene's static group is the upper one): a tetrahedralization
+    // needs probes in 3D.
+    let positions: [f32; 15] =
+        [-1.0, 0.2, 0.5, 1.5, 0.2, 0.5, 0.2, 0.2, -1.5, 0.2, 1.2, -0.3, 0.2, -0.6, -0.3];
+    let probes = capi::technique::kage_technique_desc {
+        probe_placement: kage_probe_placement::Positions as u32,
+        probe_positions: positions.as_ptr(),
+        probe_position_count: 5,
+        probe_cube_size: 8,
+        probe_light: capi::technique::kage_probe_light::Sky as u32,
+        ..c.technique(capi::technique::kage_technique::Probes as u32)
+    };
+    let create = |technique| {
+        let desc = capi::renderer::kage_renderer_desc { width: 8, height: 8, technique };
+        let mut renderer = null_mut();
+        // SAFETY: live handles, a desc whose positions hold the count it states, a writable out.
+        let code = unsafe { capi::renderer::kage_renderer_create(c.context, c.scene, &desc, &mut renderer) };
+        (code, renderer)
+    };
+    let (code, renderer) = create(probes);
+    assert_eq!(code, kage_result::Ok, "{}", last_error());
+    let mut stats = capi::renderer::kage_renderer_stats::default();
+    // SAFETY: a live renderer and a local stats struct.
+    unsafe {
+        assert_eq!(capi::renderer::kage_renderer_render(renderer), kage_result::Ok, "{}", last_error());
+        assert_eq!(capi::renderer::kage_renderer_get_stats(renderer, &mut stats), kage_result::Ok);
+        assert_eq!(capi::renderer::kage_renderer_destroy(renderer), kage_result::Ok);
+    }
+    assert_eq!((stats.probes, stats.probe_candidates, stats.probes_inside_geometry), (5, 5, 0));
+
+    let hanning = kage_probe_dering::Hanning as u32;
+    let trilinear = kage_probe_interpolation::Trilinear as u32;
+    for (technique, expected, named) in [
+        (
+            capi::technique::kage_technique_desc { probe_placement: 3, ..probes },
+            kage_result::InvalidValue,
+            "probe_placement",
+        ),
+        (
+            capi::technique::kage_technique_desc { probe_positions: null(), ..probes },
+            kage_result::NullArgument,
+            "probe_positions",
+        ),
+        (
+            capi::technique::kage_technique_desc { probe_interpolation: trilinear, ..probes },
+            kage_result::InvalidValue,
+            "trilinear",
+        ),
+        (
+            capi::technique::kage_technique_desc { probe_dering: hanning, ..probes },
+            kage_result::InvalidValue,
+            "window width 0",
+        ),
+        (
+            capi::technique::kage_technique_desc {
+                probe_placement: kage_probe_placement::Auto as u32,
+                probe_tolerance: -1.0,
+                ..probes
+            },
+            kage_result::InvalidValue,
+            "tolerance -1",
+        ),
+    ] {
+        let (code, renderer) = create(technique);
+        assert_eq!((code, renderer), (expected, null_mut()), "{named}: {}", last_error());
+        assert!(last_error().contains(named), "{} does not name {named}", last_error());
+    }
+}

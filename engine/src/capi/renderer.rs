@@ -74,7 +74,8 @@ pub unsafe extern "C" fn kage_renderer_create(
         let (context, scene, desc) = unsafe {
             (handles::get(context, "context")?, handles::get(scene, "scene")?, args::value(desc, "desc")?)
         };
-        let technique = desc.technique.settings()?.choice(scene.transfer.clone())?;
+        // SAFETY: the caller promises a valid desc, its probe positions included.
+        let technique = unsafe { desc.technique.settings() }?.choice(scene.transfer.clone())?;
         let options = RenderOptions { width: desc.width, height: desc.height, technique };
         let made = Renderer::new(&context.ctx, &scene.scene, &options);
         kage_context::check_validation(&context.ctx)?;
@@ -168,6 +169,13 @@ pub struct kage_renderer_stats {
     /// Occluder/receiver/region layers the Tamura technique wanted in the last frame but had
     /// no room for (its layer limit): their shadows are missing. 0 for other techniques.
     pub dropped_layers: u32,
+    /// Light probes the probes technique interpolates; 0 for other techniques.
+    pub probes: u32,
+    /// Probes captured before automatic placement kept `probes` of them (the same as `probes`
+    /// for the other placements); 0 for other techniques.
+    pub probe_candidates: u32,
+    /// Probe positions left out because they lie inside geometry; 0 for other techniques.
+    pub probes_inside_geometry: u32,
 }
 
 /// Writes the renderer's statistics to `*stats`.
@@ -182,9 +190,14 @@ pub unsafe extern "C" fn kage_renderer_get_stats(
     boundary(|| {
         // SAFETY: the host does not destroy the handle during the call; stats NULL or writable.
         let (r, stats) = unsafe { (handles::get(renderer, "renderer")?, args::out(stats, "stats")?) };
+        let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        let probes = r.renderer.probe_counts();
         *stats = kage_renderer_stats {
             gpu_bytes: r.ctx.allocated_bytes(),
-            dropped_layers: u32::try_from(r.renderer.dropped_layers()).unwrap_or(u32::MAX),
+            dropped_layers: count(r.renderer.dropped_layers()),
+            probes: probes.map_or(0, |p| count(p.kept)),
+            probe_candidates: probes.map_or(0, |p| count(p.candidates)),
+            probes_inside_geometry: probes.map_or(0, |p| count(p.inside_geometry)),
         };
         Ok(())
     })

@@ -7,11 +7,13 @@ use super::scene::kage_scene;
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
 use crate::techniques::probes::{
-    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_GRID,
+    CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_GRID,
+    DEFAULT_TOLERANCE,
 };
 use crate::techniques::prt::{transfer, PrtParams};
 use crate::techniques::settings::{TechniqueKind, TechniqueSettings};
 use crate::techniques::tamura::technique::Penumbra;
+use glam::DVec3;
 use std::sync::Arc;
 
 /// The lighting techniques (the values of `kage_technique_desc.technique`).
@@ -72,10 +74,49 @@ pub enum kage_penumbra {
     Adaptive = 1,
 }
 
+/// Where the light probes go (the values of `kage_technique_desc.probe_placement`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_probe_placement {
+    /// `probe_grid` probes at the cell centres of that grid over the static groups' bounding box.
+    Grid = 0,
+    /// Candidates at the cell centres of a grid (`probe_candidates`; all 0: 8 along the box's
+    /// longest side, proportionally fewer along the others) outside solids are captured, then
+    /// those the others reproduce within `probe_tolerance` are dropped;
+    /// `kage_renderer_get_stats` reports how many remain.
+    Auto = 1,
+    /// The `probe_position_count` world positions at `probe_positions`.
+    Positions = 2,
+}
+
+/// How the light between probes is found (the values of `kage_technique_desc.probe_interpolation`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_probe_interpolation {
+    /// Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
+    Tetrahedral = 0,
+    /// Trilinear weights of the grid cell holding the point: `KAGE_PROBE_PLACEMENT_GRID` only.
+    Trilinear = 1,
+}
+
+/// The window on each probe's SH against ringing (the values of `kage_technique_desc.probe_dering`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_probe_dering {
+    /// The SH as captured; the shading clamps negative irradiance at 0.
+    Off = 0,
+    /// The gentlest window that keeps every probe's irradiance nonnegative.
+    NonNegative = 1,
+    /// Hanning window of width `probe_dering_width` bands (Sloan 2008).
+    Hanning = 2,
+    /// Lanczos window of width `probe_dering_width` bands (Sloan 2008).
+    Lanczos = 3,
+}
+
 /// A technique and all its parameters; each technique reads the fields it uses and ignores the
-/// rest. Start from `kage_technique_desc_default` and change what you need: techniques still to
-/// come (adaptive shadow maps: a page budget; light probes: a probe set) will add their fields
-/// here, and a host that starts from the default needs no other change than a recompile.
+/// rest. Start from `kage_technique_desc_default` and change what you need: fields added in
+/// later versions come with defaults there, so such a host needs no other change than a
+/// recompile.
 #[repr(C)]
 #[derive(Clone, Copy)]
 pub struct kage_technique_desc {
@@ -107,10 +148,36 @@ pub struct kage_technique_desc {
     pub asm_time_ms: f64,
     /// A `kage_asm_test` value; default bias.
     pub asm_test: u32,
+    /// A `kage_probe_placement` value; default grid.
+    pub probe_placement: u32,
+    /// Automatic placement's candidate grid along X, Y and Z (2 to 64 each), or all 0 for its
+    /// default; default 0, 0, 0.
+    pub probe_candidates: [u32; 3],
+    /// Automatic placement's tolerance: the relative irradiance error below which a probe the
+    /// others reproduce is dropped; default 0.05.
+    pub probe_tolerance: f32,
+    /// `KAGE_PROBE_PLACEMENT_POSITIONS`: x, y, z of each probe, read during
+    /// `kage_renderer_create` only; default NULL.
+    pub probe_positions: *const f32,
+    /// Probes at `probe_positions`; default 0.
+    pub probe_position_count: u32,
+    /// A `kage_probe_interpolation` value; default tetrahedral.
+    pub probe_interpolation: u32,
+    /// Reflections of the walls' light the probes capture (sky and walls): 1 or 2; default 2.
+    pub probe_bounces: u32,
+    /// Monte Carlo samples per wall vertex and bounce of the probes' capture; default 256.
+    pub probe_samples: u32,
+    /// A `kage_probe_dering` value; default off.
+    pub probe_dering: u32,
+    /// The Hanning or Lanczos window's width in bands (> 0); default 0 (unused).
+    pub probe_dering_width: f32,
 }
 
 impl kage_technique_desc {
-    pub(crate) fn settings(&self) -> Result<TechniqueSettings, Failure> {
+    /// # Safety
+    /// With `KAGE_PROBE_PLACEMENT_POSITIONS`, `probe_positions` must be NULL or readable for
+    /// `probe_position_count` × 3 floats.
+    pub(crate) unsafe fn settings(&self) -> Result<TechniqueSettings, Failure> {
         use kage_technique as T;
         let kind = args::enumeration(
             self.technique,
@@ -146,6 +213,46 @@ impl kage_technique_desc {
                 (kage_penumbra::Adaptive as u32, Penumbra::Adaptive),
             ],
         )?;
+        let placement = match args::enumeration(
+            self.probe_placement,
+            "probe_placement",
+            &[
+                (kage_probe_placement::Grid as u32, kage_probe_placement::Grid),
+                (kage_probe_placement::Auto as u32, kage_probe_placement::Auto),
+                (kage_probe_placement::Positions as u32, kage_probe_placement::Positions),
+            ],
+        )? {
+            kage_probe_placement::Grid => ProbePlacement::Grid(self.probe_grid),
+            kage_probe_placement::Auto => ProbePlacement::Auto {
+                tolerance: self.probe_tolerance,
+                candidates: (self.probe_candidates != [0; 3]).then_some(self.probe_candidates),
+            },
+            kage_probe_placement::Positions => {
+                let count = self.probe_position_count as usize;
+                // SAFETY: the caller promises NULL or `count` × 3 readable floats.
+                let points = unsafe { args::chunks::<3>(self.probe_positions, count, "probe_positions") }?;
+                ProbePlacement::Positions(points.iter().map(|&p| DVec3::from(p.map(f64::from))).collect())
+            }
+        };
+        let interpolation = args::enumeration(
+            self.probe_interpolation,
+            "probe_interpolation",
+            &[
+                (kage_probe_interpolation::Tetrahedral as u32, ProbeInterpolation::Tetrahedral),
+                (kage_probe_interpolation::Trilinear as u32, ProbeInterpolation::Trilinear),
+            ],
+        )?;
+        let width = self.probe_dering_width;
+        let dering = args::enumeration(
+            self.probe_dering,
+            "probe_dering",
+            &[
+                (kage_probe_dering::Off as u32, Dering::Off),
+                (kage_probe_dering::NonNegative as u32, Dering::NonNegative),
+                (kage_probe_dering::Hanning as u32, Dering::Hanning(width)),
+                (kage_probe_dering::Lanczos as u32, Dering::Lanczos(width)),
+            ],
+        )?;
         Ok(TechniqueSettings {
             kind,
             prt: PrtParams { bands: self.sh_bands, rays: self.prt_rays },
@@ -154,13 +261,15 @@ impl kage_technique_desc {
             penumbra,
             shadow_map_size: self.shadow_map_size,
             probes: ProbeSettings {
-                placement: ProbePlacement::Grid(self.probe_grid),
+                placement,
                 capture: CaptureSettings {
                     cube_size: self.probe_cube_size,
                     light: probe_light,
-                    ..Default::default()
+                    bounces: self.probe_bounces,
+                    samples: self.probe_samples,
+                    dering,
                 },
-                interpolation: ProbeInterpolation::Tetrahedral,
+                interpolation,
             },
             asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms, test: asm_test },
         }
@@ -198,9 +307,20 @@ pub unsafe extern "C" fn kage_technique_desc_default(
                 AsmTest::Bias => kage_asm_test::Bias as u32,
                 AsmTest::Id => kage_asm_test::Id as u32,
             },
+            probe_placement: kage_probe_placement::Grid as u32,
+            probe_candidates: [0; 3],
+            probe_tolerance: DEFAULT_TOLERANCE,
+            probe_positions: std::ptr::null(),
+            probe_position_count: 0,
+            probe_interpolation: kage_probe_interpolation::Tetrahedral as u32,
+            probe_bounces: d.probes.capture.bounces,
+            probe_samples: d.probes.capture.samples,
+            probe_dering: kage_probe_dering::Off as u32,
+            probe_dering_width: 0.0,
         };
         // An unknown technique is reported here already, not at the first use.
-        filled.settings()?;
+        // SAFETY: the default places no probes at positions.
+        unsafe { filled.settings() }?;
         *desc = filled;
         Ok(())
     })
@@ -226,8 +346,8 @@ pub unsafe extern "C" fn kage_precompute(
         // SAFETY: the host does not destroy or share the handles during the call.
         let (context, scene) =
             unsafe { (handles::get(context, "context")?, handles::get_mut(scene, "scene")?) };
-        // SAFETY: the caller promises NULL or a valid desc.
-        let settings = unsafe { args::value(technique, "technique") }?.settings()?;
+        // SAFETY: the caller promises NULL or a valid desc (its probe positions included).
+        let settings = unsafe { args::value(technique, "technique")?.settings() }?;
         if let Some(params) = settings.precomputation() {
             let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut |_, _| {});
             kage_context::check_validation(&context.ctx)?;

@@ -116,6 +116,13 @@ impl CaptureSettings {
             )));
         }
         check_bounces(self.bounces)?;
+        if let Dering::Hanning(w) | Dering::Lanczos(w) = self.dering {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "the probes' deringing window width {w} must be a positive number of bands"
+                )));
+            }
+        }
         if self.light == CapturedLight::SkyAndWalls && (self.bounces == 0 || self.samples == 0) {
             return Err(Error::InvalidArgument(format!(
                 "probes capturing the walls need at least 1 bounce and 1 sample per vertex (got {} and {})",
