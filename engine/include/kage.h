@@ -111,9 +111,9 @@ enum kage_technique
    */
   KAGE_TECHNIQUE_PARALLEL_LIGHTS = 3,
   /**
-   * Morishige 2014: light probes on a `probe_grid` over the static groups, captured as SH
-   * when the renderer is created, light the scene's first group (the moving one); the other
-   * groups are lit as by `Unshadowed`.
+   * Morishige 2014: light probes (`probe_placement`), captured as SH when the renderer is
+   * created, light the scene's first group (the moving one); the other groups are lit as
+   * `probe_statics` says.
    */
   KAGE_TECHNIQUE_PROBES = 4,
   /**
@@ -365,6 +365,11 @@ typedef struct {
    * The Hanning or Lanczos window's width in bands (> 0); default 0 (unused).
    */
   float probe_dering_width;
+  /**
+   * A `kage_static_lighting` value: how the probes technique lights the static groups;
+   * default unshadowed. Sloan's PRT needs `kage_precompute` (with `sh_bands`, `prt_rays`).
+   */
+  uint32_t probe_statics;
 } kage_technique_desc;
 
 /**

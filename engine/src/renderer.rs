@@ -155,8 +155,9 @@ pub enum TechniqueChoice {
     /// lights with binary shadow maps of `shadow_map_size`² texels.
     ParallelLights { regions: usize, shadow_map_size: u32 },
     /// Light probes captured when the renderer is built light the moving group; the static
-    /// groups are lit as by `Unshadowed`.
-    Probes(ProbeSettings),
+    /// groups are lit as `settings.statics` says: by `Unshadowed`, or by Sloan's PRT from
+    /// `transfer` (required then).
+    Probes { settings: ProbeSettings, transfer: Option<Arc<TransferSet>> },
     /// The scene's point and spot lights with hard shadows from one conventional shadow map of
     /// `size`² texels per light (the baseline of adaptive shadow maps).
     ShadowMap { size: u32 },
@@ -207,7 +208,9 @@ impl Renderer {
             TechniqueChoice::ParallelLights { regions, shadow_map_size } => {
                 Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
             }
-            TechniqueChoice::Probes(settings) => Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings)?),
+            TechniqueChoice::Probes { settings, transfer } => {
+                Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings, transfer.as_deref())?)
+            }
             TechniqueChoice::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
             TechniqueChoice::Asm(settings) => Box::new(Asm::new(ctx, scene, &gpu, *settings)?),
         };

@@ -119,11 +119,14 @@ fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, Technique
         ("shadowmap", TechniqueChoice::ShadowMap { size: 16 }),
         (
             "probes",
-            TechniqueChoice::Probes(ProbeSettings {
-                placement: ProbePlacement::Grid([2, 2, 2]),
-                capture: CaptureSettings { cube_size: 8, samples: 16, ..Default::default() },
-                ..Default::default()
-            }),
+            TechniqueChoice::Probes {
+                settings: ProbeSettings {
+                    placement: ProbePlacement::Grid([2, 2, 2]),
+                    capture: CaptureSettings { cube_size: 8, samples: 16, ..Default::default() },
+                    ..Default::default()
+                },
+                transfer: None,
+            },
         ),
         ("asm", TechniqueChoice::Asm(AsmSettings { budget_mb: 1.0, ..AsmSettings::default() })),
     ]
@@ -862,6 +865,19 @@ fn c_abi_places_probes_and_reports_them() {
             },
             kage_result::InvalidValue,
             "tolerance -1",
+        ),
+        (
+            capi::technique::kage_technique_desc { probe_statics: 7, ..probes },
+            kage_result::InvalidValue,
+            "probe_statics",
+        ),
+        (
+            capi::technique::kage_technique_desc {
+                probe_statics: capi::technique::kage_static_lighting::Sloan as u32,
+                ..probes
+            },
+            kage_result::InvalidValue,
+            "precompute it first",
         ),
     ] {
         let (code, renderer) = create(technique);

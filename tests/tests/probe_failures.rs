@@ -70,8 +70,11 @@ fn irradiance_range(sh: &ShRgb9) -> (f32, f32) {
 fn a_tiny_sun_rings_negative_the_shading_clamps_it_and_deringing_removes_it() {
     let ctx = Validated::new();
     let scene = sun_scene();
-    let options =
-        |dering| RenderOptions { width: 32, height: 32, technique: TechniqueChoice::Probes(probes(dering)) };
+    let options = |dering| RenderOptions {
+        width: 32,
+        height: 32,
+        technique: TechniqueChoice::Probes { settings: probes(dering), transfer: None },
+    };
     let mut renderer = Renderer::new(&ctx, &scene, &options(Dering::Off)).unwrap();
     renderer.render().unwrap();
     let image = renderer.image().unwrap();
@@ -143,7 +146,11 @@ fn a_probe_inside_a_wall_is_detected_and_left_out() {
     assert_eq!((set.invalid[0].index, set.invalid[0].position), (8, inside));
     assert_eq!(set.mesh.positions().len(), 8, "the probe in the slab is not tetrahedralized");
 
-    let options = RenderOptions { width: 24, height: 24, technique: TechniqueChoice::Probes(settings) };
+    let options = RenderOptions {
+        width: 24,
+        height: 24,
+        technique: TechniqueChoice::Probes { settings, transfer: None },
+    };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     renderer.render().unwrap();
     assert!(renderer.image().unwrap().pixels.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));

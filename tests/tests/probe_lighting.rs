@@ -29,7 +29,11 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
         },
         ..Default::default()
     };
-    let options = RenderOptions { width: 48, height: 48, technique: TechniqueChoice::Probes(probes) };
+    let options = RenderOptions {
+        width: 48,
+        height: 48,
+        technique: TechniqueChoice::Probes { settings: probes, transfer: None },
+    };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     // Two frames, the first with the bunny near the green wall: the second frame's walk starts
     // from the first's tetrahedron.
@@ -45,6 +49,47 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
     let (left, right) = (at(18, 30), at(30, 30));
     assert!(left.iter().chain(&right).all(|v| v.is_finite()));
     assert!(left[0] / left[1] > right[0] / right[1], "left {left:?} right {right:?}");
+}
+
+/// The probes combine with the static groups' own lighting in one frame and one depth buffer:
+/// with Sloan's PRT for the static groups, every pixel is exactly the pure Sloan render's (the
+/// walls, floor and sky) or exactly the probes render's with unshadowed statics (the bunny),
+/// and both kinds occur.
+#[test]
+fn static_groups_keep_their_own_prt_lighting_beside_the_probe_lit_bunny() {
+    use kage::techniques::probes::StaticLighting;
+    use kage::techniques::prt::{transfer, PrtParams};
+    use kage::techniques::tamura::technique::OcclusionSettings;
+    use std::sync::Arc;
+    let ctx = Validated::new();
+    let scene = Scene::builtin("probe-room").unwrap();
+    let params = PrtParams { bands: 3, rays: 16 };
+    let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| {}).unwrap());
+    let probes = ProbeSettings {
+        placement: ProbePlacement::Grid([2, 2, 2]),
+        capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
+        ..Default::default()
+    };
+    let render = |technique| {
+        let options = RenderOptions { width: 48, height: 48, technique };
+        let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
+        renderer.render().unwrap();
+        renderer.image().unwrap().pixels
+    };
+    let sloan_statics = ProbeSettings { statics: StaticLighting::Sloan, ..probes.clone() };
+    let combined = render(TechniqueChoice::Probes { settings: sloan_statics, transfer: Some(prt.clone()) });
+    let sloan = OcclusionSettings { regions: 0, ..OcclusionSettings::default() };
+    let pure_sloan = render(TechniqueChoice::Prt { transfer: prt, occlusion: sloan });
+    let unshadowed_statics = render(TechniqueChoice::Probes { settings: probes, transfer: None });
+    let (mut as_sloan, mut as_probes) = (0, 0);
+    for (i, p) in combined.iter().enumerate() {
+        let (s, u) = (*p == pure_sloan[i], *p == unshadowed_statics[i]);
+        assert!(s || u, "pixel {i}: {p:?}, Sloan {:?}, probes {:?}", pure_sloan[i], unshadowed_statics[i]);
+        as_sloan += usize::from(s && !u);
+        as_probes += usize::from(u && !s);
+    }
+    eprintln!("{as_sloan} pixels as Sloan's alone, {as_probes} as the probes' alone");
+    assert!(as_sloan > 500 && as_probes > 20, "{as_sloan} static, {as_probes} bunny pixels");
 }
 
 /// Points in probe-room, inside the probe grid's hull, each with a normal that sees the sky

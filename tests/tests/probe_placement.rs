@@ -13,6 +13,7 @@ fn tiny(placement: ProbePlacement, interpolation: ProbeInterpolation) -> ProbeSe
         placement,
         capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
         interpolation,
+        ..Default::default()
     }
 }
 
@@ -64,7 +65,11 @@ fn trilinear_interpolation_needs_a_grid_and_lights_the_bunny() {
     scene.camera.position = Vec3::new(0.0, 0.35, 1.2);
     scene.camera.target = Vec3::new(0.0, 0.35, 0.0);
     let probes = tiny(ProbePlacement::Grid([2, 2, 2]), ProbeInterpolation::Trilinear);
-    let options = RenderOptions { width: 24, height: 24, technique: TechniqueChoice::Probes(probes) };
+    let options = RenderOptions {
+        width: 24,
+        height: 24,
+        technique: TechniqueChoice::Probes { settings: probes, transfer: None },
+    };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     renderer.render().unwrap();
     let image = renderer.image().unwrap();

@@ -10,7 +10,8 @@ use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::probes::{
-    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_TOLERANCE,
+    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
+    DEFAULT_TOLERANCE,
 };
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
@@ -63,6 +64,15 @@ pub enum ProbeInterpolationName {
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StaticLightingName {
+    /// The environment's SH irradiance, unshadowed.
+    Unshadowed,
+    /// Sloan's PRT, self-shadowed among the static groups (precomputed and cached as for
+    /// `--technique sloan`).
+    Sloan,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AsmTestName {
     Id,
     Bias,
@@ -112,6 +122,9 @@ pub struct RenderArgs {
     /// How the light between probes is found: `trilinear` needs a `grid:` placement.
     #[arg(long, value_enum, default_value_t = ProbeInterpolationName::Tetrahedral)]
     probe_interpolation: ProbeInterpolationName,
+    /// How the probes technique lights the static groups beside the probe-lit moving group.
+    #[arg(long, value_enum, default_value_t = StaticLightingName::Unshadowed)]
+    probe_statics: StaticLightingName,
     /// Texels per side of a probe's cube-map face, 8 to 256.
     #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_CUBE_SIZE)]
     probe_cube_size: u32,
@@ -209,6 +222,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             interpolation: match args.probe_interpolation {
                 ProbeInterpolationName::Tetrahedral => ProbeInterpolation::Tetrahedral,
                 ProbeInterpolationName::Trilinear => ProbeInterpolation::Trilinear,
+            },
+            statics: match args.probe_statics {
+                StaticLightingName::Unshadowed => StaticLighting::Unshadowed,
+                StaticLightingName::Sloan => StaticLighting::Sloan,
             },
         },
         asm: AsmSettings {

@@ -7,8 +7,8 @@ use super::scene::kage_scene;
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
 use crate::techniques::probes::{
-    CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings, DEFAULT_GRID,
-    DEFAULT_TOLERANCE,
+    CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
+    StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
 use crate::techniques::prt::{transfer, PrtParams};
 use crate::techniques::settings::{TechniqueKind, TechniqueSettings};
@@ -30,9 +30,9 @@ pub enum kage_technique {
     Tamura = 2,
     /// Baseline: `regions` environment regions as directional lights with binary shadow maps.
     ParallelLights = 3,
-    /// Morishige 2014: light probes on a `probe_grid` over the static groups, captured as SH
-    /// when the renderer is created, light the scene's first group (the moving one); the other
-    /// groups are lit as by `Unshadowed`.
+    /// Morishige 2014: light probes (`probe_placement`), captured as SH when the renderer is
+    /// created, light the scene's first group (the moving one); the other groups are lit as
+    /// `probe_statics` says.
     Probes = 4,
     /// The scene's point and spot lights with hard shadows from one conventional shadow map of
     /// `shadow_map_size`² texels per light (1 to 8 lights).
@@ -113,6 +113,17 @@ pub enum kage_probe_dering {
     Lanczos = 3,
 }
 
+/// How the probes technique lights the static groups (the values of
+/// `kage_technique_desc.probe_statics`).
+#[repr(u32)]
+#[derive(Clone, Copy)]
+pub enum kage_static_lighting {
+    /// The environment's SH irradiance, unshadowed.
+    Unshadowed = 0,
+    /// Sloan's PRT, self-shadowed among the static groups.
+    Sloan = 1,
+}
+
 /// A technique and all its parameters; each technique reads the fields it uses and ignores the
 /// rest. Start from `kage_technique_desc_default` and change what you need: fields added in
 /// later versions come with defaults there, so such a host needs no other change than a
@@ -171,6 +182,9 @@ pub struct kage_technique_desc {
     pub probe_dering: u32,
     /// The Hanning or Lanczos window's width in bands (> 0); default 0 (unused).
     pub probe_dering_width: f32,
+    /// A `kage_static_lighting` value: how the probes technique lights the static groups;
+    /// default unshadowed. Sloan's PRT needs `kage_precompute` (with `sh_bands`, `prt_rays`).
+    pub probe_statics: u32,
 }
 
 impl kage_technique_desc {
@@ -270,6 +284,14 @@ impl kage_technique_desc {
                     dering,
                 },
                 interpolation,
+                statics: args::enumeration(
+                    self.probe_statics,
+                    "probe_statics",
+                    &[
+                        (kage_static_lighting::Unshadowed as u32, StaticLighting::Unshadowed),
+                        (kage_static_lighting::Sloan as u32, StaticLighting::Sloan),
+                    ],
+                )?,
             },
             asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms, test: asm_test },
         }
@@ -317,6 +339,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_samples: d.probes.capture.samples,
             probe_dering: kage_probe_dering::Off as u32,
             probe_dering_width: 0.0,
+            probe_statics: kage_static_lighting::Unshadowed as u32,
         };
         // An unknown technique is reported here already, not at the first use.
         // SAFETY: the default places no probes at positions.

@@ -3,7 +3,7 @@
 //! [`TechniqueChoice`] once the precomputation it needs is done.
 use super::asm::AsmSettings;
 use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
-use super::probes::ProbeSettings;
+use super::probes::{ProbeSettings, StaticLighting};
 use super::prt::{PrtParams, TransferSet};
 use super::tamura::technique::{OcclusionSettings, Penumbra};
 use crate::error::{Error, Result};
@@ -68,7 +68,10 @@ impl Default for TechniqueSettings {
 impl TechniqueSettings {
     /// The PRT precomputation the technique needs before its first frame, if any.
     pub fn precomputation(&self) -> Option<PrtParams> {
-        matches!(self.kind, TechniqueKind::Sloan | TechniqueKind::Tamura).then_some(self.prt)
+        let sloan_statics =
+            self.kind == TechniqueKind::Probes && self.probes.statics == StaticLighting::Sloan;
+        (matches!(self.kind, TechniqueKind::Sloan | TechniqueKind::Tamura) || sloan_statics)
+            .then_some(self.prt)
     }
 
     /// Checks what can be checked before any GPU work (the techniques check the rest when
@@ -94,7 +97,7 @@ impl TechniqueSettings {
     /// by techniques that need none); it must have been computed with `self.prt`'s bands.
     pub fn choice(&self, transfer: Option<Arc<TransferSet>>) -> Result<TechniqueChoice> {
         let settings = self.clone().validated()?;
-        let prt = |regions| match transfer {
+        let transfer = || match &transfer {
             None => Err(Error::InvalidArgument(format!(
                 "the {:?} technique needs the PRT transfer: precompute it first",
                 settings.kind
@@ -105,15 +108,18 @@ impl TechniqueSettings {
                     transfer.params.bands, settings.prt.bands
                 )))
             }
-            Some(transfer) => Ok(TechniqueChoice::Prt {
-                transfer,
+            Some(transfer) => Ok(transfer.clone()),
+        };
+        let prt = |regions| {
+            Ok(TechniqueChoice::Prt {
+                transfer: transfer()?,
                 occlusion: OcclusionSettings {
                     regions,
                     mask_size: settings.mask_size,
                     penumbra: settings.penumbra,
                     ..OcclusionSettings::default()
                 },
-            }),
+            })
         };
         match settings.kind {
             TechniqueKind::Unshadowed => Ok(TechniqueChoice::Unshadowed),
@@ -123,7 +129,13 @@ impl TechniqueSettings {
                 regions: settings.regions,
                 shadow_map_size: settings.shadow_map_size,
             }),
-            TechniqueKind::Probes => Ok(TechniqueChoice::Probes(settings.probes)),
+            TechniqueKind::Probes => Ok(TechniqueChoice::Probes {
+                transfer: match settings.probes.statics {
+                    StaticLighting::Unshadowed => None,
+                    StaticLighting::Sloan => Some(transfer()?),
+                },
+                settings: settings.probes.clone(),
+            }),
             TechniqueKind::ShadowMap => Ok(TechniqueChoice::ShadowMap { size: settings.shadow_map_size }),
             TechniqueKind::Asm => Ok(TechniqueChoice::Asm(settings.asm)),
         }
@@ -156,7 +168,10 @@ mod tests {
         assert!(matches!(map.choice(None), Ok(TechniqueChoice::ShadowMap { size: 2048 })));
         assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
         assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
-        assert!(matches!(of(TechniqueKind::Probes).choice(None), Ok(TechniqueChoice::Probes(_))));
+        assert!(matches!(
+            of(TechniqueKind::Probes).choice(None),
+            Ok(TechniqueChoice::Probes { transfer: None, .. })
+        ));
         let asm = TechniqueSettings {
             asm: AsmSettings { budget_mb: 4.0, time_ms: 2.0, ..AsmSettings::default() },
             ..of(TechniqueKind::Asm)
@@ -165,6 +180,15 @@ mod tests {
             matches!(asm.choice(None), Ok(TechniqueChoice::Asm(s)) if s.budget_mb == 4.0 && s.time_ms == 2.0)
         );
         assert_eq!(of(TechniqueKind::Probes).precomputation(), None);
+        // Static groups by Sloan's PRT: the probes technique needs the transfer too.
+        let mut sloan_statics = of(TechniqueKind::Probes);
+        sloan_statics.probes.statics = StaticLighting::Sloan;
+        assert_eq!(sloan_statics.precomputation(), Some(PrtParams::DEFAULT));
+        assert!(matches!(
+            sloan_statics.choice(transfer(3)),
+            Ok(TechniqueChoice::Probes { transfer: Some(_), .. })
+        ));
+        assert!(error(sloan_statics, None).contains("precompute it first"));
     }
 
     #[test]

@@ -48,7 +48,7 @@ pub use lookup::{Location, Walker};
 pub use reduce::reduce;
 pub use set::{
     bounds, capture_at, grid_lattice, is_static, ProbeCounts, ProbeInterpolation, ProbePlacement, ProbeSet,
-    ProbeSettings, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
+    ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
 };
 pub use solids::{Hit, Solids};
 pub use tetmesh::{Across, TetMesh};

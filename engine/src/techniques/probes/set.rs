@@ -66,12 +66,23 @@ impl Default for ProbePlacement {
     }
 }
 
-/// The probes' placement and capture.
+/// How the static groups are lit in the frame the probes light the moving group in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StaticLighting {
+    /// The environment's SH irradiance, unshadowed.
+    #[default]
+    Unshadowed,
+    /// Sloan's PRT: self-shadowed by the static groups (needs the PRT precomputation).
+    Sloan,
+}
+
+/// The probes' placement and capture, and the static groups' lighting beside them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ProbeSettings {
     pub placement: ProbePlacement,
     pub capture: CaptureSettings,
     pub interpolation: ProbeInterpolation,
+    pub statics: StaticLighting,
 }
 
 impl ProbeSettings {

@@ -1,26 +1,36 @@
 //! The light-probe technique: the moving group ([`MOVING_GROUP`]) takes its irradiance from
 //! the probes, E(n) = nᵀMn (Ramamoorthi & Hanrahan 2001) with M from the SH interpolated at the
 //! group's centre by a walker that starts where the last frame's lookup ended (one lookup per
-//! object per frame, on the host; with trilinear interpolation, from the grid cell instead); negative irradiance is clamped; times albedo / π. The static
-//! groups keep their own lighting: for now the unshadowed technique's (environment SH, no
-//! shadows). The probes are captured once, when the technique is built, with the environment
-//! unrotated: turning the environment afterwards turns the static groups' light, not the
-//! probes'.
-use super::set::{bounds, is_static, ProbeSet, ProbeSettings, MOVING_GROUP};
+//! object per frame, on the host; with trilinear interpolation, from the grid cell instead);
+//! negative irradiance is clamped; times albedo / π. The static groups keep their own lighting
+//! in the same frame and depth buffer: the unshadowed technique's (environment SH, no shadows)
+//! or Sloan's PRT (self-shadowed among the static groups: walls shade each other). The probes
+//! are captured once, when the technique is built, with the environment unrotated: turning the
+//! environment afterwards turns the static groups' light, not the probes'.
+use super::set::{bounds, is_static, ProbeSet, ProbeSettings, StaticLighting, MOVING_GROUP};
 use super::Walker;
 use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, GraphicsPipeline, MemoryLocation};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, spirv, ProbeLight};
 use crate::pass::Pass;
 use crate::renderer::GpuScene;
 use crate::scene::Scene;
+use crate::techniques::prt::TransferSet;
+use crate::techniques::tamura::technique::{OcclusionSettings, PrtTechnique};
 use crate::techniques::unshadowed::{draw_meshes, scene_pipeline, Unshadowed};
 use crate::techniques::{FrameInputs, FrameState, Technique};
 use glam::Vec3;
 use std::sync::Arc;
 
+/// The static groups' lighting.
+enum Statics {
+    Unshadowed(Unshadowed),
+    /// Sloan's PRT (a PRT technique without regions), drawing the static groups only.
+    Sloan(Box<PrtTechnique>),
+}
+
 pub struct ProbeTechnique {
-    statics: Unshadowed,
+    statics: Statics,
     pipeline: GraphicsPipeline,
     set: ProbeSet,
     /// The moving group's centre in its object space (its bounding box's), where it looks up
@@ -32,19 +42,33 @@ pub struct ProbeTechnique {
 }
 
 impl ProbeTechnique {
-    /// Captures the probes (see [`ProbeSet::capture`]).
+    /// Captures the probes (see [`ProbeSet::capture`]). `transfer`: the PRT transfer, which
+    /// static groups lit by Sloan's PRT need.
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
         gpu: &GpuScene,
         settings: &ProbeSettings,
+        transfer: Option<&TransferSet>,
     ) -> Result<ProbeTechnique> {
+        let statics = match (settings.statics, transfer) {
+            (StaticLighting::Unshadowed, _) => Statics::Unshadowed(Unshadowed::new(ctx)?),
+            (StaticLighting::Sloan, Some(transfer)) => {
+                let sloan = OcclusionSettings { regions: 0, ..OcclusionSettings::default() };
+                Statics::Sloan(Box::new(PrtTechnique::new(ctx, scene, gpu, transfer, sloan)?))
+            }
+            (StaticLighting::Sloan, None) => {
+                return Err(Error::InvalidArgument(
+                    "static groups lit by Sloan's PRT need the PRT transfer: precompute it first".into(),
+                ))
+            }
+        };
         let centre = scene.groups.get(MOVING_GROUP).and_then(|group| {
             let points = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
             bounds(points).map(|(lo, hi)| (lo + hi) * 0.5)
         });
         Ok(ProbeTechnique {
-            statics: Unshadowed::new(ctx)?,
+            statics,
             pipeline: scene_pipeline(ctx, "scene_probes", spirv::PROBE_SCENE_FRAG)?,
             set: ProbeSet::capture(ctx, scene, gpu, settings)?,
             centre,
@@ -64,6 +88,9 @@ impl ProbeTechnique {
 
 impl Technique for ProbeTechnique {
     fn update(&mut self, state: &FrameState) -> Result<()> {
+        if let Statics::Sloan(prt) = &mut self.statics {
+            prt.update(state)?;
+        }
         let (Some(centre), Some(transform)) = (self.centre, state.transforms.get(MOVING_GROUP)) else {
             return Ok(());
         };
@@ -72,16 +99,32 @@ impl Technique for ProbeTechnique {
         self.light.write(0, bytes_of(&ProbeLight { red, green, blue }))
     }
 
+    fn persistent(&self) -> &'static [&'static str] {
+        match &self.statics {
+            Statics::Unshadowed(_) => &[],
+            Statics::Sloan(prt) => prt.persistent(),
+        }
+    }
+
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, env_sh, scene, targets) =
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
-        vec![Pass::new("scene", &["frame_uniforms", "env_sh", "color"], &["color", "depth"], move |cmd| {
+        let (mut passes, reads): (Vec<Pass>, &'static [&'static str]) = match &self.statics {
+            Statics::Unshadowed(_) => (Vec::new(), &["frame_uniforms", "env_sh", "color"]),
+            Statics::Sloan(prt) => (prt.prepasses(ctx, scene), &["frame_uniforms", "self_shadow", "color"]),
+        };
+        passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.statics.draw(ctx, cmd, uniforms, env_sh, scene, |m| is_static(m.group).then_some(m.albedo));
+            match &self.statics {
+                Statics::Unshadowed(unshadowed) => unshadowed
+                    .draw(ctx, cmd, uniforms, env_sh, scene, |m| is_static(m.group).then_some(m.albedo)),
+                Statics::Sloan(prt) => prt.record_draws(ctx, cmd, uniforms, scene, is_static),
+            }
             self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(&self.light)]);
             draw_meshes(ctx, cmd, &self.pipeline, scene, |m| (!is_static(m.group)).then_some(m.albedo));
             ctx.end_rendering(cmd);
-        })]
+        }));
+        passes
     }
 
     fn probe_counts(&self) -> Option<super::ProbeCounts> {

@@ -4,7 +4,7 @@ use super::occlusion::{group_bounds, Occlusion};
 use super::regions::Regions;
 use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::backend::{
-    vk, Binding, BindingKind, Context, Edge, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, Context, Edge, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush};
@@ -168,11 +168,7 @@ impl Technique for PrtTechnique {
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
-        let mut passes: Vec<Pass> = self.self_shadow.pass(ctx, scene).into_iter().collect();
-        passes.extend(self.occlusion.passes(ctx, scene));
-        let q = self.occlusion.region_count() as u32;
-        let occlusion = &self.occlusion;
-        let self_shadow = &self.self_shadow;
+        let mut passes = self.prepasses(ctx, scene);
         let reads: &'static [&'static str] = if passes.iter().any(|p| p.name == "blur_vertical") {
             &["frame_uniforms", "self_shadow", "occlusion", "color"]
         } else {
@@ -180,35 +176,60 @@ impl Technique for PrtTechnique {
         };
         passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.scene_pipeline.bind(
-                cmd,
-                &[
-                    Binding::Uniform(uniforms),
-                    Binding::Sampled(&self_shadow.texture, &self.nearest),
-                    Binding::Storage(&occlusion.region_basis),
-                    Binding::Uniform(&occlusion.energy),
-                    Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
-                    Binding::Uniform(&occlusion.layers),
-                ],
-            );
-            for (i, mesh) in scene.meshes.iter().enumerate() {
-                let (first_layer, layer_count) = occlusion.ranges[mesh.group];
-                let push = PrtDrawPush {
-                    model: scene.transforms[mesh.group].to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
-                    layers: [first_layer, layer_count, 0, occlusion.resolution],
-                };
-                self.scene_pipeline.push(cmd, bytes_of(&push));
-                ctx.draw_indexed(
-                    cmd,
-                    &[&mesh.vertices, &self_shadow.transfer[i]],
-                    &mesh.indices,
-                    mesh.index_count,
-                );
-            }
+            self.record_draws(ctx, cmd, uniforms, scene, |_| true);
             ctx.end_rendering(cmd);
         }));
         passes
+    }
+}
+
+impl PrtTechnique {
+    /// The passes before the scene's: the self-shadow texels of the groups that turned, and
+    /// the occlusion layers between groups (none for Sloan's PRT).
+    pub fn prepasses<'a>(&'a self, ctx: &'a Arc<Context>, scene: &'a GpuScene) -> Vec<Pass<'a>> {
+        let mut passes: Vec<Pass> = self.self_shadow.pass(ctx, scene).into_iter().collect();
+        passes.extend(self.occlusion.passes(ctx, scene));
+        passes
+    }
+
+    /// Records, inside a rendering scope, the meshes of the groups `drawn` keeps with eq. (15)
+    /// (Sloan's PRT where there are no regions).
+    pub fn record_draws(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        uniforms: &Buffer,
+        scene: &GpuScene,
+        drawn: impl Fn(usize) -> bool,
+    ) {
+        let (occlusion, self_shadow) = (&self.occlusion, &self.self_shadow);
+        self.scene_pipeline.bind(
+            cmd,
+            &[
+                Binding::Uniform(uniforms),
+                Binding::Sampled(&self_shadow.texture, &self.nearest),
+                Binding::Storage(&occlusion.region_basis),
+                Binding::Uniform(&occlusion.energy),
+                Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
+                Binding::Uniform(&occlusion.layers),
+            ],
+        );
+        let q = occlusion.region_count() as u32;
+        for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| drawn(m.group)) {
+            let (first_layer, layer_count) = occlusion.ranges[mesh.group];
+            let push = PrtDrawPush {
+                model: scene.transforms[mesh.group].to_cols_array_2d(),
+                albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
+                layers: [first_layer, layer_count, 0, occlusion.resolution],
+            };
+            self.scene_pipeline.push(cmd, bytes_of(&push));
+            ctx.draw_indexed(
+                cmd,
+                &[&mesh.vertices, &self_shadow.transfer[i]],
+                &mesh.indices,
+                mesh.index_count,
+            );
+        }
     }
 }
