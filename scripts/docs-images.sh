@@ -9,7 +9,18 @@
 #                              |luminance(tamura) − luminance(reference)|, viridis, yellow at the
 #                              99th percentile of those errors
 #
-# and prints the relative RMSE of tamura and sloan against the reference (`kage compare`).
+# and prints the relative RMSE of tamura and sloan against the reference (`kage compare`);
+# then adaptive shadow maps on the `asm` scene's grating close-up (walkthrough keyframe 1):
+#
+#   docs/asm-reference.png     `kage reference --light local` (hard shadows, exact)
+#   docs/asm-asm.png           `kage render --technique asm --asm-budget-mb 16` after 20 frames
+#   docs/asm-mismatch-asm.png  `kage compare --mismatch-image` of the ASM render: red lit in
+#                              the render only, blue lit in the reference only
+#   docs/asm-mismatch-map.png  the same for the conventional 2048² map (16 MiB too)
+#
+# and the light probes in probe-room, the bunny lit by 18 probes, the room by Sloan's PRT:
+#
+#   docs/probes-room.png       `kage render --technique probes --probe-statics sloan`
 # Four separate PNGs, put side by side by a Markdown table in README.md: no image tool needed.
 #
 # Run by hand (not in CI), from anywhere: bash scripts/docs-images.sh
@@ -45,3 +56,18 @@ echo "== tamura vs reference"
 echo "== sloan vs reference"
 "$kage" compare "$work/sloan.exr" "$work/reference.exr"
 echo "wrote docs/tamura-reference.png docs/tamura-tamura.png docs/tamura-sloan.png docs/tamura-diff.png"
+
+close=(--scene asm --keyframe 1 --width "$SIZE" --height "$SIZE")
+"$kage" reference "${close[@]}" --light local --out "$work/asm-reference.exr"
+"$kage" reference "${close[@]}" --light local --out docs/asm-reference.png
+"$kage" render "${close[@]}" --technique asm --asm-budget-mb 16 --frames 20 --out "$work/asm.exr"
+"$kage" render "${close[@]}" --technique asm --asm-budget-mb 16 --frames 20 --out docs/asm-asm.png
+"$kage" render "${close[@]}" --technique shadowmap --shadowmap-size 2048 --out "$work/map.exr"
+echo "== asm (16 MiB) vs reference"
+"$kage" compare "$work/asm.exr" "$work/asm-reference.exr" --shadow-mismatch --mismatch-image docs/asm-mismatch-asm.png
+echo "== shadowmap 2048² (16 MiB) vs reference"
+"$kage" compare "$work/map.exr" "$work/asm-reference.exr" --shadow-mismatch --mismatch-image docs/asm-mismatch-map.png
+echo "wrote docs/asm-reference.png docs/asm-asm.png docs/asm-mismatch-asm.png docs/asm-mismatch-map.png"
+
+"$kage" render --scene probe-room --width "$SIZE" --height "$SIZE" --technique probes --probe-statics sloan --exposure 4 --out docs/probes-room.png
+echo "wrote docs/probes-room.png"

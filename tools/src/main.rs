@@ -54,6 +54,36 @@ impl GpuArgs {
     }
 }
 
+/// The scene a command looks at: `--scene` and, optionally, a keyframe of its walkthrough.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium), a scene
+    /// file (.json), or a folder holding scene.json.
+    #[arg(long, default_value = "teapot")]
+    scene: String,
+    /// Look from keyframe K (from 0) of the scene's camera walkthrough instead of its camera.
+    #[arg(long)]
+    keyframe: Option<usize>,
+}
+
+impl SceneArgs {
+    pub fn load(&self) -> Result<kage::scene::Scene> {
+        let mut scene = kage::scene::Scene::from_arg(&self.scene)?;
+        if let Some(k) = self.keyframe {
+            let Some(camera) = scene.walkthrough.get(k) else {
+                bail!(
+                    "--keyframe {k}: scene {} has {} walkthrough keyframes (\"walkthrough\" in scene files)",
+                    scene.name,
+                    scene.walkthrough.len()
+                );
+            };
+            scene.camera = *camera;
+        }
+        report_clamped(&scene.environment);
+        Ok(scene)
+    }
+}
+
 /// Says so when loading an environment map changed it (negative texels clamped to 0).
 pub fn report_clamped(map: &kage::scene::EnvMap) {
     if map.clamped_negative() > 0 {

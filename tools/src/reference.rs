@@ -15,9 +15,8 @@ use std::time::{Duration, Instant};
 
 #[derive(Args)]
 pub struct ReferenceArgs {
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
-    #[arg(long, default_value = "teapot")]
-    scene: String,
+    #[command(flatten)]
+    scene: crate::SceneArgs,
     /// Samples per pixel (or per point). Each sample casts two shadow rays (one drawn from the
     /// environment, one cosine-weighted). The paper's reference uses 16384.
     #[arg(long, default_value_t = 1024)]
@@ -120,8 +119,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     }
     // Bad input files fail before the GPU is set up.
     let points = args.irradiance.as_deref().map(read_points).transpose()?;
-    let scene = Scene::from_arg(&args.scene)?;
-    crate::report_clamped(&scene.environment);
+    let scene = args.scene.load()?;
     let ctx = args.gpu.context()?;
     match points {
         Some(points) => run_irradiance(args, &ctx, &scene, &points)?,

@@ -151,9 +151,8 @@ pub struct RenderArgs {
     animate: bool,
     #[command(flatten)]
     prt: PrtArgs,
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium) or a scene file (.json).
-    #[arg(long, default_value = "teapot")]
-    scene: String,
+    #[command(flatten)]
+    scene: crate::SceneArgs,
     #[arg(long, default_value_t = 512)]
     width: u32,
     #[arg(long, default_value_t = 512)]
@@ -189,8 +188,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !(args.exposure.is_finite() && args.exposure > 0.0) {
         anyhow::bail!("--exposure must be a positive number");
     }
-    let scene = Scene::from_arg(&args.scene)?;
-    crate::report_clamped(&scene.environment);
+    if args.animate && args.scene.keyframe.is_some() {
+        anyhow::bail!("--animate plays the walkthrough and --keyframe holds one of its cameras: give one of them");
+    }
+    let scene = args.scene.load()?;
     let ctx = args.gpu.context()?;
     let settings = TechniqueSettings {
         kind: match args.technique {

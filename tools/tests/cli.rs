@@ -169,8 +169,10 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 10] = [
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
+        (&["render", "--scene", "asm", "--keyframe", "5"], "scene asm has 5 walkthrough keyframes"),
+        (&["reference", "--keyframe", "1", "--out", "x.exr"], "scene teapot has 0 walkthrough keyframes"),
         (&["render", "--scene", bad_scene.to_str().unwrap()], "colour"),
         (&["render", "--width", "0"], "image size"),
         (&["render", "--out", "picture.jpg", "--width", "8", "--height", "8"], "picture.jpg"),
