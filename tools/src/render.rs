@@ -189,7 +189,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("--exposure must be a positive number");
     }
     if args.animate && args.scene.keyframe.is_some() {
-        anyhow::bail!("--animate plays the walkthrough and --keyframe holds one of its cameras: give one of them");
+        anyhow::bail!(
+            "--animate plays the walkthrough and --keyframe holds one of its cameras: give one of them"
+        );
     }
     let scene = args.scene.load()?;
     let ctx = args.gpu.context()?;
