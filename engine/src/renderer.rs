@@ -310,7 +310,9 @@ impl Renderer {
         imports.extend_from_slice(self.technique.persistent());
         let analysis = self.technique.analysis_passes(&inputs);
         let mut timings = Vec::new();
-        if !analysis.is_empty() {
+        if analysis.is_empty() {
+            drop(analysis);
+        } else {
             timings = self.executor.run(&imports, analysis)?;
             self.technique.analysed()?;
         }
@@ -326,7 +328,9 @@ impl Renderer {
         passes.push(Pass::new("readback", &["color"], &[], move |cmd| {
             targets.color.record_copy_to(cmd, &targets.readback)
         }));
-        timings.extend(self.executor.run(&imports, passes)?);
+        let frame = self.executor.run(&imports, passes)?;
+        self.technique.timed(&frame);
+        timings.extend(frame);
         self.env_dirty = false;
         Ok(timings)
     }

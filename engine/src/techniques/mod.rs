@@ -17,7 +17,7 @@ pub mod unshadowed;
 
 use crate::backend::{Buffer, Context};
 use crate::error::Result;
-use crate::pass::Pass;
+use crate::pass::{Pass, PassTiming};
 use crate::renderer::{GpuScene, Targets};
 use crate::scene::Light;
 use environment::GpuEnvironment;
@@ -69,6 +69,9 @@ pub trait Technique {
     fn analysed(&mut self) -> Result<()> {
         Ok(())
     }
+    /// The GPU times of the frame's own passes, after it completed (the adaptive shadow map
+    /// scales its tile cost model by them).
+    fn timed(&mut self, _timings: &[PassTiming]) {}
     /// Occlusion layers the last frame wanted but had no room for (their light was left
     /// unshadowed): 0 for techniques without a layer budget.
     fn dropped_layers(&self) -> usize {

@@ -6,7 +6,9 @@
 //!   (factors of two in texel size) those pixels lack.
 //! - Cost: a·N + b milliseconds, N the triangles drawn for the tile (the groups whose light-uv
 //!   bounds overlap it), a and b fitted by least squares to timed tile renders on the running
-//!   device ([`CostModel::fit`]).
+//!   device ([`CostModel::fit`]) at start-up, and scaled frame by frame by how long the tiles
+//!   the model planned took (`Asm::timed`): tiles timed one by one at start-up and tiles
+//!   rendered back to back in a frame cost differently on some devices (4x on lavapipe).
 //! - Requests are taken by benefit/cost, best first, until their summed cost would pass the
 //!   per-frame time budget; the best one is always taken, so that the refinement progresses on
 //!   a device slower than the budget assumes. A request under a tile that is not resident
@@ -45,6 +47,11 @@ impl CostModel {
         self.ms_per_triangle * triangles as f64 + self.ms_per_tile
     }
 
+    /// The model with both coefficients times `factor`.
+    pub fn scaled(&self, factor: f64) -> CostModel {
+        CostModel { ms_per_triangle: self.ms_per_triangle * factor, ms_per_tile: self.ms_per_tile * factor }
+    }
+
     /// The least-squares line through (triangles, ms) samples. Both coefficients are kept
     /// positive (a timing can only grow with work; a tile is never free): with samples that
     /// all draw the same N, or noise that tilts the line below zero, the model falls back to a
@@ -72,6 +79,14 @@ impl CostModel {
         let sxy0: f64 = samples.iter().map(|s| s.0 as f64 * s.1).sum();
         CostModel { ms_per_triangle: (sxy0 / sx2).max(0.0), ms_per_tile: FLOOR_MS }
     }
+}
+
+/// The factor on the start-up model after a frame whose tiles the model (times 1) predicted
+/// at `predicted_ms` took `measured_ms`: the geometric mean of the old factor and this frame's
+/// ratio (clamped to 1/20–20), so that it follows the device within a few frames and one noisy
+/// timing moves it by at most the square root of its error.
+pub fn rescaled(scale: f64, predicted_ms: f64, measured_ms: f64) -> f64 {
+    (scale * (measured_ms / predicted_ms).clamp(0.05, 20.0)).sqrt()
 }
 
 /// The requests to render this frame, each with its benefit/cost, within `budget_ms` (the best
@@ -175,5 +190,19 @@ mod tests {
         // With its parent resident it is taken first.
         let chosen = plan(requests, &model, 1.0, |k| k == TileKey::ROOT || k == child);
         assert_eq!(chosen[0].0.key, grandchild);
+    }
+
+    #[test]
+    fn the_scale_follows_the_measured_cost_and_damps_outliers() {
+        // Tiles that take 4x the model's prediction, frame after frame: within 1 % in 8 frames.
+        let mut scale = 1.0;
+        for _ in 0..8 {
+            scale = rescaled(scale, 2.0, 8.0);
+        }
+        assert!((scale - 4.0).abs() < 0.04, "{scale}");
+        // One frame 16x off moves a settled factor by 4x at most, never to 16x.
+        assert!((rescaled(1.0, 1.0, 16.0) - 4.0).abs() < 1e-12);
+        // Absurd timings are clamped.
+        assert!((rescaled(1.0, 1.0, 1e9) - 20f64.sqrt()).abs() < 1e-12);
     }
 }

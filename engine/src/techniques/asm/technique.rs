@@ -23,7 +23,7 @@
 //! group somewhere in its square.
 use super::light_view::{tile_view_proj, UvRect};
 use super::page_table;
-use super::plan::{plan, CostModel, Request};
+use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{Insert, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
 use super::tile::TileKey;
 use crate::backend::{
@@ -32,7 +32,7 @@ use crate::backend::{
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, AsmTilePush, LocalDrawPush, ShadowLight};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::renderer::{GpuScene, DEPTH_FORMAT};
 use crate::scene::{Light, Scene};
 use crate::techniques::parallel_lights::scene_sphere;
@@ -163,7 +163,12 @@ pub struct Asm {
     table: Buffer,
     /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by `analysed`.
     requests: Buffer,
+    /// The start-up calibration's model.
     cost: CostModel,
+    /// What the tiles of recent frames took over what `cost` predicted (geometric mean).
+    cost_scale: f64,
+    /// What `cost` predicts for this frame's planned tiles, ms.
+    planned_ms: f64,
     frame: u64,
     /// The light record, group transforms and group light-uv bounds of the frame.
     record: Option<ShadowLight>,
@@ -286,6 +291,8 @@ impl Asm {
             table,
             requests,
             cost: CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 },
+            cost_scale: 1.0,
+            planned_ms: 0.0,
             frame: 0,
             record: None,
             transforms: Vec::new(),
@@ -592,7 +599,8 @@ impl Technique for Asm {
         let requests = self.read_requests()?;
         let view_proj = Mat4::from_cols_array_2d(&self.record.expect("update sets the record").view_proj);
         let pool = &self.pool;
-        let chosen = plan(requests, &self.cost, self.settings.time_ms, |key| pool.page(key).is_some());
+        let model = self.cost.scaled(self.cost_scale);
+        let chosen = plan(requests, &model, self.settings.time_ms, |key| pool.page(key).is_some());
         let mut render = Vec::new();
         for (request, ratio) in chosen {
             // A parent evicted by an earlier insertion of this frame, or refused a page, refuses
@@ -605,6 +613,7 @@ impl Technique for Asm {
         }
         // A tile whose page a later insertion of this frame took is no longer resident.
         render.retain(|t| self.pool.page(t.key) == Some(t.page));
+        self.planned_ms = render.iter().map(|t| self.cost.cost_ms(self.tile_triangles(&t.groups))).sum();
         self.render = render;
         self.write_table()?;
         self.stats = AsmStats {
@@ -613,7 +622,7 @@ impl Technique for Asm {
             resident_tiles: self.table_keys.len(),
             deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
             rendered: self.refresh.iter().chain(&self.render).map(|t| t.key).collect(),
-            cost: (self.cost.ms_per_triangle, self.cost.ms_per_tile),
+            cost: (model.ms_per_triangle, model.ms_per_tile),
         };
         Ok(())
     }
@@ -643,6 +652,19 @@ impl Technique for Asm {
                 }
             });
         vec![tiles, lighting]
+    }
+
+    /// Scales the cost model by how long this frame's planned tiles took against what the
+    /// start-up model predicted (`plan::rescaled`).
+    fn timed(&mut self, timings: &[PassTiming]) {
+        // Frames of one or two tiles time mostly the pass' own overhead.
+        if self.planned_ms < 4.0 * self.cost.ms_per_tile.max(0.01) {
+            return;
+        }
+        let measured = timings.iter().find(|t| t.name == "asm_tiles").and_then(|t| t.gpu_ms);
+        if let Some(ms) = measured.filter(|ms| *ms > 0.0) {
+            self.cost_scale = rescaled(self.cost_scale, self.planned_ms, ms);
+        }
     }
 
     fn asm_stats(&self) -> Option<AsmStats> {
