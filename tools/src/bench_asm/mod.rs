@@ -20,6 +20,7 @@ use kage::imageio::RgbaF32Image;
 use kage::reference::{shadow_flips, shadow_mismatch, SHADOW_THRESHOLD};
 use kage::renderer::{RenderOptions, Renderer, MAX_SIZE};
 use kage::scene::Scene;
+use kage::techniques::asm::technique::AsmTest;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use report::{FrameRow, Series};
@@ -36,7 +37,8 @@ pub struct AsmBenchArgs {
     #[arg(long, default_value = "asm")]
     scene: String,
     /// The configurations, `KIND:VALUE` each: `shadowmap:SIDE` (a conventional map of SIDE²
-    /// texels per light), `asm:MB` (an adaptive shadow map within MB megabytes). The first is the one the others' frame times are divided by.
+    /// texels per light), `asm:MB` (an adaptive shadow map within MB megabytes), `asm-id:MB`
+    /// (the same with the paper's polygon-ID test). The first is the one the others' frame times are divided by.
     #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_CONFIGS.map(String::from))]
     configs: Vec<String>,
     /// Frames sampling the walkthrough (t = i / frames, as `kage render --animate`).
@@ -96,6 +98,12 @@ const KINDS: &[ConfigKind] = &[
         series: "adaptive shadow map (budget, MB)",
         settings: asm,
     },
+    ConfigKind {
+        name: "asm-id",
+        parameter: "budget_mb",
+        series: "adaptive shadow map, polygon IDs (budget, MB)",
+        settings: asm_id,
+    },
 ];
 
 fn shadowmap(value: &str) -> Result<TechniqueSettings> {
@@ -103,10 +111,19 @@ fn shadowmap(value: &str) -> Result<TechniqueSettings> {
     Ok(TechniqueSettings { kind: TechniqueKind::ShadowMap, shadow_map_size: size, ..Default::default() })
 }
 
-fn asm(value: &str) -> Result<TechniqueSettings> {
+fn asm_with(value: &str, test: AsmTest) -> Result<TechniqueSettings> {
     let budget_mb = value.parse().with_context(|| format!("{value:?} is not a number of MB"))?;
-    let asm = AsmSettings { budget_mb, ..AsmSettings::default() };
+    let asm = AsmSettings { budget_mb, test, ..AsmSettings::default() };
     Ok(TechniqueSettings { kind: TechniqueKind::Asm, asm, ..Default::default() })
+}
+
+fn asm(value: &str) -> Result<TechniqueSettings> {
+    asm_with(value, AsmTest::Bias)
+}
+
+/// ASM with the paper's polygon-ID test (its pages twice the bytes).
+fn asm_id(value: &str) -> Result<TechniqueSettings> {
+    asm_with(value, AsmTest::Id)
 }
 
 /// One configuration of the run.
