@@ -55,7 +55,8 @@ impl ProbeTechnique {
             (StaticLighting::Unshadowed, _) => Statics::Unshadowed(Unshadowed::new(ctx)?),
             (StaticLighting::Sloan, Some(transfer)) => {
                 let sloan = OcclusionSettings { regions: 0, ..OcclusionSettings::default() };
-                Statics::Sloan(Box::new(PrtTechnique::new(ctx, scene, gpu, transfer, sloan)?))
+                let prt = PrtTechnique::new(ctx, scene, gpu, transfer, sloan)?.for_groups(is_static);
+                Statics::Sloan(Box::new(prt))
             }
             (StaticLighting::Sloan, None) => {
                 return Err(Error::InvalidArgument(
@@ -118,7 +119,7 @@ impl Technique for ProbeTechnique {
             match &self.statics {
                 Statics::Unshadowed(unshadowed) => unshadowed
                     .draw(ctx, cmd, uniforms, env_sh, scene, |m| is_static(m.group).then_some(m.albedo)),
-                Statics::Sloan(prt) => prt.record_draws(ctx, cmd, uniforms, scene, is_static),
+                Statics::Sloan(prt) => prt.record_draws(ctx, cmd, uniforms, scene),
             }
             self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(&self.light)]);
             draw_meshes(ctx, cmd, &self.pipeline, scene, |m| (!is_static(m.group)).then_some(m.albedo));

@@ -152,10 +152,14 @@ impl SelfShadow {
         })
     }
 
-    /// Marks the groups whose orientation relative to the light changed and rotates the
-    /// environment's SH into their frames: g(ω) = L_map(R_envᵀ R_group ω).
-    pub fn update(&mut self, transforms: &[Mat4], env: Mat3) -> Result<()> {
+    /// Marks the groups `drawn` keeps whose orientation relative to the light changed, and
+    /// rotates the environment's SH into their frames: g(ω) = L_map(R_envᵀ R_group ω).
+    pub fn update(&mut self, transforms: &[Mat4], env: Mat3, drawn: fn(usize) -> bool) -> Result<()> {
         for (g, transform) in transforms.iter().enumerate() {
+            if !drawn(g) {
+                self.dirty[g] = false;
+                continue;
+            }
             let relative = env.transpose() * rotation_of(transform);
             let unchanged = self.computed[g].is_some_and(|c| c.abs_diff_eq(relative, 1e-6));
             self.dirty[g] = !unchanged;

@@ -53,6 +53,8 @@ impl Default for OcclusionSettings {
 }
 
 pub struct PrtTechnique {
+    /// The groups it lights (all, unless another technique lights some: see `for_groups`).
+    drawn: fn(usize) -> bool,
     self_shadow: SelfShadow,
     occlusion: Occlusion,
     scene_pipeline: GraphicsPipeline,
@@ -109,6 +111,7 @@ impl PrtTechnique {
         let region_vec4 = regions.regions.len().div_ceil(4).max(1) as u32;
         let basis_vec4 = (bands * bands).div_ceil(4) as u32;
         Ok(PrtTechnique {
+            drawn: |_| true,
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
             occlusion: Occlusion::new(
                 ctx,
@@ -158,7 +161,7 @@ impl Technique for PrtTechnique {
 
     fn update(&mut self, state: &FrameState) -> Result<()> {
         let env = env_rotation(state.env_rotation);
-        self.self_shadow.update(state.transforms, env)?;
+        self.self_shadow.update(state.transforms, env, self.drawn)?;
         self.occlusion.update(state.transforms, env)
     }
 
@@ -176,7 +179,7 @@ impl Technique for PrtTechnique {
         };
         passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
             ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
-            self.record_draws(ctx, cmd, uniforms, scene, |_| true);
+            self.record_draws(ctx, cmd, uniforms, scene);
             ctx.end_rendering(cmd);
         }));
         passes
@@ -184,6 +187,12 @@ impl Technique for PrtTechnique {
 }
 
 impl PrtTechnique {
+    /// The technique lighting only the groups `drawn` keeps (their self-shadow texels are the
+    /// only ones kept up to date).
+    pub fn for_groups(self, drawn: fn(usize) -> bool) -> PrtTechnique {
+        PrtTechnique { drawn, ..self }
+    }
+
     /// The passes before the scene's: the self-shadow texels of the groups that turned, and
     /// the occlusion layers between groups (none for Sloan's PRT).
     pub fn prepasses<'a>(&'a self, ctx: &'a Arc<Context>, scene: &'a GpuScene) -> Vec<Pass<'a>> {
@@ -192,16 +201,9 @@ impl PrtTechnique {
         passes
     }
 
-    /// Records, inside a rendering scope, the meshes of the groups `drawn` keeps with eq. (15)
+    /// Records, inside a rendering scope, the meshes of the groups it lights with eq. (15)
     /// (Sloan's PRT where there are no regions).
-    pub fn record_draws(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        uniforms: &Buffer,
-        scene: &GpuScene,
-        drawn: impl Fn(usize) -> bool,
-    ) {
+    pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, uniforms: &Buffer, scene: &GpuScene) {
         let (occlusion, self_shadow) = (&self.occlusion, &self.self_shadow);
         self.scene_pipeline.bind(
             cmd,
@@ -215,7 +217,7 @@ impl PrtTechnique {
             ],
         );
         let q = occlusion.region_count() as u32;
-        for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| drawn(m.group)) {
+        for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| (self.drawn)(m.group)) {
             let (first_layer, layer_count) = occlusion.ranges[mesh.group];
             let push = PrtDrawPush {
                 model: scene.transforms[mesh.group].to_cols_array_2d(),
