@@ -351,6 +351,32 @@ fn probe_file(dir: &std::path::Path) -> std::path::PathBuf {
     path
 }
 
+/// `--keyframe K` looks from the walkthrough's keyframe K, for the renderer and the reference
+/// alike: two keyframes give two pictures, and a render matches its reference's lit pixels.
+#[test]
+fn keyframes_of_the_walkthrough_are_cameras_for_render_and_reference() {
+    let dir = scratch_dir("cli-keyframe");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let run = |command: &[&str], k: &str, out: &str| {
+        let view = ["--scene", "asm", "--keyframe", k, "--width", "24", "--height", "24", "--out", out];
+        let out = kage(&[command, &view[..]].concat());
+        assert!(out.status.success(), "{}", text(&out));
+    };
+    for k in ["1", "2"] {
+        run(&["render", "--technique", "shadowmap"], k, &path(&format!("k{k}.exr")));
+        run(&["reference", "--light", "local"], k, &path(&format!("r{k}.exr")));
+    }
+    let read = |name: &str| kage::imageio::read_exr(dir.join(name)).unwrap();
+    assert!(read("k1.exr").pixels != read("k2.exr").pixels, "two keyframes, one picture");
+    let mismatch = |a: &str, b: &str| {
+        kage::reference::shadow_mismatch(&read(a), &read(b), kage::reference::SHADOW_THRESHOLD)
+            .unwrap()
+            .fraction
+    };
+    // The render and the reference of the same keyframe agree far better than across keyframes.
+    assert!(mismatch("k1.exr", "r1.exr") < 0.1 && mismatch("k1.exr", "r2.exr") > 0.1);
+}
+
 /// `--probes auto` reports how many of its candidates it kept (the issue asks for the count);
 /// a grid reports its probe count.
 #[test]

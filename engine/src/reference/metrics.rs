@@ -325,6 +325,14 @@ mod tests {
             assert!(err.contains("between 0 and 1"), "{bad}: {err}");
         }
         assert!(shadow_mismatch(&image(2, 1, &[0.0; 2]), &reference, 0.25).is_err());
+        // The picture of the same: a colour per pixel for each pair of states, counted alike.
+        let picture = shadow_mismatch_image(&render, &reference, 0.25).unwrap();
+        let colours: Vec<&[u8]> = picture.rgb.chunks(3).collect();
+        let (red, blue) = ([230, 40, 40], [40, 110, 255]);
+        assert_eq!((colours[0], colours[2]), (&red[..], &blue[..]));
+        assert_eq!(colours.iter().filter(|c| **c == red || **c == blue).count(), m.differing);
+        assert_eq!((colours[1], colours[4]), (&[170u8, 170, 170][..], &[50u8, 50, 50][..]));
+        assert_eq!((picture.width, picture.height, picture.scale), (4, 2, 0.5));
     }
 
     #[test]
