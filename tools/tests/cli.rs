@@ -237,6 +237,22 @@ fn precompute_caches_and_tamura_renders_from_the_cache() {
 /// A small sweep: one row per setting, the header naming every pose, errors that a working
 /// technique and reference give (finite, below 1, Tamura's below unshadowed's: the teapot's
 /// shadow on the floor is what unshadowed misses), times and memory filled in.
+/// What `kage sweep` wrote to `dir`: its chart is a PNG and its CSV starts with `header`;
+/// returns the CSV and its rows split into fields.
+fn sweep_outputs(dir: &std::path::Path, header: &str) -> (String, Vec<Vec<String>>) {
+    assert_eq!(&std::fs::read(dir.join("pareto.png")).unwrap()[1..4], b"PNG");
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(header), "{csv}");
+    let rows = lines.map(|l| l.split(',').map(String::from).collect()).collect();
+    (csv, rows)
+}
+
+/// Field `column` of a sweep row as a number.
+fn number(row: &[String], column: usize) -> f64 {
+    row[column].parse().unwrap_or_else(|e| panic!("{row:?}[{column}]: {e}"))
+}
+
 #[test]
 fn sweep_writes_one_csv_row_per_setting() {
     let dir = scratch_dir("cli-sweep");
@@ -274,17 +290,12 @@ fn sweep_writes_one_csv_row_per_setting() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("scene: cheapest within relative RMSE 1: unshadowed"), "{stdout}");
     assert!(stdout.contains("scene: no setting runs within 0.000001 ms"), "{stdout}");
-    assert_eq!(&std::fs::read(dir.join("pareto.png")).unwrap()[1..4], b"PNG");
-    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
-    let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(
-        lines[0],
-        "scene,env,technique,parameter,value,error_mean,error_t0,error_t0.3,frame_ms,precompute_s,memory_mb"
+    let (csv, fields) = sweep_outputs(
+        &dir,
+        "scene,env,technique,parameter,value,error_mean,error_t0,error_t0.3,frame_ms,precompute_s,memory_mb",
     );
-    assert_eq!(lines.len(), 3, "{csv}");
-    let fields: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split(',').collect()).collect();
-    assert_eq!((fields[0][2], fields[1][2], fields[1][4]), ("unshadowed", "tamura", "8"));
-    let number = |row: &[&str], column: usize| row[column].parse::<f64>().unwrap();
+    assert_eq!(fields.len(), 2, "{csv}");
+    assert_eq!((&*fields[0][2], &*fields[1][2], &*fields[1][4]), ("unshadowed", "tamura", "8"));
     for row in &fields {
         assert!((0.0..1.0).contains(&number(row, 5)), "{row:?}");
         assert!(number(row, 8) > 0.0 && number(row, 10) > 0.0, "{row:?}");
@@ -316,17 +327,15 @@ fn sweep_asm_compares_budgets_with_map_sizes() {
     assert!(out.status.success(), "{}", text(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("asm: cheapest within mismatch 1: "), "{stdout}");
-    assert_eq!(&std::fs::read(dir.join("pareto.png")).unwrap()[1..4], b"PNG");
-    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
-    let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(
-        lines[0],
-        "scene,technique,parameter,value,error_mean,error_max,error_at_rest,flips_mean,frame_ms,ratio,memory_mb"
+    let (csv, rows) = sweep_outputs(
+        &dir,
+        "scene,technique,parameter,value,error_mean,error_max,error_at_rest,flips_mean,frame_ms,ratio,memory_mb",
     );
-    assert_eq!(lines.len(), 3, "{csv}");
-    let rows: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split(',').collect()).collect();
-    assert_eq!((rows[0][1], rows[0][3], rows[1][1], rows[1][2]), ("shadowmap", "256", "asm", "budget_mb"));
-    let number = |row: &[&str], column: usize| row[column].parse::<f64>().unwrap();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert_eq!(
+        (&*rows[0][1], &*rows[0][3], &*rows[1][1], &*rows[1][2]),
+        ("shadowmap", "256", "asm", "budget_mb")
+    );
     // 256² D32 texels: 0.25 MiB; the ASM pool: at most its 1 MB (MiB) budget.
     assert_eq!(number(&rows[0], 10), 0.25);
     assert!(number(&rows[1], 10) > 0.0 && number(&rows[1], 10) <= 1.0, "{csv}");

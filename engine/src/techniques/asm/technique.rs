@@ -532,6 +532,9 @@ impl Technique for Asm {
             // The light moved (or the depth range changed): every tile's depths are stale.
             self.pool = PagePool::new(self.settings.budget_bytes(), self.settings.test.page_bytes())?;
             refresh.push(TileKey::ROOT);
+            // The analysis descends the new pool's table; otherwise last frame's `analysed`
+            // wrote the table of the pool as it still is (refreshing tiles moves none).
+            self.write_table()?;
         } else {
             let moved: Vec<UvRect> = (0..rects.len())
                 .filter(|&g| self.transforms[g] != state.transforms[g])
@@ -551,7 +554,6 @@ impl Technique for Asm {
                 self.pool.page(key).map(|page| self.tile_render(key, page, &view_proj, &self.group_rects))
             })
             .collect();
-        self.write_table()?;
         self.records.write(0, bytes_of(&record))?;
         Ok(())
     }
@@ -657,7 +659,7 @@ impl Technique for Asm {
     /// Scales the cost model by how long this frame's planned tiles took against what the
     /// start-up model predicted (`plan::rescaled`).
     fn timed(&mut self, timings: &[PassTiming]) {
-        // Frames of one or two tiles time mostly the pass' own overhead.
+        // Frames of a few tiles time mostly the pass' own overhead.
         if self.planned_ms < 4.0 * self.cost.ms_per_tile.max(0.01) {
             return;
         }
