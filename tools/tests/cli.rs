@@ -237,6 +237,15 @@ fn precompute_caches_and_tamura_renders_from_the_cache() {
 /// A small sweep: one row per setting, the header naming every pose, errors that a working
 /// technique and reference give (finite, below 1, Tamura's below unshadowed's: the teapot's
 /// shadow on the floor is what unshadowed misses), times and memory filled in.
+/// `kage sweep --technique ARGS… --validate --out DIR --pick --max-error 1`, which must
+/// succeed; returns its standard output.
+fn sweep(dir: &std::path::Path, args: &[&str]) -> String {
+    let tail = ["--validate", "--out", dir.to_str().unwrap(), "--pick", "--max-error", "1"];
+    let out = kage(&[&["sweep", "--technique"][..], args, &tail[..]].concat());
+    assert!(out.status.success(), "{}", text(&out));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 /// What `kage sweep` wrote to `dir`: its chart is a PNG and its CSV starts with `header`;
 /// returns the CSV and its rows split into fields.
 fn sweep_outputs(dir: &std::path::Path, header: &str) -> (String, Vec<Vec<String>>) {
@@ -257,37 +266,30 @@ fn number(row: &[String], column: usize) -> f64 {
 fn sweep_writes_one_csv_row_per_setting() {
     let dir = scratch_dir("cli-sweep");
     let cache = dir.join("cache");
-    let out = kage(&[
-        "sweep",
-        "--technique",
-        "prt",
-        "--only",
-        "unshadowed,tamura:8",
-        "--poses",
-        "0,0.3",
-        "--size",
-        "32",
-        "--spp",
-        "64",
-        "--frames",
-        "2",
-        "--time-size",
-        "32",
-        "--rays",
-        "64",
-        "--cache",
-        cache.to_str().unwrap(),
-        "--validate",
-        "--out",
-        dir.to_str().unwrap(),
-        "--pick",
-        "--max-error",
-        "1",
-        "--max-ms",
-        "1e-6",
-    ]);
-    assert!(out.status.success(), "{}", text(&out));
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = sweep(
+        &dir,
+        &[
+            "prt",
+            "--only",
+            "unshadowed,tamura:8",
+            "--poses",
+            "0,0.3",
+            "--size",
+            "32",
+            "--spp",
+            "64",
+            "--frames",
+            "2",
+            "--time-size",
+            "32",
+            "--rays",
+            "64",
+            "--cache",
+            cache.to_str().unwrap(),
+            "--max-ms",
+            "1e-6",
+        ],
+    );
     assert!(stdout.contains("scene: cheapest within relative RMSE 1: unshadowed"), "{stdout}");
     assert!(stdout.contains("scene: no setting runs within 0.000001 ms"), "{stdout}");
     let (csv, fields) = sweep_outputs(
@@ -307,25 +309,7 @@ fn sweep_writes_one_csv_row_per_setting() {
 #[test]
 fn sweep_asm_compares_budgets_with_map_sizes() {
     let dir = scratch_dir("cli-sweep-asm");
-    let out = kage(&[
-        "sweep",
-        "--technique",
-        "asm",
-        "--only",
-        "shadowmap:256,asm:1",
-        "--frames",
-        "2",
-        "--size",
-        "32",
-        "--validate",
-        "--out",
-        dir.to_str().unwrap(),
-        "--pick",
-        "--max-error",
-        "1",
-    ]);
-    assert!(out.status.success(), "{}", text(&out));
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = sweep(&dir, &["asm", "--only", "shadowmap:256,asm:1", "--frames", "2", "--size", "32"]);
     assert!(stdout.contains("asm: cheapest within mismatch 1: "), "{stdout}");
     let (csv, rows) = sweep_outputs(
         &dir,
