@@ -16,10 +16,16 @@ pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room", "as
 
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     if name == "probe-room" {
-        return probe_room_scene(name);
+        let camera = Camera {
+            position: Vec3::new(0.0, 1.4, 1.9),
+            target: Vec3::new(0.0, 0.5, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 70.0,
+        };
+        return courtyard_scene(name, probe_room::groups, camera);
     }
     if name == "atrium" {
-        return atrium_scene(name);
+        return courtyard_scene(name, atrium::groups, atrium::camera());
     }
     // Floor grid vertices per side: 31×31 is the paper's low-resolution receiver, 111×111 its
     // high-resolution one.
@@ -69,37 +75,23 @@ fn context(name: &str) -> impl Fn(SceneError) -> SceneError + Copy + '_ {
     move |e: SceneError| e.within(&format!("built-in scene \"{name}\""))
 }
 
-/// See [`probe_room`]: the room lit by the courtyard through its opening, seen from inside
-/// near the front wall.
-fn probe_room_scene(name: &str) -> Result<Scene, SceneError> {
+/// A scene of `groups` under the courtyard sky, seen by `camera`, with no local light: the
+/// probe scenes. See [`probe_room`] (the room lit through its opening, seen from inside near
+/// the front wall) and [`atrium`] (the bunny passing from the courtyard's sun into the
+/// gallery's shade).
+fn courtyard_scene(
+    name: &str,
+    groups: fn() -> Result<Vec<Group>, SceneError>,
+    camera: Camera,
+) -> Result<Scene, SceneError> {
     let context = context(name);
     Ok(Scene {
         name: name.to_string(),
-        groups: probe_room::groups().map_err(context)?,
+        groups: groups().map_err(context)?,
         environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
         lights: Vec::new(),
         walkthrough: Vec::new(),
         probes: Vec::new(),
-        camera: Camera {
-            position: Vec3::new(0.0, 1.4, 1.9),
-            target: Vec3::new(0.0, 0.5, 0.0),
-            up: Vec3::Y,
-            fov_y_deg: 70.0,
-        },
-    })
-}
-
-/// See [`atrium`]: a courtyard building under the courtyard sky, the bunny passing from the
-/// courtyard's sun into the gallery's shade.
-fn atrium_scene(name: &str) -> Result<Scene, SceneError> {
-    let context = context(name);
-    Ok(Scene {
-        name: name.to_string(),
-        groups: atrium::groups().map_err(context)?,
-        environment: EnvMap::from_exr_bytes(COURTYARD_EXR).map_err(context)?,
-        lights: Vec::new(),
-        walkthrough: Vec::new(),
-        probes: Vec::new(),
-        camera: atrium::camera(),
+        camera,
     })
 }
