@@ -52,6 +52,28 @@ vec2 light_uv(ShadowLight s, vec3 p) {
     return clip.xy / clip.w * 0.5 + 0.5;
 }
 
+// Whether the occluder stored in the texel of `tile` holding p lies in front of the receiver's
+// tangent plane at that texel's centre. On a plane 1/w (w the light's view depth) is affine in
+// light uv, so the plane's depth there follows from p and its screen neighbours p + dx, p + dy
+// (light uv m.xy + ux, m.xy + uy) with no slope bias, only a margin for the receiver's own
+// curvature and creases.
+#define ASM_PLANE_MARGIN_TEXELS 4.0
+bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec3 dx, vec3 dy, vec2 ux, vec2 uy, uvec4 tile) {
+    float det = ux.x * uy.y - ux.y * uy.x;
+    if (det == 0.0) return false;
+    float iw = 1.0 / m.z;
+    float a = 1.0 / (s.view_proj * vec4(p + dx, 1.0)).w - iw;
+    float b = 1.0 / (s.view_proj * vec4(p + dy, 1.0)).w - iw;
+    vec2 slope = vec2(a * uy.y - b * ux.y, ux.x * b - uy.x * a) / det;
+    ivec3 texel = asm_texel(tile, m.xy, ivec2(0));
+    float scale = float(1u << tile.y);
+    vec2 centre = (vec2(tile.zw) + (vec2(texel.xy) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale;
+    float inv = iw + dot(slope, centre - m.xy);
+    if (inv <= 0.0) return false;
+    float stored = texelFetch(asm_pool, texel, 0).r;
+    return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, s.map.z / scale, vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0));
+}
+
 void main() {
     // One pixel of each 2x2 block per frame, the block's corner turning frame by frame (the
     // paper analyses 1/8 of the pixels per frame): the refinement is progressive anyway.
@@ -96,6 +118,10 @@ void main() {
             edge = edge || asm_visible(s, m, p, ng, tile, ivec2(i, j), bias) != centre;
         }
     }
+    // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
+    // under grazing light): a finer tile's bias is narrower and shows the shadow.
+    edge = edge || (asm_visible(s, m, p, ng, tile, ivec2(0), push.bias)
+                    && occluded_at_plane(s, m, p, ng, dx, dy, ux, uy, tile));
     if (!edge) return;
     // The chain of tiles under this one towards the pixel, as deep as it lacks levels (at most
     // KAGE_ASM_CHAIN_LEVELS): slots of depth d start at (4^d - 4) / 3 within the node's block.

@@ -7,8 +7,12 @@
 
 #include "local_lights_shading.glsl"
 
+// The frame's use marks for the pool's LRU: per page-table node, the last frame (params.z) whose
+// lighting looked a point up in its tile. Hidden fragments mark nothing.
+layout(early_fragment_tests) in;
+layout(std430, set = 0, binding = 4) writeonly buffer AsmUsed { uint asm_used[]; };
 #ifdef ASM_ID_TEST
-layout(set = 0, binding = 4) uniform usampler2DArray asm_ids;
+layout(set = 0, binding = 5) uniform usampler2DArray asm_ids;
 #endif
 
 #include "asm_lookup.glsl"
@@ -17,7 +21,9 @@ bool visible(uint k, vec3 p, vec3 ng) {
     ShadowLight s = lights[k];
     vec4 m = shadow_map_coords(s, p);
     if (m.w < 0.0) return true;
-    uvec4 tile = asm_nodes[asm_descend(m.xy)].tile;
+    uint node = asm_descend(m.xy);
+    asm_used[node] = draw.params.z;
+    uvec4 tile = asm_nodes[node].tile;
 #ifdef ASM_ID_TEST
     if (texelFetch(asm_ids, asm_texel(tile, m.xy, ivec2(0)), 0).r == draw.params.y + uint(gl_PrimitiveID)) {
         return true;

@@ -62,25 +62,30 @@
 // uniform buffer and one shadow-map layer each.
 #define KAGE_MAX_LOCAL_LIGHTS 8
 
-// Adaptive shadow maps: texels per side of a tile (one page of the pool, 64 KiB of D32).
-#define KAGE_ASM_TILE_TEXELS 128
-// The deepest quadtree level: 2^16 tiles per side, an effective 8,388,608² map (the paper
+// Adaptive shadow maps: texels per side of a tile (one page of the pool, 16 KiB of D32). With
+// texels a fixed fraction of the eye pixel, the pages a shadow edge takes grow with the tile's
+// side (a tile covers a band of which the edge uses a strip): at equal memory 64² tiles
+// misclassified 18 % fewer pixels of the `asm` walkthrough than 128² (BENCHMARKS.md); 32²
+// little fewer again, at a frame cost over the paper's 1.74x. A pool holds at most
+// maxImageArrayLayers pages (2048 on lavapipe and NVIDIA: 32 MiB).
+#define KAGE_ASM_TILE_TEXELS 64
+// The deepest quadtree level: 2^17 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
-#define KAGE_ASM_MAX_LEVEL 16
+#define KAGE_ASM_MAX_LEVEL 17
 // Levels the ASM refinement asks for beyond the one whose texels match the eye pixel's
-// footprint: a nearest-texel edge lies up to half a texel off, so texels an eighth of the pixel
-// keep the lit/shadowed state of pixel centres right but within ~1/16 pixel of an edge (a
-// quarter, 2, misclassified a third more pixels of the `asm` walkthrough; 4 no fewer).
-#define KAGE_ASM_EXTRA_LEVELS 3
-// The page table's directory: one entry per tile of this level (128² entries, 64 KiB) naming
+// footprint: a nearest-texel edge lies up to half a texel off, so texels a sixteenth of the
+// pixel keep the lit/shadowed state of pixel centres right but within ~1/32 pixel of an edge
+// (with 128² tiles an eighth, 3, was as good as 4: the pages they took ran out first).
+#define KAGE_ASM_EXTRA_LEVELS 4
+// The page table's directory: one entry per tile of this level (256² entries, 256 KiB) naming
 // the finest resident tile at or above it, where the lookup's descent starts. The descent is a
 // chain of dependent reads, one per level, that a CPU rasterizer pays per fragment in full (it
 // was half of the lighting pass on lavapipe); below this level views rarely refine.
-#define KAGE_ASM_DIRECTORY_LEVEL 7
+#define KAGE_ASM_DIRECTORY_LEVEL 8
 // Levels below a pixel's finest resident tile the ASM analysis asks for at once (the tiles of
 // its chain, each at most this many levels under the tile): a camera arriving at a new view
 // refines that many levels in one frame instead of one.
-#define KAGE_ASM_CHAIN_LEVELS 3
+#define KAGE_ASM_CHAIN_LEVELS 4
 // Workgroup of the ASM refinement analysis: 8x8 eye pixels.
 #define KAGE_ASM_ANALYSIS_GROUP 8
 

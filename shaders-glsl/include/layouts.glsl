@@ -224,7 +224,7 @@ struct ShadowLight {
 struct LocalDrawPush {
     mat4 model;
     vec4 albedo; // rgb: diffuse albedo, a: unused
-    uvec4 params; // x: light count, y: polygon ID of the mesh's first triangle (ASM's ID test), z, w: unused
+    uvec4 params; // x: light count, y: polygon ID of the mesh's first triangle (ASM's ID test), z: the frame number ASM's use marks record, w: unused
     vec4 bias; // x: constant depth bias, y: slope-scaled depth bias (both in texels at the receiver's depth), z: the largest slope (tangent) the bias follows, w: unused
 };
 

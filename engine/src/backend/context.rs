@@ -179,6 +179,7 @@ impl Context {
         let enabled = vk::PhysicalDeviceFeatures::default()
             .shader_clip_distance(true)
             .geometry_shader(info.has(device::GEOMETRY_SHADER))
+            .fragment_stores_and_atomics(info.has(device::FRAGMENT_STORES))
             .shader_storage_image_extended_formats(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)

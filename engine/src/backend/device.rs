@@ -92,6 +92,7 @@ pub(crate) fn probe(
             ),
             ("shaderFloat64", features.shader_float64 == vk::TRUE),
             (GEOMETRY_SHADER, features.geometry_shader == vk::TRUE),
+            (FRAGMENT_STORES, features.fragment_stores_and_atomics == vk::TRUE),
             (
                 "ray query (not used: Kage casts rays through its own BVH)",
                 has_extension(&device_exts, ash::khr::ray_query::NAME),
@@ -109,6 +110,10 @@ pub(crate) fn probe(
 /// The feature that lets fragment shaders read gl_PrimitiveID (SPIR-V's Geometry capability):
 /// the polygon IDs of adaptive shadow maps. Enabled where the device has it.
 pub const GEOMETRY_SHADER: &str = "geometryShader (ASM polygon IDs: gl_PrimitiveID in fragment shaders)";
+
+/// The feature that lets fragment shaders write storage buffers: the ASM lighting pass marks
+/// the tiles it looks up for the page pool's LRU. Enabled where the device has it.
+pub const FRAGMENT_STORES: &str = "fragmentStoresAndAtomics (ASM: the lighting marks the tiles it uses)";
 
 /// Chooses a Vulkan 1.2+ device with a graphics+compute queue: by name when asked, otherwise
 /// discrete GPU first, then integrated, virtual, CPU.

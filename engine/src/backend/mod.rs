@@ -17,7 +17,7 @@ pub use buffer::{Buffer, BufferDesc};
 pub use commands::CommandRecorder;
 pub use context::{Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
-pub use device::GEOMETRY_SHADER;
+pub use device::{FRAGMENT_STORES, GEOMETRY_SHADER};
 pub use image::{Edge, Image, ImageDesc, Sampler};
 pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer};
 pub use rendering::Target;

@@ -50,7 +50,7 @@ impl UvRect {
 /// World to the clip space of tile `key`: the light's `view_proj` followed by the crop and
 /// scale that maps the tile's square of the view onto the whole of clip x, y ∈ [−1, 1]
 /// (depth unchanged, so tiles store the same depths as the light's full map). Composed in
-/// double precision: the crop's scale reaches 2^16.
+/// double precision: the crop's scale reaches 2^KAGE_ASM_MAX_LEVEL.
 pub fn tile_view_proj(view_proj: &Mat4, key: TileKey) -> Mat4 {
     let s = (1u64 << key.level) as f64;
     // uv' = s uv − x, so ndc' = s ndc + (s − 2x − 1), times w in clip space.

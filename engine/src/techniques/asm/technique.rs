@@ -28,7 +28,7 @@ use super::pool::{Insert, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
 use super::tile::TileKey;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsDesc,
-    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, GEOMETRY_SHADER,
+    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, FRAGMENT_STORES, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, AsmTilePush, LocalDrawPush, ShadowLight};
@@ -83,8 +83,9 @@ pub struct AsmSettings {
 
 impl Default for AsmSettings {
     fn default() -> Self {
-        // 8 ms: a few 128² tiles per frame on lavapipe, with the scene's 5,000 triangles.
-        AsmSettings { budget_mb: 16.0, time_ms: 8.0, test: AsmTest::default() }
+        // 32 ms: some 30 64² tiles per frame on lavapipe, with the scene's 5,000 triangles; at
+        // 8 ms the walkthrough of BENCHMARKS.md misclassified 17 % more pixels at 16 MiB.
+        AsmSettings { budget_mb: 16.0, time_ms: 32.0, test: AsmTest::default() }
     }
 }
 
@@ -163,6 +164,10 @@ pub struct Asm {
     table: Buffer,
     /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by `analysed`.
     requests: Buffer,
+    /// Per page-table node, the last frame whose lighting looked a point up in its tile.
+    used: Buffer,
+    /// The tile of each node of the page table the last lighting pass descended.
+    lit_keys: Vec<TileKey>,
     /// The start-up calibration's model.
     cost: CostModel,
     /// What the tiles of recent frames took over what `cost` predicted (geometric mean).
@@ -205,6 +210,12 @@ impl Asm {
                 scene.lights.len()
             )));
         };
+        if !ctx.info().has(FRAGMENT_STORES) {
+            return Err(Error::Unsupported(format!(
+                "the asm technique needs {FRAGMENT_STORES} on {}",
+                ctx.info().name
+            )));
+        }
         let pool = PagePool::new(settings.budget_bytes(), settings.test.page_bytes())?;
         let capacity = pool.capacity();
         let tiles =
@@ -223,6 +234,7 @@ impl Asm {
             BindingKind::UniformBuffer,
             BindingKind::UniformBuffer,
             BindingKind::SampledImage,
+            BindingKind::StorageBuffer,
             BindingKind::StorageBuffer,
         ];
         let fragment = match settings.test {
@@ -273,6 +285,12 @@ impl Asm {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
+        let used = buffer(
+            "asm.used",
+            u64::from(capacity) * 4,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )?;
         let triangles = (0..scene.groups.len())
             .map(|g| gpu.meshes.iter().filter(|m| m.group == g).map(|m| u64::from(m.index_count / 3)).sum())
             .collect();
@@ -290,6 +308,8 @@ impl Asm {
             records,
             table,
             requests,
+            used,
+            lit_keys: Vec::new(),
             cost: CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 },
             cost_scale: 1.0,
             planned_ms: 0.0,
@@ -415,15 +435,17 @@ impl Asm {
         groups.iter().zip(&self.triangles).filter(|(drawn, _)| **drawn).map(|(_, t)| t).sum()
     }
 
-    /// Marks the tiles this frame's lookups use, and turns the analysis' edge counts into
+    /// Marks the tiles the last frame's lighting and this frame's analysis looked up as used
+    /// (the analysis sees the new view first), and turns the analysis' edge counts into
     /// requests.
     fn read_requests(&mut self) -> Result<Vec<Request>> {
-        let words: Vec<u32> = self
-            .requests
-            .read()?
-            .chunks_exact(4)
-            .map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
+        let last = (self.frame - 1) as u32;
+        for (key, mark) in self.lit_keys.iter().zip(read_words(&self.used)?) {
+            if mark == last {
+                self.pool.touch(*key, self.frame);
+            }
+        }
+        let words = read_words(&self.requests)?;
         let capacity = self.pool.capacity() as usize;
         let (counts, missing) = words[capacity..].split_at(capacity * REQUEST_SLOTS);
         let mut requests = Vec::new();
@@ -469,6 +491,11 @@ impl Asm {
     pub fn stats(&self) -> AsmStats {
         self.stats.clone()
     }
+}
+
+/// A host-readable buffer's contents as native-endian words.
+fn read_words(buffer: &Buffer) -> Result<Vec<u32>> {
+    Ok(buffer.read()?.chunks_exact(4).map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect())
 }
 
 impl TileIds {
@@ -618,6 +645,7 @@ impl Technique for Asm {
         self.planned_ms = render.iter().map(|t| self.cost.cost_ms(self.tile_triangles(&t.groups))).sum();
         self.render = render;
         self.write_table()?;
+        self.lit_keys.clone_from(&self.table_keys);
         self.stats = AsmStats {
             budget_bytes: self.settings.budget_bytes(),
             bytes_used: self.pool.bytes_in_use(),
@@ -639,17 +667,20 @@ impl Technique for Asm {
             Binding::Uniform(&self.records),
             self.tiles.binding(),
             Binding::Storage(&self.table),
+            Binding::Storage(&self.used),
         ];
         if let Some(ids) = &self.ids {
             bindings.push(Binding::Sampled(&ids.image, &self.nearest));
         }
         let ids = &self.ids;
+        // Frame numbers wrap after 2^32 frames; a stale mark then only keeps a tile a frame longer.
+        let frame = self.frame as u32;
         let lighting =
             scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
                 LocalDrawPush {
                     model: model.to_cols_array_2d(),
                     albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    params: [1, ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), 0, 0],
+                    params: [1, ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), frame, 0],
                     bias: DEPTH_BIAS,
                 }
             });
