@@ -47,23 +47,19 @@ vec3 difference(vec3 p, ivec2 q, ivec2 step) {
     return dot(db, db) < dot(da, da) ? db : da;
 }
 
-vec2 light_uv(ShadowLight s, vec3 p) {
-    vec4 clip = s.view_proj * vec4(p, 1.0);
-    return clip.xy / clip.w * 0.5 + 0.5;
-}
-
 // Whether the occluder stored in the texel of `tile` holding p lies in front of the receiver's
 // tangent plane at that texel's centre. On a plane 1/w (w the light's view depth) is affine in
-// light uv, so the plane's depth there follows from p and its screen neighbours p + dx, p + dy
-// (light uv m.xy + ux, m.xy + uy) with no slope bias, only a margin for the receiver's own
-// curvature and creases.
+// light uv, so the plane's depth there follows from p and its screen neighbours (their map
+// coordinates mx, my) with no slope bias, only a margin for the receiver's own curvature and
+// creases.
 #define ASM_PLANE_MARGIN_TEXELS 4.0
-bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec3 dx, vec3 dy, vec2 ux, vec2 uy, uvec4 tile) {
+bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my, uvec4 tile) {
+    vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
     float det = ux.x * uy.y - ux.y * uy.x;
     if (det == 0.0) return false;
     float iw = 1.0 / m.z;
-    float a = 1.0 / (s.view_proj * vec4(p + dx, 1.0)).w - iw;
-    float b = 1.0 / (s.view_proj * vec4(p + dy, 1.0)).w - iw;
+    float a = 1.0 / mx.z - iw;
+    float b = 1.0 / my.z - iw;
     vec2 slope = vec2(a * uy.y - b * ux.y, ux.x * b - uy.x * a) / det;
     ivec3 texel = asm_texel(tile, m.xy, ivec2(0));
     float scale = float(1u << tile.y);
@@ -101,7 +97,8 @@ void main() {
     // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
     // level L has texels of 1 / (TILE 2^L) a side, so it matches the pixel where
     // 2^L = 1 / (TILE sqrt(area)); KAGE_ASM_EXTRA_LEVELS finer.
-    vec2 ux = light_uv(s, p + dx) - m.xy, uy = light_uv(s, p + dy) - m.xy;
+    vec4 mx = shadow_map_coords(s, p + dx), my = shadow_map_coords(s, p + dy);
+    vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
     float area = abs(ux.x * uy.y - ux.y * uy.x);
     float needed = area > 0.0 ? -log2(float(KAGE_ASM_TILE_TEXELS) * sqrt(area)) : float(KAGE_ASM_MAX_LEVEL);
     needed += float(KAGE_ASM_EXTRA_LEVELS);
@@ -121,7 +118,7 @@ void main() {
     // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
     // under grazing light): a finer tile's bias is narrower and shows the shadow.
     edge = edge || (asm_visible(s, m, p, ng, tile, ivec2(0), push.bias)
-                    && occluded_at_plane(s, m, p, ng, dx, dy, ux, uy, tile));
+                    && occluded_at_plane(s, m, p, ng, mx, my, tile));
     if (!edge) return;
     // The chain of tiles under this one towards the pixel, as deep as it lacks levels (at most
     // KAGE_ASM_CHAIN_LEVELS): slots of depth d start at (4^d - 4) / 3 within the node's block.
