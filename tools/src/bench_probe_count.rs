@@ -11,7 +11,9 @@
 //!
 //! Captures are shared: the grid levels are captured once each, and automatic placement's
 //! candidates are the finest grid's probes outside solids, reduced at each tolerance on the
-//! host.
+//! host. Automatic placement is measured with the kept probes' own captures and, as the engine
+//! runs it, with their SH fitted to every candidate's; each grid is also measured fitted to the
+//! same candidates, to tell the fit's gain from the placement's.
 use crate::bench::Pcg32;
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
@@ -35,7 +37,7 @@ use std::time::Instant;
 /// Grid levels and placement tolerances measured unless told (`kage sweep --technique probes`
 /// measures these too).
 pub const DEFAULT_GRIDS: [u32; 6] = [2, 3, 4, 6, 8, 10];
-pub const DEFAULT_TOLERANCES: [f32; 6] = [0.4, 0.2, 0.1, 0.05, 0.025, 0.0125];
+pub const DEFAULT_TOLERANCES: [f32; 6] = [0.5, 0.35, 0.25, 0.1, 0.05, 0.025];
 
 #[derive(Args)]
 pub struct ProbeCountArgs {
@@ -171,18 +173,24 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
             m.capture_ms_per_probe
         );
         println!(
-            "path region {:.2?} to {:.2?}\n{:<32} {:>12} {:>8} {:>10}",
+            "path region {:.2?} to {:.2?}\n{:<36} {:>12} {:>8} {:>10}",
             m.path.0, m.path.1, "method", "setting", "probes", "rel. RMS"
         );
         for row in &m.rows {
-            println!("{:<32} {:>12} {:>8} {:>10.4}", row.method, row.setting, row.probes, row.error);
+            println!("{:<36} {:>12} {:>8} {:>10.4}", row.method, row.setting, row.probes, row.error);
         }
         // Like for like (each region's grid against automatic placement in it), and the
         // paper's comparison: a grid over the whole box against probes where objects move.
-        for (grid, tetra) in
-            [(Region::Box, Region::Box), (Region::Path, Region::Path), (Region::Box, Region::Path)]
-        {
-            compare(&m.rows, &method(TRILINEAR, grid), &method(AUTO, tetra), args.target);
+        // Then what the fit adds: placement with captured values against the grid, and the
+        // fitted grid against fitted placement.
+        for (grid, tetra, region, tetra_region) in [
+            (TRILINEAR, AUTO, Region::Box, Region::Box),
+            (TRILINEAR, AUTO, Region::Path, Region::Path),
+            (TRILINEAR, AUTO, Region::Box, Region::Path),
+            (TRILINEAR, AUTO_CAPTURED, Region::Path, Region::Path),
+            (GRID_FITTED, AUTO, Region::Path, Region::Path),
+        ] {
+            compare(&m.rows, &method(grid, region), &method(tetra, tetra_region), args.target);
         }
     }
     args.gpu.finish(&ctx)
@@ -222,7 +230,10 @@ fn compare(rows: &[Row], grid: &str, tetra: &str, target: Option<f64>) {
 
 const TRILINEAR: &str = "grid, trilinear";
 const GRID_TETRA: &str = "grid, tetrahedral";
+const GRID_FITTED: &str = "grid, trilinear, fitted";
+/// Automatic placement as the engine does it: the kept probes' SH fitted to every candidate.
 const AUTO: &str = "auto, tetrahedral";
+const AUTO_CAPTURED: &str = "auto, tetrahedral, captured";
 
 /// Where probes go: the static groups' box (as `kage render --probes grid:` and `auto` place
 /// them), or the part of it that the moving group sweeps (where the test points are).
@@ -295,7 +306,7 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
     let mut captured = 0usize;
     let start = Instant::now();
     for (region, (lo, hi)) in [(Region::Box, static_box), (Region::Path, path)] {
-        let mut finest_grid = None;
+        let mut levels = Vec::new();
         for &level in params.grids {
             let counts = grid_counts(hi - lo, level);
             let lattice = Lattice::cell_centres(lo, hi, counts);
@@ -307,23 +318,33 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
             rows.push(Row { method: method(TRILINEAR, region), setting, probes, error: error(&trilinear)? });
             let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
             rows.push(Row { method: method(GRID_TETRA, region), setting, probes, error: error(&tetra)? });
-            if level == finest {
-                finest_grid = Some((lattice, sh));
-            }
+            levels.push((level, lattice, sh));
         }
-        let Some((lattice, sh)) = finest_grid else { unreachable!("the finest level is one of the levels") };
-        let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) =
-            lattice.positions().into_iter().zip(sh).filter(|(p, _)| !solids.contains(p.as_vec3())).unzip();
+        let Some((_, lattice, sh)) = levels.iter().find(|(level, ..)| *level == finest) else {
+            unreachable!("the finest level is one of the levels")
+        };
+        let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) = lattice
+            .positions()
+            .into_iter()
+            .zip(sh.iter().copied())
+            .filter(|(p, _)| !solids.contains(p.as_vec3()))
+            .unzip();
+        // Each grid fitted to the same captures as automatic placement: how much of its gain
+        // is the fit and how much the placement.
+        for (_, lattice, grid_sh) in levels {
+            let setting = Setting::Grid(lattice.counts);
+            let fitted = ProbeSet::trilinear(lattice, grid_sh)?.fitted(&positions, &sh)?;
+            let probes = fitted.probe_count();
+            rows.push(Row { method: method(GRID_FITTED, region), setting, probes, error: error(&fitted)? });
+        }
         for &tolerance in params.tolerances {
             let set = ProbeSet::reduced(&positions, &sh, tolerance)?;
-            let (probes, error) = (set.probe_count(), error(&set)?);
-            rows.push(Row {
-                method: method(AUTO, region),
-                setting: Setting::Tolerance(tolerance),
-                probes,
-                error,
-            });
+            let (setting, probes) = (Setting::Tolerance(tolerance), set.probe_count());
+            rows.push(Row { method: method(AUTO_CAPTURED, region), setting, probes, error: error(&set)? });
+            let fitted = set.fitted(&positions, &sh)?;
+            rows.push(Row { method: method(AUTO, region), setting, probes, error: error(&fitted)? });
         }
+        // Every candidate kept: each probe is its own capture, which the fit leaves as it is.
         let all = ProbeSet::tetrahedral(&positions, sh)?;
         rows.push(Row {
             method: method(AUTO, region),

@@ -12,6 +12,8 @@ pub enum ProbeError {
     TooFew { distinct: usize, total: usize },
     #[error("all {distinct} distinct probe positions lie {shape}: a tetrahedralization needs 4 that do not lie in one plane")]
     Flat { distinct: usize, shape: &'static str },
+    #[error("the least-squares fit of {probes} probes' SH did not converge")]
+    FitDiverged { probes: usize },
     #[error("{total} probes given: at most {max} are supported")]
     TooMany { total: usize, max: usize },
 }

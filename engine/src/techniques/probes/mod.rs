@@ -4,8 +4,9 @@
 //! [`ProbeSet`]: placement, capture and interpolation; [`technique`]: the moving group lit by
 //! the probes. The geometry:
 //!
-//! Automatic placement ([`ProbePlacement::Auto`], [`reduce`]) captures a dense set of candidates
-//! and keeps those the others cannot reproduce; a regular grid with trilinear interpolation
+//! Automatic placement ([`ProbePlacement::Auto`], [`reduce`]) captures a dense set of candidates,
+//! keeps those the others cannot reproduce and fits the kept ones' SH to every candidate's
+//! capture ([`fit`]); a regular grid with trilinear interpolation
 //! ([`Lattice`], [`ProbeInterpolation::Trilinear`]) is the baseline it is measured against
 //! (`kage bench probe-count`).
 //!
@@ -23,6 +24,7 @@ mod delaunay;
 mod dering;
 mod error;
 mod extrapolate;
+pub mod fit;
 mod input;
 mod lookup;
 mod predicates;

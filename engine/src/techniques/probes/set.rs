@@ -2,6 +2,7 @@
 //! tetrahedralization, each probe's SH, and the SH interpolated at any point with the
 //! tetrahedral weights.
 use super::capture::{CaptureSettings, InvalidProbe, ProbeCapture};
+use super::fit::fit;
 use super::reduce::{blend, reduce};
 use super::solids::Solids;
 use super::trilinear::Lattice;
@@ -229,7 +230,9 @@ impl ProbeSet {
             positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect::<Result<_>>()?;
         let candidates = positions.len();
         let mut set = match (&settings.placement, settings.interpolation) {
-            (ProbePlacement::Auto { tolerance, .. }, _) => ProbeSet::reduced(&positions, &sh, *tolerance)?,
+            (ProbePlacement::Auto { tolerance, .. }, _) => {
+                ProbeSet::reduced(&positions, &sh, *tolerance)?.fitted(&positions, &sh)?
+            }
             (ProbePlacement::Grid(counts), ProbeInterpolation::Trilinear) => {
                 // A lattice needs every corner: a probe left out leaves a hole no weight fills.
                 if let Some(probe) = invalid.first() {
@@ -267,13 +270,26 @@ impl ProbeSet {
     }
 
     /// Tetrahedral interpolation of those of the SH captured at `positions` that automatic
-    /// placement keeps at `tolerance` ([`reduce`]).
+    /// placement keeps at `tolerance` ([`reduce`]), each with its own capture ([`ProbeSet::fitted`]
+    /// gives them the values that reproduce all of `sh` best).
     pub fn reduced(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<ProbeSet> {
         let kept = reduce(positions, sh, tolerance)?;
         let points: Vec<DVec3> = kept.iter().map(|&i| positions[i]).collect();
         let mut set = ProbeSet::tetrahedral(&points, kept.iter().map(|&i| sh[i]).collect())?;
         set.candidates = positions.len();
         Ok(set)
+    }
+
+    /// The set with its probes' SH fitted by least squares to `captured`, the SH captured at
+    /// each of `positions` (see [`super::fit`]).
+    pub fn fitted(mut self, positions: &[DVec3], captured: &[ShRgb9]) -> Result<ProbeSet> {
+        let mut walker = Walker::default();
+        let rows = positions
+            .iter()
+            .map(|&p| Ok(self.weights(&mut walker, p)?.into_iter().filter(|&(_, w)| w != 0.0).collect()))
+            .collect::<Result<Vec<Vec<_>>>>()?;
+        self.sh = fit(&rows, captured, &self.sh)?;
+        Ok(self)
     }
 
     /// The probes the set interpolates.
@@ -294,14 +310,24 @@ impl ProbeSet {
     /// tetrahedral (outside the hull, extrapolation) weights that `walker` finds from where it
     /// last stopped.
     pub fn interpolate(&self, walker: &mut Walker, p: Vec3) -> Result<ShRgb9> {
+        let weights = self.weights(walker, p.as_dvec3())?;
+        Ok(blend(weights.iter().map(|&(probe, w)| (&self.sh[probe], w))))
+    }
+
+    /// The interpolation's (probe, weight) pairs at `p`: a grid cell's eight, or a
+    /// tetrahedron's four and four of weight 0.
+    fn weights(&self, walker: &mut Walker, p: DVec3) -> Result<[(usize, f64); 8]> {
         if let Some(lattice) = &self.trilinear {
-            let weights = lattice.weights(p.as_dvec3());
-            return Ok(blend(weights.iter().map(|&(probe, w)| (&self.sh[probe as usize], w))));
+            return Ok(lattice.weights(p).map(|(probe, w)| (probe as usize, w)));
         }
-        let location = walker.locate(&self.mesh, p.as_dvec3())?;
-        Ok(blend(
-            location.probes.iter().zip(location.weights).map(|(&probe, w)| (&self.sh[probe as usize], w)),
-        ))
+        let location = walker.locate(&self.mesh, p)?;
+        Ok(std::array::from_fn(|k| {
+            if k < 4 {
+                (location.probes[k] as usize, location.weights[k])
+            } else {
+                (0, 0.0)
+            }
+        }))
     }
 }
 
