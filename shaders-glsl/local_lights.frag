@@ -1,6 +1,7 @@
 #version 460
-// Shadowmap technique: V_k of the shared local-light shading is one depth comparison in light
-// k's map (no filtering: the reference's shadows are hard). Points outside the map (a point
+// Shadowmap technique: V_k of the shared local-light shading is the depth comparison in light
+// k's map, reconstructed between texel centres and kept hard (shadow_footprint_texel: the
+// reference's shadows are hard). Points outside the map (a point
 // light's map covers only its field of view) are lit.
 #include "local_lights_shading.glsl"
 
@@ -11,7 +12,12 @@ bool visible(uint k, vec3 p, vec3 ng) {
     vec4 m = shadow_map_coords(s, p);
     if (m.w < 0.0) return true;
     int size = textureSize(shadow_maps, 0).x;
-    ivec2 texel = min(ivec2(m.xy * float(size)), ivec2(size - 1));
-    float stored = texelFetch(shadow_maps, ivec3(texel, int(k)), 0).r;
-    return shadow_depth_visible(s, stored, m.z, p, ng, s.map.z, draw.bias);
+    vec2 f = m.xy * float(size);
+    float lit = 0.0;
+    for (int j = 0; j < 4; ++j) {
+        ivec2 texel = clamp(shadow_footprint_texel(f, j), ivec2(0), ivec2(size - 1));
+        float stored = texelFetch(shadow_maps, ivec3(texel, int(k)), 0).r;
+        if (shadow_depth_visible(s, stored, m.z, p, ng, s.map.z, draw.bias)) lit += shadow_footprint_weight(f, j);
+    }
+    return lit >= 0.5;
 }

@@ -29,7 +29,16 @@ bool visible(uint k, vec3 p, vec3 ng) {
         return true;
     }
 #endif
-    return asm_visible(s, m, p, ng, tile, ivec2(0), draw.bias);
+    // The four texels around the point in its tile (shadow_footprint_texel; at the tile's
+    // border the border texel again).
+    vec2 f = asm_texel_coords(tile, m.xy);
+    float texel = asm_texel_size(s, tile);
+    float lit = 0.0;
+    for (int j = 0; j < 4; ++j) {
+        float stored = texelFetch(asm_pool, asm_page_texel(tile, shadow_footprint_texel(f, j)), 0).r;
+        if (shadow_depth_visible(s, stored, m.z, p, ng, texel, draw.bias)) lit += shadow_footprint_weight(f, j);
+    }
+    return lit >= 0.5;
 }
 
 #endif

@@ -36,18 +36,32 @@ uint asm_descend(vec2 uv) {
     return at;
 }
 
-// The texel of `tile` (AsmNode.tile) holding uv, moved by `offset` texels and kept in the tile.
-ivec3 asm_texel(uvec4 tile, vec2 uv, ivec2 offset) {
-    vec2 local = uv * float(1u << tile.y) - vec2(tile.zw);
-    ivec2 texel = ivec2(local * float(KAGE_ASM_TILE_TEXELS)) + offset;
+// Light uv in `tile`'s (AsmNode.tile) texel space.
+vec2 asm_texel_coords(uvec4 tile, vec2 uv) {
+    return (uv * float(1u << tile.y) - vec2(tile.zw)) * float(KAGE_ASM_TILE_TEXELS);
+}
+
+// Texel `texel` of `tile`, kept in the tile (its neighbours' texels are in other pages).
+ivec3 asm_page_texel(uvec4 tile, ivec2 texel) {
     return ivec3(clamp(texel, ivec2(0), ivec2(KAGE_ASM_TILE_TEXELS - 1)), int(tile.x));
 }
 
-// Light k's visibility at p (geometric normal ng; m = shadow_map_coords) in the finest resident
-// tile: the depth comparison with the slope-scaled bias, texels scaled to the tile's level.
+// The texel of `tile` holding uv, moved by `offset` texels and kept in the tile.
+ivec3 asm_texel(uvec4 tile, vec2 uv, ivec2 offset) {
+    return asm_page_texel(tile, ivec2(asm_texel_coords(tile, uv)) + offset);
+}
+
+// The world size at unit depth of `tile`'s texels.
+float asm_texel_size(ShadowLight s, uvec4 tile) {
+    return s.map.z / float(1u << tile.y);
+}
+
+// Light k's visibility at p (geometric normal ng; m = shadow_map_coords) in the texel of `tile`
+// holding it, moved by `offset`: the depth comparison with the slope-scaled bias, texels scaled
+// to the tile's level. The refinement analysis's test, texel by texel (the lighting blends four).
 bool asm_visible(ShadowLight s, vec4 m, vec3 p, vec3 ng, uvec4 tile, ivec2 offset, vec4 bias) {
     float stored = texelFetch(asm_pool, asm_texel(tile, m.xy, offset), 0).r;
-    return shadow_depth_visible(s, stored, m.z, p, ng, s.map.z / float(1u << tile.y), bias);
+    return shadow_depth_visible(s, stored, m.z, p, ng, asm_texel_size(s, tile), bias);
 }
 
 #endif

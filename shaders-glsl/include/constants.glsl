@@ -73,8 +73,8 @@
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 17
 // Levels the ASM refinement asks for beyond the one whose texels match the eye pixel's
-// footprint: a nearest-texel edge lies up to half a texel off, so texels a sixteenth of the
-// pixel keep the lit/shadowed state of pixel centres right but within ~1/32 pixel of an edge
+// footprint: a reconstructed edge lies within a fraction of a texel of the true one, so texels a
+// sixteenth of the pixel keep the lit/shadowed state of pixel centres right but near an edge
 // (with 128² tiles an eighth, 3, was as good as 4: the pages they took ran out first).
 #define KAGE_ASM_EXTRA_LEVELS 4
 // The page table's directory: one entry per tile of this level (256² entries, 256 KiB) naming

@@ -69,17 +69,19 @@ fn boundary_pixels(image: &kage::imageio::RgbaF32Image, threshold: f64) -> usize
         .count()
 }
 
-/// The bound on misclassified pixels, derived from the map's texel size: the nearest-texel
-/// lookup places a shadow edge at most half a texel diagonal (√½ texel) away from where the
-/// ray-traced edge lies. On the floor, at view depth d below the light, a texel spans
+/// The bound on misclassified pixels, derived from the map's texel size: the lookup blends the
+/// tests of the four texels around the point and thresholds at 1/2, so its shadow edge runs
+/// through the cells between texel centres that the ray-traced edge also crosses (only there
+/// do the centres' tests differ), at most a cell diagonal (√2 texels) away from it. On the floor, at view depth d below the light, a texel spans
 /// d · 2 tan(fov/2) / S in world units (the floor faces the light: no stretching); seen from
 /// the camera at distance D with a vertical field of view φ over H pixels, a floor segment
 /// spans at most its length / (D · 2 tan(φ/2) / H) pixels. So every misclassified pixel lies
-/// within t = √½ · texel / pixel of a reference boundary, and their number is at most
+/// within t = √2 · texel / pixel of a reference boundary, and their number is at most
 /// B · (2t + 1) for B boundary pixels (a band 2t wide plus the pixel the edge crosses). The
 /// boundary count B also holds the box's own lit/unlit face edges and the cone's edge, where
 /// both images agree, so the bound is loose (measured: 9 pixels at S = 512 against a bound of
-/// 1107, 252 against 8082 at S = 32).
+/// 1510, 252 against 14519 at S = 32; the nearest texel's lookup, bound by √½ texel, also
+/// misclassified 9 and 252 here: the box's edges run along the texel rows).
 fn texel_bound(scene: &Scene, map_size: u32, boundary: usize) -> usize {
     let Light::Spot { position: light, .. } = scene.lights[0] else { unreachable!("a spot light") };
     let depth = light.y; // the floor is y = 0, the light looks straight down
@@ -96,7 +98,7 @@ fn texel_bound(scene: &Scene, map_size: u32, boundary: usize) -> usize {
     let hi = on_floor.iter().copied().reduce(Vec3::max).unwrap();
     let nearest = scene.camera.position.distance(scene.camera.position.clamp(lo, hi));
     let pixel = nearest * 2.0 * (0.5 * scene.camera.fov_y_deg.to_radians()).tan() / SIZE as f32;
-    let t = std::f32::consts::FRAC_1_SQRT_2 * texel / pixel;
+    let t = std::f32::consts::SQRT_2 * texel / pixel;
     (boundary as f32 * (2.0 * t + 1.0)).ceil() as usize
 }
 

@@ -39,10 +39,12 @@ pub const SHADOW_MAP_SIZES: std::ops::RangeInclusive<u32> = 16..=MAX_SIZE;
 pub const POINT_LIGHT_FOV_DEG: f32 = 122.0;
 
 /// Depth bias at any slope, in texels of the receiver's depth: half a texel covers the
-/// nearest-texel lookup's offset from the texel centre on a surface facing the light.
+/// depth quantisation and rasterisation offsets on a surface facing the light.
 const CONSTANT_BIAS_TEXELS: f32 = 0.5;
 /// Depth bias per unit of tan θ, in texels: the depth a tilted surface spans across the
-/// distance (at most √½ texel) from the lookup point to the texel centre, with some margin.
+/// distance from the lookup point to the centres of the four texels the lookup blends: those
+/// farther than 1 texel weigh under 0.14 together, short of the ½ that decides
+/// (`shadow_footprint_texel` in shaders-glsl/include/shadow_test.glsl).
 const SLOPE_BIAS_TEXELS: f32 = 1.0;
 /// tan θ beyond which the bias stops growing (θ ≈ 84°).
 const MAX_SLOPE: f32 = 10.0;
