@@ -13,11 +13,10 @@ bool visible(uint k, vec3 p, vec3 ng) {
     if (m.w < 0.0) return true;
     int size = textureSize(shadow_maps, 0).x;
     vec2 f = m.xy * float(size);
-    float lit = 0.0;
+    vec4 stored;
     for (int j = 0; j < 4; ++j) {
         ivec2 texel = clamp(shadow_footprint_texel(f, j), ivec2(0), ivec2(size - 1));
-        float stored = texelFetch(shadow_maps, ivec3(texel, int(k)), 0).r;
-        if (shadow_depth_visible(s, stored, m.z, p, ng, s.map.z, draw.bias)) lit += shadow_footprint_weight(f, j);
+        stored[j] = texelFetch(shadow_maps, ivec3(texel, int(k)), 0).r;
     }
-    return lit >= 0.5;
+    return shadow_footprint_visible(s, f, stored, shadow_receiver_depth(s, m.z, p, ng, s.map.z, draw.bias));
 }

@@ -32,13 +32,12 @@ bool visible(uint k, vec3 p, vec3 ng) {
     // The four texels around the point in its tile (shadow_footprint_texel; at the tile's
     // border the border texel again).
     vec2 f = asm_texel_coords(tile, m.xy);
-    float texel = asm_texel_size(s, tile);
-    float lit = 0.0;
+    vec4 stored;
     for (int j = 0; j < 4; ++j) {
-        float stored = texelFetch(asm_pool, asm_page_texel(tile, shadow_footprint_texel(f, j)), 0).r;
-        if (shadow_depth_visible(s, stored, m.z, p, ng, texel, draw.bias)) lit += shadow_footprint_weight(f, j);
+        stored[j] = texelFetch(asm_pool, asm_page_texel(tile, shadow_footprint_texel(f, j)), 0).r;
     }
-    return lit >= 0.5;
+    float receiver = shadow_receiver_depth(s, m.z, p, ng, asm_texel_size(s, tile), draw.bias);
+    return shadow_footprint_visible(s, f, stored, receiver);
 }
 
 #endif

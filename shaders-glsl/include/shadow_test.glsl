@@ -15,14 +15,11 @@ vec4 shadow_map_coords(ShadowLight s, vec3 p) {
     return vec4(uv, clip.w, inside ? 1.0 : -1.0);
 }
 
-// Whether a receiver at view depth w (point p, geometric normal ng) is lit past a texel that
-// stores Vulkan depth `stored`, for texels of world size `texel` at unit depth. bias: x constant
-// and y slope-scaled bias in texels, z the largest slope (tan) the bias follows.
-bool shadow_depth_visible(ShadowLight s, float stored, float w, vec3 p, vec3 ng, float texel, vec4 bias) {
-    // Vulkan depth of a right-handed perspective projection back to view depth:
-    // z = near * far / (far - d * (far - near)).
+// The view depth a receiver at view depth w (point p, geometric normal ng) must not pass to be
+// lit, for texels of world size `texel` at unit depth. bias: x constant and y slope-scaled bias
+// in texels, z the largest slope (tan) the bias follows.
+float shadow_receiver_depth(ShadowLight s, float w, vec3 p, vec3 ng, float texel, vec4 bias) {
     float near = s.map.x, far = s.map.y;
-    float occluder = near * far / (far - stored * (far - near));
     // The depth a surface spans inside one texel grows with the texel (w * texel in world
     // units) and with tan of the light's angle to the surface: the slope-scaled bias.
     vec3 l = normalize(s.light.position.xyz - p);
@@ -31,7 +28,22 @@ bool shadow_depth_visible(ShadowLight s, float stored, float w, vec3 p, vec3 ng,
     // Fine texels (deep ASM tiles) fall below the D32 depth's own resolution near the far plane:
     // d(z)/d(d) = z^2 (far - near) / (near far), times 4 ulps of a depth near 1 (2^-24 each).
     float resolution = w * w * (far - near) / (near * far) * 2.4e-7;
-    return w - w * texel * (bias.x + bias.y * slope) - resolution <= occluder;
+    return w - w * texel * (bias.x + bias.y * slope) - resolution;
+}
+
+// Whether a receiver whose biased depth is `receiver` (shadow_receiver_depth) is lit past a
+// texel that stores Vulkan depth `stored`.
+bool shadow_lit_past(ShadowLight s, float stored, float receiver) {
+    // Vulkan depth of a right-handed perspective projection back to view depth:
+    // z = near * far / (far - d * (far - near)).
+    float near = s.map.x, far = s.map.y;
+    return receiver <= near * far / (far - stored * (far - near));
+}
+
+// Whether a receiver at view depth w is lit past a texel that stores Vulkan depth `stored`
+// (shadow_receiver_depth's arguments).
+bool shadow_depth_visible(ShadowLight s, float stored, float w, vec3 p, vec3 ng, float texel, vec4 bias) {
+    return shadow_lit_past(s, stored, shadow_receiver_depth(s, w, p, ng, texel, bias));
 }
 
 // Hard shadows reconstructed between texel centres: the four texels around texel-space point f
@@ -46,10 +58,16 @@ ivec2 shadow_footprint_texel(vec2 f, int j) {
     return ivec2(floor(f - 0.5)) + ivec2(j & 1, j >> 1);
 }
 
-// Corner j's bilinear weight.
-float shadow_footprint_weight(vec2 f, int j) {
+// Whether f is lit, the four texels of its footprint (shadow_footprint_texel, in corner order)
+// storing Vulkan depths `stored`, for a receiver of biased depth `receiver`.
+bool shadow_footprint_visible(ShadowLight s, vec2 f, vec4 stored, float receiver) {
     vec2 a = fract(f - 0.5);
-    return ((j & 1) == 1 ? a.x : 1.0 - a.x) * ((j >> 1) == 1 ? a.y : 1.0 - a.y);
+    vec4 weight = vec4((1.0 - a.x) * (1.0 - a.y), a.x * (1.0 - a.y), (1.0 - a.x) * a.y, a.x * a.y);
+    float lit = 0.0;
+    for (int j = 0; j < 4; ++j) {
+        if (shadow_lit_past(s, stored[j], receiver)) lit += weight[j];
+    }
+    return lit >= 0.5;
 }
 
 #endif

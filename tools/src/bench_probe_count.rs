@@ -306,35 +306,34 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
     let mut captured = 0usize;
     let start = Instant::now();
     for (region, (lo, hi)) in [(Region::Box, static_box), (Region::Path, path)] {
+        // Each level's trilinear set with the counts and captures it was built from.
         let mut levels = Vec::new();
         for &level in params.grids {
             let counts = grid_counts(hi - lo, level);
             let lattice = Lattice::cell_centres(lo, hi, counts);
             let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
             captured += sh.len();
-            let setting = Setting::Grid(counts);
-            let trilinear = ProbeSet::trilinear(lattice, sh.clone())?;
-            let probes = sh.len();
-            rows.push(Row { method: method(TRILINEAR, region), setting, probes, error: error(&trilinear)? });
+            let (setting, probes) = (Setting::Grid(counts), sh.len());
             let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
+            let trilinear = ProbeSet::trilinear(lattice, sh)?;
+            rows.push(Row { method: method(TRILINEAR, region), setting, probes, error: error(&trilinear)? });
             rows.push(Row { method: method(GRID_TETRA, region), setting, probes, error: error(&tetra)? });
-            levels.push((level, lattice, sh));
+            levels.push((level, lattice, trilinear));
         }
-        let Some((_, lattice, sh)) = levels.iter().find(|(level, ..)| *level == finest) else {
+        let Some((_, lattice, finest_set)) = levels.iter().find(|(level, ..)| *level == finest) else {
             unreachable!("the finest level is one of the levels")
         };
         let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) = lattice
             .positions()
             .into_iter()
-            .zip(sh.iter().copied())
+            .zip(finest_set.sh.iter().copied())
             .filter(|(p, _)| !solids.contains(p.as_vec3()))
             .unzip();
         // Each grid fitted to the same captures as automatic placement: how much of its gain
         // is the fit and how much the placement.
-        for (_, lattice, grid_sh) in levels {
-            let setting = Setting::Grid(lattice.counts);
-            let fitted = ProbeSet::trilinear(lattice, grid_sh)?.fitted(&positions, &sh)?;
-            let probes = fitted.probe_count();
+        for (_, lattice, trilinear) in levels {
+            let fitted = trilinear.fitted(&positions, &sh)?;
+            let (setting, probes) = (Setting::Grid(lattice.counts), fitted.probe_count());
             rows.push(Row { method: method(GRID_FITTED, region), setting, probes, error: error(&fitted)? });
         }
         for &tolerance in params.tolerances {

@@ -126,6 +126,7 @@ pub fn fit(rows: &[Vec<(usize, f64)>], captured: &[ShRgb9], own: &[ShRgb9]) -> R
 
 #[cfg(test)]
 mod tests {
+    use super::super::reduce::blend;
     use super::super::{Lattice, ProbeSet, Walker};
     use super::*;
     use glam::{DVec3, Vec3};
@@ -137,17 +138,34 @@ mod tests {
         sh
     }
 
+    /// The squared distance of two SH's coefficients.
+    fn distance2(a: &ShRgb9, b: &ShRgb9) -> f64 {
+        flat(a).iter().zip(flat(b)).map(|(a, b)| (a - b) * (a - b)).sum()
+    }
+
+    fn assert_close(a: &[ShRgb9], b: &[ShRgb9], tolerance: f32) {
+        for (f, o) in a.iter().zip(b) {
+            for (a, b) in f.c.iter().flatten().zip(o.c.iter().flatten()) {
+                assert!((a - b).abs() < tolerance, "{a} against {b}");
+            }
+        }
+    }
+
+    /// The squared coefficient residual of the values `x` interpolated by `rows` against `captured`.
     fn squared_residual(rows: &[Vec<(usize, f64)>], captured: &[ShRgb9], x: &[ShRgb9]) -> f64 {
         rows.iter()
             .zip(captured)
-            .map(|(row, s)| {
-                let s = flat(s);
-                let mut v = [0.0; 27];
-                for &(i, w) in row {
-                    v.iter_mut().zip(flat(&x[i])).for_each(|(v, e)| *v += w * e);
-                }
-                v.iter().zip(&s).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
-            })
+            .map(|(row, s)| distance2(&blend(row.iter().map(|&(i, w)| (&x[i], w))), s))
+            .sum()
+    }
+
+    /// The squared coefficient residual of `set`'s interpolation at each of `positions`.
+    fn set_residual(set: &ProbeSet, positions: &[DVec3], sh: &[ShRgb9]) -> f64 {
+        let mut walker = Walker::default();
+        positions
+            .iter()
+            .zip(sh)
+            .map(|(p, s)| distance2(&set.interpolate(&mut walker, p.as_vec3()).unwrap(), s))
             .sum()
     }
 
@@ -163,11 +181,7 @@ mod tests {
         let (rows, captured) = segment(&[1.0, 1.5, 2.0, 2.5, 3.0]);
         let own = [captured[0], captured[4]];
         let fitted = fit(&rows, &captured, &own).unwrap();
-        for (f, o) in fitted.iter().zip(&own) {
-            for (a, b) in f.c.iter().flatten().zip(o.c.iter().flatten()) {
-                assert!((a - b).abs() < 1e-5, "{a} against {b}");
-            }
-        }
+        assert_close(&fitted, &own, 1e-5);
     }
 
     #[test]
@@ -196,19 +210,6 @@ mod tests {
         for (f, e) in fitted.iter().zip(exact) {
             assert!((f64::from(f.c[0][0]) - e).abs() < 1e-5, "{} against {e}", f.c[0][0]);
         }
-    }
-
-    /// The squared coefficient residual of `set`'s interpolation at each of `positions`.
-    fn set_residual(set: &ProbeSet, positions: &[DVec3], sh: &[ShRgb9]) -> f64 {
-        let mut walker = Walker::default();
-        positions
-            .iter()
-            .zip(sh)
-            .map(|(p, s)| {
-                let a = set.interpolate(&mut walker, p.as_vec3()).unwrap();
-                flat(&a).iter().zip(flat(s)).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
-            })
-            .sum()
     }
 
     #[test]
@@ -242,11 +243,7 @@ mod tests {
         let inside = Lattice::cell_centres(Vec3::splat(0.125), Vec3::splat(0.875), [5; 3]).positions();
         let captured: Vec<ShRgb9> = inside.iter().map(|&p| linear(p)).collect();
         let fitted = ProbeSet::trilinear(lattice, own.clone()).unwrap().fitted(&inside, &captured).unwrap();
-        for (f, o) in fitted.sh.iter().zip(&own) {
-            for (a, b) in f.c.iter().flatten().zip(o.c.iter().flatten()) {
-                assert!((a - b).abs() < 1e-4, "{a} against {b}");
-            }
-        }
+        assert_close(&fitted.sh, &own, 1e-4);
     }
 
     #[test]
