@@ -8,6 +8,9 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 0) out vec3 world_position;
 layout(location = 1) out vec3 world_normal;
+// depth_prepass.vert computes the same position; the shadowmap and ASM scene passes keep only
+// fragments at exactly its depths (depth test EQUAL).
+precise gl_Position;
 
 void main() {
     // Uniform scale only: the model matrix's upper 3x3 keeps normals perpendicular.

@@ -313,7 +313,11 @@ impl Renderer {
         if analysis.is_empty() {
             drop(analysis);
         } else {
+            // What the analysis wrote stays for the frame (the ASM depth prepass).
+            let written: Vec<&'static str> =
+                analysis.iter().flat_map(|p| p.outputs.iter().copied()).collect();
             timings = self.executor.run(&imports, analysis)?;
+            imports.extend(written);
             self.technique.analysed()?;
         }
         let mut passes: Vec<Pass> = Vec::new();

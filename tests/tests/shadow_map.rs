@@ -214,3 +214,30 @@ fn the_asm_walkthrough_renders_cleanly() {
     let lit = image.pixels.iter().filter(|p| p[1] > 0.0).count() as f32 / image.pixels.len() as f32;
     assert!((0.3..0.9).contains(&lit), "lit fraction of the grating close-up: {lit}");
 }
+
+/// The local-light techniques shade over a depth prepass with the depth test EQUAL: every pixel
+/// the scene covers must still be shaded, exactly the pixels the unshadowed technique (one
+/// pass, depth test LESS) covers. A position computed differently in the two passes would
+/// leave holes showing the background. The environment is a constant no shading reproduces,
+/// so a pixel shows geometry exactly where it differs from it.
+#[test]
+fn the_depth_prepass_leaves_no_pixel_unshaded() {
+    let ctx = Validated::new();
+    let mut scene = box_over_floor();
+    scene.environment = EnvMap::constant([2.0; 3]);
+    let covered = |technique| {
+        let image = render(&ctx, &scene, technique);
+        image.pixels.iter().map(|p| p[..3] != [2.0; 3]).collect::<Vec<bool>>()
+    };
+    let expected = covered(TechniqueChoice::Unshadowed);
+    let count = expected.iter().filter(|&&c| c).count();
+    assert!(count > expected.len() / 4, "the scene covers {count} pixels");
+    let asm = kage::techniques::asm::AsmSettings { budget_mb: 1.0, ..Default::default() };
+    for technique in [TechniqueChoice::ShadowMap { size: 512 }, TechniqueChoice::Asm(asm)] {
+        let name = format!("{technique:?}");
+        let got = covered(technique);
+        let holes = expected.iter().zip(&got).filter(|(e, g)| **e && !**g).count();
+        let extra = expected.iter().zip(&got).filter(|(e, g)| !**e && **g).count();
+        assert_eq!((holes, extra), (0, 0), "{name}: pixels unshaded, shaded outside the scene");
+    }
+}

@@ -19,8 +19,10 @@ pub use context::{Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
 pub use device::{FRAGMENT_STORES, GEOMETRY_SHADER};
 pub use image::{Edge, Image, ImageDesc, Sampler};
-pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer};
-pub use rendering::Target;
+pub use pipeline::{
+    ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
+};
+pub use rendering::{Depth, Target};
 pub use timestamps::TimestampPool;
 pub use validation::ValidationLog;
 

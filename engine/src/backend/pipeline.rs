@@ -160,6 +160,19 @@ pub struct VertexBuffer<'a> {
     pub attributes: &'a [VertexAttribute],
 }
 
+/// How a graphics pipeline tests and writes depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthTest {
+    /// No test, no write.
+    Off,
+    /// Nearer fragments pass and write their depth.
+    Less,
+    /// Only fragments at exactly the depth a prepass stored pass, writing nothing: one fragment
+    /// per pixel is shaded whatever the draw order. The prepass must compute `gl_Position` with
+    /// the same operations on the same inputs, `precise` (shaders-glsl/depth_prepass.vert).
+    Equal,
+}
+
 pub struct GraphicsDesc<'a> {
     pub name: &'a str,
     pub vertex_spirv: &'a [u8],
@@ -171,7 +184,7 @@ pub struct GraphicsDesc<'a> {
     pub topology: vk::PrimitiveTopology,
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
-    pub depth_test: bool,
+    pub depth: DepthTest,
     /// Add to the colour target instead of replacing it (accumulating lights).
     pub additive: bool,
     /// Specialization constants of both stages, `constant_id` 0, 1, … in order (a stage ignores
@@ -186,6 +199,7 @@ pub struct GraphicsPipeline {
     ctx: Arc<Context>,
     raw: vk::Pipeline,
     layout: Layout,
+    depth: DepthTest,
 }
 
 impl GraphicsPipeline {
@@ -248,9 +262,13 @@ impl GraphicsPipeline {
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(desc.depth_test)
-            .depth_write_enable(desc.depth_test)
-            .depth_compare_op(vk::CompareOp::LESS);
+            .depth_test_enable(desc.depth != DepthTest::Off)
+            .depth_write_enable(desc.depth == DepthTest::Less)
+            .depth_compare_op(if desc.depth == DepthTest::Equal {
+                vk::CompareOp::EQUAL
+            } else {
+                vk::CompareOp::LESS
+            });
         let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
             .color_write_mask(vk::ColorComponentFlags::RGBA)
             .blend_enable(desc.additive)
@@ -289,7 +307,11 @@ impl GraphicsPipeline {
                 }
             };
         ctx.set_name(raw, desc.name);
-        Ok(GraphicsPipeline { ctx: ctx.clone(), raw, layout })
+        Ok(GraphicsPipeline { ctx: ctx.clone(), raw, layout, depth: desc.depth })
+    }
+
+    pub fn depth(&self) -> DepthTest {
+        self.depth
     }
 
     /// Binds the pipeline and its resources (call inside a rendering scope).

@@ -16,15 +16,31 @@ impl<'a> From<&'a Image> for Target<'a> {
     }
 }
 
+/// A depth attachment: cleared to 1 (the far plane), or kept as an earlier pass left it (a
+/// depth prepass).
+#[derive(Clone, Copy)]
+pub enum Depth<'a> {
+    Clear(Target<'a>),
+    Keep(Target<'a>),
+}
+
+impl<'a> Depth<'a> {
+    fn target(self) -> Target<'a> {
+        match self {
+            Depth::Clear(t) | Depth::Keep(t) => t,
+        }
+    }
+}
+
 impl Context {
-    /// Begins rendering into `color` (cleared to `clear` when given, else loaded) and `depth`
-    /// (always cleared to 1, the far plane). Either may be absent (depth-only shadow maps).
+    /// Begins rendering into `color` (cleared to `clear` when given, else loaded) and `depth`.
+    /// Either may be absent (depth-only shadow maps).
     pub fn begin_rendering(
         &self,
         cmd: vk::CommandBuffer,
         color: Option<Target>,
         clear: Option<[f32; 4]>,
-        depth: Option<Target>,
+        depth: Option<Depth>,
     ) {
         let color_attachment: Vec<vk::RenderingAttachmentInfo> = color
             .iter()
@@ -44,16 +60,22 @@ impl Context {
             })
             .collect();
         let depth_attachment = depth.map(|d| {
+            let load = match d {
+                Depth::Clear(_) => vk::AttachmentLoadOp::CLEAR,
+                Depth::Keep(_) => vk::AttachmentLoadOp::LOAD,
+            };
+            let d = d.target();
             vk::RenderingAttachmentInfo::default()
                 .image_view(d.image.attachment_view(d.layer))
                 .image_layout(vk::ImageLayout::GENERAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .load_op(load)
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(vk::ClearValue {
                     depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 },
                 })
         });
-        let size = color.or(depth).map(|t| (t.image.width, t.image.height)).unwrap_or((1, 1));
+        let size =
+            color.or(depth.map(Depth::target)).map(|t| (t.image.width, t.image.height)).unwrap_or((1, 1));
         let area = vk::Rect2D {
             offset: vk::Offset2D::default(),
             extent: vk::Extent2D { width: size.0, height: size.1 },

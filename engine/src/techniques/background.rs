@@ -2,7 +2,7 @@
 //! colour target and looks up the map along each pixel's view ray.
 use super::environment::GpuEnvironment;
 use super::FrameInputs;
-use crate::backend::{vk, Binding, BindingKind, Buffer, Context, GraphicsDesc, GraphicsPipeline};
+use crate::backend::{vk, Binding, BindingKind, Buffer, Context, DepthTest, GraphicsDesc, GraphicsPipeline};
 use crate::error::Result;
 use crate::layouts::spirv;
 use crate::pass::Pass;
@@ -27,7 +27,7 @@ impl Background {
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 color_formats: &[COLOR_FORMAT],
                 depth_format: None,
-                depth_test: false,
+                depth: DepthTest::Off,
                 additive: false,
                 constants: &[],
             },

@@ -26,7 +26,7 @@ use super::tamura::regions::Regions;
 use super::tamura::self_shadow::env_rotation;
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, GraphicsPipeline, MemoryLocation,
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight};
@@ -85,6 +85,7 @@ impl ParallelLights {
             (spirv::PARALLEL_LIGHTS_VERT, spirv::PARALLEL_LIGHTS_FRAG),
             &[BindingKind::UniformBuffer, BindingKind::UniformBuffer, BindingKind::SampledImage],
             size_of::<ParallelDrawPush>(),
+            DepthTest::Less,
         )?;
         let lights = Buffer::new(
             ctx,

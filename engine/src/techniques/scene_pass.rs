@@ -1,29 +1,80 @@
 //! The pass most techniques end with: every mesh drawn once into the colour and depth targets
 //! by a pipeline that reads the mesh vertices (position, normal), with per-draw push constants.
-//! Shared by the unshadowed, parallel-lights and shadowmap techniques.
-use super::unshadowed::MESH_VERTICES;
+//! Shared by the unshadowed, parallel-lights, shadowmap and adaptive shadow map techniques.
+//!
+//! The local-light techniques (shadowmap, adaptive shadow maps) lay the depth down first in a
+//! depth-only prepass with the scene pass's own vertex shader, then shade with the depth test
+//! EQUAL: their lighting looks up a shadow map per fragment, and with the scene drawn in any
+//! order a fragment hidden later would pay for it too (the `asm` scene's overdraw made its
+//! ASM lighting pass 2x as long on lavapipe; BENCHMARKS.md).
+use super::unshadowed::{MESH_POSITIONS, MESH_VERTICES};
 use super::FrameInputs;
-use crate::backend::{vk, Binding, BindingKind, Context, GraphicsDesc, GraphicsPipeline, VertexBuffer};
+use crate::backend::{
+    vk, Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
+};
 use crate::error::Result;
-use crate::layouts::{bytes_of, Pod};
+use crate::layouts::{bytes_of, spirv, Pod};
 use crate::pass::Pass;
-use crate::renderer::{GpuMesh, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use glam::Mat4;
 use std::sync::Arc;
 
 /// What a shadow-map technique's scene pass reads.
 pub const SCENE_READS: [&str; 3] = ["frame_uniforms", "shadow_maps", "color"];
+/// What a shadow-map technique's scene pass after a depth prepass reads.
+pub const PREPASS_SCENE_READS: [&str; 4] = ["frame_uniforms", "shadow_maps", "color", "depth"];
 
 /// A scene pipeline named `name` from its two shaders, resources and push-constant size, drawing
-/// the meshes' positions and normals.
+/// the meshes' positions and normals with the depth test `depth` (`Equal` after
+/// [`depth_prepass`]).
 pub fn scene_pipeline(
     ctx: &Arc<Context>,
     name: &str,
     shaders: (&[u8], &[u8]),
     bindings: &[BindingKind],
     push_size: usize,
+    depth: DepthTest,
 ) -> Result<GraphicsPipeline> {
-    scene_pipeline_with(ctx, name, shaders, bindings, push_size, &[MESH_VERTICES])
+    scene_pipeline_with(ctx, name, shaders, bindings, push_size, &[MESH_VERTICES], depth)
+}
+
+/// The depth prepass' pipeline for scene pipelines drawn with shaders-glsl/local_lights.vert
+/// and push constants of `push_size` bytes: depth_prepass.vert, which computes the same
+/// `gl_Position` (so the scene pass' EQUAL test meets the same depths), no colour.
+pub fn depth_prepass_pipeline(ctx: &Arc<Context>, name: &str, push_size: usize) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        ctx,
+        &GraphicsDesc {
+            name,
+            vertex_spirv: spirv::DEPTH_PREPASS_VERT,
+            fragment_spirv: spirv::SHADOW_DEPTH_FRAG,
+            bindings: &[BindingKind::UniformBuffer],
+            push_size: push_size as u32,
+            vertex_buffers: &[MESH_POSITIONS],
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[],
+            depth_format: Some(DEPTH_FORMAT),
+            depth: DepthTest::Less,
+            additive: false,
+            constants: &[],
+        },
+    )
+}
+
+/// The `depth_prepass` pass: every mesh's depth into the depth target, with the push constants
+/// the scene pass gives it (`push`; the vertex shader reads the model matrix).
+pub fn depth_prepass<'a, P: Pod>(
+    frame: &FrameInputs<'a>,
+    pipeline: &'a GraphicsPipeline,
+    push: impl Fn(&GpuMesh, &Mat4) -> P + 'a,
+) -> Pass<'a> {
+    let (ctx, scene, targets, uniforms) = (frame.ctx, frame.scene, frame.targets, frame.uniforms);
+    Pass::new("depth_prepass", &["frame_uniforms"], &["depth"], move |cmd| {
+        ctx.begin_rendering(cmd, None, None, Some(Depth::Clear((&targets.depth).into())));
+        pipeline.bind(cmd, &[Binding::Uniform(uniforms)]);
+        draw_meshes(ctx, cmd, scene, pipeline, &push);
+        ctx.end_rendering(cmd);
+    })
 }
 
 /// [`scene_pipeline`] with other vertex buffers (per-vertex data beside the positions).
@@ -34,6 +85,7 @@ pub fn scene_pipeline_with(
     bindings: &[BindingKind],
     push_size: usize,
     vertex_buffers: &[VertexBuffer],
+    depth: DepthTest,
 ) -> Result<GraphicsPipeline> {
     GraphicsPipeline::new(
         ctx,
@@ -47,7 +99,7 @@ pub fn scene_pipeline_with(
             topology: vk::PrimitiveTopology::TRIANGLE_LIST,
             color_formats: &[COLOR_FORMAT],
             depth_format: Some(DEPTH_FORMAT),
-            depth_test: true,
+            depth,
             additive: false,
             constants: &[],
         },
@@ -55,7 +107,8 @@ pub fn scene_pipeline_with(
 }
 
 /// The `scene` pass: binds `bindings`, then draws each mesh with the push constants
-/// `push(mesh, its model matrix)` gives.
+/// `push(mesh, its model matrix)` gives; over the depth prepass' depth when the pipeline tests
+/// `Equal`, else into a cleared depth target.
 pub fn scene_pass<'a, P: Pod>(
     frame: &FrameInputs<'a>,
     reads: &'a [&'static str],
@@ -65,13 +118,27 @@ pub fn scene_pass<'a, P: Pod>(
 ) -> Pass<'a> {
     let (ctx, scene, targets) = (frame.ctx, frame.scene, frame.targets);
     Pass::new("scene", reads, &["color", "depth"], move |cmd| {
-        ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
+        let depth = (&targets.depth).into();
+        let depth =
+            if pipeline.depth() == DepthTest::Equal { Depth::Keep(depth) } else { Depth::Clear(depth) };
+        ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some(depth));
         pipeline.bind(cmd, &bindings);
-        for mesh in &scene.meshes {
-            let p = push(mesh, &scene.transforms[mesh.group]);
-            pipeline.push(cmd, bytes_of(&p));
-            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-        }
+        draw_meshes(ctx, cmd, scene, pipeline, &push);
         ctx.end_rendering(cmd);
     })
+}
+
+/// Draws every mesh of `scene` with the push constants `push(mesh, its model matrix)` gives.
+fn draw_meshes<P: Pod>(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    scene: &GpuScene,
+    pipeline: &GraphicsPipeline,
+    push: &impl Fn(&GpuMesh, &Mat4) -> P,
+) {
+    for mesh in &scene.meshes {
+        let p = push(mesh, &scene.transforms[mesh.group]);
+        pipeline.push(cmd, bytes_of(&p));
+        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+    }
 }

@@ -5,7 +5,8 @@
 //! shadow maps (its page pool: one tile per layer).
 use super::unshadowed::MESH_POSITIONS;
 use crate::backend::{
-    vk, Binding, Context, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, Target,
+    vk, Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
+    Target,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
@@ -38,7 +39,7 @@ impl ShadowMaps {
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 color_formats: &[],
                 depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
+                depth: DepthTest::Less,
                 additive: false,
                 constants: &[],
             },
@@ -89,21 +90,7 @@ impl ShadowMaps {
         view_proj: &Mat4,
         draws: impl Fn(&GpuMesh) -> bool,
     ) {
-        self.record_into(ctx, cmd, scene, self.target(layer), view_proj, draws);
-    }
-
-    /// [`ShadowMaps::record`] into another depth target of the same format (the ASM's eye-view
-    /// depth).
-    pub fn record_into(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        scene: &GpuScene,
-        target: Target<'_>,
-        view_proj: &Mat4,
-        draws: impl Fn(&GpuMesh) -> bool,
-    ) {
-        ctx.begin_rendering(cmd, None, None, Some(target));
+        ctx.begin_rendering(cmd, None, None, Some(Depth::Clear(self.target(layer))));
         self.pipeline.bind(cmd, &[]);
         for mesh in scene.meshes.iter().filter(|m| draws(m)) {
             let push = ShadowDepthPush {

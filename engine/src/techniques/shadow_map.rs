@@ -17,18 +17,20 @@
 //! a depth of tan θ per unit of width inside a texel, so the bias grows with tan θ (capped:
 //! grazing surfaces would otherwise detach their shadows entirely).
 use super::parallel_lights::scene_sphere;
-use super::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use super::scene_pass::{
+    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
+};
 use super::shadow_depth::ShadowMaps;
 use super::tamura::occlusion::{group_bounds, GroupBounds};
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, GraphicsPipeline, MemoryLocation,
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of_slice, constants, spirv, LocalDrawPush, ShadowLight};
 use crate::pass::Pass;
 use crate::reference::render::reference_light;
-use crate::renderer::MAX_SIZE;
+use crate::renderer::{GpuMesh, MAX_SIZE};
 use crate::scene::{Light, Scene};
 use glam::{Mat4, Vec3};
 use std::sync::Arc;
@@ -57,6 +59,7 @@ pub struct ShadowMap {
     size: u32,
     /// One map per light.
     shadow_maps: ShadowMaps,
+    prepass_pipeline: GraphicsPipeline,
     scene_pipeline: GraphicsPipeline,
     /// `ShadowLight` per light, `MAX_LOCAL_LIGHTS` records (the shader's array size).
     records: Buffer,
@@ -86,6 +89,7 @@ impl ShadowMap {
             (spirv::LOCAL_LIGHTS_VERT, spirv::LOCAL_LIGHTS_FRAG),
             &[BindingKind::UniformBuffer, BindingKind::UniformBuffer, BindingKind::SampledImage],
             size_of::<LocalDrawPush>(),
+            DepthTest::Equal,
         )?;
         let records = Buffer::new(
             ctx,
@@ -100,6 +104,11 @@ impl ShadowMap {
             bounds: group_bounds(scene),
             size,
             shadow_maps: ShadowMaps::new(ctx, "shadow_map", size, scene.lights.len() as u32)?,
+            prepass_pipeline: depth_prepass_pipeline(
+                ctx,
+                "shadow_map.depth_prepass",
+                size_of::<LocalDrawPush>(),
+            )?,
             scene_pipeline,
             records,
         })
@@ -155,16 +164,15 @@ impl Technique for ShadowMap {
             Binding::Uniform(&self.records),
             self.shadow_maps.binding(),
         ];
-        let scene_pass =
-            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
-                LocalDrawPush {
-                    model: model.to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    params: [count, 0, 0, 0],
-                    bias: DEPTH_BIAS,
-                }
-            });
-        vec![shadow_maps, scene_pass]
+        let push = move |mesh: &GpuMesh, model: &Mat4| LocalDrawPush {
+            model: model.to_cols_array_2d(),
+            albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+            params: [count, 0, 0, 0],
+            bias: DEPTH_BIAS,
+        };
+        let prepass = depth_prepass(inputs, &self.prepass_pipeline, push);
+        let scene_pass = scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, push);
+        vec![shadow_maps, prepass, scene_pass]
     }
 
     fn shadow_memory_bytes(&self) -> Option<u64> {

@@ -2,7 +2,8 @@
 use super::scene_pass;
 use super::{FrameInputs, FrameState, Technique};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, Context, GraphicsPipeline, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, GraphicsPipeline, VertexAttribute,
+    VertexBuffer,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, DrawPush};
@@ -42,6 +43,7 @@ pub fn scene_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> 
         (spirv::SCENE_VERT, fragment_spirv),
         &bindings,
         size_of::<DrawPush>(),
+        DepthTest::Less,
     )
 }
 
@@ -73,7 +75,12 @@ impl Technique for Unshadowed {
         let (ctx, uniforms, env_sh, scene, targets) =
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
         vec![Pass::new("scene", &["frame_uniforms", "env_sh", "color"], &["color", "depth"], move |cmd| {
-            ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
+            ctx.begin_rendering(
+                cmd,
+                Some((&targets.color).into()),
+                None,
+                Some(Depth::Clear((&targets.depth).into())),
+            );
             self.draw(ctx, cmd, uniforms, env_sh, scene, |mesh| Some(mesh.albedo));
             ctx.end_rendering(cmd);
         })]

@@ -5,9 +5,10 @@
 //! A frame follows the paper's order: the eye view is analysed first, and the tiles it asks for
 //! are rendered before the same frame looks them up. Two submissions:
 //! 1. analysis: `asm_refresh` re-renders the resident tiles a moving group touched (see below),
-//!    `asm_eye_depth` draws the scene's depth from the eye, and `asm_analysis` finds, per eye
-//!    pixel (one of each 2×2 block per frame, in turn), the tile it uses, and on shadow edges
-//!    short of resolution the chain of finer tiles it asks for, counted in a buffer;
+//!    `depth_prepass` draws the scene's depth from the eye (the lighting pass shades over it),
+//!    and `asm_analysis` finds, per eye pixel (one of each 2×2 block per frame, in turn), the
+//!    tile it uses, and on shadow edges short of resolution the chain of finer tiles it asks
+//!    for, counted in a buffer;
 //! 2. the host reads the counts, marks the used tiles, and plans within the time budget
 //!    (`plan`); then the frame: `asm_tiles` renders the planned tiles, each depth-only into its
 //!    page with the light's projection cropped to its square (one debug label per tile), and
@@ -27,16 +28,19 @@ use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{Insert, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
 use super::tile::TileKey;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsDesc,
-    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, FRAGMENT_STORES, GEOMETRY_SHADER,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
+    GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, FRAGMENT_STORES,
+    GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, AsmTilePush, LocalDrawPush, ShadowLight};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
-use crate::renderer::{GpuScene, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene, DEPTH_FORMAT};
 use crate::scene::{Light, Scene};
 use crate::techniques::parallel_lights::scene_sphere;
-use crate::techniques::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use crate::techniques::scene_pass::{
+    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
+};
 use crate::techniques::shadow_depth::ShadowMaps;
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
 use crate::techniques::tamura::occlusion::{group_bounds, GroupBounds};
@@ -155,6 +159,7 @@ pub struct Asm {
     /// The ID test's polygon IDs: an R32_UINT layer per page, the pipeline that renders depth
     /// and IDs, and each mesh's first ID (by group, then mesh).
     ids: Option<TileIds>,
+    prepass_pipeline: GraphicsPipeline,
     scene_pipeline: GraphicsPipeline,
     analysis: ComputePipeline,
     nearest: Sampler,
@@ -179,8 +184,6 @@ pub struct Asm {
     record: Option<ShadowLight>,
     transforms: Vec<Mat4>,
     group_rects: Vec<UvRect>,
-    /// World to the eye's clip space this frame.
-    eye_view_proj: Mat4,
     /// The tile of each node of the page table the analysis descends.
     table_keys: Vec<TileKey>,
     /// Resident tiles a moving group made stale, rendered before the analysis.
@@ -250,6 +253,7 @@ impl Asm {
             (spirv::LOCAL_LIGHTS_VERT, fragment),
             &bindings,
             size_of::<LocalDrawPush>(),
+            DepthTest::Equal,
         )?;
         let analysis = ComputePipeline::new(
             ctx,
@@ -302,6 +306,7 @@ impl Asm {
             pool,
             tiles,
             ids,
+            prepass_pipeline: depth_prepass_pipeline(ctx, "asm.depth_prepass", size_of::<LocalDrawPush>())?,
             scene_pipeline,
             analysis,
             nearest: Sampler::new(ctx, "asm.eye_depth_sampler", false, Edge::Clamp, Edge::Clamp)?,
@@ -317,7 +322,6 @@ impl Asm {
             record: None,
             transforms: Vec::new(),
             group_rects: Vec::new(),
-            eye_view_proj: Mat4::IDENTITY,
             table_keys: Vec::new(),
             refresh: Vec::new(),
             render: Vec::new(),
@@ -386,7 +390,7 @@ impl Asm {
             return self.tiles.record(ctx, cmd, scene, t.page, &t.view_proj, |m| t.groups[m.group]);
         };
         let (color, depth) = (Target { image: &ids.image, layer: t.page }, self.tiles.target(t.page));
-        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(depth));
+        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(depth)));
         ids.pipeline.bind(cmd, &[]);
         for mesh in scene.meshes.iter().filter(|m| t.groups[m.group]) {
             let push = AsmTilePush {
@@ -487,6 +491,18 @@ impl Asm {
         self.table.write(0, &table.bytes())
     }
 
+    /// The push constants of each mesh's draw, in the depth prepass and the lighting pass.
+    fn draw_push(&self) -> impl Fn(&GpuMesh, &Mat4) -> LocalDrawPush + '_ {
+        // Frame numbers wrap after 2^32 frames; a stale mark then only keeps a tile a frame longer.
+        let frame = self.frame as u32;
+        move |mesh, model| LocalDrawPush {
+            model: model.to_cols_array_2d(),
+            albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+            params: [1, self.ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), frame, 0],
+            bias: DEPTH_BIAS,
+        }
+    }
+
     /// The hierarchy's state for measurements.
     pub fn stats(&self) -> AsmStats {
         self.stats.clone()
@@ -520,7 +536,7 @@ impl TileIds {
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 color_formats: &[ID_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
+                depth: DepthTest::Less,
                 additive: false,
                 constants: &[],
             },
@@ -546,7 +562,6 @@ impl TileIds {
 impl Technique for Asm {
     fn update(&mut self, state: &FrameState) -> Result<()> {
         self.frame += 1;
-        self.eye_view_proj = state.view_proj;
         // The renderer keeps the scene's light count (Renderer::set_light replaces, never adds),
         // and `new` accepted exactly one.
         self.light = state.lights[0];
@@ -590,9 +605,8 @@ impl Technique for Asm {
         let refresh = Pass::new("asm_refresh", &[], &["shadow_maps"], move |cmd| {
             self.record_tiles(ctx, cmd, scene, &self.refresh);
         });
-        let eye_depth = Pass::new("asm_eye_depth", &[], &["depth"], move |cmd| {
-            self.tiles.record_into(ctx, cmd, scene, (&targets.depth).into(), &self.eye_view_proj, |_| true);
-        });
+        // The eye view the analysis reads is the lighting pass' depth prepass.
+        let eye_depth = depth_prepass(inputs, &self.prepass_pipeline, self.draw_push());
         let (width, height) = (targets.depth.width, targets.depth.height);
         let analysis = Pass::new(
             "asm_analysis",
@@ -672,18 +686,8 @@ impl Technique for Asm {
         if let Some(ids) = &self.ids {
             bindings.push(Binding::Sampled(&ids.image, &self.nearest));
         }
-        let ids = &self.ids;
-        // Frame numbers wrap after 2^32 frames; a stale mark then only keeps a tile a frame longer.
-        let frame = self.frame as u32;
         let lighting =
-            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
-                LocalDrawPush {
-                    model: model.to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    params: [1, ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), frame, 0],
-                    bias: DEPTH_BIAS,
-                }
-            });
+            scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, self.draw_push());
         vec![tiles, lighting]
     }
 

@@ -24,8 +24,8 @@
 use super::dering::Dering;
 use super::set::is_static;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Edge, GraphicsPipeline, Image, ImageDesc,
-    MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Depth, DepthTest, Edge, GraphicsPipeline, Image,
+    ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::ReferenceLight;
@@ -227,6 +227,7 @@ impl ProbeCapture {
                 &[BindingKind::UniformBuffer],
                 size_of::<DrawPush>(),
                 &[MESH_POSITIONS, RADIANCE_VERTICES],
+                DepthTest::Less,
             )?,
             radiance: static_radiance(ctx, &statics, settings)?,
             lights: scene.lights.iter().map(crate::reference::render::reference_light).collect(),
@@ -281,7 +282,7 @@ impl ProbeCapture {
                 &["probe_faces", "probe_radiance", "probe_cube"],
                 &["probe_cube", "probe_depth"],
                 move |cmd| {
-                    ctx.begin_rendering(cmd, Some(cube.into()), None, Some(depth.into()));
+                    ctx.begin_rendering(cmd, Some(cube.into()), None, Some(Depth::Clear(depth.into())));
                     for (f, uniforms) in faces.iter().enumerate() {
                         ctx.set_viewport(cmd, face_area(f as u32));
                         surfaces.bind(cmd, &[Binding::Uniform(uniforms)]);

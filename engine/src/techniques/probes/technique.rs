@@ -9,7 +9,7 @@
 //! environment afterwards turns the static groups' light, not the probes'.
 use super::set::{bounds, is_static, ProbeSet, ProbeSettings, StaticLighting, MOVING_GROUP};
 use super::Walker;
-use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, GraphicsPipeline, MemoryLocation};
+use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, Depth, GraphicsPipeline, MemoryLocation};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, spirv, ProbeLight};
 use crate::pass::Pass;
@@ -115,7 +115,12 @@ impl Technique for ProbeTechnique {
             Statics::Sloan(prt) => (prt.prepasses(ctx, scene), &["frame_uniforms", "self_shadow", "color"]),
         };
         passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
-            ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
+            ctx.begin_rendering(
+                cmd,
+                Some((&targets.color).into()),
+                None,
+                Some(Depth::Clear((&targets.depth).into())),
+            );
             match &self.statics {
                 Statics::Unshadowed(unshadowed) => unshadowed
                     .draw(ctx, cmd, uniforms, env_sh, scene, |m| is_static(m.group).then_some(m.albedo)),

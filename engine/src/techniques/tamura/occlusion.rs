@@ -23,7 +23,7 @@ use super::regions::Regions;
 use super::self_shadow::rotation_of;
 use super::technique::Penumbra;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Edge, GraphicsDesc,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, DepthTest, Edge, GraphicsDesc,
     GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
 use crate::error::Result;
@@ -185,7 +185,7 @@ impl Occlusion {
                     topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                     color_formats: &[MASK_FORMAT],
                     depth_format: None,
-                    depth_test: false,
+                    depth: DepthTest::Off,
                     additive: false,
                     constants: &[],
                 },

@@ -2,8 +2,8 @@
 //! as points carrying their transfer vectors. It reruns only for groups whose orientation
 //! relative to the light changed since the last frame; other texels keep their values.
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
-    MemoryLocation, VertexAttribute, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Image,
+    ImageDesc, MemoryLocation, VertexAttribute, VertexBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, GroupLight, SelfShadowPush};
@@ -134,7 +134,7 @@ impl SelfShadow {
                 topology: vk::PrimitiveTopology::POINT_LIST,
                 color_formats: &[vk::Format::R32G32B32A32_SFLOAT],
                 depth_format: None,
-                depth_test: false,
+                depth: DepthTest::Off,
                 additive: false,
                 constants: &[],
             },

@@ -4,7 +4,8 @@ use super::occlusion::{group_bounds, Occlusion};
 use super::regions::Regions;
 use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, Context, Edge, GraphicsDesc, GraphicsPipeline, Sampler, VertexBuffer,
+    vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline,
+    Sampler, VertexBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush};
@@ -144,7 +145,7 @@ impl PrtTechnique {
                     topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                     color_formats: &[COLOR_FORMAT],
                     depth_format: Some(DEPTH_FORMAT),
-                    depth_test: true,
+                    depth: DepthTest::Less,
                     additive: false,
                     constants: &[(settings.penumbra == Penumbra::Adaptive) as u32, region_vec4, basis_vec4],
                 },
@@ -178,7 +179,12 @@ impl Technique for PrtTechnique {
             &["frame_uniforms", "self_shadow", "color"]
         };
         passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
-            ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some((&targets.depth).into()));
+            ctx.begin_rendering(
+                cmd,
+                Some((&targets.color).into()),
+                None,
+                Some(Depth::Clear((&targets.depth).into())),
+            );
             self.record_draws(ctx, cmd, uniforms, scene);
             ctx.end_rendering(cmd);
         }));
