@@ -2,9 +2,9 @@
 // ASM refinement analysis, per visible eye pixel (Fernando et al. 2001, section 4): where its
 // light uv lands in the finest resident tile, whether it is on a shadow edge, and how many
 // levels finer a tile would have to be for a shadow texel to be no larger than the eye pixel's
-// footprint. Edge pixels short of resolution are counted per requested tile (the tiles under
-// theirs towards them, up to KAGE_ASM_CHAIN_LEVELS deep) for the host's planner, which renders
-// the chosen ones before the same frame's lighting.
+// footprint. Edge pixels short of resolution are recorded (AsmAnalysisPush) for the host's
+// planner, which counts them per requested tile (the tiles under theirs towards them, up to
+// KAGE_ASM_CHAIN_LEVELS deep) and renders the chosen ones before the same frame's lighting.
 //
 // Projected areas from screen-space derivatives of the light uv, taken by finite differences of
 // the world positions reconstructed from the depth target, not from the paper's mip-map trick:
@@ -22,9 +22,6 @@ layout(std430, set = 0, binding = 5) buffer Requests { uint requests[]; };
 layout(push_constant) uniform Push { AsmAnalysisPush push; };
 
 #include "asm_lookup.glsl"
-
-// Request slots per node: 4 + 16 + ... + 4^KAGE_ASM_CHAIN_LEVELS.
-#define ASM_REQUEST_SLOTS (((1u << (2u * uint(KAGE_ASM_CHAIN_LEVELS) + 2u)) - 4u) / 3u)
 
 // The world position seen at pixel q, or w = 0 where the pixel shows no surface.
 vec4 surface(ivec2 q) {
@@ -53,7 +50,7 @@ vec3 difference(vec3 p, ivec2 q, ivec2 step) {
 // coordinates mx, my) with no slope bias, only a margin for the receiver's own curvature and
 // creases.
 #define ASM_PLANE_MARGIN_TEXELS 4.0
-bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my, uvec4 tile) {
+bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my, AsmPage page) {
     vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
     float det = ux.x * uy.y - ux.y * uy.x;
     if (det == 0.0) return false;
@@ -61,19 +58,19 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     float a = 1.0 / mx.z - iw;
     float b = 1.0 / my.z - iw;
     vec2 slope = vec2(a * uy.y - b * ux.y, ux.x * b - uy.x * a) / det;
-    ivec3 texel = asm_texel(tile, m.xy, ivec2(0));
-    float scale = float(1u << tile.y);
-    vec2 centre = (vec2(tile.zw) + (vec2(texel.xy) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale;
+    ivec2 texel = asm_atlas_texel(page, ivec2(asm_texel_coords(page.tile, m.xy))) - page.atlas + page.quadrant;
+    float scale = float(1u << page.tile.x);
+    vec2 centre = (vec2(page.tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale;
     float inv = iw + dot(slope, centre - m.xy);
     if (inv <= 0.0) return false;
-    float stored = texelFetch(asm_pool, texel, 0).r;
+    float stored = asm_depth(page, texel);
     return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, s.map.z / scale, vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0));
 }
 
 void main() {
     // One pixel of each 2x2 block per frame, the block's corner turning frame by frame (the
     // paper analyses 1/8 of the pixels per frame): the refinement is progressive anyway.
-    ivec2 q = 2 * ivec2(gl_GlobalInvocationID.xy) + ivec2(push.size.w & 1u, push.size.w >> 1u);
+    ivec2 q = 2 * ivec2(gl_GlobalInvocationID.xy) + ivec2(push.phase.x & 1u, push.phase.x >> 1u);
     vec4 here = surface(q);
     if (here.w == 0.0) return;
     vec3 p = here.xyz;
@@ -91,9 +88,10 @@ void main() {
     if (s.light.position.w > 0.5 && dot(-l, s.light.direction.xyz) < s.light.direction.w) return;
 
     uint node = asm_descend(m.xy);
-    requests[node] = 1u;
-    uvec4 tile = asm_nodes[node].tile;
-    if (tile.y >= uint(KAGE_ASM_MAX_LEVEL)) return;
+    requests[1u + node] = 1u;
+    AsmPage page = asm_page(node, m.xy);
+    uint level = page.tile.x;
+    if (level >= uint(KAGE_ASM_MAX_LEVEL)) return;
     // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
     // level L has texels of 1 / (TILE 2^L) a side, so it matches the pixel where
     // 2^L = 1 / (TILE sqrt(area)); KAGE_ASM_EXTRA_LEVELS finer.
@@ -102,32 +100,29 @@ void main() {
     float area = abs(ux.x * uy.y - ux.y * uy.x);
     float needed = area > 0.0 ? -log2(float(KAGE_ASM_TILE_TEXELS) * sqrt(area)) : float(KAGE_ASM_MAX_LEVEL);
     needed += float(KAGE_ASM_EXTRA_LEVELS);
-    float missing = min(ceil(needed), float(KAGE_ASM_MAX_LEVEL)) - float(tile.y);
+    float missing = min(ceil(needed), float(KAGE_ASM_MAX_LEVEL)) - float(level);
     if (missing < 1.0) return;
     // On a shadow edge: the receiver's visibility against its texel and the 8 around it
     // disagrees (an occluder's silhouette, a depth discontinuity in the light's view, passes
     // within a texel). Neighbours lie up to 1 + sqrt(2) texels from p: the slope term grows so.
     vec4 bias = vec4(push.bias.x, push.bias.y * 2.5, push.bias.z, 0.0);
-    bool centre = asm_visible(s, m, p, ng, tile, ivec2(0), bias);
+    bool centre = asm_visible(s, m, p, ng, page, ivec2(0), bias);
     bool edge = false;
     for (int j = -1; j <= 1; ++j) {
         for (int i = -1; i <= 1; ++i) {
-            edge = edge || asm_visible(s, m, p, ng, tile, ivec2(i, j), bias) != centre;
+            edge = edge || asm_visible(s, m, p, ng, page, ivec2(i, j), bias) != centre;
         }
     }
     // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
     // under grazing light): a finer tile's bias is narrower and shows the shadow.
-    edge = edge || (asm_visible(s, m, p, ng, tile, ivec2(0), push.bias)
-                    && occluded_at_plane(s, m, p, ng, mx, my, tile));
+    edge = edge || (asm_visible(s, m, p, ng, page, ivec2(0), push.bias)
+                    && occluded_at_plane(s, m, p, ng, mx, my, page));
     if (!edge) return;
-    // The chain of tiles under this one towards the pixel, as deep as it lacks levels (at most
-    // KAGE_ASM_CHAIN_LEVELS): slots of depth d start at (4^d - 4) / 3 within the node's block.
-    uint chain = min(uint(missing), uint(KAGE_ASM_CHAIN_LEVELS));
-    for (uint d = 1u; d <= chain; ++d) {
-        uint n = 1u << (tile.y + d);
-        uvec2 cell = min(uvec2(m.xy * float(n)), uvec2(n - 1u)) - (tile.zw << d);
-        uint slot = node * ASM_REQUEST_SLOTS + ((1u << (2u * d)) - 4u) / 3u + (cell.y << d) + cell.x;
-        atomicAdd(requests[push.size.z + slot], 1u);
-        atomicAdd(requests[push.size.z * (1u + ASM_REQUEST_SLOTS) + slot], uint(missing) - d + 1u);
-    }
+    uint record = atomicAdd(requests[0], 1u);
+    if (record >= push.size.w) return;
+    uint at = 1u + push.size.z + 4u * record;
+    requests[at] = floatBitsToUint(m.x);
+    requests[at + 1u] = floatBitsToUint(m.y);
+    requests[at + 2u] = node;
+    requests[at + 3u] = uint(missing);
 }

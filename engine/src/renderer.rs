@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
+use crate::scene::clusters::{clustered, Cluster};
 use crate::scene::{Light, Scene};
 use crate::techniques::asm::technique::Asm;
 use crate::techniques::asm::{AsmSettings, AsmStats};
@@ -43,6 +44,9 @@ pub struct GpuMesh {
     pub group: usize,
     /// Index of the mesh within its group.
     pub mesh: usize,
+    /// The index buffer's runs of triangles and their object-space bounds (the buffer holds the
+    /// triangles in cluster order, `scene::clusters`).
+    pub clusters: Vec<Cluster>,
 }
 
 /// Geometry on the GPU: one vertex and index buffer per mesh, one transform per group.
@@ -63,7 +67,8 @@ impl GpuScene {
                     .flat_map(|(p, n)| [p[0], p[1], p[2], n[0], n[1], n[2]])
                     .flat_map(f32::to_ne_bytes)
                     .collect();
-                let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
+                let (indices, clusters) = clustered(mesh);
+                let indices: Vec<u8> = indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
                 let name = format!("{}.{}", group.name, mesh.name);
                 meshes.push(GpuMesh {
                     name: name.clone(),
@@ -84,6 +89,7 @@ impl GpuScene {
                     mesh: m,
                     albedo: mesh.albedo,
                     group: g,
+                    clusters,
                 });
             }
         }
@@ -212,7 +218,9 @@ impl Renderer {
                 Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings, transfer.as_deref())?)
             }
             TechniqueChoice::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
-            TechniqueChoice::Asm(settings) => Box::new(Asm::new(ctx, scene, &gpu, *settings)?),
+            TechniqueChoice::Asm(settings) => {
+                Box::new(Asm::new(ctx, scene, &gpu, *settings, (options.width, options.height))?)
+            }
         };
         Ok(Renderer {
             ctx: ctx.clone(),

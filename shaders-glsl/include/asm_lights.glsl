@@ -12,7 +12,8 @@
 layout(early_fragment_tests) in;
 layout(std430, set = 0, binding = 4) writeonly buffer AsmUsed { uint asm_used[]; };
 #ifdef ASM_ID_TEST
-layout(set = 0, binding = 5) uniform usampler2DArray asm_ids;
+// The polygon IDs, an atlas laid out as the depth pool's.
+layout(set = 0, binding = 5) uniform usampler2D asm_ids;
 #endif
 
 #include "asm_lookup.glsl"
@@ -23,20 +24,20 @@ bool visible(uint k, vec3 p, vec3 ng) {
     if (m.w < 0.0) return true;
     uint node = asm_descend(m.xy);
     asm_used[node] = draw.params.z;
-    uvec4 tile = asm_nodes[node].tile;
+    AsmPage page = asm_page(node, m.xy);
+    vec2 f = asm_texel_coords(page.tile, m.xy);
 #ifdef ASM_ID_TEST
-    if (texelFetch(asm_ids, asm_texel(tile, m.xy, ivec2(0)), 0).r == draw.params.y + uint(gl_PrimitiveID)) {
+    if (texelFetch(asm_ids, asm_atlas_texel(page, ivec2(f)), 0).r == draw.params.y + uint(gl_PrimitiveID)) {
         return true;
     }
 #endif
-    // The four texels around the point in its tile (shadow_footprint_texel; at the tile's
+    // The four texels around the point in its page (shadow_footprint_texel; at the page's
     // border the border texel again).
-    vec2 f = asm_texel_coords(tile, m.xy);
     vec4 stored;
     for (int j = 0; j < 4; ++j) {
-        stored[j] = texelFetch(asm_pool, asm_page_texel(tile, shadow_footprint_texel(f, j)), 0).r;
+        stored[j] = asm_depth(page, shadow_footprint_texel(f, j));
     }
-    float receiver = shadow_receiver_depth(s, m.z, p, ng, asm_texel_size(s, tile), draw.bias);
+    float receiver = shadow_receiver_depth(s, m.z, p, ng, asm_texel_size(s, page.tile.x), draw.bias);
     return shadow_footprint_visible(s, f, stored, receiver);
 }
 

@@ -1,6 +1,7 @@
 // The adaptive shadow map's page table and its descent (engine/src/techniques/asm/page_table.rs),
-// shared by the lighting pass and the refinement analysis, with the page pool (one tile per
-// layer). The including shader declares nothing else at set 0, bindings 2 and 3.
+// shared by the lighting pass and the refinement analysis, with the page pool (an atlas of
+// pages, each one quadrant of a tile). The including shader declares nothing else at set 0,
+// bindings 2 and 3.
 #ifndef KAGE_ASM_LOOKUP_GLSL
 #define KAGE_ASM_LOOKUP_GLSL
 
@@ -8,7 +9,7 @@
 
 #define ASM_DIRECTORY_SIDE (1u << KAGE_ASM_DIRECTORY_LEVEL)
 
-layout(set = 0, binding = 2) uniform sampler2DArray asm_pool;
+layout(set = 0, binding = 2) uniform sampler2D asm_pool;
 // The directory (rows of ASM_DIRECTORY_SIDE entries: node index | level << 24, the finest
 // resident tile at or above the directory's level over each of its tiles), then the nodes.
 layout(std430, set = 0, binding = 3) readonly buffer PageTable {
@@ -36,32 +37,53 @@ uint asm_descend(vec2 uv) {
     return at;
 }
 
-// Light uv in `tile`'s (AsmNode.tile) texel space.
-vec2 asm_texel_coords(uvec4 tile, vec2 uv) {
-    return (uv * float(1u << tile.y) - vec2(tile.zw)) * float(KAGE_ASM_TILE_TEXELS);
+// The first atlas texel of the page in cell `cell` (column | row << 16, as AsmNode.pages).
+ivec2 asm_cell_origin(uint cell) {
+    return ivec2(cell & 0xffffu, cell >> 16) * KAGE_ASM_PAGE_TEXELS;
 }
 
-// Texel `texel` of `tile`, kept in the tile (its neighbours' texels are in other pages).
-ivec3 asm_page_texel(uvec4 tile, ivec2 texel) {
-    return ivec3(clamp(texel, ivec2(0), ivec2(KAGE_ASM_TILE_TEXELS - 1)), int(tile.x));
+// The quadrant of a resident tile that holds a point: the tile, and where its texels lie.
+struct AsmPage {
+    uvec3 tile; // x: level, y, z: tile x, y at that level (AsmNode.tile)
+    ivec2 quadrant; // the quadrant's first texel within the tile
+    ivec2 atlas; // the page's first texel in the atlas
+};
+
+// Light uv in the texel space of tile `tile` (level, x, y).
+vec2 asm_texel_coords(uvec3 tile, vec2 uv) {
+    return (uv * float(1u << tile.x) - vec2(tile.yz)) * float(KAGE_ASM_TILE_TEXELS);
 }
 
-// The texel of `tile` holding uv, moved by `offset` texels and kept in the tile.
-ivec3 asm_texel(uvec4 tile, vec2 uv, ivec2 offset) {
-    return asm_page_texel(tile, ivec2(asm_texel_coords(tile, uv)) + offset);
+// The page of node `node`'s quadrant holding uv: the node is the finest resident tile there
+// (asm_descend), so no resident child covers that quadrant and its page is stored.
+AsmPage asm_page(uint node, vec2 uv) {
+    uvec3 tile = asm_nodes[node].tile.xyz;
+    ivec2 q = ivec2(clamp(asm_texel_coords(tile, uv) / float(KAGE_ASM_PAGE_TEXELS), vec2(0.0), vec2(1.0)));
+    return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_nodes[node].pages[2 * q.y + q.x]));
 }
 
-// The world size at unit depth of `tile`'s texels.
-float asm_texel_size(ShadowLight s, uvec4 tile) {
-    return s.map.z / float(1u << tile.y);
+// The atlas texel of tile texel `texel`, kept in the page's quadrant (the texels beyond it are
+// in other pages, or in none where a child covers them).
+ivec2 asm_atlas_texel(AsmPage page, ivec2 texel) {
+    return page.atlas + clamp(texel - page.quadrant, ivec2(0), ivec2(KAGE_ASM_PAGE_TEXELS - 1));
 }
 
-// Light k's visibility at p (geometric normal ng; m = shadow_map_coords) in the texel of `tile`
+// The stored depth of tile texel `texel` (kept in the page's quadrant).
+float asm_depth(AsmPage page, ivec2 texel) {
+    return texelFetch(asm_pool, asm_atlas_texel(page, texel), 0).r;
+}
+
+// The world size at unit depth of the texels of a tile at `level`.
+float asm_texel_size(ShadowLight s, uint level) {
+    return s.map.z / float(1u << level);
+}
+
+// Light k's visibility at p (geometric normal ng; m = shadow_map_coords) in the texel of `page`
 // holding it, moved by `offset`: the depth comparison with the slope-scaled bias, texels scaled
 // to the tile's level. The refinement analysis's test, texel by texel (the lighting blends four).
-bool asm_visible(ShadowLight s, vec4 m, vec3 p, vec3 ng, uvec4 tile, ivec2 offset, vec4 bias) {
-    float stored = texelFetch(asm_pool, asm_texel(tile, m.xy, offset), 0).r;
-    return shadow_depth_visible(s, stored, m.z, p, ng, asm_texel_size(s, tile), bias);
+bool asm_visible(ShadowLight s, vec4 m, vec3 p, vec3 ng, AsmPage page, ivec2 offset, vec4 bias) {
+    float stored = asm_depth(page, ivec2(asm_texel_coords(page.tile, m.xy)) + offset);
+    return shadow_depth_visible(s, stored, m.z, p, ng, asm_texel_size(s, page.tile.x), bias);
 }
 
 #endif

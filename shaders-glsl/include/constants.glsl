@@ -62,13 +62,16 @@
 // uniform buffer and one shadow-map layer each.
 #define KAGE_MAX_LOCAL_LIGHTS 8
 
-// Adaptive shadow maps: texels per side of a tile (one page of the pool, 16 KiB of D32). With
-// texels a fixed fraction of the eye pixel, the pages a shadow edge takes grow with the tile's
-// side (a tile covers a band of which the edge uses a strip): at equal memory 64² tiles
-// misclassified 18 % fewer pixels of the `asm` walkthrough than 128² (BENCHMARKS.md); 32²
-// little fewer again, at a frame cost over the paper's 1.74x. A pool holds at most
-// maxImageArrayLayers pages (2048 on lavapipe and NVIDIA: 32 MiB).
+// Adaptive shadow maps: texels per side of a tile (a node of the quadtree, rendered in one
+// go). With texels a fixed fraction of the eye pixel, the memory a shadow edge takes grows with
+// the tile's side (a tile covers a band of which the edge uses a strip): at equal memory 64²
+// tiles misclassified 18 % fewer pixels of the `asm` walkthrough than 128² (BENCHMARKS.md); 32²
+// little fewer again, at a frame cost over the paper's 1.74x.
 #define KAGE_ASM_TILE_TEXELS 64
+// Texels per side of a page of the pool: one quadrant of a tile (4 KiB of D32). A tile keeps a
+// page only for the quadrants its resident children do not cover (every point there descends
+// into the child), so a tile refined all over takes no memory of its own.
+#define KAGE_ASM_PAGE_TEXELS 32
 // The deepest quadtree level: 2^17 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 17

@@ -233,7 +233,8 @@ struct LocalDrawPush {
 // it is resident and uses the last node's page (engine/src/techniques/asm/page_table.rs).
 struct AsmNode {
     uvec4 children; // node index of the child in quadrant 2 * (y & 1) + (x & 1); 0: not resident
-    uvec4 tile; // x: physical page (layer of the tile array), y: level, z, w: tile x, y at that level
+    uvec4 pages; // the atlas cell (column | row << 16) of the page of each quadrant whose child is not resident (else unused)
+    uvec4 tile; // x: level, y, z: tile x, y at that level, w: unused
 };
 
 // Push constants of an ASM tile render with polygon IDs (asm_tile.vert/frag): one draw per mesh.
@@ -242,13 +243,14 @@ struct AsmTilePush {
     uvec4 ids; // x: polygon ID of the mesh's first triangle (IDs start at 1; 0: no surface), y, z, w: unused
 };
 
-// Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer holds
-// three uint arrays of `size.z` (page table nodes) blocks: a used flag per node, then per node
-// and requested descendant (its 4 children, 16 grandchildren, ... down to
-// KAGE_ASM_CHAIN_LEVELS, row by row within each level) the edge pixels asking for that tile,
-// then the same slots' sums of the levels those pixels still lack at that tile.
+// Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer is uint
+// words: [0] the number of edge records written; [1, 1 + size.z) a used flag per page table
+// node (a pixel's lookup ended there); then up to size.w edge records of 4 words, one per eye
+// pixel on a shadow edge short of resolution: its light uv (2 floats), the node of the finest
+// resident tile holding it, and the levels finer than that tile it needs (at least 1).
 struct AsmAnalysisPush {
-    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: the pixel of each 2x2 block analysed this frame (x + 2y)
+    uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: most edge records
+    uvec4 phase; // x: the pixel of each 2x2 block analysed this frame (x + 2y), y, z, w: unused
     vec4 bias; // as LocalDrawPush.bias
 };
 

@@ -211,7 +211,13 @@ impl Image {
 
     /// Records a layout change of the whole image, ordered after all earlier commands.
     fn transition(&self, cmd: vk::CommandBuffer, from: vk::ImageLayout, to: vk::ImageLayout) {
-        let barrier = vk::ImageMemoryBarrier::default()
+        record_layout_barriers(&self.ctx, cmd, &[self.layout_barrier(from, to)]);
+    }
+
+    /// A layout change of the whole image, ordered after all earlier commands on it and before
+    /// all later ones.
+    fn layout_barrier(&self, from: vk::ImageLayout, to: vk::ImageLayout) -> vk::ImageMemoryBarrier<'static> {
+        vk::ImageMemoryBarrier::default()
             .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
             .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
             .old_layout(from)
@@ -219,19 +225,7 @@ impl Image {
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(self.raw)
-            .subresource_range(self.range());
-        // SAFETY: recording command buffer; the image is alive until the submission completes.
-        unsafe {
-            self.ctx.device.cmd_pipeline_barrier(
-                cmd,
-                vk::PipelineStageFlags::ALL_COMMANDS,
-                vk::PipelineStageFlags::ALL_COMMANDS,
-                vk::DependencyFlags::empty(),
-                &[],
-                &[],
-                &[barrier],
-            )
-        }
+            .subresource_range(self.range())
     }
 
     pub(crate) fn range(&self) -> vk::ImageSubresourceRange {
@@ -287,6 +281,53 @@ impl Image {
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
 
+    /// Records copies of `size`² squares into layer 0 of `dst` (the same format), ordered after
+    /// all earlier commands on either image and before all later ones (the copies step into the
+    /// transfer layouts and back). Destination squares must not overlap.
+    pub fn record_copy_squares(
+        &self,
+        cmd: vk::CommandBuffer,
+        dst: &Image,
+        squares: &[SquareCopy],
+        size: u32,
+    ) {
+        let layer = |base_array_layer| vk::ImageSubresourceLayers {
+            aspect_mask: aspect_of(self.format),
+            mip_level: 0,
+            base_array_layer,
+            layer_count: 1,
+        };
+        let offset = |[x, y]: [u32; 2]| vk::Offset3D { x: x as i32, y: y as i32, z: 0 };
+        let regions: Vec<vk::ImageCopy> = squares
+            .iter()
+            .map(|c| vk::ImageCopy {
+                src_subresource: layer(c.layer),
+                src_offset: offset(c.from),
+                dst_subresource: layer(0),
+                dst_offset: offset(c.to),
+                extent: vk::Extent3D { width: size, height: size, depth: 1 },
+            })
+            .collect();
+        let (general, src, to) = (
+            vk::ImageLayout::GENERAL,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        );
+        record_layout_barriers(
+            &self.ctx,
+            cmd,
+            &[self.layout_barrier(general, src), dst.layout_barrier(general, to)],
+        );
+        // SAFETY: recording command buffer; both images are alive until the submission completes
+        // and were just moved to the layouts named.
+        unsafe { self.ctx.device.cmd_copy_image(cmd, self.raw, src, dst.raw, to, &regions) }
+        record_layout_barriers(
+            &self.ctx,
+            cmd,
+            &[self.layout_barrier(src, general), dst.layout_barrier(to, general)],
+        );
+    }
+
     /// Fills the image from tightly packed texels through a staging buffer.
     pub fn upload(&self, data: &[u8]) -> Result<()> {
         let expected = self.byte_size()?;
@@ -330,6 +371,30 @@ impl Image {
         )?;
         self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| self.record_copy_to(cmd, &staging))?;
         staging.read()
+    }
+}
+
+/// A square of [`Image::record_copy_squares`]: from layer `layer` at texel `from` to texel `to`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SquareCopy {
+    pub layer: u32,
+    pub from: [u32; 2],
+    pub to: [u32; 2],
+}
+
+/// Records `barriers`, each ordered after all earlier commands and before all later ones.
+fn record_layout_barriers(ctx: &Context, cmd: vk::CommandBuffer, barriers: &[vk::ImageMemoryBarrier]) {
+    // SAFETY: recording command buffer; the images are alive until the submission completes.
+    unsafe {
+        ctx.device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            barriers,
+        )
     }
 }
 

@@ -135,13 +135,26 @@ impl Context {
         indices: &super::Buffer,
         count: u32,
     ) {
+        self.draw_indexed_range(cmd, vertices, indices, 0, count);
+    }
+
+    /// [`Context::draw_indexed`] of the `count` indices from index `first` on (gl_PrimitiveID
+    /// counts from the first of them).
+    pub fn draw_indexed_range(
+        &self,
+        cmd: vk::CommandBuffer,
+        vertices: &[&super::Buffer],
+        indices: &super::Buffer,
+        first: u32,
+        count: u32,
+    ) {
         let raw: Vec<vk::Buffer> = vertices.iter().map(|b| b.raw).collect();
         let offsets = vec![0; raw.len()];
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {
             self.device.cmd_bind_vertex_buffers(cmd, 0, &raw, &offsets);
             self.device.cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
-            self.device.cmd_draw_indexed(cmd, count, 1, 0, 0, 0);
+            self.device.cmd_draw_indexed(cmd, count, 1, first, 0, 0);
         }
     }
 

@@ -23,6 +23,7 @@ mod asm_room;
 pub mod atrium;
 mod builtin;
 mod camera;
+pub mod clusters;
 pub mod envmap;
 mod error;
 mod export;

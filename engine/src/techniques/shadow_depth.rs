@@ -44,7 +44,10 @@ impl ShadowMaps {
                 constants: &[],
             },
         )?;
-        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        // TRANSFER_SRC: the ASM's scratch tile is copied into its pages.
+        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
         let maps_name = format!("{name}.maps");
         let desc = ImageDesc::square_array(&maps_name, size, layers, DEPTH_FORMAT, usage);
         Ok(ShadowMaps {
@@ -65,6 +68,11 @@ impl ShadowMaps {
         Binding::Sampled(&self.maps, &self.nearest)
     }
 
+    /// The maps' image.
+    pub fn image(&self) -> &Image {
+        &self.maps
+    }
+
     /// Map `layer` as a depth attachment.
     pub fn target(&self, layer: u32) -> Target<'_> {
         Target { image: &self.maps, layer }
@@ -74,31 +82,33 @@ impl ShadowMaps {
     pub fn pass<'a>(&'a self, ctx: &'a Context, scene: &'a GpuScene) -> Pass<'a> {
         Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
             for (layer, view_proj) in self.view_projs.iter().enumerate() {
-                self.record(ctx, cmd, scene, layer as u32, view_proj, |_| true);
+                let whole = scene.meshes.iter().map(|m| (m, 0, m.index_count));
+                self.record(ctx, cmd, scene, layer as u32, view_proj, whole);
             }
         })
     }
 
-    /// Records one rendering scope that clears map `layer` and draws the meshes of `scene` that
-    /// `draws` keeps with `view_proj` (world to the map's clip space).
-    pub fn record(
+    /// Records one rendering scope that clears map `layer` and draws, with `view_proj` (world to
+    /// the map's clip space), the runs of `scene`'s index buffers `draws` names: (mesh, first
+    /// index, index count).
+    pub fn record<'m>(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
         layer: u32,
         view_proj: &Mat4,
-        draws: impl Fn(&GpuMesh) -> bool,
+        draws: impl IntoIterator<Item = (&'m GpuMesh, u32, u32)>,
     ) {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear(self.target(layer))));
         self.pipeline.bind(cmd, &[]);
-        for mesh in scene.meshes.iter().filter(|m| draws(m)) {
+        for (mesh, first, count) in draws {
             let push = ShadowDepthPush {
                 model: scene.transforms[mesh.group].to_cols_array_2d(),
                 view_proj: view_proj.to_cols_array_2d(),
             };
             self.pipeline.push(cmd, bytes_of(&push));
-            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+            ctx.draw_indexed_range(cmd, &[&mesh.vertices], &mesh.indices, first, count);
         }
         ctx.end_rendering(cmd);
     }

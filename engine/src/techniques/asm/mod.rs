@@ -7,16 +7,22 @@
 //!   every tile after its parent).
 //! - [`light_view`]: tile projections and the light-uv bounds of groups.
 //! - [`tile`]: the quadtree of tiles over the light's view; a tile at level L covers 1/2^L of
-//!   the view's side and holds `ASM_TILE_TEXELS`² texels, so each level doubles the resolution.
-//! - [`pool`]: the physical page pool: one page per resident tile, as many pages as a byte
-//!   budget holds (never more), least-recently-used eviction of leaf tiles.
+//!   the view's side and is rendered at `ASM_TILE_TEXELS`² texels, so each level doubles the
+//!   resolution.
+//! - [`pool`]: the physical page pool: a page is one quadrant of a tile, and a resident tile
+//!   keeps pages only for the quadrants its resident children do not cover; as many pages as a
+//!   byte budget holds (never more), least-recently-used eviction of leaf tiles.
+//! - [`pages`]: the pool on the GPU: the atlas of pages, and the tile renders (through a
+//!   scratch target, each drawing only the triangle clusters over its square) that fill them.
 //! - [`page_table`]: the resident tree flattened into `AsmNode` records for the GPU lookup
 //!   (shaders-glsl/include/layouts.glsl) behind a directory of one level's tiles: start at the
-//!   directory's tile and descend while the child holding the point is resident; the last node reached is the finest resident tile, so a missing tile
-//!   falls back to its nearest resident ancestor, at worst the root (always resident), never to
-//!   "lit".
+//!   directory's tile and descend while the child holding the point is resident; the last node
+//!   reached is the finest resident tile, and its quadrant holding the point is stored, so a
+//!   missing tile falls back to its nearest resident ancestor, at worst the root (always
+//!   resident), never to "lit".
 pub mod light_view;
 pub mod page_table;
+pub mod pages;
 pub mod plan;
 pub mod pool;
 pub mod technique;

@@ -1,12 +1,14 @@
 //! The page table the GPU lookup descends: the resident tiles as a tree of `AsmNode` records
 //! in a buffer, the root at index 0 and every node's children after it (breadth first). A child
 //! index of 0 means "not resident" (the root is no one's child), so the lookup stops there and
-//! uses the last node's page: the finest resident tile over the point.
+//! uses the last node's page of that quadrant: the finest resident tile over the point, which
+//! stores every quadrant no resident child covers (`pool`).
 //!
 //! A directory comes first in the buffer: one entry per tile of level
 //! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
 //! that the descent starts there instead of at the root.
-use super::pool::PagePool;
+use super::pages::AtlasLayout;
+use super::pool::{PagePool, TilePages};
 use super::tile::TileKey;
 use crate::layouts::constants::ASM_DIRECTORY_LEVEL;
 use crate::layouts::{bytes_of_slice, AsmNode};
@@ -39,11 +41,17 @@ impl PageTable {
     }
 }
 
-/// The page table of `pool`'s resident tiles, root first.
-pub fn build(pool: &PagePool) -> PageTable {
-    let node = |key: TileKey, page: u32| AsmNode { children: [0; 4], tile: [page, key.level, key.x, key.y] };
-    let root_page = pool.page(TileKey::ROOT).unwrap_or(0);
-    let mut nodes = vec![node(TileKey::ROOT, root_page)];
+/// The page table of `pool`'s resident tiles, root first, their pages' cells in an atlas laid
+/// out as `layout`.
+pub fn build(pool: &PagePool, layout: &AtlasLayout) -> PageTable {
+    // A covered quadrant's page is never read: 0 stands in.
+    let node = |key: TileKey, pages: TilePages| AsmNode {
+        children: [0; 4],
+        pages: pages.map(|p| p.map_or(0, |p| layout.cell(p))),
+        tile: [key.level, key.x, key.y, 0],
+    };
+    let root = pool.pages(TileKey::ROOT).expect("the root is always resident");
+    let mut nodes = vec![node(TileKey::ROOT, root)];
     let mut directory = vec![0u32; (DIRECTORY_SIDE * DIRECTORY_SIDE) as usize];
     let mut queue = VecDeque::from([(TileKey::ROOT, 0usize)]);
     while let Some((key, at)) = queue.pop_front() {
@@ -58,10 +66,10 @@ pub fn build(pool: &PagePool) -> PageTable {
         }
         let Some(children) = key.children() else { continue };
         for (q, child) in children.into_iter().enumerate() {
-            if let Some(page) = pool.page(child) {
+            if let Some(pages) = pool.pages(child) {
                 nodes[at].children[q] = nodes.len() as u32;
                 queue.push_back((child, nodes.len()));
-                nodes.push(node(child, page));
+                nodes.push(node(child, pages));
             }
         }
     }
@@ -72,13 +80,18 @@ pub fn build(pool: &PagePool) -> PageTable {
 mod tests {
     use super::*;
     use crate::techniques::asm::pool::DEPTH_PAGE_BYTES as PAGE_BYTES;
+    const LAYOUT: AtlasLayout = AtlasLayout { columns: 16, rows: 16 };
+
+    fn key_of(node: &AsmNode) -> TileKey {
+        let [level, x, y, _] = node.tile;
+        TileKey { level, x, y }
+    }
 
     /// From node `at`, into the resident child holding `uv` until there is none.
     fn descend(table: &PageTable, mut at: usize, uv: [f32; 2]) -> TileKey {
         loop {
-            let [_, level, x, y] = table.nodes[at].tile;
-            let here = TileKey { level, x, y };
-            let Some(child) = TileKey::containing(uv, level + 1) else { return here };
+            let here = key_of(&table.nodes[at]);
+            let Some(child) = TileKey::containing(uv, here.level + 1) else { return here };
             match table.nodes[at].children[child.quadrant()] {
                 0 => return here,
                 next => at = next as usize,
@@ -92,23 +105,22 @@ mod tests {
         let cell = |c: f32| ((c * DIRECTORY_SIDE as f32) as u32).min(DIRECTORY_SIDE - 1);
         let entry = table.directory[(cell(uv[1]) * DIRECTORY_SIDE + cell(uv[0])) as usize];
         let at = (entry & 0xff_ffff) as usize;
-        assert_eq!(table.nodes[at].tile[1], entry >> LEVEL_SHIFT, "the entry's level is its node's");
+        assert_eq!(table.nodes[at].tile[0], entry >> LEVEL_SHIFT, "the entry's level is its node's");
         if entry >> LEVEL_SHIFT < ASM_DIRECTORY_LEVEL {
-            let [_, level, x, y] = table.nodes[at].tile;
-            return TileKey { level, x, y };
+            return key_of(&table.nodes[at]);
         }
         descend(table, at, uv)
     }
 
     #[test]
     fn a_missing_tile_falls_back_to_its_nearest_resident_ancestor() {
-        let mut pool = PagePool::new(8 * PAGE_BYTES, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(16, PAGE_BYTES).unwrap();
         // Refine towards uv = (0.3, 0.6) down to level 4.
         let uv = [0.3, 0.6];
         for level in 1..=4 {
             pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1.0).unwrap();
         }
-        let table = build(&pool);
+        let table = build(&pool, &LAYOUT);
         assert_eq!(table.nodes.len(), 5);
         assert_eq!(lookup(&table, uv), TileKey::containing(uv, 4).unwrap());
         // A point in the same level-2 tile but another level-3 one gets the level-2 tile.
@@ -117,30 +129,31 @@ mod tests {
         assert_eq!(lookup(&table, beside), TileKey::containing(uv, 2).unwrap());
         // Far away: the root, which every lookup can fall back to; never "no tile".
         assert_eq!(lookup(&table, [0.9, 0.1]), TileKey::ROOT);
-        // Each node's page is its tile's page in the pool.
+        // Each node's pages are its tile's in the pool, where no child covers the quadrant.
         for node in &table.nodes {
-            let [page, level, x, y] = node.tile;
-            assert_eq!(pool.page(TileKey { level, x, y }), Some(page));
+            let pages = pool.pages(key_of(node)).unwrap();
+            for (q, page) in pages.iter().enumerate() {
+                assert_eq!(page.is_none(), node.children[q] != 0);
+                assert_eq!(page.map_or(0, |p| LAYOUT.cell(p)), node.pages[q]);
+            }
         }
     }
 
     #[test]
     fn children_follow_their_parents_and_point_at_the_right_quadrant() {
-        let mut pool = PagePool::new(16 * PAGE_BYTES, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(19, PAGE_BYTES).unwrap();
         for child in TileKey::ROOT.children().unwrap() {
             pool.insert(child, 1, 1.0).unwrap();
         }
         let grandchild = TileKey::ROOT.children().unwrap()[2].children().unwrap()[1];
         pool.insert(grandchild, 1, 1.0).unwrap();
-        let table = build(&pool);
+        let table = build(&pool, &LAYOUT);
         assert_eq!(table.nodes.len(), 6);
         for (at, node) in table.nodes.iter().enumerate() {
-            let [_, level, x, y] = node.tile;
             for (q, &child) in node.children.iter().enumerate().filter(|(_, c)| **c != 0) {
                 assert!(child as usize > at);
-                let [_, cl, cx, cy] = table.nodes[child as usize].tile;
-                let key = TileKey { level: cl, x: cx, y: cy };
-                assert_eq!((key.parent(), key.quadrant()), (Some(TileKey { level, x, y }), q));
+                let key = key_of(&table.nodes[child as usize]);
+                assert_eq!((key.parent(), key.quadrant()), (Some(key_of(node)), q));
             }
         }
     }
@@ -150,7 +163,7 @@ mod tests {
         // Chains refined past the directory's level at two points, and a full level 2, so that
         // the directory holds tiles above, at and (through them) below its level.
         let deep = ASM_DIRECTORY_LEVEL + 3;
-        let mut pool = PagePool::new(64 * PAGE_BYTES, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(256, PAGE_BYTES).unwrap();
         for uv in [[0.3, 0.6], [0.71, 0.12]] {
             for level in 1..=deep {
                 pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1.0).unwrap();
@@ -162,7 +175,7 @@ mod tests {
                 pool.insert(child, 1, 1.0).unwrap();
             }
         }
-        let table = build(&pool);
+        let table = build(&pool, &LAYOUT);
         assert_eq!(table.bytes().len() as u64, PageTable::buffer_bytes(table.nodes.len() as u32));
         // A lattice of points finer than the deepest tiles near the chains, coarser elsewhere.
         let mut reached_deep = 0;

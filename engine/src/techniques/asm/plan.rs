@@ -9,10 +9,12 @@
 //!   device ([`CostModel::fit`]) at start-up, and scaled frame by frame by how long the tiles
 //!   the model planned took (`Asm::timed`): tiles timed one by one at start-up and tiles
 //!   rendered back to back in a frame cost differently on some devices (4x on lavapipe).
-//! - Requests are taken by benefit/cost, best first, until their summed cost would pass the
-//!   per-frame time budget; the best one is always taken, so that the refinement progresses on
-//!   a device slower than the budget assumes. A request under a tile that is not resident
-//!   (the analysis asks for whole chains of tiles) waits until its parent is taken.
+//! - Requests are taken by benefit/cost, best first, until what the taken ones planned (their
+//!   renders and those of the parents their evictions give quadrants back to) and the next one's
+//!   cost would pass the per-frame time budget; the best one is always taken, so that the
+//!   refinement progresses on a device slower than the budget assumes. A request under a tile
+//!   that is not resident (the analysis asks for whole chains of tiles) waits until its parent
+//!   is taken.
 use super::tile::TileKey;
 use std::collections::HashMap;
 
@@ -89,15 +91,19 @@ pub fn rescaled(scale: f64, predicted_ms: f64, measured_ms: f64) -> f64 {
     (scale * (measured_ms / predicted_ms).clamp(0.05, 20.0)).sqrt()
 }
 
-/// The requests to render this frame, each with its benefit/cost, within `budget_ms` (the best
-/// always), in an order that takes every tile after its parent: among the requests whose
-/// parent is `resident` or taken already, the best benefit/cost first.
+/// Takes the requests to render this frame within `budget_ms`, in an order that takes every
+/// tile after its parent: among the requests whose parent is `resident` or taken already, the
+/// best benefit/cost first. `take(request, benefit/cost)` takes one and returns the ms it
+/// planned by the model (its render and the renders its evictions need), or `None` where the
+/// tile could not be taken (its children then wait). The best is always taken; returns the
+/// requests taken, in order.
 pub fn plan(
     requests: Vec<Request>,
     model: &CostModel,
     budget_ms: f64,
     resident: impl Fn(TileKey) -> bool,
-) -> Vec<(Request, f32)> {
+    mut take: impl FnMut(&Request, f32) -> Option<f64>,
+) -> Vec<Request> {
     let ratio = |r: &Request| r.benefit() / model.cost_ms(r.triangles);
     let mut ready = Vec::new();
     let mut waiting: HashMap<TileKey, Vec<Request>> = HashMap::new();
@@ -108,20 +114,20 @@ pub fn plan(
         }
     }
     let mut spent = 0.0;
-    let mut chosen = Vec::new();
+    let mut taken = Vec::new();
     while let Some(best) = (0..ready.len())
         .max_by(|&a, &b| ratio(&ready[a]).total_cmp(&ratio(&ready[b])).then(ready[b].key.cmp(&ready[a].key)))
     {
         let r = ready.swap_remove(best);
-        let cost = model.cost_ms(r.triangles);
-        if !chosen.is_empty() && spent + cost > budget_ms {
+        if !taken.is_empty() && spent + model.cost_ms(r.triangles) > budget_ms {
             break;
         }
-        spent += cost;
-        chosen.push((r, ratio(&r) as f32));
+        let Some(ms) = take(&r, ratio(&r) as f32) else { continue };
+        spent += ms;
+        taken.push(r);
         ready.extend(waiting.remove(&r.key).unwrap_or_default());
     }
-    chosen
+    taken
 }
 
 #[cfg(test)]
@@ -158,17 +164,31 @@ mod tests {
             request(2, 400, 1000, 10_000),
             request(3, 0, 0, 1000),
         ];
-        let keys = |chosen: &[(Request, f32)]| chosen.iter().map(|(r, _)| r.key.x).collect::<Vec<_>>();
-        // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
+        let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key.x).collect::<Vec<_>>();
         let root = |_| true;
-        assert_eq!(keys(&plan(requests.clone(), &model, 15.0, root)), vec![2, 1, 0]);
-        assert_eq!(keys(&plan(requests.clone(), &model, 13.0, root)), vec![2, 1]);
+        // Each take planned its tile's cost.
+        let render = |r: &Request, _| Some(model.cost_ms(r.triangles));
+        // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
+        assert_eq!(keys(plan(requests.clone(), &model, 15.0, root, render)), vec![2, 1, 0]);
+        assert_eq!(keys(plan(requests.clone(), &model, 13.0, root, render)), vec![2, 1]);
         // The best is taken even when it alone is over budget; nothing after it then.
-        assert_eq!(keys(&plan(requests.clone(), &model, 1.0, root)), vec![2]);
+        assert_eq!(keys(plan(requests.clone(), &model, 1.0, root, render)), vec![2]);
         // No benefit, no request.
-        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0, root).is_empty());
-        let chosen = plan(requests, &model, 100.0, root);
-        assert!(chosen.windows(2).all(|w| w[0].1 >= w[1].1));
+        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0, root, render).is_empty());
+        let mut ratios = Vec::new();
+        plan(requests.clone(), &model, 100.0, root, |r, ratio| {
+            ratios.push(ratio);
+            render(r, ratio)
+        });
+        assert!(ratios.len() == 3 && ratios.windows(2).all(|w| w[0] >= w[1]), "{ratios:?}");
+        // What a take planned beyond its tile (an eviction's render) counts: with the big one's
+        // 11 ms, a 2 ms one fits in 14; with an eviction's 2 ms more, none does.
+        assert_eq!(keys(plan(requests.clone(), &model, 14.0, root, render)), vec![2, 1]);
+        let evicting = |r: &Request, _| Some(model.cost_ms(r.triangles) + 2.0);
+        assert_eq!(keys(plan(requests.clone(), &model, 14.0, root, evicting)), vec![2]);
+        // A refused take is skipped, the next taken.
+        let refusing = |r: &Request, _| (r.key.x != 2).then(|| model.cost_ms(r.triangles));
+        assert_eq!(keys(plan(requests, &model, 15.0, root, refusing)), vec![1, 0]);
     }
 
     #[test]
@@ -181,15 +201,20 @@ mod tests {
         // The grandchild has the best ratio, but comes after its parent; the tile beside
         // comes between them, as its ratio is better than the grandchild's parent's.
         let requests = vec![ask(grandchild, 50), ask(child, 10), ask(beside, 20)];
-        let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT);
-        let keys: Vec<TileKey> = chosen.iter().map(|(r, _)| r.key).collect();
-        assert_eq!(keys, vec![beside, child, grandchild]);
+        let render = |_: &Request, _| Some(1.0);
+        let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key).collect::<Vec<_>>();
+        let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT, render);
+        assert_eq!(keys(chosen), vec![beside, child, grandchild]);
         // Within a budget of two tiles the grandchild waits for a later frame.
-        let chosen = plan(requests.clone(), &model, 2.0, |k| k == TileKey::ROOT);
-        assert_eq!(chosen.iter().map(|(r, _)| r.key).collect::<Vec<_>>(), vec![beside, child]);
+        let chosen = plan(requests.clone(), &model, 2.0, |k| k == TileKey::ROOT, render);
+        assert_eq!(keys(chosen), vec![beside, child]);
+        // A parent refused keeps its child waiting.
+        let refusing = |r: &Request, _| (r.key != child).then_some(1.0);
+        let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT, refusing);
+        assert_eq!(keys(chosen), vec![beside]);
         // With its parent resident it is taken first.
-        let chosen = plan(requests, &model, 1.0, |k| k == TileKey::ROOT || k == child);
-        assert_eq!(chosen[0].0.key, grandchild);
+        let chosen = plan(requests, &model, 1.0, |k| k == TileKey::ROOT || k == child, render);
+        assert_eq!(chosen[0].key, grandchild);
     }
 
     #[test]

@@ -7,13 +7,13 @@
 //! 1. analysis: `asm_refresh` re-renders the resident tiles a moving group touched (see below),
 //!    `depth_prepass` draws the scene's depth from the eye (the lighting pass shades over it),
 //!    and `asm_analysis` finds, per eye pixel (one of each 2×2 block per frame, in turn), the
-//!    tile it uses, and on shadow edges short of resolution the chain of finer tiles it asks
-//!    for, counted in a buffer;
-//! 2. the host reads the counts, marks the used tiles, and plans within the time budget
-//!    (`plan`); then the frame: `asm_tiles` renders the planned tiles, each depth-only into its
-//!    page with the light's projection cropped to its square (one debug label per tile), and
-//!    `scene` shades with each point's visibility looked up in the finest resident tile holding
-//!    it (the page table's directory and descent).
+//!    tile it uses, and records the pixels on shadow edges short of resolution;
+//! 2. the host marks the used tiles, counts the edge pixels for the chain of finer tiles each
+//!    asks for, and plans within the time budget (`plan`); then the frame: `asm_tiles` renders
+//!    the planned tiles, each depth-only with the light's projection cropped to its square, into
+//!    the pool's pages (and rebuilds the quadrants evictions give back; `pages`, one debug label
+//!    each), and `scene` shades with each point's visibility looked up in the finest resident
+//!    tile holding it (the page table's directory and descent).
 //!
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
 //! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
@@ -24,29 +24,29 @@
 //! group somewhere in its square.
 use super::light_view::{tile_view_proj, UvRect};
 use super::page_table;
+use super::pages::{scratch_bytes, PageStore, TileWrite};
 use super::plan::{plan, rescaled, CostModel, Request};
-use super::pool::{Insert, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
+use super::pool::{Insert, PageOp, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES, TILE_PAGES};
 use super::tile::TileKey;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
-    GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target, FRAGMENT_STORES,
-    GEOMETRY_SHADER,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, DepthTest, Edge,
+    GraphicsPipeline, MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
-use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, AsmTilePush, LocalDrawPush, ShadowLight};
+use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, LocalDrawPush, ShadowLight};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
-use crate::renderer::{GpuMesh, GpuScene, DEPTH_FORMAT};
+use crate::renderer::{GpuMesh, GpuScene};
+use crate::scene::clusters::Cluster;
 use crate::scene::{Light, Scene};
 use crate::techniques::parallel_lights::scene_sphere;
 use crate::techniques::scene_pass::{
     depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
 };
-use crate::techniques::shadow_depth::ShadowMaps;
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
 use crate::techniques::tamura::occlusion::{group_bounds, GroupBounds};
-use crate::techniques::unshadowed::MESH_POSITIONS;
 use crate::techniques::{FrameInputs, FrameState, Technique};
 use glam::{Mat4, Vec3};
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
@@ -73,6 +73,11 @@ impl AsmTest {
             AsmTest::Bias => DEPTH_PAGE_BYTES,
         }
     }
+
+    /// The least budget: the root tile's pages and the scratch every page write goes through.
+    pub fn least_budget_bytes(self) -> u64 {
+        TILE_PAGES * self.page_bytes() + scratch_bytes(self.page_bytes())
+    }
 }
 
 /// The technique's parameters.
@@ -96,11 +101,12 @@ impl Default for AsmSettings {
 impl AsmSettings {
     pub fn validated(self) -> Result<AsmSettings> {
         let bytes = self.budget_mb * MB as f64;
-        if !(bytes >= self.test.page_bytes() as f64 && bytes.is_finite()) {
+        let least = self.test.least_budget_bytes();
+        if !(bytes >= least as f64 && bytes.is_finite()) {
             return Err(Error::InvalidArgument(format!(
-                "an ASM budget of {} MB holds no tile: a tile takes {} KiB",
+                "an ASM budget of {} MB holds no tile: the root tile and the scratch take {} KiB",
                 self.budget_mb,
-                self.test.page_bytes() / 1024
+                least / 1024
             )));
         }
         if !(self.time_ms > 0.0 && self.time_ms.is_finite()) {
@@ -121,44 +127,29 @@ impl AsmSettings {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AsmStats {
     pub budget_bytes: u64,
-    /// Bytes of the resident tiles' pages (never above the budget).
+    /// Bytes of the resident tiles' pages and the scratch (never above the budget).
     pub bytes_used: u64,
     pub resident_tiles: usize,
     /// The finest resident level (0: the root alone).
     pub deepest_level: u32,
-    /// Tiles rendered this frame, in render order.
+    /// Tiles rendered this frame, in render order (a tile refreshed, refined, or given a
+    /// quadrant back by an eviction).
     pub rendered: Vec<TileKey>,
+    /// Tiles evicted this frame.
+    pub evicted: usize,
     /// The cost model fitted at start-up: ms per triangle and per tile.
     pub cost: (f64, f64),
-}
-
-struct TileIds {
-    image: Image,
-    pipeline: GraphicsPipeline,
-    first: Vec<Vec<u32>>,
-}
-
-/// A tile to render this frame.
-struct TileRender {
-    key: TileKey,
-    page: u32,
-    view_proj: Mat4,
-    /// Per group: whether its light-uv bounds overlap the tile (else it is not drawn).
-    groups: Vec<bool>,
 }
 
 pub struct Asm {
     light: Light,
     bounds: Vec<GroupBounds>,
-    /// Triangles of each group.
-    triangles: Vec<u64>,
+    /// Each mesh's group and triangle clusters (`GpuMesh::clusters`), in the scene's order.
+    clusters: Vec<(usize, Vec<Cluster>)>,
     settings: AsmSettings,
     pool: PagePool,
-    /// The page pool: one D32 layer of `ASM_TILE_TEXELS`² per page.
-    tiles: ShadowMaps,
-    /// The ID test's polygon IDs: an R32_UINT layer per page, the pipeline that renders depth
-    /// and IDs, and each mesh's first ID (by group, then mesh).
-    ids: Option<TileIds>,
+    /// The pool's pages on the GPU.
+    pages: PageStore,
     prepass_pipeline: GraphicsPipeline,
     scene_pipeline: GraphicsPipeline,
     analysis: ComputePipeline,
@@ -169,6 +160,8 @@ pub struct Asm {
     table: Buffer,
     /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by `analysed`.
     requests: Buffer,
+    /// Edge records `requests` holds: one per pixel the analysis looks at in a frame.
+    edge_capacity: u32,
     /// Per page-table node, the last frame whose lighting looked a point up in its tile.
     used: Buffer,
     /// The tile of each node of the page table the last lighting pass descended.
@@ -180,31 +173,32 @@ pub struct Asm {
     /// What `cost` predicts for this frame's planned tiles, ms.
     planned_ms: f64,
     frame: u64,
-    /// The light record, group transforms and group light-uv bounds of the frame.
+    /// The light record, group transforms, group and cluster (per mesh) light-uv bounds of the
+    /// frame.
     record: Option<ShadowLight>,
     transforms: Vec<Mat4>,
     group_rects: Vec<UvRect>,
+    cluster_rects: Vec<Vec<UvRect>>,
     /// The tile of each node of the page table the analysis descends.
     table_keys: Vec<TileKey>,
     /// Resident tiles a moving group made stale, rendered before the analysis.
-    refresh: Vec<TileRender>,
-    /// Tiles the analysis asked for, rendered before the lighting.
-    render: Vec<TileRender>,
+    refresh: Vec<TileWrite>,
+    /// Tiles the analysis asked for, and the quadrants evictions gave back, before the lighting.
+    render: Vec<TileWrite>,
+    /// Tiles evicted this frame.
+    evicted: usize,
     stats: AsmStats,
 }
 
-/// The ID test's polygon IDs.
-const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
-
-/// Tiles the analysis may ask for under one page-table node: 4 + 16 + ... down to
-/// `ASM_CHAIN_LEVELS` (as asm_analysis.comp's `ASM_REQUEST_SLOTS`).
-const REQUEST_SLOTS: usize = ((1 << (2 * constants::ASM_CHAIN_LEVELS + 2)) - 4) / 3;
-/// Uints of the analysis output per page-table node: a used flag, an edge count and a sum of
-/// missing levels per slot.
-const REQUEST_WORDS: u64 = 1 + 2 * REQUEST_SLOTS as u64;
-
 impl Asm {
-    pub fn new(ctx: &Arc<Context>, scene: &Scene, gpu: &GpuScene, settings: AsmSettings) -> Result<Asm> {
+    /// The technique for `scene` rendered at `size` (width, height) pixels.
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        gpu: &GpuScene,
+        settings: AsmSettings,
+        size: (u32, u32),
+    ) -> Result<Asm> {
         let settings = settings.validated()?;
         let [light] = scene.lights[..] else {
             return Err(Error::InvalidArgument(format!(
@@ -219,20 +213,17 @@ impl Asm {
                 ctx.info().name
             )));
         }
-        let pool = PagePool::new(settings.budget_bytes(), settings.test.page_bytes())?;
-        let capacity = pool.capacity();
-        let tiles =
-            ShadowMaps::new(ctx, "asm", constants::ASM_TILE_TEXELS, capacity).map_err(|e| match e {
-                Error::InvalidArgument(e) => Error::InvalidArgument(format!(
-                    "an ASM budget of {} MB is {capacity} pages, one image layer each: {e}",
-                    settings.budget_mb
-                )),
-                e => e,
-            })?;
-        let ids = match settings.test {
-            AsmTest::Bias => None,
-            AsmTest::Id => Some(TileIds::new(ctx, gpu, capacity)?),
-        };
+        let ids = settings.test == AsmTest::Id;
+        if ids && !ctx.info().has(GEOMETRY_SHADER) {
+            return Err(Error::Unsupported(format!(
+                "the ASM polygon-ID test needs {GEOMETRY_SHADER} on {}; use the bias test",
+                ctx.info().name
+            )));
+        }
+        let page_bytes = settings.test.page_bytes();
+        let pages = PageStore::new(ctx, gpu, settings.budget_bytes(), page_bytes, ids)?;
+        let pool = PagePool::new(pages.layout().pages(), page_bytes)?;
+        let nodes = pool.max_tiles();
         let mut bindings = vec![
             BindingKind::UniformBuffer,
             BindingKind::UniformBuffer,
@@ -279,33 +270,31 @@ impl Asm {
         )?;
         let table = buffer(
             "asm.page_table",
-            page_table::PageTable::buffer_bytes(capacity),
+            page_table::PageTable::buffer_bytes(nodes),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
+        // The analysis looks at one pixel of each 2×2 block per frame.
+        let edge_capacity = size.0.div_ceil(2) * size.1.div_ceil(2);
         let requests = buffer(
             "asm.requests",
-            REQUEST_WORDS * u64::from(capacity) * 4,
+            4 * (1 + u64::from(nodes) + 4 * u64::from(edge_capacity)),
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
         let used = buffer(
             "asm.used",
-            u64::from(capacity) * 4,
+            u64::from(nodes) * 4,
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        let triangles = (0..scene.groups.len())
-            .map(|g| gpu.meshes.iter().filter(|m| m.group == g).map(|m| u64::from(m.index_count / 3)).sum())
-            .collect();
         let mut asm = Asm {
             light,
             bounds: group_bounds(scene),
-            triangles,
+            clusters: gpu.meshes.iter().map(|m| (m.group, m.clusters.clone())).collect(),
             settings,
             pool,
-            tiles,
-            ids,
+            pages,
             prepass_pipeline: depth_prepass_pipeline(ctx, "asm.depth_prepass", size_of::<LocalDrawPush>())?,
             scene_pipeline,
             analysis,
@@ -313,6 +302,7 @@ impl Asm {
             records,
             table,
             requests,
+            edge_capacity,
             used,
             lit_keys: Vec::new(),
             cost: CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 },
@@ -322,9 +312,11 @@ impl Asm {
             record: None,
             transforms: Vec::new(),
             group_rects: Vec::new(),
+            cluster_rects: Vec::new(),
             table_keys: Vec::new(),
             refresh: Vec::new(),
             render: Vec::new(),
+            evicted: 0,
             stats: AsmStats::default(),
         };
         asm.cost = asm.calibrate(ctx, gpu)?;
@@ -334,7 +326,9 @@ impl Asm {
     /// The cost model a·N + b of a tile render, fitted to timed renders of tiles drawing
     /// different numbers of triangles on this device (the root, and tiles of levels 1 to 3
     /// along the view's diagonals), each rendered twice and the second timing kept (the first
-    /// pays for cold caches). Without timestamps the model stays at 1 ms per tile.
+    /// pays for cold caches), each stored into pages as a frame's tiles are (into the root's,
+    /// which the first frame renders again). Without timestamps the model stays at 1 ms per
+    /// tile.
     fn calibrate(&self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
         if ctx.info().timestamp_period_ns.is_none() {
             return Ok(self.cost);
@@ -342,7 +336,7 @@ impl Asm {
         let (centre, radius) = scene_sphere(&self.bounds, &gpu.transforms);
         let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
         let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
-        let rects = self.group_rects_for(&view_proj, &gpu.transforms);
+        let rects = self.cluster_rects_for(&view_proj, &gpu.transforms);
         let mut keys = vec![TileKey::ROOT];
         for level in 1..=3u32 {
             let n = 1 << level;
@@ -352,8 +346,9 @@ impl Asm {
                 y,
             }));
         }
-        let renders: Vec<TileRender> =
-            keys.iter().map(|&k| self.tile_render(k, 0, &view_proj, &rects)).collect();
+        let pages = self.pool.pages(TileKey::ROOT).expect("the root is always resident");
+        let renders: Vec<TileWrite> =
+            keys.iter().map(|&key| self.write(PageOp { key, pages }, &view_proj, &rects)).collect();
         let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
         let mut samples = Vec::new();
         for round in 0..2 {
@@ -361,87 +356,53 @@ impl Asm {
                 .iter()
                 .map(|t| {
                     Pass::new("asm_calibration", &[], &["asm_calibration"], move |cmd| {
-                        self.record_tile(ctx, cmd, gpu, t)
+                        self.pages.record(ctx, cmd, gpu, std::slice::from_ref(t))
                     })
                 })
                 .collect();
             let timings = executor.run(&[], passes)?;
             if round == 1 {
                 for (t, timing) in renders.iter().zip(timings) {
-                    samples.push((self.tile_triangles(&t.groups), timing.gpu_ms.unwrap_or(0.0)));
+                    samples.push((draw_triangles(&t.draws), timing.gpu_ms.unwrap_or(0.0)));
                 }
             }
         }
         Ok(CostModel::fit(&samples))
     }
 
-    /// Records the renders of `tiles`, one debug label each.
-    fn record_tiles(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, tiles: &[TileRender]) {
-        for t in tiles {
-            ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", t.key.level, t.key.x, t.key.y));
-            self.record_tile(ctx, cmd, scene, t);
-            ctx.end_label(cmd);
-        }
-    }
-
-    /// Records the render of one tile into its page (and its ID layer for the ID test).
-    fn record_tile(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, t: &TileRender) {
-        let Some(ids) = &self.ids else {
-            return self.tiles.record(ctx, cmd, scene, t.page, &t.view_proj, |m| t.groups[m.group]);
-        };
-        let (color, depth) = (Target { image: &ids.image, layer: t.page }, self.tiles.target(t.page));
-        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(depth)));
-        ids.pipeline.bind(cmd, &[]);
-        for mesh in scene.meshes.iter().filter(|m| t.groups[m.group]) {
-            let push = AsmTilePush {
-                transform: (t.view_proj * scene.transforms[mesh.group]).to_cols_array_2d(),
-                ids: [ids.first[mesh.group][mesh.mesh], 0, 0, 0],
-            };
-            ids.pipeline.push(cmd, bytes_of(&push));
-            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-        }
-        ctx.end_rendering(cmd);
-    }
-
     /// Each group's light-uv bounds under `transforms`.
     fn group_rects_for(&self, view_proj: &Mat4, transforms: &[Mat4]) -> Vec<UvRect> {
-        self.bounds
-            .iter()
-            .zip(transforms)
-            .map(|(b, t)| {
-                let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-                for corner in 0..8 {
-                    let pick = |bit: usize, a: f32, b: f32| if corner >> bit & 1 == 0 { a } else { b };
-                    let local = Vec3::new(
-                        pick(0, b.min.x, b.max.x),
-                        pick(1, b.min.y, b.max.y),
-                        pick(2, b.min.z, b.max.z),
-                    );
-                    let world = t.transform_point3(local);
-                    (lo, hi) = (lo.min(world), hi.max(world));
-                }
-                UvRect::of_box(view_proj, lo, hi)
-            })
-            .collect()
+        self.bounds.iter().zip(transforms).map(|(b, t)| box_rect(view_proj, t, b.min, b.max)).collect()
     }
 
-    fn tile_render(&self, key: TileKey, page: u32, view_proj: &Mat4, rects: &[UvRect]) -> TileRender {
-        let square = UvRect::of_tile(key);
-        TileRender {
-            key,
-            page,
-            view_proj: tile_view_proj(view_proj, key),
-            groups: rects.iter().map(|r| r.overlaps(&square)).collect(),
+    /// Each mesh's clusters' light-uv bounds under `transforms`.
+    fn cluster_rects_for(&self, view_proj: &Mat4, transforms: &[Mat4]) -> Vec<Vec<UvRect>> {
+        let rect = |g: usize, c: &Cluster| box_rect(view_proj, &transforms[g], c.min, c.max);
+        self.clusters.iter().map(|(g, clusters)| clusters.iter().map(|c| rect(*g, c)).collect()).collect()
+    }
+
+    /// A queued render as the GPU records it: the tile's cropped projection and the clusters
+    /// (bounds `rects`) it draws.
+    fn write(&self, op: PageOp, view_proj: &Mat4, rects: &[Vec<UvRect>]) -> TileWrite {
+        TileWrite {
+            key: op.key,
+            pages: op.pages,
+            view_proj: tile_view_proj(view_proj, op.key),
+            draws: tile_draws(&self.clusters, rects, op.key),
         }
     }
 
-    fn tile_triangles(&self, groups: &[bool]) -> u64 {
-        groups.iter().zip(&self.triangles).filter(|(drawn, _)| **drawn).map(|(_, t)| t).sum()
+    /// Queued renders as this frame records them.
+    fn writes(&self, ops: Vec<PageOp>) -> Vec<TileWrite> {
+        let view_proj = Mat4::from_cols_array_2d(&self.record.expect("update sets the record").view_proj);
+        ops.into_iter().map(|op| self.write(op, &view_proj, &self.cluster_rects)).collect()
     }
 
     /// Marks the tiles the last frame's lighting and this frame's analysis looked up as used
-    /// (the analysis sees the new view first), and turns the analysis' edge counts into
-    /// requests.
+    /// (the analysis sees the new view first), and counts the analysis' edge pixels for the
+    /// tiles of their chains: the tiles under the pixel's towards it, as deep as it lacks
+    /// levels (at most `ASM_CHAIN_LEVELS`), each counting the pixel and the levels it still
+    /// lacks at that tile's parent.
     fn read_requests(&mut self) -> Result<Vec<Request>> {
         let last = (self.frame - 1) as u32;
         for (key, mark) in self.lit_keys.iter().zip(read_words(&self.used)?) {
@@ -450,44 +411,47 @@ impl Asm {
             }
         }
         let words = read_words(&self.requests)?;
-        let capacity = self.pool.capacity() as usize;
-        let (counts, missing) = words[capacity..].split_at(capacity * REQUEST_SLOTS);
-        let mut requests = Vec::new();
+        let nodes = self.pool.max_tiles() as usize;
         for (node, &key) in self.table_keys.iter().enumerate() {
-            if words[node] != 0 {
+            if words[1 + node] != 0 {
                 self.pool.touch(key, self.frame);
             }
-            // Slots row by row within each depth, as the analysis counts them.
-            let mut slot = node * REQUEST_SLOTS;
-            for depth in 1..=constants::ASM_CHAIN_LEVELS {
-                let side = 1u32 << depth;
-                for i in 0..side * side {
-                    let edge_pixels = counts[slot];
-                    let (x, y) = (key.x * side + i % side, key.y * side + i / side);
-                    let tile = TileKey { level: key.level + depth, x, y };
-                    slot += 1;
-                    if edge_pixels == 0 || tile.level > constants::ASM_MAX_LEVEL {
-                        continue;
-                    }
-                    let square = UvRect::of_tile(tile);
-                    let groups: Vec<bool> = self.group_rects.iter().map(|r| r.overlaps(&square)).collect();
-                    requests.push(Request {
-                        key: tile,
-                        edge_pixels,
-                        missing_levels: missing[slot - 1],
-                        triangles: self.tile_triangles(&groups),
-                    });
+        }
+        let count = words[0].min(self.edge_capacity) as usize;
+        let mut asked: HashMap<TileKey, (u32, u32)> = HashMap::new();
+        for edge in words[1 + nodes..].chunks_exact(4).take(count) {
+            let uv = [f32::from_bits(edge[0]), f32::from_bits(edge[1])];
+            let (key, missing) = (self.table_keys[edge[2] as usize], edge[3]);
+            for depth in 1..=missing.min(constants::ASM_CHAIN_LEVELS) {
+                let level = key.level + depth;
+                if level > constants::ASM_MAX_LEVEL {
+                    break;
                 }
+                // The descendant of `key` at `level` holding uv, as the analysis placed it.
+                let n = 1u32 << level;
+                let cell = |c: f32, at: u32| {
+                    ((c * n as f32) as u32).min(n - 1).clamp(at << depth, ((at + 1) << depth) - 1)
+                };
+                let tile = TileKey { level, x: cell(uv[0], key.x), y: cell(uv[1], key.y) };
+                let slot = asked.entry(tile).or_default();
+                slot.0 += 1;
+                slot.1 += missing - depth + 1;
             }
         }
-        Ok(requests)
+        Ok(asked
+            .into_iter()
+            .map(|(key, (edge_pixels, missing_levels))| {
+                let triangles = draw_triangles(&tile_draws(&self.clusters, &self.cluster_rects, key));
+                Request { key, edge_pixels, missing_levels, triangles }
+            })
+            .collect())
     }
 
     /// Rebuilds the page table from the pool and uploads it.
     fn write_table(&mut self) -> Result<()> {
-        let table = page_table::build(&self.pool);
+        let table = page_table::build(&self.pool, &self.pages.layout());
         self.table_keys =
-            table.nodes.iter().map(|n| TileKey { level: n.tile[1], x: n.tile[2], y: n.tile[3] }).collect();
+            table.nodes.iter().map(|n| TileKey { level: n.tile[0], x: n.tile[1], y: n.tile[2] }).collect();
         self.table.write(0, &table.bytes())
     }
 
@@ -498,7 +462,7 @@ impl Asm {
         move |mesh, model| LocalDrawPush {
             model: model.to_cols_array_2d(),
             albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-            params: [1, self.ids.as_ref().map_or(0, |ids| ids.first[mesh.group][mesh.mesh]), frame, 0],
+            params: [1, self.pages.first_id(mesh.group, mesh.mesh), frame, 0],
             bias: DEPTH_BIAS,
         }
     }
@@ -509,54 +473,46 @@ impl Asm {
     }
 }
 
+/// The index runs a render of `key` draws: the clusters (per mesh: its group, its clusters)
+/// whose bounds `rects` overlap its square, neighbours merged; (mesh, first index, count).
+fn tile_draws(
+    clusters: &[(usize, Vec<Cluster>)],
+    rects: &[Vec<UvRect>],
+    key: TileKey,
+) -> Vec<(usize, u32, u32)> {
+    let square = UvRect::of_tile(key);
+    let mut draws: Vec<(usize, u32, u32)> = Vec::new();
+    for (m, ((_, clusters), rects)) in clusters.iter().zip(rects).enumerate() {
+        for (c, _) in clusters.iter().zip(rects).filter(|(_, r)| r.overlaps(&square)) {
+            match draws.last_mut() {
+                Some(last) if last.0 == m && last.1 + last.2 == c.first => last.2 += c.count,
+                _ => draws.push((m, c.first, c.count)),
+            }
+        }
+    }
+    draws
+}
+
+/// Triangles of index runs.
+fn draw_triangles(draws: &[(usize, u32, u32)]) -> u64 {
+    draws.iter().map(|d| u64::from(d.2 / 3)).sum()
+}
+
+/// The light-uv bounds of the object-space box `min`..`max` under `transform`.
+fn box_rect(view_proj: &Mat4, transform: &Mat4, min: Vec3, max: Vec3) -> UvRect {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for corner in 0..8 {
+        let pick = |bit: usize, a: f32, b: f32| if corner >> bit & 1 == 0 { a } else { b };
+        let local = Vec3::new(pick(0, min.x, max.x), pick(1, min.y, max.y), pick(2, min.z, max.z));
+        let world = transform.transform_point3(local);
+        (lo, hi) = (lo.min(world), hi.max(world));
+    }
+    UvRect::of_box(view_proj, lo, hi)
+}
+
 /// A host-readable buffer's contents as native-endian words.
 fn read_words(buffer: &Buffer) -> Result<Vec<u32>> {
     Ok(buffer.read()?.chunks_exact(4).map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect())
-}
-
-impl TileIds {
-    fn new(ctx: &Arc<Context>, gpu: &GpuScene, capacity: u32) -> Result<TileIds> {
-        if !ctx.info().has(GEOMETRY_SHADER) {
-            return Err(Error::Unsupported(format!(
-                "the ASM polygon-ID test needs {GEOMETRY_SHADER} on {}; use the bias test",
-                ctx.info().name
-            )));
-        }
-        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
-        let desc = ImageDesc::square_array("asm.ids", constants::ASM_TILE_TEXELS, capacity, ID_FORMAT, usage);
-        let pipeline = GraphicsPipeline::new(
-            ctx,
-            &GraphicsDesc {
-                name: "asm.tile_ids",
-                vertex_spirv: spirv::ASM_TILE_VERT,
-                fragment_spirv: spirv::ASM_TILE_FRAG,
-                bindings: &[],
-                push_size: size_of::<AsmTilePush>() as u32,
-                vertex_buffers: &[MESH_POSITIONS],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[ID_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth: DepthTest::Less,
-                additive: false,
-                constants: &[],
-            },
-        )?;
-        // IDs from 1 (0 is a texel no surface covers), numbered mesh after mesh.
-        let mut next = 1u32;
-        let mut first: Vec<Vec<u32>> = Vec::new();
-        for mesh in &gpu.meshes {
-            if first.len() <= mesh.group {
-                first.resize(mesh.group + 1, Vec::new());
-            }
-            let of_group = &mut first[mesh.group];
-            if of_group.len() <= mesh.mesh {
-                of_group.resize(mesh.mesh + 1, 0);
-            }
-            of_group[mesh.mesh] = next;
-            next += mesh.index_count / 3;
-        }
-        Ok(TileIds { image: Image::new(ctx, &desc)?, pipeline, first })
-    }
 }
 
 impl Technique for Asm {
@@ -569,33 +525,36 @@ impl Technique for Asm {
         let record = shadow_light(&self.light, centre, radius, constants::ASM_TILE_TEXELS);
         let view_proj = Mat4::from_cols_array_2d(&record.view_proj);
         let rects = self.group_rects_for(&view_proj, state.transforms);
-        let mut refresh = Vec::new();
-        if self.record.is_none_or(|r| bytes_of(&r) != bytes_of(&record)) {
-            // The light moved (or the depth range changed): every tile's depths are stale.
-            self.pool = PagePool::new(self.settings.budget_bytes(), self.settings.test.page_bytes())?;
-            refresh.push(TileKey::ROOT);
-            // The analysis descends the new pool's table; otherwise last frame's `analysed`
-            // wrote the table of the pool as it still is (refreshing tiles moves none).
-            self.write_table()?;
+        let reset = self.record.is_none_or(|r| bytes_of(&r) != bytes_of(&record));
+        if reset {
+            // The light moved (or the depth range changed): every tile's depths are stale. The
+            // new pool queues the root's render.
+            self.pool = PagePool::new(self.pages.layout().pages(), self.settings.test.page_bytes())?;
         } else {
             let moved: Vec<UvRect> = (0..rects.len())
                 .filter(|&g| self.transforms[g] != state.transforms[g])
                 .flat_map(|g| [self.group_rects[g], rects[g]])
                 .collect();
             let touched = |key: TileKey| moved.iter().any(|r| r.overlaps(&UvRect::of_tile(key)));
-            refresh.extend(self.pool.resident().map(|(key, _)| key).filter(|&key| touched(key)));
+            let mut stale: Vec<TileKey> =
+                self.pool.resident().map(|(key, _)| key).filter(|&k| touched(k)).collect();
             // Coarse levels first: the root leads.
-            refresh.sort();
+            stale.sort();
+            for key in stale {
+                self.pool.refresh(key);
+            }
         }
         self.record = Some(record);
         self.transforms = state.transforms.to_vec();
         self.group_rects = rects;
-        self.refresh = refresh
-            .iter()
-            .filter_map(|&key| {
-                self.pool.page(key).map(|page| self.tile_render(key, page, &view_proj, &self.group_rects))
-            })
-            .collect();
+        self.cluster_rects = self.cluster_rects_for(&view_proj, state.transforms);
+        let ops = self.pool.take_ops();
+        self.refresh = self.writes(ops);
+        if reset {
+            // The analysis descends the new pool's table; otherwise last frame's `analysed`
+            // wrote the table of the pool as it still is (refreshing tiles moves none).
+            self.write_table()?;
+        }
         self.records.write(0, bytes_of(&record))?;
         Ok(())
     }
@@ -603,7 +562,7 @@ impl Technique for Asm {
     fn analysis_passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene, targets, uniforms) = (inputs.ctx, inputs.scene, inputs.targets, inputs.uniforms);
         let refresh = Pass::new("asm_refresh", &[], &["shadow_maps"], move |cmd| {
-            self.record_tiles(ctx, cmd, scene, &self.refresh);
+            self.pages.record(ctx, cmd, scene, &self.refresh);
         });
         // The eye view the analysis reads is the lighting pass' depth prepass.
         let eye_depth = depth_prepass(inputs, &self.prepass_pipeline, self.draw_push());
@@ -616,7 +575,8 @@ impl Technique for Asm {
                 self.requests.record_zero(cmd);
                 ctx.full_barrier(cmd);
                 let push = AsmAnalysisPush {
-                    size: [width, height, self.pool.capacity(), (self.frame % 4) as u32],
+                    size: [width, height, self.pool.max_tiles(), self.edge_capacity],
+                    phase: [(self.frame % 4) as u32, 0, 0, 0],
                     bias: DEPTH_BIAS,
                 };
                 let group = constants::ASM_ANALYSIS_GROUP;
@@ -625,7 +585,7 @@ impl Technique for Asm {
                     &[
                         Binding::Uniform(uniforms),
                         Binding::Uniform(&self.records),
-                        self.tiles.binding(),
+                        self.pages.depth_binding(),
                         Binding::Storage(&self.table),
                         Binding::Sampled(&targets.depth, &self.nearest),
                         Binding::Storage(&self.requests),
@@ -640,32 +600,41 @@ impl Technique for Asm {
 
     fn analysed(&mut self) -> Result<()> {
         let requests = self.read_requests()?;
-        let view_proj = Mat4::from_cols_array_2d(&self.record.expect("update sets the record").view_proj);
-        let pool = &self.pool;
         let model = self.cost.scaled(self.cost_scale);
-        let chosen = plan(requests, &model, self.settings.time_ms, |key| pool.page(key).is_some());
-        let mut render = Vec::new();
-        for (request, ratio) in chosen {
-            // A parent evicted by an earlier insertion of this frame, or refused a page, refuses
-            // its child (an error from the pool): the child waits for a later frame.
-            if let Ok(Insert::Allocated { page } | Insert::Replaced { page, .. }) =
-                self.pool.insert(request.key, self.frame, ratio)
-            {
-                render.push(self.tile_render(request.key, page, &view_proj, &self.group_rects));
-            }
-        }
-        // A tile whose page a later insertion of this frame took is no longer resident.
-        render.retain(|t| self.pool.page(t.key) == Some(t.page));
-        self.planned_ms = render.iter().map(|t| self.cost.cost_ms(self.tile_triangles(&t.groups))).sum();
-        self.render = render;
+        let (frame, time_ms) = (self.frame, self.settings.time_ms);
+        let resident: std::collections::HashSet<TileKey> = self.pool.resident().map(|(k, _)| k).collect();
+        self.evicted = 0;
+        let mut planned = Vec::new();
+        plan(
+            requests,
+            &model,
+            time_ms,
+            |key| resident.contains(&key),
+            |request, ratio| {
+                // A parent evicted by an earlier insertion of this frame refuses its child (an error
+                // from the pool), as a pool with no page to free does: the child waits.
+                let Ok(Insert::Inserted { evicted }) = self.pool.insert(request.key, frame, ratio) else {
+                    return None;
+                };
+                self.evicted += evicted;
+                let ops = self.pool.take_ops();
+                let draws =
+                    |op: &PageOp| draw_triangles(&tile_draws(&self.clusters, &self.cluster_rects, op.key));
+                planned.extend(ops.iter().copied());
+                Some(ops.iter().map(|op| model.cost_ms(draws(op))).sum())
+            },
+        );
+        self.render = self.writes(planned);
+        self.planned_ms = self.render.iter().map(|w| self.cost.cost_ms(draw_triangles(&w.draws))).sum();
         self.write_table()?;
         self.lit_keys.clone_from(&self.table_keys);
         self.stats = AsmStats {
             budget_bytes: self.settings.budget_bytes(),
-            bytes_used: self.pool.bytes_in_use(),
+            bytes_used: self.pool.bytes_in_use() + scratch_bytes(self.settings.test.page_bytes()),
             resident_tiles: self.table_keys.len(),
             deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
-            rendered: self.refresh.iter().chain(&self.render).map(|t| t.key).collect(),
+            rendered: self.refresh.iter().chain(&self.render).map(|w| w.key).collect(),
+            evicted: self.evicted,
             cost: (model.ms_per_triangle, model.ms_per_tile),
         };
         Ok(())
@@ -674,18 +643,16 @@ impl Technique for Asm {
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene) = (inputs.ctx, inputs.scene);
         let tiles = Pass::new("asm_tiles", &[], &["shadow_maps"], move |cmd| {
-            self.record_tiles(ctx, cmd, scene, &self.render);
+            self.pages.record(ctx, cmd, scene, &self.render);
         });
         let mut bindings = vec![
             Binding::Uniform(inputs.uniforms),
             Binding::Uniform(&self.records),
-            self.tiles.binding(),
+            self.pages.depth_binding(),
             Binding::Storage(&self.table),
             Binding::Storage(&self.used),
         ];
-        if let Some(ids) = &self.ids {
-            bindings.push(Binding::Sampled(&ids.image, &self.nearest));
-        }
+        bindings.extend(self.pages.id_binding());
         let lighting =
             scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, self.draw_push());
         vec![tiles, lighting]
@@ -708,8 +675,9 @@ impl Technique for Asm {
         Some(self.stats())
     }
 
-    /// The whole page pool, allocated up front (within the budget), whatever is resident.
+    /// The whole atlas and the scratch, allocated up front (within the budget), whatever
+    /// is resident.
     fn shadow_memory_bytes(&self) -> Option<u64> {
-        Some(self.pool.bytes_allocated())
+        Some(self.pages.bytes(self.settings.test.page_bytes()))
     }
 }

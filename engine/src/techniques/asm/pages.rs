@@ -1,0 +1,300 @@
+//! The GPU side of the page pool ([`super::pool`]): the atlas every page lives in, and the
+//! recording of the pool's page operations. Pages are a tile's quadrants and need not lie side
+//! by side in the atlas, so every page write goes through a scratch target of
+//! [`SCRATCH_TILES`] tiles: tiles render into it whole, one after the other, and their stored
+//! quadrants are copied out together (a CPU rasterizer waits at every barrier, so one copy and
+//! its barriers per tile cost more than the tile's render). The scratch counts in the budget.
+//!
+//! The polygon-ID test keeps a second atlas and scratch, of IDs, laid out as the depth ones.
+use super::pool::{TilePages, TILE_PAGES};
+use super::tile::TileKey;
+use crate::backend::{
+    vk, Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
+    SquareCopy, Target,
+};
+use crate::error::{Error, Result};
+use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
+use crate::layouts::{bytes_of, spirv, AsmTilePush};
+use crate::renderer::{GpuScene, DEPTH_FORMAT};
+use crate::techniques::shadow_depth::ShadowMaps;
+use crate::techniques::unshadowed::MESH_POSITIONS;
+use glam::Mat4;
+use std::sync::Arc;
+
+/// The ID test's polygon IDs.
+const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
+/// Most pages per atlas row: 16384 texels, the largest image side of lavapipe and NVIDIA.
+const MAX_COLUMNS: u32 = 16384 / ASM_PAGE_TEXELS;
+/// Tiles the scratch holds: renders between two copies into the atlas.
+pub const SCRATCH_TILES: u32 = 8;
+
+/// Bytes of the scratch for pages of `page_bytes`.
+pub fn scratch_bytes(page_bytes: u64) -> u64 {
+    u64::from(SCRATCH_TILES) * TILE_PAGES * page_bytes
+}
+
+/// How the atlas lays its pages out: row by row, `columns` to a row.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtlasLayout {
+    pub columns: u32,
+    pub rows: u32,
+}
+
+impl AtlasLayout {
+    /// The atlas of the most pages of `page_bytes` that fit in `bytes` (rows and columns as
+    /// near equal as that count allows, so that its sides stay small); an error below one
+    /// tile's pages.
+    pub fn within(bytes: u64, page_bytes: u64) -> Result<AtlasLayout> {
+        let pages = u32::try_from(bytes / page_bytes).unwrap_or(u32::MAX);
+        if u64::from(pages) < TILE_PAGES {
+            return Err(Error::InvalidArgument(format!(
+                "{bytes} bytes hold no ASM tile: a tile takes {} bytes",
+                TILE_PAGES * page_bytes
+            )));
+        }
+        let square = (f64::from(pages).sqrt().ceil() as u32).min(MAX_COLUMNS);
+        let best = (square..=MAX_COLUMNS.min(pages).max(square))
+            .map(|columns| AtlasLayout { columns, rows: pages / columns })
+            .max_by_key(|l| (l.pages(), std::cmp::Reverse(l.columns)))
+            .expect("the range holds `square`");
+        Ok(best)
+    }
+
+    pub fn pages(&self) -> u32 {
+        self.columns * self.rows
+    }
+
+    /// The page's cell in the atlas as `AsmNode.pages` holds it: column | row << 16.
+    pub fn cell(&self, page: u32) -> u32 {
+        (page % self.columns) | ((page / self.columns) << 16)
+    }
+
+    /// The page's first texel in the atlas.
+    fn origin(&self, page: u32) -> [u32; 2] {
+        [page % self.columns * ASM_PAGE_TEXELS, page / self.columns * ASM_PAGE_TEXELS]
+    }
+}
+
+/// A tile render of this frame: its quadrants `pages` names are stored.
+pub struct TileWrite {
+    pub key: TileKey,
+    pub pages: TilePages,
+    /// The light's projection cropped to the tile's square.
+    pub view_proj: Mat4,
+    /// The index runs it draws: (mesh of the scene, first index, index count).
+    pub draws: Vec<(usize, u32, u32)>,
+}
+
+struct IdPages {
+    atlas: Image,
+    scratch: Image,
+    /// Renders a tile's depth and IDs.
+    tile: GraphicsPipeline,
+    /// Each mesh's first ID (by group, then mesh).
+    first: Vec<Vec<u32>>,
+}
+
+pub struct PageStore {
+    layout: AtlasLayout,
+    atlas: Image,
+    /// One tile of depth, rendered with the shadow-depth pipeline.
+    scratch: ShadowMaps,
+    ids: Option<IdPages>,
+    nearest: Sampler,
+}
+
+impl PageStore {
+    /// The atlas and scratch of the most pages of `page_bytes` whose bytes, with the scratch
+    /// tile's, stay within `budget_bytes`; with polygon IDs when `ids` (`page_bytes` then counts
+    /// a depth and an ID per texel).
+    pub fn new(
+        ctx: &Arc<Context>,
+        gpu: &GpuScene,
+        budget_bytes: u64,
+        page_bytes: u64,
+        ids: bool,
+    ) -> Result<PageStore> {
+        let scratch = scratch_bytes(page_bytes);
+        let layout = AtlasLayout::within(budget_bytes.saturating_sub(scratch), page_bytes).map_err(|_| {
+            Error::InvalidArgument(format!(
+                "an ASM budget of {budget_bytes} bytes holds no tile: the root and the scratch take {} bytes",
+                scratch + TILE_PAGES * page_bytes
+            ))
+        })?;
+        let (width, height) = (layout.columns * ASM_PAGE_TEXELS, layout.rows * ASM_PAGE_TEXELS);
+        let atlas_usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
+        let atlas = |name, format| {
+            let desc = ImageDesc { name, width, height, layers: 1, array: false, format, usage: atlas_usage };
+            Image::new(ctx, &desc).map_err(|e| match e {
+                Error::InvalidArgument(e) => Error::InvalidArgument(format!(
+                    "an ASM budget of {budget_bytes} bytes is {} pages: {e}",
+                    layout.pages()
+                )),
+                e => e,
+            })
+        };
+        let depth_atlas = atlas("asm.atlas", DEPTH_FORMAT)?;
+        let ids = if ids { Some(IdPages::new(ctx, gpu, atlas("asm.id_atlas", ID_FORMAT)?)?) } else { None };
+        Ok(PageStore {
+            layout,
+            atlas: depth_atlas,
+            scratch: ShadowMaps::new(ctx, "asm.scratch", ASM_TILE_TEXELS, SCRATCH_TILES)?,
+            ids,
+            nearest: Sampler::new(ctx, "asm.pages_sampler", false, Edge::Clamp, Edge::Clamp)?,
+        })
+    }
+
+    pub fn layout(&self) -> AtlasLayout {
+        self.layout
+    }
+
+    /// Bytes of the atlas and the scratch (the ID test's IDs included).
+    pub fn bytes(&self, page_bytes: u64) -> u64 {
+        u64::from(self.layout.pages()) * page_bytes + scratch_bytes(page_bytes)
+    }
+
+    /// The depth atlas as the lookups sample it.
+    pub fn depth_binding(&self) -> Binding<'_> {
+        Binding::Sampled(&self.atlas, &self.nearest)
+    }
+
+    /// The ID atlas as the lookups sample it, for the ID test.
+    pub fn id_binding(&self) -> Option<Binding<'_>> {
+        self.ids.as_ref().map(|ids| Binding::Sampled(&ids.atlas, &self.nearest))
+    }
+
+    /// The polygon ID of the first triangle of mesh `mesh` of group `group` (0 without IDs).
+    pub fn first_id(&self, group: usize, mesh: usize) -> u32 {
+        self.ids.as_ref().map_or(0, |ids| ids.first[group][mesh])
+    }
+
+    /// Records `writes` in order, one debug label each.
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, writes: &[TileWrite]) {
+        let half = ASM_PAGE_TEXELS;
+        // Squares of the scratch waiting to be stored, with their pages.
+        let mut pending: Vec<(SquareCopy, u32)> = Vec::new();
+        for (i, write) in writes.iter().enumerate() {
+            let layer = i as u32 % SCRATCH_TILES;
+            if layer == 0 {
+                self.store(cmd, &mut pending);
+            }
+            let key = write.key;
+            ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
+            self.render_tile(ctx, cmd, scene, layer, write);
+            for (q, page) in write.pages.iter().enumerate().filter_map(|(q, p)| p.map(|p| (q as u32, p))) {
+                pending.push((SquareCopy { layer, from: [q % 2 * half, q / 2 * half], to: [0, 0] }, page));
+            }
+            ctx.end_label(cmd);
+        }
+        self.store(cmd, &mut pending);
+    }
+
+    /// A tile into scratch tile `layer`: depth, and IDs for the ID test.
+    fn render_tile(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        layer: u32,
+        write: &TileWrite,
+    ) {
+        let draws = write.draws.iter().map(|&(m, first, count)| (&scene.meshes[m], first, count));
+        let Some(ids) = &self.ids else {
+            return self.scratch.record(ctx, cmd, scene, layer, &write.view_proj, draws);
+        };
+        let color = Target { image: &ids.scratch, layer };
+        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(layer))));
+        ids.tile.bind(cmd, &[]);
+        for (mesh, first, count) in draws {
+            // gl_PrimitiveID counts from the run's first triangle.
+            let push = AsmTilePush {
+                transform: (write.view_proj * scene.transforms[mesh.group]).to_cols_array_2d(),
+                ids: [ids.first[mesh.group][mesh.mesh] + first / 3, 0, 0, 0],
+            };
+            ids.tile.push(cmd, bytes_of(&push));
+            ctx.draw_indexed_range(cmd, &[&mesh.vertices], &mesh.indices, first, count);
+        }
+        ctx.end_rendering(cmd);
+    }
+
+    /// Copies the pending squares of the scratch (each with the page it goes to) into the
+    /// atlases and empties the list. A page written twice keeps the later square: a tile's
+    /// quadrant given back to a child rendered after it in the same batch, or an evicted tile's
+    /// page taken by another.
+    fn store(&self, cmd: vk::CommandBuffer, pending: &mut Vec<(SquareCopy, u32)>) {
+        let mut seen = std::collections::HashSet::new();
+        let mut squares: Vec<SquareCopy> = pending
+            .drain(..)
+            .rev()
+            .filter(|(_, page)| seen.insert(*page))
+            .map(|(square, page)| SquareCopy { to: self.layout.origin(page), ..square })
+            .collect();
+        if squares.is_empty() {
+            return;
+        }
+        squares.reverse();
+        self.scratch.image().record_copy_squares(cmd, &self.atlas, &squares, ASM_PAGE_TEXELS);
+        if let Some(ids) = &self.ids {
+            ids.scratch.record_copy_squares(cmd, &ids.atlas, &squares, ASM_PAGE_TEXELS);
+        }
+    }
+}
+
+impl IdPages {
+    fn new(ctx: &Arc<Context>, gpu: &GpuScene, atlas: Image) -> Result<IdPages> {
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+        let desc =
+            ImageDesc::square_array("asm.id_scratch", ASM_TILE_TEXELS, SCRATCH_TILES, ID_FORMAT, usage);
+        let tile = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "asm.tile_ids",
+                vertex_spirv: spirv::ASM_TILE_VERT,
+                fragment_spirv: spirv::ASM_TILE_FRAG,
+                bindings: &[],
+                push_size: size_of::<AsmTilePush>() as u32,
+                vertex_buffers: &[MESH_POSITIONS],
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[ID_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth: DepthTest::Less,
+                additive: false,
+                constants: &[],
+            },
+        )?;
+        // IDs from 1 (0 is a texel no surface covers), numbered mesh after mesh.
+        let mut next = 1u32;
+        let mut first: Vec<Vec<u32>> = Vec::new();
+        for mesh in &gpu.meshes {
+            if first.len() <= mesh.group {
+                first.resize(mesh.group + 1, Vec::new());
+            }
+            let of_group = &mut first[mesh.group];
+            if of_group.len() <= mesh.mesh {
+                of_group.resize(mesh.mesh + 1, 0);
+            }
+            of_group[mesh.mesh] = next;
+            next += mesh.index_count / 3;
+        }
+        Ok(IdPages { atlas, scratch: Image::new(ctx, &desc)?, tile, first })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_atlas_holds_what_the_bytes_allow_near_square() {
+        let page = 4096;
+        for (pages, expected) in [(4, (2, 2)), (1020, (34, 30)), (4092, (66, 62)), (1021, (34, 30))] {
+            let layout = AtlasLayout::within(pages * page + page / 2, page).unwrap();
+            assert_eq!((layout.columns, layout.rows), expected, "{pages} pages");
+            assert!(u64::from(layout.pages()) <= pages && layout.rows <= layout.columns);
+        }
+        assert!(AtlasLayout::within(3 * page, page).is_err());
+        let layout = AtlasLayout { columns: 34, rows: 30 };
+        assert_eq!(layout.cell(35), 1 | 1 << 16);
+        assert_eq!(layout.origin(35), [ASM_PAGE_TEXELS, ASM_PAGE_TEXELS]);
+    }
+}
