@@ -105,18 +105,23 @@ void main() {
     // On a shadow edge: the receiver's visibility against its texel and the 8 around it
     // disagrees (an occluder's silhouette, a depth discontinuity in the light's view, passes
     // within a texel). Neighbours lie up to 1 + sqrt(2) texels from p: the slope term grows so.
-    vec4 bias = vec4(push.bias.x, push.bias.y * 2.5, push.bias.z, 0.0);
-    bool centre = asm_visible(s, m, p, ng, page, ivec2(0), bias);
+    // The receiver's biased depths are computed once for all the texels.
+    float texel = asm_texel_size(s, level);
+    vec4 wide_bias = vec4(push.bias.x, push.bias.y * 2.5, push.bias.z, 0.0);
+    float wide = shadow_receiver_depth(s, m.z, p, ng, texel, wide_bias);
+    ivec2 t = ivec2(asm_texel_coords(page.tile, m.xy));
+    float stored = asm_depth(page, t);
+    bool centre = shadow_lit_past(s, stored, wide);
     bool edge = false;
     for (int j = -1; j <= 1; ++j) {
         for (int i = -1; i <= 1; ++i) {
-            edge = edge || asm_visible(s, m, p, ng, page, ivec2(i, j), bias) != centre;
+            edge = edge || shadow_lit_past(s, asm_depth(page, t + ivec2(i, j)), wide) != centre;
         }
     }
     // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
     // under grazing light): a finer tile's bias is narrower and shows the shadow.
-    edge = edge || (asm_visible(s, m, p, ng, page, ivec2(0), push.bias)
-                    && occluded_at_plane(s, m, p, ng, mx, my, page));
+    bool lit = shadow_lit_past(s, stored, shadow_receiver_depth(s, m.z, p, ng, texel, push.bias));
+    edge = edge || (lit && occluded_at_plane(s, m, p, ng, mx, my, page));
     if (!edge) return;
     uint record = atomicAdd(requests[0], 1u);
     if (record >= push.size.w) return;

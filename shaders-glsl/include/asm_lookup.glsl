@@ -78,12 +78,4 @@ float asm_texel_size(ShadowLight s, uint level) {
     return s.map.z / float(1u << level);
 }
 
-// Light k's visibility at p (geometric normal ng; m = shadow_map_coords) in the texel of `page`
-// holding it, moved by `offset`: the depth comparison with the slope-scaled bias, texels scaled
-// to the tile's level. The refinement analysis's test, texel by texel (the lighting blends four).
-bool asm_visible(ShadowLight s, vec4 m, vec3 p, vec3 ng, AsmPage page, ivec2 offset, vec4 bias) {
-    float stored = asm_depth(page, ivec2(asm_texel_coords(page.tile, m.xy)) + offset);
-    return shadow_depth_visible(s, stored, m.z, p, ng, asm_texel_size(s, page.tile.x), bias);
-}
-
 #endif

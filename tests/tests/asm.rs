@@ -260,7 +260,7 @@ fn a_fast_camera_turn_keeps_the_churn_per_frame_within_the_time_budget() {
             stats.rendered.len()
         );
         // The analysis of the new view runs before its lighting, but the pool is full of tiles
-        // the last frame's lighting used, which go only for a larger benefit in the turn's
+        // the last frame's lighting used, which go only for a much larger benefit in the turn's
         // first frame (the paper's rule); in the second they are unused and the LRU frees them.
         assert!(frame == 0 || !rendered.is_empty() || !stats.rendered.is_empty(), "{stats:?}");
         rendered.extend(stats.rendered);

@@ -126,6 +126,28 @@ impl Context {
         unsafe { self.dynamic_rendering.cmd_end_rendering(cmd) };
     }
 
+    /// Restricts the current rendering scope's viewport and scissor to its top-left
+    /// `side`² texels (begin_rendering covers the whole target).
+    pub fn restrict_to_square(&self, cmd: vk::CommandBuffer, side: u32) {
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: side as f32,
+            height: side as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let scissor = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D { width: side, height: side },
+        };
+        // SAFETY: recording command buffer inside a rendering scope.
+        unsafe {
+            self.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            self.device.cmd_set_scissor(cmd, 0, &[scissor]);
+        }
+    }
+
     /// Binds vertex buffers (binding i = `vertices[i]`) and a u32 index buffer and draws `count`
     /// indices.
     pub fn draw_indexed(

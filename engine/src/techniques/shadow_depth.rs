@@ -83,24 +83,27 @@ impl ShadowMaps {
         Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
             for (layer, view_proj) in self.view_projs.iter().enumerate() {
                 let whole = scene.meshes.iter().map(|m| (m, 0, m.index_count));
-                self.record(ctx, cmd, scene, layer as u32, view_proj, whole);
+                self.record(ctx, cmd, scene, layer as u32, self.maps.width, view_proj, whole);
             }
         })
     }
 
-    /// Records one rendering scope that clears map `layer` and draws, with `view_proj` (world to
-    /// the map's clip space), the runs of `scene`'s index buffers `draws` names: (mesh, first
-    /// index, index count).
+    /// Records one rendering scope that clears map `layer` and draws into its top-left `side`²
+    /// texels, with `view_proj` (world to the map's clip space), the runs of `scene`'s index
+    /// buffers `draws` names: (mesh, first index, index count).
+    #[allow(clippy::too_many_arguments)]
     pub fn record<'m>(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
         layer: u32,
+        side: u32,
         view_proj: &Mat4,
         draws: impl IntoIterator<Item = (&'m GpuMesh, u32, u32)>,
     ) {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear(self.target(layer))));
+        ctx.restrict_to_square(cmd, side);
         self.pipeline.bind(cmd, &[]);
         for (mesh, first, count) in draws {
             let push = ShadowDepthPush {

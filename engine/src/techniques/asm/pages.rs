@@ -26,7 +26,7 @@ const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
 /// Most pages per atlas row: 16384 texels, the largest image side of lavapipe and NVIDIA.
 const MAX_COLUMNS: u32 = 16384 / ASM_PAGE_TEXELS;
 /// Tiles the scratch holds: renders between two copies into the atlas.
-pub const SCRATCH_TILES: u32 = 8;
+pub const SCRATCH_TILES: u32 = 4;
 
 /// Bytes of the scratch for pages of `page_bytes`.
 pub fn scratch_bytes(page_bytes: u64) -> u64 {
@@ -75,14 +75,26 @@ impl AtlasLayout {
     }
 }
 
-/// A tile render of this frame: its quadrants `pages` names are stored.
+/// A tile render of this frame (`super::pool::PageOp`): the square of `key` at `side`² texels,
+/// its quadrants `pages` names stored.
 pub struct TileWrite {
     pub key: TileKey,
+    pub side: u32,
     pub pages: TilePages,
     /// The light's projection cropped to the tile's square.
     pub view_proj: Mat4,
     /// The index runs it draws: (mesh of the scene, first index, index count).
     pub draws: Vec<(usize, u32, u32)>,
+}
+
+impl TileWrite {
+    /// The tile whose texels it writes: its own, or at its parent's resolution its parent's.
+    pub fn owner(&self) -> TileKey {
+        match self.side {
+            ASM_TILE_TEXELS => self.key,
+            _ => self.key.parent().expect("the root holds no parent's quadrant"),
+        }
+    }
 }
 
 struct IdPages {
@@ -200,10 +212,11 @@ impl PageStore {
     ) {
         let draws = write.draws.iter().map(|&(m, first, count)| (&scene.meshes[m], first, count));
         let Some(ids) = &self.ids else {
-            return self.scratch.record(ctx, cmd, scene, layer, &write.view_proj, draws);
+            return self.scratch.record(ctx, cmd, scene, layer, write.side, &write.view_proj, draws);
         };
         let color = Target { image: &ids.scratch, layer };
         ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(layer))));
+        ctx.restrict_to_square(cmd, write.side);
         ids.tile.bind(cmd, &[]);
         for (mesh, first, count) in draws {
             // gl_PrimitiveID counts from the run's first triangle.

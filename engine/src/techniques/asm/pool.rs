@@ -6,15 +6,17 @@
 //! (it takes four, its parent gives one back): N resident tiles hold exactly 3N + 1 pages. The
 //! root is allocated first and never evicted, so every lookup finds a tile.
 //!
-//! Evicting a leaf gives its parent the quadrant back, which the parent's render then fills
-//! again (exactly: a rebuild from the leaf's finer texels would shift the coarse samples off
-//! their centres). The renders this takes are queued as [`PageOp`]s, in order: a page one
+//! Evicting a leaf gives its parent the quadrant back, which a render of the leaf's square at
+//! the parent's resolution fills again (exactly: a rebuild from the leaf's finer texels would
+//! shift the coarse samples off their centres; the parent's texels there sample the same
+//! points, and the render draws only what lies over the leaf's square). The renders this takes are queued as [`PageOp`]s, in order: a page one
 //! frees may be written by a later one; the technique records them before the lookups.
 //!
 //! Eviction follows the paper: among the evictable tiles (resident leaves other than the root:
 //! evicting a tile with resident children would cut them off from the lookup's descent) the
 //! least recently used one not used in the current frame goes first; if every evictable tile
-//! was used this frame, the one of least benefit goes, and only for a tile of larger benefit.
+//! was used this frame, the one of least benefit goes, and only for a tile of a benefit
+//! [`EVICTION_MARGIN`] times as large.
 use super::tile::TileKey;
 use crate::error::{Error, Result};
 use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
@@ -32,6 +34,12 @@ pub const TILE_PAGES: u64 =
 /// covers the quadrant.
 pub type TilePages = [Option<u32>; 4];
 
+/// How much larger a tile's benefit must be than a resident tile's (used this frame) to evict
+/// it: with the paper's "larger" alone, tiles of like benefit displaced each other frame after
+/// frame in a full pool, a render each time (BENCHMARKS.md: 24 of 50 renders a frame were
+/// evictions' on the walkthrough at 4 MiB).
+const EVICTION_MARGIN: f32 = 2.0;
+
 #[derive(Clone, Copy, Debug)]
 struct Resident {
     pages: TilePages,
@@ -39,11 +47,22 @@ struct Resident {
     benefit: f32,
 }
 
-/// A render the pages need: tile `key`, its quadrants stored where `pages` names a page.
+/// A render the pages need: the square of tile `key` at `side`² texels, its quadrants stored
+/// where `pages` names a page.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PageOp {
     pub key: TileKey,
+    /// A tile's own (`ASM_TILE_TEXELS`), or its parent's resolution (`ASM_PAGE_TEXELS`: one
+    /// page, quadrant 0, the parent's quadrant over it that an eviction gives back).
+    pub side: u32,
     pub pages: TilePages,
+}
+
+impl PageOp {
+    /// The render of a tile's quadrants `pages`.
+    fn tile(key: TileKey, pages: TilePages) -> PageOp {
+        PageOp { key, side: ASM_TILE_TEXELS, pages }
+    }
 }
 
 /// What [`PagePool::insert`] did.
@@ -85,7 +104,7 @@ impl PagePool {
         };
         let pages = pool.take_tile_pages();
         pool.tiles.insert(TileKey::ROOT, Resident { pages, last_used: 0, benefit: f32::INFINITY });
-        pool.ops.push(PageOp { key: TileKey::ROOT, pages });
+        pool.ops.push(PageOp::tile(TileKey::ROOT, pages));
         Ok(pool)
     }
 
@@ -133,7 +152,7 @@ impl PagePool {
     pub fn refresh(&mut self, key: TileKey) -> bool {
         let Some(r) = self.tiles.get(&key) else { return false };
         if r.pages.iter().any(Option::is_some) {
-            self.ops.push(PageOp { key, pages: r.pages });
+            self.ops.push(PageOp::tile(key, r.pages));
         }
         true
     }
@@ -170,7 +189,7 @@ impl PagePool {
         self.free.extend(given_back);
         let pages = self.take_tile_pages();
         self.tiles.insert(key, Resident { pages, last_used: frame, benefit });
-        self.ops.push(PageOp { key, pages });
+        self.ops.push(PageOp::tile(key, pages));
         Ok(Insert::Inserted { evicted })
     }
 
@@ -186,9 +205,7 @@ impl PagePool {
         let parent_key = key.parent().expect("the root is never evicted");
         let parent = self.tiles.get_mut(&parent_key).expect("a resident tile's parent is resident");
         parent.pages[key.quadrant()] = Some(first);
-        let mut pages = [None; 4];
-        pages[key.quadrant()] = Some(first);
-        self.ops.push(PageOp { key: parent_key, pages });
+        self.ops.push(PageOp { key, side: ASM_PAGE_TEXELS, pages: [Some(first), None, None, None] });
         self.free.extend(rest);
     }
 
@@ -206,7 +223,7 @@ impl PagePool {
             return Some(*k);
         }
         let least = current.into_iter().min_by(|a, b| a.1.benefit.total_cmp(&b.1.benefit).then(a.0.cmp(b.0)));
-        least.filter(|(_, r)| r.benefit < benefit).map(|(k, _)| *k)
+        least.filter(|(_, r)| EVICTION_MARGIN * r.benefit < benefit).map(|(k, _)| *k)
     }
 }
 
@@ -230,12 +247,13 @@ mod tests {
         let mut pool = PagePool::new(TILE_PAGES as u32, PAGE_BYTES).unwrap();
         assert_eq!((pool.capacity(), pool.max_tiles(), pool.bytes_in_use()), (4, 1, budget(4)));
         let root = pool.pages(TileKey::ROOT).unwrap();
-        assert_eq!(pool.take_ops(), vec![PageOp { key: TileKey::ROOT, pages: root }]);
+        assert_eq!(pool.take_ops(), vec![PageOp::tile(TileKey::ROOT, root)]);
         assert_eq!(pool.insert(child(TileKey::ROOT, 0), 1, 1.0).unwrap(), Insert::Refused);
     }
 
     /// A child takes four pages and its parent gives back the one under it; evicting the child
-    /// gives that quadrant back to the parent, whose render of it is queued after the child's.
+    /// gives that quadrant back to the parent, its render (the child's square at the parent's
+    /// resolution) queued after the child's.
     #[test]
     fn a_child_takes_three_pages_and_eviction_gives_its_quadrant_back() {
         let mut pool = PagePool::new(7, PAGE_BYTES).unwrap();
@@ -249,8 +267,10 @@ mod tests {
         let b = child(TileKey::ROOT, 1);
         assert_eq!(pool.insert(b, 2, 1.0).unwrap(), Insert::Inserted { evicted: 1 });
         let ops = pool.take_ops();
-        assert_eq!(ops[0], PageOp { key: a, pages: a_pages.map(Some) });
-        assert_eq!(ops[1], PageOp { key: TileKey::ROOT, pages: [None, None, Some(a_pages[0]), None] });
+        assert_eq!(ops[0], PageOp::tile(a, a_pages.map(Some)));
+        // a's square at the root's resolution: the root's quadrant over it.
+        let restored = PageOp { key: a, side: ASM_PAGE_TEXELS, pages: [Some(a_pages[0]), None, None, None] };
+        assert_eq!(ops[1], restored);
         assert_eq!(pool.pages(TileKey::ROOT).unwrap()[2], Some(a_pages[0]));
         assert_eq!(ops[2].key, b);
         assert_eq!(ops.len(), 3);
@@ -270,9 +290,10 @@ mod tests {
         assert_eq!(pool.insert(child(a, 1), 3, 1.0).unwrap(), Insert::Inserted { evicted: 1 });
         assert!(!pool.contains(b));
         // Now a has a resident child, so only that child is evictable; used this frame, it
-        // goes only for a larger benefit.
+        // goes only for a benefit EVICTION_MARGIN times as large.
         assert_eq!(pool.insert(b, 3, 0.5).unwrap(), Insert::Refused);
-        assert_eq!(pool.insert(b, 3, 2.0).unwrap(), Insert::Inserted { evicted: 1 });
+        assert_eq!(pool.insert(b, 3, EVICTION_MARGIN).unwrap(), Insert::Refused);
+        assert_eq!(pool.insert(b, 3, 1.01 * EVICTION_MARGIN).unwrap(), Insert::Inserted { evicted: 1 });
         assert!(pool.touch(a, 4) && !pool.touch(child(a, 1), 4));
         assert!(pool.contains(TileKey::ROOT), "the root is never evicted");
     }

@@ -347,8 +347,9 @@ impl Asm {
             }));
         }
         let pages = self.pool.pages(TileKey::ROOT).expect("the root is always resident");
+        let op = |key| PageOp { key, side: constants::ASM_TILE_TEXELS, pages };
         let renders: Vec<TileWrite> =
-            keys.iter().map(|&key| self.write(PageOp { key, pages }, &view_proj, &rects)).collect();
+            keys.iter().map(|&key| self.write(op(key), &view_proj, &rects)).collect();
         let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
         let mut samples = Vec::new();
         for round in 0..2 {
@@ -386,6 +387,7 @@ impl Asm {
     fn write(&self, op: PageOp, view_proj: &Mat4, rects: &[Vec<UvRect>]) -> TileWrite {
         TileWrite {
             key: op.key,
+            side: op.side,
             pages: op.pages,
             view_proj: tile_view_proj(view_proj, op.key),
             draws: tile_draws(&self.clusters, rects, op.key),
@@ -633,7 +635,8 @@ impl Technique for Asm {
             bytes_used: self.pool.bytes_in_use() + scratch_bytes(self.settings.test.page_bytes()),
             resident_tiles: self.table_keys.len(),
             deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
-            rendered: self.refresh.iter().chain(&self.render).map(|w| w.key).collect(),
+            // A quadrant given back is its parent's texels.
+            rendered: self.refresh.iter().chain(&self.render).map(|w| w.owner()).collect(),
             evicted: self.evicted,
             cost: (model.ms_per_triangle, model.ms_per_tile),
         };
