@@ -306,7 +306,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             stats.bytes_used as f64 / MB as f64,
             stats.budget_bytes as f64 / MB as f64,
             stats.deepest_level,
-            stats.rendered.len(),
+            stats.refreshed.len() + stats.rendered.len(),
             stats.cost.0,
             stats.cost.1
         );

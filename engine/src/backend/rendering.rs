@@ -126,19 +126,14 @@ impl Context {
         unsafe { self.dynamic_rendering.cmd_end_rendering(cmd) };
     }
 
-    /// Restricts the current rendering scope's viewport and scissor to its top-left
-    /// `side`² texels (begin_rendering covers the whole target).
-    pub fn restrict_to_square(&self, cmd: vk::CommandBuffer, side: u32) {
-        let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: side as f32,
-            height: side as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
+    /// Restricts the current rendering scope's viewport and scissor to the `side`² texels from
+    /// `origin` (begin_rendering covers the whole target).
+    pub fn restrict_to_square(&self, cmd: vk::CommandBuffer, origin: [u32; 2], side: u32) {
+        let (x, y) = (origin[0] as f32, origin[1] as f32);
+        let viewport =
+            vk::Viewport { x, y, width: side as f32, height: side as f32, min_depth: 0.0, max_depth: 1.0 };
         let scissor = vk::Rect2D {
-            offset: vk::Offset2D::default(),
+            offset: vk::Offset2D { x: origin[0] as i32, y: origin[1] as i32 },
             extent: vk::Extent2D { width: side, height: side },
         };
         // SAFETY: recording command buffer inside a rendering scope.

@@ -83,28 +83,44 @@ impl ShadowMaps {
         Pass::new("shadow_maps", &[], &["shadow_maps"], move |cmd| {
             for (layer, view_proj) in self.view_projs.iter().enumerate() {
                 let whole = scene.meshes.iter().map(|m| (m, 0, m.index_count));
-                self.record(ctx, cmd, scene, layer as u32, self.maps.width, view_proj, whole);
+                self.record(ctx, cmd, scene, layer as u32, view_proj, whole);
             }
         })
     }
 
-    /// Records one rendering scope that clears map `layer` and draws into its top-left `side`²
-    /// texels, with `view_proj` (world to the map's clip space), the runs of `scene`'s index
-    /// buffers `draws` names: (mesh, first index, index count).
-    #[allow(clippy::too_many_arguments)]
+    /// Records one rendering scope that clears map `layer` and draws into it, with `view_proj`
+    /// (world to the map's clip space), the runs of `scene`'s index buffers `draws` names:
+    /// (mesh, first index, index count).
     pub fn record<'m>(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
         layer: u32,
-        side: u32,
         view_proj: &Mat4,
         draws: impl IntoIterator<Item = (&'m GpuMesh, u32, u32)>,
     ) {
+        self.begin(ctx, cmd, layer);
+        self.draw(ctx, cmd, scene, view_proj, draws);
+        ctx.end_rendering(cmd);
+    }
+
+    /// Opens a rendering scope that clears map `layer`, with the depth pipeline bound, for
+    /// [`ShadowMaps::draw`]s (in parts of it: `Context::restrict_to_square`).
+    pub fn begin(&self, ctx: &Context, cmd: vk::CommandBuffer, layer: u32) {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear(self.target(layer))));
-        ctx.restrict_to_square(cmd, side);
         self.pipeline.bind(cmd, &[]);
+    }
+
+    /// Draws, inside [`ShadowMaps::begin`]'s scope, the runs `draws` names with `view_proj`.
+    pub fn draw<'m>(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        view_proj: &Mat4,
+        draws: impl IntoIterator<Item = (&'m GpuMesh, u32, u32)>,
+    ) {
         for (mesh, first, count) in draws {
             let push = ShadowDepthPush {
                 model: scene.transforms[mesh.group].to_cols_array_2d(),
@@ -113,6 +129,5 @@ impl ShadowMaps {
             self.pipeline.push(cmd, bytes_of(&push));
             ctx.draw_indexed_range(cmd, &[&mesh.vertices], &mesh.indices, first, count);
         }
-        ctx.end_rendering(cmd);
     }
 }

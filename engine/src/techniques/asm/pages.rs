@@ -1,9 +1,10 @@
 //! The GPU side of the page pool ([`super::pool`]): the atlas every page lives in, and the
 //! recording of the pool's page operations. Pages are a tile's quadrants and need not lie side
 //! by side in the atlas, so every page write goes through a scratch target of
-//! [`SCRATCH_TILES`] tiles: tiles render into it whole, one after the other, and their stored
-//! quadrants are copied out together (a CPU rasterizer waits at every barrier, so one copy and
-//! its barriers per tile cost more than the tile's render). The scratch counts in the budget.
+//! [`SCRATCH_TILES`] tiles side by side: tiles render into it whole, in one rendering scope,
+//! and their stored quadrants are copied out together (a CPU rasterizer waits at every barrier
+//! and pays for every scope, so a copy and a scope per tile cost more than the tile's
+//! triangles). The scratch counts in the budget.
 //!
 //! The polygon-ID test keeps a second atlas and scratch, of IDs, laid out as the depth ones.
 use super::pool::{TilePages, TILE_PAGES};
@@ -27,6 +28,8 @@ const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
 const MAX_COLUMNS: u32 = 16384 / ASM_PAGE_TEXELS;
 /// Tiles the scratch holds: renders between two copies into the atlas.
 pub const SCRATCH_TILES: u32 = 4;
+/// Texels a side of the scratch: its tiles 2 × 2.
+const SCRATCH_SIDE: u32 = 2 * ASM_TILE_TEXELS;
 
 /// Bytes of the scratch for pages of `page_bytes`.
 pub fn scratch_bytes(page_bytes: u64) -> u64 {
@@ -150,7 +153,7 @@ impl PageStore {
         Ok(PageStore {
             layout,
             atlas: depth_atlas,
-            scratch: ShadowMaps::new(ctx, "asm.scratch", ASM_TILE_TEXELS, SCRATCH_TILES)?,
+            scratch: ShadowMaps::new(ctx, "asm.scratch", SCRATCH_SIDE, 1)?,
             ids,
             nearest: Sampler::new(ctx, "asm.pages_sampler", false, Edge::Clamp, Edge::Clamp)?,
         })
@@ -183,41 +186,42 @@ impl PageStore {
     /// Records `writes` in order, one debug label each.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, writes: &[TileWrite]) {
         let half = ASM_PAGE_TEXELS;
-        // Squares of the scratch waiting to be stored, with their pages.
-        let mut pending: Vec<(SquareCopy, u32)> = Vec::new();
-        for (i, write) in writes.iter().enumerate() {
-            let layer = i as u32 % SCRATCH_TILES;
-            if layer == 0 {
-                self.store(cmd, &mut pending);
+        for batch in writes.chunks(SCRATCH_TILES as usize) {
+            self.begin_batch(ctx, cmd);
+            // Squares of the scratch to store, with their pages.
+            let mut squares: Vec<(SquareCopy, u32)> = Vec::new();
+            for (i, write) in batch.iter().enumerate() {
+                let key = write.key;
+                ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
+                let at = [i as u32 % 2 * ASM_TILE_TEXELS, i as u32 / 2 * ASM_TILE_TEXELS];
+                ctx.restrict_to_square(cmd, at, write.side);
+                self.draw_tile(ctx, cmd, scene, write);
+                for (q, page) in write.pages.iter().enumerate().filter_map(|(q, p)| p.map(|p| (q as u32, p)))
+                {
+                    let from = [at[0] + q % 2 * half, at[1] + q / 2 * half];
+                    squares.push((SquareCopy { layer: 0, from, to: [0, 0] }, page));
+                }
+                ctx.end_label(cmd);
             }
-            let key = write.key;
-            ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
-            self.render_tile(ctx, cmd, scene, layer, write);
-            for (q, page) in write.pages.iter().enumerate().filter_map(|(q, p)| p.map(|p| (q as u32, p))) {
-                pending.push((SquareCopy { layer, from: [q % 2 * half, q / 2 * half], to: [0, 0] }, page));
-            }
-            ctx.end_label(cmd);
+            ctx.end_rendering(cmd);
+            self.store(cmd, squares);
         }
-        self.store(cmd, &mut pending);
     }
 
-    /// A tile into scratch tile `layer`: depth, and IDs for the ID test.
-    fn render_tile(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        scene: &GpuScene,
-        layer: u32,
-        write: &TileWrite,
-    ) {
+    /// Opens the rendering scope of a batch: the scratch cleared, depth and IDs for the ID test.
+    fn begin_batch(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        let Some(ids) = &self.ids else { return self.scratch.begin(ctx, cmd, 0) };
+        let color = Target { image: &ids.scratch, layer: 0 };
+        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(0))));
+        ids.tile.bind(cmd, &[]);
+    }
+
+    /// A tile's draws into the part of the scratch the scope is restricted to.
+    fn draw_tile(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, write: &TileWrite) {
         let draws = write.draws.iter().map(|&(m, first, count)| (&scene.meshes[m], first, count));
         let Some(ids) = &self.ids else {
-            return self.scratch.record(ctx, cmd, scene, layer, write.side, &write.view_proj, draws);
+            return self.scratch.draw(ctx, cmd, scene, &write.view_proj, draws);
         };
-        let color = Target { image: &ids.scratch, layer };
-        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(layer))));
-        ctx.restrict_to_square(cmd, write.side);
-        ids.tile.bind(cmd, &[]);
         for (mesh, first, count) in draws {
             // gl_PrimitiveID counts from the run's first triangle.
             let push = AsmTilePush {
@@ -227,17 +231,15 @@ impl PageStore {
             ids.tile.push(cmd, bytes_of(&push));
             ctx.draw_indexed_range(cmd, &[&mesh.vertices], &mesh.indices, first, count);
         }
-        ctx.end_rendering(cmd);
     }
 
-    /// Copies the pending squares of the scratch (each with the page it goes to) into the
-    /// atlases and empties the list. A page written twice keeps the later square: a tile's
-    /// quadrant given back to a child rendered after it in the same batch, or an evicted tile's
-    /// page taken by another.
-    fn store(&self, cmd: vk::CommandBuffer, pending: &mut Vec<(SquareCopy, u32)>) {
+    /// Copies squares of the scratch (each with the page it goes to) into the atlases. A page
+    /// written twice keeps the later square: a tile's quadrant given back to a child rendered
+    /// after it in the same batch, or an evicted tile's page taken by another.
+    fn store(&self, cmd: vk::CommandBuffer, pending: Vec<(SquareCopy, u32)>) {
         let mut seen = std::collections::HashSet::new();
         let mut squares: Vec<SquareCopy> = pending
-            .drain(..)
+            .into_iter()
             .rev()
             .filter(|(_, page)| seen.insert(*page))
             .map(|(square, page)| SquareCopy { to: self.layout.origin(page), ..square })
@@ -256,8 +258,7 @@ impl PageStore {
 impl IdPages {
     fn new(ctx: &Arc<Context>, gpu: &GpuScene, atlas: Image) -> Result<IdPages> {
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-        let desc =
-            ImageDesc::square_array("asm.id_scratch", ASM_TILE_TEXELS, SCRATCH_TILES, ID_FORMAT, usage);
+        let desc = ImageDesc::square_array("asm.id_scratch", SCRATCH_SIDE, 1, ID_FORMAT, usage);
         let tile = GraphicsPipeline::new(
             ctx,
             &GraphicsDesc {

@@ -132,8 +132,10 @@ pub struct AsmStats {
     pub resident_tiles: usize,
     /// The finest resident level (0: the root alone).
     pub deepest_level: u32,
-    /// Tiles rendered this frame, in render order (a tile refreshed, refined, or given a
-    /// quadrant back by an eviction).
+    /// Tiles rendered again this frame because a moving group touched them, in render order.
+    pub refreshed: Vec<TileKey>,
+    /// Tiles rendered this frame for the refinement, in render order (a tile refined, or given
+    /// a quadrant back by an eviction).
     pub rendered: Vec<TileKey>,
     /// Tiles evicted this frame.
     pub evicted: usize,
@@ -635,8 +637,9 @@ impl Technique for Asm {
             bytes_used: self.pool.bytes_in_use() + scratch_bytes(self.settings.test.page_bytes()),
             resident_tiles: self.table_keys.len(),
             deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
+            refreshed: self.refresh.iter().map(|w| w.key).collect(),
             // A quadrant given back is its parent's texels.
-            rendered: self.refresh.iter().chain(&self.render).map(|w| w.owner()).collect(),
+            rendered: self.render.iter().map(|w| w.owner()).collect(),
             evicted: self.evicted,
             cost: (model.ms_per_triangle, model.ms_per_tile),
         };
