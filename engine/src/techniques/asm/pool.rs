@@ -9,8 +9,9 @@
 //! Evicting a leaf gives its parent the quadrant back, which a render of the leaf's square at
 //! the parent's resolution fills again (exactly: a rebuild from the leaf's finer texels would
 //! shift the coarse samples off their centres; the parent's texels there sample the same
-//! points, and the render draws only what lies over the leaf's square). The renders this takes are queued as [`PageOp`]s, in order: a page one
-//! frees may be written by a later one; the technique records them before the lookups.
+//! points, and the render draws only what lies over the leaf's square). The renders this takes
+//! are queued as [`PageOp`]s, in order: a page one frees may be written by a later one; the
+//! technique records them before the lookups.
 //!
 //! Eviction follows the paper: among the evictable tiles (resident leaves other than the root:
 //! evicting a tile with resident children would cut them off from the lookup's descent) the

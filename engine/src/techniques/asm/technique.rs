@@ -11,9 +11,9 @@
 //! 2. the host marks the used tiles, counts the edge pixels for the chain of finer tiles each
 //!    asks for, and plans within the time budget (`plan`); then the frame: `asm_tiles` renders
 //!    the planned tiles, each depth-only with the light's projection cropped to its square, into
-//!    the pool's pages (and rebuilds the quadrants evictions give back; `pages`, one debug label
-//!    each), and `scene` shades with each point's visibility looked up in the finest resident
-//!    tile holding it (the page table's directory and descent).
+//!    the pool's pages (and the quadrants evictions give back, at the parents' resolution;
+//!    `pages`, one debug label each), and `scene` shades with each point's visibility looked up
+//!    in the finest resident tile holding it (the page table's directory and descent).
 //!
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
 //! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
