@@ -58,7 +58,7 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     float a = 1.0 / mx.z - iw;
     float b = 1.0 / my.z - iw;
     vec2 slope = vec2(a * uy.y - b * ux.y, ux.x * b - uy.x * a) / det;
-    ivec2 texel = asm_atlas_texel(page, ivec2(asm_texel_coords(page.tile, m.xy))) - page.atlas + page.quadrant;
+    ivec2 texel = asm_quadrant_texel(page, ivec2(asm_texel_coords(page.tile, m.xy)));
     float scale = float(1u << page.tile.x);
     vec2 centre = (vec2(page.tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale;
     float inv = iw + dot(slope, centre - m.xy);

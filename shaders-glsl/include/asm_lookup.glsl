@@ -62,10 +62,15 @@ AsmPage asm_page(uint node, vec2 uv) {
     return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_nodes[node].pages[2 * q.y + q.x]));
 }
 
-// The atlas texel of tile texel `texel`, kept in the page's quadrant (the texels beyond it are
-// in other pages, or in none where a child covers them).
+// Tile texel `texel` kept in the page's quadrant (the texels beyond it are in other pages, or in
+// none where a child covers them).
+ivec2 asm_quadrant_texel(AsmPage page, ivec2 texel) {
+    return clamp(texel, page.quadrant, page.quadrant + KAGE_ASM_PAGE_TEXELS - 1);
+}
+
+// The atlas texel of tile texel `texel`, kept in the page's quadrant.
 ivec2 asm_atlas_texel(AsmPage page, ivec2 texel) {
-    return page.atlas + clamp(texel - page.quadrant, ivec2(0), ivec2(KAGE_ASM_PAGE_TEXELS - 1));
+    return page.atlas + asm_quadrant_texel(page, texel) - page.quadrant;
 }
 
 // The stored depth of tile texel `texel` (kept in the page's quadrant).

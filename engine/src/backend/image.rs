@@ -281,30 +281,31 @@ impl Image {
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
 
-    /// Records copies of `size`² squares into layer 0 of `dst` (the same format), ordered after
-    /// all earlier commands on either image and before all later ones (the copies step into the
-    /// transfer layouts and back). Destination squares must not overlap.
+    /// Records copies of `size`² squares of layer 0 into layer 0 of `dst` (the same format),
+    /// each from its first texel here to its first texel there, ordered after all earlier
+    /// commands on either image and before all later ones (the copies step into the transfer
+    /// layouts and back). Destination squares must not overlap.
     pub fn record_copy_squares(
         &self,
         cmd: vk::CommandBuffer,
         dst: &Image,
-        squares: &[SquareCopy],
+        squares: &[([u32; 2], [u32; 2])],
         size: u32,
     ) {
-        let layer = |base_array_layer| vk::ImageSubresourceLayers {
+        let layer = vk::ImageSubresourceLayers {
             aspect_mask: aspect_of(self.format),
             mip_level: 0,
-            base_array_layer,
+            base_array_layer: 0,
             layer_count: 1,
         };
         let offset = |[x, y]: [u32; 2]| vk::Offset3D { x: x as i32, y: y as i32, z: 0 };
         let regions: Vec<vk::ImageCopy> = squares
             .iter()
-            .map(|c| vk::ImageCopy {
-                src_subresource: layer(c.layer),
-                src_offset: offset(c.from),
-                dst_subresource: layer(0),
-                dst_offset: offset(c.to),
+            .map(|&(from, to)| vk::ImageCopy {
+                src_subresource: layer,
+                src_offset: offset(from),
+                dst_subresource: layer,
+                dst_offset: offset(to),
                 extent: vk::Extent3D { width: size, height: size, depth: 1 },
             })
             .collect();
@@ -372,14 +373,6 @@ impl Image {
         self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| self.record_copy_to(cmd, &staging))?;
         staging.read()
     }
-}
-
-/// A square of [`Image::record_copy_squares`]: from layer `layer` at texel `from` to texel `to`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SquareCopy {
-    pub layer: u32,
-    pub from: [u32; 2],
-    pub to: [u32; 2],
 }
 
 /// Records `barriers`, each ordered after all earlier commands and before all later ones.

@@ -18,7 +18,7 @@ pub use commands::CommandRecorder;
 pub use context::{Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
 pub use device::{FRAGMENT_STORES, GEOMETRY_SHADER};
-pub use image::{Edge, Image, ImageDesc, Sampler, SquareCopy};
+pub use image::{Edge, Image, ImageDesc, Sampler};
 pub use pipeline::{
     ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
 };

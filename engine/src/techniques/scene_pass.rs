@@ -7,7 +7,8 @@
 //! EQUAL: their lighting looks up a shadow map per fragment, and with the scene drawn in any
 //! order a fragment hidden later would pay for it too (the `asm` scene's overdraw made its
 //! ASM lighting pass 2x as long on lavapipe; BENCHMARKS.md).
-use super::unshadowed::{MESH_POSITIONS, MESH_VERTICES};
+use super::shadow_depth::depth_only_pipeline;
+use super::unshadowed::MESH_VERTICES;
 use super::FrameInputs;
 use crate::backend::{
     vk, Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
@@ -42,23 +43,7 @@ pub fn scene_pipeline(
 /// and push constants of `push_size` bytes: depth_prepass.vert, which computes the same
 /// `gl_Position` (so the scene pass' EQUAL test meets the same depths), no colour.
 pub fn depth_prepass_pipeline(ctx: &Arc<Context>, name: &str, push_size: usize) -> Result<GraphicsPipeline> {
-    GraphicsPipeline::new(
-        ctx,
-        &GraphicsDesc {
-            name,
-            vertex_spirv: spirv::DEPTH_PREPASS_VERT,
-            fragment_spirv: spirv::SHADOW_DEPTH_FRAG,
-            bindings: &[BindingKind::UniformBuffer],
-            push_size: push_size as u32,
-            vertex_buffers: &[MESH_POSITIONS],
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            color_formats: &[],
-            depth_format: Some(DEPTH_FORMAT),
-            depth: DepthTest::Less,
-            additive: false,
-            constants: &[],
-        },
-    )
+    depth_only_pipeline(ctx, name, spirv::DEPTH_PREPASS_VERT, &[BindingKind::UniformBuffer], push_size)
 }
 
 /// The `depth_prepass` pass: every mesh's depth into the depth target, with the push constants

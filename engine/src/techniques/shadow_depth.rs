@@ -5,8 +5,8 @@
 //! shadow maps (its page pool: one tile per layer).
 use super::unshadowed::MESH_POSITIONS;
 use crate::backend::{
-    vk, Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
-    Target,
+    vk, Binding, BindingKind, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image,
+    ImageDesc, Sampler, Target,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
@@ -24,25 +24,43 @@ pub struct ShadowMaps {
     pub view_projs: Vec<Mat4>,
 }
 
+/// A depth-only pipeline drawing mesh positions with `vertex_spirv` (its resources `bindings`,
+/// push constants of `push_size` bytes) and a fragment stage that writes nothing.
+pub fn depth_only_pipeline(
+    ctx: &Arc<Context>,
+    name: &str,
+    vertex_spirv: &[u8],
+    bindings: &[BindingKind],
+    push_size: usize,
+) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        ctx,
+        &GraphicsDesc {
+            name,
+            vertex_spirv,
+            fragment_spirv: spirv::SHADOW_DEPTH_FRAG,
+            bindings,
+            push_size: push_size as u32,
+            vertex_buffers: &[MESH_POSITIONS],
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[],
+            depth_format: Some(DEPTH_FORMAT),
+            depth: DepthTest::Less,
+            additive: false,
+            constants: &[],
+        },
+    )
+}
+
 impl ShadowMaps {
     /// `layers` maps of `size`² texels; `name` prefixes the debug names of its objects.
     pub fn new(ctx: &Arc<Context>, name: &str, size: u32, layers: u32) -> Result<ShadowMaps> {
-        let pipeline = GraphicsPipeline::new(
+        let pipeline = depth_only_pipeline(
             ctx,
-            &GraphicsDesc {
-                name: &format!("{name}.depth"),
-                vertex_spirv: spirv::SHADOW_DEPTH_VERT,
-                fragment_spirv: spirv::SHADOW_DEPTH_FRAG,
-                bindings: &[],
-                push_size: size_of::<ShadowDepthPush>() as u32,
-                vertex_buffers: &[MESH_POSITIONS],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[],
-                depth_format: Some(DEPTH_FORMAT),
-                depth: DepthTest::Less,
-                additive: false,
-                constants: &[],
-            },
+            &format!("{name}.depth"),
+            spirv::SHADOW_DEPTH_VERT,
+            &[],
+            size_of::<ShadowDepthPush>(),
         )?;
         // TRANSFER_SRC: the ASM's scratch tile is copied into its pages.
         let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT

@@ -11,7 +11,7 @@ use super::pool::{TilePages, TILE_PAGES};
 use super::tile::TileKey;
 use crate::backend::{
     vk, Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
-    SquareCopy, Target,
+    Target,
 };
 use crate::error::{Error, Result};
 use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
@@ -188,8 +188,8 @@ impl PageStore {
         let half = ASM_PAGE_TEXELS;
         for batch in writes.chunks(SCRATCH_TILES as usize) {
             self.begin_batch(ctx, cmd);
-            // Squares of the scratch to store, with their pages.
-            let mut squares: Vec<(SquareCopy, u32)> = Vec::new();
+            // Squares of the scratch to store (their first texel), with their pages.
+            let mut squares: Vec<([u32; 2], u32)> = Vec::new();
             for (i, write) in batch.iter().enumerate() {
                 let key = write.key;
                 ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
@@ -199,7 +199,7 @@ impl PageStore {
                 for (q, page) in write.pages.iter().enumerate().filter_map(|(q, p)| p.map(|p| (q as u32, p)))
                 {
                     let from = [at[0] + q % 2 * half, at[1] + q / 2 * half];
-                    squares.push((SquareCopy { layer: 0, from, to: [0, 0] }, page));
+                    squares.push((from, page));
                 }
                 ctx.end_label(cmd);
             }
@@ -236,13 +236,13 @@ impl PageStore {
     /// Copies squares of the scratch (each with the page it goes to) into the atlases. A page
     /// written twice keeps the later square: a tile's quadrant given back to a child rendered
     /// after it in the same batch, or an evicted tile's page taken by another.
-    fn store(&self, cmd: vk::CommandBuffer, pending: Vec<(SquareCopy, u32)>) {
+    fn store(&self, cmd: vk::CommandBuffer, pending: Vec<([u32; 2], u32)>) {
         let mut seen = std::collections::HashSet::new();
-        let mut squares: Vec<SquareCopy> = pending
+        let mut squares: Vec<([u32; 2], [u32; 2])> = pending
             .into_iter()
             .rev()
             .filter(|(_, page)| seen.insert(*page))
-            .map(|(square, page)| SquareCopy { to: self.layout.origin(page), ..square })
+            .map(|(from, page)| (from, self.layout.origin(page)))
             .collect();
         if squares.is_empty() {
             return;

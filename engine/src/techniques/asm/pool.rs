@@ -61,7 +61,7 @@ pub struct PageOp {
 
 impl PageOp {
     /// The render of a tile's quadrants `pages`.
-    fn tile(key: TileKey, pages: TilePages) -> PageOp {
+    pub fn tile(key: TileKey, pages: TilePages) -> PageOp {
         PageOp { key, side: ASM_TILE_TEXELS, pages }
     }
 }

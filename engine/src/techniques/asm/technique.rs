@@ -349,9 +349,10 @@ impl Asm {
             }));
         }
         let pages = self.pool.pages(TileKey::ROOT).expect("the root is always resident");
-        let op = |key| PageOp { key, side: constants::ASM_TILE_TEXELS, pages };
-        let renders: Vec<TileWrite> =
-            keys.iter().map(|&key| self.write(op(key), &view_proj, &rects)).collect();
+        let renders: Vec<TileWrite> = keys
+            .iter()
+            .map(|&key| tile_write(PageOp::tile(key, pages), &view_proj, &self.clusters, &rects))
+            .collect();
         let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
         let mut samples = Vec::new();
         for round in 0..2 {
@@ -384,22 +385,15 @@ impl Asm {
         self.clusters.iter().map(|(g, clusters)| clusters.iter().map(|c| rect(*g, c)).collect()).collect()
     }
 
-    /// A queued render as the GPU records it: the tile's cropped projection and the clusters
-    /// (bounds `rects`) it draws.
-    fn write(&self, op: PageOp, view_proj: &Mat4, rects: &[Vec<UvRect>]) -> TileWrite {
-        TileWrite {
-            key: op.key,
-            side: op.side,
-            pages: op.pages,
-            view_proj: tile_view_proj(view_proj, op.key),
-            draws: tile_draws(&self.clusters, rects, op.key),
-        }
-    }
-
     /// Queued renders as this frame records them.
     fn writes(&self, ops: Vec<PageOp>) -> Vec<TileWrite> {
-        let view_proj = Mat4::from_cols_array_2d(&self.record.expect("update sets the record").view_proj);
-        ops.into_iter().map(|op| self.write(op, &view_proj, &self.cluster_rects)).collect()
+        let view_proj = self.view_proj();
+        ops.into_iter().map(|op| tile_write(op, &view_proj, &self.clusters, &self.cluster_rects)).collect()
+    }
+
+    /// World to the light map's clip space this frame.
+    fn view_proj(&self) -> Mat4 {
+        Mat4::from_cols_array_2d(&self.record.expect("update sets the record").view_proj)
     }
 
     /// Marks the tiles the last frame's lighting and this frame's analysis looked up as used
@@ -495,6 +489,23 @@ fn tile_draws(
         }
     }
     draws
+}
+
+/// A queued render as the GPU records it: the tile's cropped projection (of the light's
+/// `view_proj`) and the clusters (bounds `rects`) it draws.
+fn tile_write(
+    op: PageOp,
+    view_proj: &Mat4,
+    clusters: &[(usize, Vec<Cluster>)],
+    rects: &[Vec<UvRect>],
+) -> TileWrite {
+    TileWrite {
+        key: op.key,
+        side: op.side,
+        pages: op.pages,
+        view_proj: tile_view_proj(view_proj, op.key),
+        draws: tile_draws(clusters, rects, op.key),
+    }
 }
 
 /// Triangles of index runs.
@@ -605,7 +616,7 @@ impl Technique for Asm {
     fn analysed(&mut self) -> Result<()> {
         let requests = self.read_requests()?;
         let model = self.cost.scaled(self.cost_scale);
-        let (frame, time_ms) = (self.frame, self.settings.time_ms);
+        let (frame, time_ms, view_proj) = (self.frame, self.settings.time_ms, self.view_proj());
         let resident: std::collections::HashSet<TileKey> = self.pool.resident().map(|(k, _)| k).collect();
         self.evicted = 0;
         let mut planned = Vec::new();
@@ -621,14 +632,15 @@ impl Technique for Asm {
                     return None;
                 };
                 self.evicted += evicted;
-                let ops = self.pool.take_ops();
-                let draws =
-                    |op: &PageOp| draw_triangles(&tile_draws(&self.clusters, &self.cluster_rects, op.key));
-                planned.extend(ops.iter().copied());
-                Some(ops.iter().map(|op| model.cost_ms(draws(op))).sum())
+                let (clusters, rects) = (&self.clusters, &self.cluster_rects);
+                let writes =
+                    self.pool.take_ops().into_iter().map(|op| tile_write(op, &view_proj, clusters, rects));
+                let before = planned.len();
+                planned.extend(writes);
+                Some(planned[before..].iter().map(|w| model.cost_ms(draw_triangles(&w.draws))).sum())
             },
         );
-        self.render = self.writes(planned);
+        self.render = planned;
         self.planned_ms = self.render.iter().map(|w| self.cost.cost_ms(draw_triangles(&w.draws))).sum();
         self.write_table()?;
         self.lit_keys.clone_from(&self.table_keys);
