@@ -57,6 +57,12 @@ pub struct ProbeCountArgs {
     /// Random normals per test position.
     #[arg(long, default_value_t = 6)]
     normals: usize,
+    /// Where the test points are: `path`, in the moving group's box along its motion (grids
+    /// and placement over the static box and over the path); `box`, anywhere in the static
+    /// groups' box outside solids (grids and placement over the box only: the paper's
+    /// setting, a grid over the whole scene against probes kept where the light needs them).
+    #[arg(long, value_enum, default_value_t = TestRegion::Path)]
+    test_region: TestRegion,
     /// Reference samples per point.
     #[arg(long, default_value_t = 8192)]
     spp: u32,
@@ -132,6 +138,7 @@ pub struct Measurement {
 }
 
 pub struct Params<'a> {
+    pub test_region: TestRegion,
     pub grids: &'a [u32],
     pub tolerances: &'a [f32],
     pub points: usize,
@@ -144,6 +151,7 @@ pub struct Params<'a> {
 pub fn run(args: &ProbeCountArgs) -> Result<()> {
     let ctx = args.gpu.context()?;
     let params = Params {
+        test_region: args.test_region,
         grids: &args.grids,
         tolerances: &args.tolerances,
         points: args.points,
@@ -157,8 +165,8 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         cache: Some(&args.cache),
     };
     println!(
-        "probe count against error: {} test positions x {} normals (in the moving group's box along its path), reference {} spp, cube faces {}², capture {:?}, {}",
-        args.points, args.normals, args.spp, args.cube_size, params.capture.light, ctx.info().name
+        "probe count against error: {} test positions x {} normals ({}), reference {} spp, cube faces {}², capture {:?}, {}",
+        args.points, args.normals, args.test_region.describe(), args.spp, args.cube_size, params.capture.light, ctx.info().name
     );
     for name in &args.scenes {
         let scene = Scene::from_arg(name)?;
@@ -183,13 +191,21 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         // paper's comparison: a grid over the whole box against probes where objects move.
         // Then what the fit adds: placement with captured values against the grid, and the
         // fitted grid against fitted placement.
-        for (grid, tetra, region, tetra_region) in [
-            (TRILINEAR, AUTO, Region::Box, Region::Box),
-            (TRILINEAR, AUTO, Region::Path, Region::Path),
-            (TRILINEAR, AUTO, Region::Box, Region::Path),
-            (TRILINEAR, AUTO_CAPTURED, Region::Path, Region::Path),
-            (GRID_FITTED, AUTO, Region::Path, Region::Path),
-        ] {
+        let comparisons: &[_] = match args.test_region {
+            TestRegion::Path => &[
+                (TRILINEAR, AUTO, Region::Box, Region::Box),
+                (TRILINEAR, AUTO, Region::Path, Region::Path),
+                (TRILINEAR, AUTO, Region::Box, Region::Path),
+                (TRILINEAR, AUTO_CAPTURED, Region::Path, Region::Path),
+                (GRID_FITTED, AUTO, Region::Path, Region::Path),
+            ],
+            TestRegion::Box => &[
+                (TRILINEAR, AUTO, Region::Box, Region::Box),
+                (TRILINEAR, AUTO_CAPTURED, Region::Box, Region::Box),
+                (GRID_FITTED, AUTO, Region::Box, Region::Box),
+            ],
+        };
+        for &(grid, tetra, region, tetra_region) in comparisons {
             compare(&m.rows, &method(grid, region), &method(tetra, tetra_region), args.target);
         }
     }
@@ -243,6 +259,33 @@ pub enum Region {
     Path,
 }
 
+/// Where the test points are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TestRegion {
+    /// In the moving group's box at random times of its motion: where probe lighting is used.
+    Path,
+    /// Anywhere in the static groups' box: where any moving object could go.
+    Box,
+}
+
+impl TestRegion {
+    fn describe(self) -> &'static str {
+        match self {
+            TestRegion::Path => "in the moving group's box along its path",
+            TestRegion::Box => "anywhere in the static groups' box",
+        }
+    }
+
+    /// The probe regions measured against these test points: probes confined to the path
+    /// would extrapolate over the rest of the box.
+    fn probe_regions(self) -> &'static [Region] {
+        match self {
+            TestRegion::Path => &[Region::Box, Region::Path],
+            TestRegion::Box => &[Region::Box],
+        }
+    }
+}
+
 /// A method's name in `region`.
 pub fn method(name: &str, region: Region) -> String {
     format!("{name} ({})", if region == Region::Box { "box" } else { "path" })
@@ -280,7 +323,9 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         bail!("--points and --normals must be at least 1");
     }
     let solids = Solids::of_static(scene);
-    let points = test_points(scene, &solids, params.points, params.normals)?;
+    let unit = grid_lattice(scene, [1; 3])?;
+    let static_box = ((unit.first - 0.5 * unit.step).as_vec3(), (unit.first + 0.5 * unit.step).as_vec3());
+    let points = test_points(scene, &solids, params, static_box)?;
     let (truth, noise, reference_seconds) = reference(ctx, scene, &points, params)?;
 
     // The probes leave the moving group out of their captures; it stays where it is.
@@ -296,8 +341,6 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         Ok((sum / (3 * truth.len()) as f64).sqrt() / rms_truth)
     };
 
-    let unit = grid_lattice(scene, [1; 3])?;
-    let static_box = ((unit.first - 0.5 * unit.step).as_vec3(), (unit.first + 0.5 * unit.step).as_vec3());
     let path = path_bounds(&scene.groups[MOVING_GROUP], static_box)
         .filter(|(lo, hi)| (*hi - *lo).min_element() > 0.0)
         .context("the moving group's path has no volume inside the static box")?;
@@ -305,7 +348,8 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
     let mut rows = Vec::new();
     let mut captured = 0usize;
     let start = Instant::now();
-    for (region, (lo, hi)) in [(Region::Box, static_box), (Region::Path, path)] {
+    for &region in params.test_region.probe_regions() {
+        let (lo, hi) = if region == Region::Box { static_box } else { path };
         // Each level's trilinear set with the counts and captures it was built from.
         let mut levels = Vec::new();
         for &level in params.grids {
@@ -377,9 +421,16 @@ fn squared_error(sh: &ShRgb9, point: &Point, exact: &[f64; 3]) -> f64 {
     (0..3).map(|k| (f64::from(e[k].max(0.0)) - exact[k]).powi(2)).sum()
 }
 
-/// `normals` points per position: random positions in the moving group's bounding box at
-/// random times of its motion, outside solids, each with random normals.
-fn test_points(scene: &Scene, solids: &Solids, positions: usize, normals: usize) -> Result<Vec<Point>> {
+/// `normals` points per position, each with random normals: random positions outside solids,
+/// in the moving group's bounding box at random times of its motion (`TestRegion::Path`) or in
+/// the static box (`TestRegion::Box`).
+fn test_points(
+    scene: &Scene,
+    solids: &Solids,
+    params: &Params,
+    static_box: (Vec3, Vec3),
+) -> Result<Vec<Point>> {
+    let (positions, normals) = (params.points, params.normals);
     let Some(group) = scene.groups.get(MOVING_GROUP) else {
         bail!("scene {} has no moving group (group {MOVING_GROUP}) to take a path from", scene.name)
     };
@@ -396,8 +447,12 @@ fn test_points(scene: &Scene, solids: &Solids, positions: usize, normals: usize)
             break;
         }
         let t = rng.next();
+        let (lo, hi) = if params.test_region == TestRegion::Path { (lo, hi) } else { static_box };
         let local = lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next());
-        let p = animation::pose(group, t).matrix().transform_point3(local);
+        let p = match params.test_region {
+            TestRegion::Path => animation::pose(group, t).matrix().transform_point3(local),
+            TestRegion::Box => local,
+        };
         if solids.contains(p) {
             continue;
         }
@@ -407,8 +462,9 @@ fn test_points(scene: &Scene, solids: &Solids, positions: usize, normals: usize)
     }
     if points.len() < positions * normals {
         bail!(
-            "only {} of {positions} test positions along the moving group's path are outside solids",
-            points.len() / normals
+            "only {} of {positions} test positions {} are outside solids",
+            points.len() / normals,
+            params.test_region.describe()
         );
     }
     Ok(points)
@@ -429,8 +485,10 @@ fn reference(
     points: &[Point],
     params: &Params,
 ) -> Result<(Vec<[f64; 3]>, f64, f64)> {
-    let path =
-        params.cache.map(|dir| dir.join(format!("{}-{}-{}spp.json", scene.name, points.len(), params.spp)));
+    let path = params.cache.map(|dir| {
+        let region = format!("{:?}", params.test_region).to_lowercase();
+        dir.join(format!("{}-{region}-{}-{}spp.json", scene.name, points.len(), params.spp))
+    });
     let cached = path.as_ref().and_then(|p| std::fs::read_to_string(p).ok()).and_then(|text| {
         serde_json::from_str::<Cached>(&text).ok().filter(|c| c.scene == scene.name && c.points == points)
     });
@@ -477,10 +535,37 @@ mod tests {
     use kage_tests::Validated;
 
     #[test]
+    fn box_test_points_spread_over_the_static_box() {
+        let scene = Scene::builtin("atrium").unwrap();
+        let solids = Solids::of_static(&scene);
+        let params = Params {
+            test_region: TestRegion::Box,
+            grids: &[2],
+            tolerances: &[],
+            points: 64,
+            normals: 2,
+            spp: 1,
+            capture: CaptureSettings::default(),
+            cache: None,
+        };
+        let static_box = (Vec3::new(-1.0, 0.0, -2.0), Vec3::new(5.0, 3.0, 2.0));
+        let points = test_points(&scene, &solids, &params, static_box).unwrap();
+        assert_eq!(points.len(), 128);
+        let positions: Vec<Vec3> = points.iter().map(|p| Vec3::from(p.position)).collect();
+        assert!(positions.iter().all(|&p| p.cmpge(static_box.0).all() && p.cmple(static_box.1).all()));
+        assert!(positions.iter().all(|&p| !solids.contains(p)));
+        // Each position carries its normals; the positions themselves reach both ends of x.
+        assert!(positions.chunks(2).all(|c| c[0] == c[1]));
+        let (lo, hi) = kage::techniques::probes::bounds(positions.iter().copied()).unwrap();
+        assert!(lo.x < 0.0 && hi.x > 4.0, "{lo} {hi}");
+    }
+
+    #[test]
     fn the_measurement_runs_at_a_tiny_size() {
         let ctx = Validated::new();
         let scene = Scene::builtin("probe-room").unwrap();
         let params = Params {
+            test_region: TestRegion::Path,
             grids: &[2, 4],
             tolerances: &[0.2],
             points: 4,

@@ -26,8 +26,13 @@ impl Camera {
     /// View to Vulkan clip space: depth 0 at [`NEAR`] to 1 at [`FAR`], and Y negated because
     /// Vulkan's framebuffer Y points down; so +Y in the world is up in the image (row 0 = top).
     pub fn projection(&self, aspect: f32) -> Mat4 {
+        self.projection_from(aspect, NEAR)
+    }
+
+    /// [`Camera::projection`] with the near plane at `near` instead of [`NEAR`].
+    pub fn projection_from(&self, aspect: f32, near: f32) -> Mat4 {
         let flip_y = Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0));
-        flip_y * Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, NEAR, FAR)
+        flip_y * Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, near, FAR)
     }
 
     /// A checked camera from plain arrays, as scene files and the C ABI give it.

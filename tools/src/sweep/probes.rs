@@ -6,7 +6,7 @@
 //! here (SH storage and captures; the per-frame lookup is one walk per object whatever the
 //! count), so the chart's x axis counts probes and `--pick` takes `--max-probes`.
 use super::{write_outputs, SweepArgs, Terms};
-use crate::bench_probe_count::{measure, Params, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
+use crate::bench_probe_count::{measure, Params, TestRegion, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
 use crate::render::ProbeLightName;
 use crate::sweep::chart::Axes;
 use crate::sweep::pick::Point;
@@ -35,6 +35,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let ctx = args.gpu.context()?;
     let cache = args.out.join("reference-cache");
     let params = Params {
+        test_region: TestRegion::Path,
         grids: &DEFAULT_GRIDS,
         tolerances: &DEFAULT_TOLERANCES,
         points: POINTS,

@@ -49,6 +49,12 @@ use std::sync::Arc;
 pub const CUBE_SIZES: RangeInclusive<u32> = 8..=256;
 pub const DEFAULT_CUBE_SIZE: u32 = 128;
 
+/// The capture's near plane: a surface nearer the probe than this (up to √3 times it towards a
+/// face's corner) is clipped and the probe sees through it. The eye's 1 cm let probes a few
+/// millimetres from a wall see the sky behind it; at 1 mm a 32-bit float depth buffer still
+/// resolves about 1 mm at 4 m (Δz ≈ z² ε / near).
+pub const CAPTURE_NEAR: f32 = 1e-3;
+
 /// Face f looks along `CUBE_FACES[f].0` with `CUBE_FACES[f].1` up; the SH projection maps
 /// texels back to directions with the same table (shaders-glsl/include/cube.glsl).
 const CUBE_FACES: [(Vec3, Vec3); 6] = [
@@ -251,7 +257,7 @@ impl ProbeCapture {
         }
         for (buffer, (forward, up)) in self.faces.iter_mut().zip(CUBE_FACES) {
             let camera = Camera { position, target: position + forward, up, fov_y_deg: 90.0 };
-            let view_proj = camera.projection(1.0) * camera.view();
+            let view_proj = camera.projection_from(1.0, CAPTURE_NEAR) * camera.view();
             let uniforms = FrameUniforms {
                 view_proj: view_proj.to_cols_array_2d(),
                 inv_view_proj: view_proj.inverse().to_cols_array_2d(),
