@@ -93,7 +93,7 @@ pub fn rescaled(scale: f64, predicted_ms: f64, measured_ms: f64) -> f64 {
 
 /// Takes the requests to render this frame within `budget_ms`, in an order that takes every
 /// tile after its parent: among the requests whose parent is `resident` or taken already, the
-/// best benefit/cost first. `take(request, benefit/cost)` takes one and returns the ms it
+/// best benefit/cost first. `take(request)` takes one and returns the ms it
 /// planned by the model (its render and the renders its evictions need), or `None` where the
 /// tile could not be taken (its children then wait). The best is always taken; returns the
 /// requests taken, in order.
@@ -102,7 +102,7 @@ pub fn plan(
     model: &CostModel,
     budget_ms: f64,
     resident: impl Fn(TileKey) -> bool,
-    mut take: impl FnMut(&Request, f32) -> Option<f64>,
+    mut take: impl FnMut(&Request) -> Option<f64>,
 ) -> Vec<Request> {
     let ratio = |r: &Request| r.benefit() / model.cost_ms(r.triangles);
     let mut ready = Vec::new();
@@ -122,7 +122,7 @@ pub fn plan(
         if !taken.is_empty() && spent + model.cost_ms(r.triangles) > budget_ms {
             break;
         }
-        let Some(ms) = take(&r, ratio(&r) as f32) else { continue };
+        let Some(ms) = take(&r) else { continue };
         spent += ms;
         taken.push(r);
         ready.extend(waiting.remove(&r.key).unwrap_or_default());
@@ -167,7 +167,7 @@ mod tests {
         let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key.x).collect::<Vec<_>>();
         let root = |_| true;
         // Each take planned its tile's cost.
-        let render = |r: &Request, _| Some(model.cost_ms(r.triangles));
+        let render = |r: &Request| Some(model.cost_ms(r.triangles));
         // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
         assert_eq!(keys(plan(requests.clone(), &model, 15.0, root, render)), vec![2, 1, 0]);
         assert_eq!(keys(plan(requests.clone(), &model, 13.0, root, render)), vec![2, 1]);
@@ -175,19 +175,13 @@ mod tests {
         assert_eq!(keys(plan(requests.clone(), &model, 1.0, root, render)), vec![2]);
         // No benefit, no request.
         assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0, root, render).is_empty());
-        let mut ratios = Vec::new();
-        plan(requests.clone(), &model, 100.0, root, |r, ratio| {
-            ratios.push(ratio);
-            render(r, ratio)
-        });
-        assert!(ratios.len() == 3 && ratios.windows(2).all(|w| w[0] >= w[1]), "{ratios:?}");
         // What a take planned beyond its tile (an eviction's render) counts: with the big one's
         // 11 ms, a 2 ms one fits in 14; with an eviction's 2 ms more, none does.
         assert_eq!(keys(plan(requests.clone(), &model, 14.0, root, render)), vec![2, 1]);
-        let evicting = |r: &Request, _| Some(model.cost_ms(r.triangles) + 2.0);
+        let evicting = |r: &Request| Some(model.cost_ms(r.triangles) + 2.0);
         assert_eq!(keys(plan(requests.clone(), &model, 14.0, root, evicting)), vec![2]);
         // A refused take is skipped, the next taken.
-        let refusing = |r: &Request, _| (r.key.x != 2).then(|| model.cost_ms(r.triangles));
+        let refusing = |r: &Request| (r.key.x != 2).then(|| model.cost_ms(r.triangles));
         assert_eq!(keys(plan(requests, &model, 15.0, root, refusing)), vec![1, 0]);
     }
 
@@ -201,7 +195,7 @@ mod tests {
         // The grandchild has the best ratio, but comes after its parent; the tile beside
         // comes between them, as its ratio is better than the grandchild's parent's.
         let requests = vec![ask(grandchild, 50), ask(child, 10), ask(beside, 20)];
-        let render = |_: &Request, _| Some(1.0);
+        let render = |_: &Request| Some(1.0);
         let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key).collect::<Vec<_>>();
         let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT, render);
         assert_eq!(keys(chosen), vec![beside, child, grandchild]);
@@ -209,7 +203,7 @@ mod tests {
         let chosen = plan(requests.clone(), &model, 2.0, |k| k == TileKey::ROOT, render);
         assert_eq!(keys(chosen), vec![beside, child]);
         // A parent refused keeps its child waiting.
-        let refusing = |r: &Request, _| (r.key != child).then_some(1.0);
+        let refusing = |r: &Request| (r.key != child).then_some(1.0);
         let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT, refusing);
         assert_eq!(keys(chosen), vec![beside]);
         // With its parent resident it is taken first.

@@ -163,7 +163,7 @@ impl PagePool {
         std::mem::take(&mut self.ops)
     }
 
-    /// Makes `key` resident in `frame` with `benefit` (the refinement's benefit/cost), evicting
+    /// Makes `key` resident in `frame` with `benefit` (the refinement's, per page), evicting
     /// tiles if the pool is short of pages (see the module's rules), and queues its render. Its
     /// parent must be resident: the tree grows from the root, so the lookup's descent reaches
     /// every resident tile.

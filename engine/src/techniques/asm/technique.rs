@@ -625,10 +625,14 @@ impl Technique for Asm {
             &model,
             time_ms,
             |key| resident.contains(&key),
-            |request, ratio| {
+            |request| {
                 // A parent evicted by an earlier insertion of this frame refuses its child (an error
-                // from the pool), as a pool with no page to free does: the child waits.
-                let Ok(Insert::Inserted { evicted }) = self.pool.insert(request.key, frame, ratio) else {
+                // from the pool), as a pool with no page to free does: the child waits. The pool
+                // weighs tiles by benefit alone: an eviction trades pages, which every tile takes
+                // alike, where the plan's order trades milliseconds.
+                let Ok(Insert::Inserted { evicted }) =
+                    self.pool.insert(request.key, frame, request.benefit() as f32)
+                else {
                     return None;
                 };
                 self.evicted += evicted;
