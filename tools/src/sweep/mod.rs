@@ -94,6 +94,10 @@ pub struct SweepArgs {
     /// With `--pick` (probes): the most probes acceptable.
     #[arg(long, requires = "pick")]
     max_probes: Option<u32>,
+    /// probes: where the test points are, as `kage bench probe-count --test-region` (`box`:
+    /// grids and placement over the static box, measured anywhere in it).
+    #[arg(long, value_enum)]
+    test_region: Option<crate::bench_probe_count::TestRegion>,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -209,6 +213,9 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             "--max-probes bounds the probe sweep's cost; the {:?} sweep's is frame time: --max-ms",
             args.technique
         );
+    }
+    if args.test_region.is_some() && args.technique != SweptTechnique::Probes {
+        bail!("--test-region places the probe sweep's test points; the {:?} sweep has none", args.technique);
     }
     if args.max_error.into_iter().chain(args.max_ms).any(|b| !(b.is_finite() && b > 0.0)) {
         bail!("--max-error and --max-ms must be positive numbers");
