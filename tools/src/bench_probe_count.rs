@@ -269,10 +269,10 @@ pub enum TestRegion {
 }
 
 impl TestRegion {
-    fn describe(self) -> &'static str {
+    pub fn describe(self) -> &'static str {
         match self {
-            TestRegion::Path => "in the moving group's box along its path",
-            TestRegion::Box => "anywhere in the static groups' box",
+            TestRegion::Path => "along the moving group's path",
+            TestRegion::Box => "anywhere in the static box",
         }
     }
 
@@ -438,6 +438,10 @@ fn test_points(
     let Some((lo, hi)) = bounds(corners) else {
         bail!("the moving group of scene {} has no vertices", scene.name)
     };
+    let (lo, hi, moving) = match params.test_region {
+        TestRegion::Path => (lo, hi, Some(group)),
+        TestRegion::Box => (static_box.0, static_box.1, None),
+    };
     let mut rng = Pcg32(0x2545_f491_4f6c_dd1d);
     let mut points = Vec::new();
     // Positions inside solids are redrawn, up to a bound so that a moving group buried in
@@ -446,13 +450,10 @@ fn test_points(
         if points.len() == positions * normals {
             break;
         }
+        // The time is drawn for both regions, so that each keeps the random stream it had.
         let t = rng.next();
-        let (lo, hi) = if params.test_region == TestRegion::Path { (lo, hi) } else { static_box };
         let local = lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next());
-        let p = match params.test_region {
-            TestRegion::Path => animation::pose(group, t).matrix().transform_point3(local),
-            TestRegion::Box => local,
-        };
+        let p = moving.map_or(local, |g| animation::pose(g, t).matrix().transform_point3(local));
         if solids.contains(p) {
             continue;
         }

@@ -90,9 +90,8 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             });
         }
     }
-    let region = if test_region == TestRegion::Box { "anywhere in the box" } else { "on the path" };
-    let title =
-        format!("{} ({} x {NORMALS} test points {region}), {}", scene.name, m.test_points, ctx.info().name);
+    let (region, device) = (test_region.describe(), &ctx.info().name);
+    let title = format!("{} ({} x {NORMALS} test points {region}), {device}", scene.name, m.test_points);
     let axes = Axes { cost: "probes", error: "relative RMS irradiance error against the reference" };
     write_outputs(
         args,
