@@ -17,11 +17,22 @@ pub enum Across {
 
 /// p ↦ weights of a tetrahedron's vertices: with the vertex at `origin` as p₃ and the others
 /// p₀, p₁, p₂ in order, [a b c]ᵀ = M⁻¹ (p − p₃) and the origin's weight is 1 − a − b − c.
+/// `None` for a sliver (see [`SLIVER`]).
 #[derive(Clone, Copy, Debug)]
 struct Barycentric {
     origin: usize,
-    inverse: DMat3,
+    inverse: Option<DMat3>,
 }
+
+/// A tetrahedron whose matrix's determinant (six times its volume) is below this fraction of
+/// its longest edge cubed is a sliver. Its inverse would amplify the coordinates' rounding by
+/// the inverse of that fraction (and where the determinant rounds to 0, give NaN), while its
+/// four probes are all but coplanar, so the weights of the face that holds p's projection
+/// reproduce p to within the sliver's thickness: below 1e-8 of the edge, past which the matrix
+/// is the more accurate. Cell-centre lattices make
+/// slivers wherever four of their points are coplanar in exact terms but not in binary
+/// fractions (1/12 + k/6, for one).
+const SLIVER: f64 = 1e-8;
 
 impl Barycentric {
     /// The origin is the vertex nearest the others: for a needle (three close probes and a far
@@ -32,8 +43,51 @@ impl Barycentric {
         let origin = (1..4).fold(0, |best, i| if spread(i) < spread(best) { i } else { best });
         let [a, b, c] = opposite(v, origin);
         let o = v[origin];
-        Barycentric { origin, inverse: DMat3::from_cols(a - o, b - o, c - o).inverse() }
+        let m = DMat3::from_cols(a - o, b - o, c - o);
+        let longest = (0..4).flat_map(|i| (0..i).map(move |j| v[i].distance(v[j]))).fold(0.0, f64::max);
+        let volume = m.determinant().abs();
+        let sliver = !volume.is_finite() || volume <= SLIVER * longest.powi(3);
+        Barycentric { origin, inverse: (!sliver).then(|| m.inverse()) }
     }
+}
+
+/// The weights in a sliver: those of p projected onto the face whose triangle holds the
+/// projection best (largest least weight), 0 for the vertex off it.
+fn sliver_weights(v: [DVec3; 4], p: DVec3) -> [f64; 4] {
+    let mut best: Option<(f64, usize, [f64; 3])> = None;
+    for slot in 0..4 {
+        let [a, b, c] = opposite(v, slot);
+        let (e0, e1, e2) = (b - a, c - a, p - a);
+        let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+        let denom = d00 * d11 - d01 * d01;
+        // A face with its three probes on one line has no weights of its own.
+        if !denom.is_finite() || denom <= 1e-12 * d00 * d11 {
+            continue;
+        }
+        let (d20, d21) = (e2.dot(e0), e2.dot(e1));
+        let beta = (d11 * d20 - d01 * d21) / denom;
+        let gamma = (d00 * d21 - d01 * d20) / denom;
+        let w = [1.0 - beta - gamma, beta, gamma];
+        let least = w.iter().copied().fold(f64::MAX, f64::min);
+        if best.is_none_or(|(l, ..)| least > l) {
+            best = Some((least, slot, w));
+        }
+    }
+    let mut weights = [0.0; 4];
+    match best {
+        Some((_, slot, w)) => {
+            let sum: f64 = w.iter().map(|x| x.max(0.0)).sum();
+            for (k, x) in w.into_iter().enumerate() {
+                weights[k + usize::from(k >= slot)] = x.max(0.0) / sum;
+            }
+        }
+        // Every face on a line: the four probes nearly on one, and p among them.
+        None => {
+            let near = (1..4).fold(0, |n, k| if v[k].distance(p) < v[n].distance(p) { k } else { n });
+            weights[near] = 1.0;
+        }
+    }
+    weights
 }
 
 pub struct TetMesh {
@@ -107,11 +161,13 @@ impl TetMesh {
 
     /// The barycentric weights of p in tetrahedron `tet` (in the order of its vertices). Like any
     /// floating-point solve, they are accurate to about 1e-16 × (longest edge)³ / volume of the
-    /// tetrahedron, relative to the coordinates: slivers (nearly coplanar probes) lose digits.
+    /// tetrahedron, relative to the coordinates; in a sliver (see [`SLIVER`]) they are a
+    /// face's, which reproduce p to within the sliver's thickness.
     pub fn weights(&self, tet: u32, p: DVec3) -> [f64; 4] {
         let b = &self.barycentric[tet as usize];
-        let origin = self.positions[self.tets[tet as usize][b.origin] as usize];
-        let [x, y, z] = (b.inverse * (p - origin)).to_array();
+        let corners = self.tets[tet as usize].map(|i| self.positions[i as usize]);
+        let Some(inverse) = b.inverse else { return sliver_weights(corners, p) };
+        let [x, y, z] = (inverse * (p - corners[b.origin])).to_array();
         let mut w = [x, y, z, 1.0 - x - y - z];
         w[b.origin..].rotate_right(1);
         w
