@@ -169,7 +169,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 12] = [
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", "asm", "--keyframe", "5"], "scene asm has 5 walkthrough keyframes"),
         (&["reference", "--keyframe", "1", "--out", "x.exr"], "scene teapot has 0 walkthrough keyframes"),
@@ -181,6 +181,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["sweep", "--technique", "prt", "--poses", "nan", "--out", "x"], "--poses"),
         (&["sweep", "--technique", "prt", "--pick", "--out", "x"], "--pick needs a bound"),
         (&["sweep", "--technique", "asm", "--test-region", "box", "--out", "x"], "--test-region places"),
+        (&["bench", "probe-count", "--scenes", "probe-room", "--candidates", "1"], "grid level 1"),
     ];
     assert_clear_errors(&cases);
 }

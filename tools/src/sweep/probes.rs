@@ -20,8 +20,9 @@ use std::fmt::Write as _;
 /// Tolerances over the whole box, where the kept set grows from 4 probes to 57 between
 /// tolerances 1.75 and 1 (BENCHMARKS.md).
 const BOX_TOLERANCES: [f32; 8] = [1.75, 1.5, 1.25, 1.0, 0.75, 0.5, 0.25, 0.1];
-/// Test positions, and random normals at each.
-const POINTS: usize = 64;
+/// Test positions, and random normals at each: as BENCHMARKS.md runs `kage bench probe-count`
+/// (the reference for 1024 points takes 13 s on two cores).
+const POINTS: usize = 256;
 const NORMALS: usize = 4;
 /// Cube-map faces of the captures, texels: the error floor of a probe captured at a test point
 /// is the same at 32² as at 128² on these scenes (bench probe-count's floor), at 1/16 the time.
@@ -42,6 +43,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let params = Params {
         test_region,
         grids: &DEFAULT_GRIDS,
+        candidates: None,
         tolerances: if test_region == TestRegion::Box { &BOX_TOLERANCES } else { &DEFAULT_TOLERANCES },
         points: POINTS,
         normals: NORMALS,

@@ -4,9 +4,10 @@
 //! [`ProbeSet`]: placement, capture and interpolation; [`technique`]: the moving group lit by
 //! the probes. The geometry:
 //!
-//! Automatic placement ([`ProbePlacement::Auto`], [`reduce`]) captures a dense set of candidates,
-//! keeps those the others cannot reproduce and fits the kept ones' SH to every candidate's
-//! capture ([`fit`]); a regular grid with trilinear interpolation
+//! Automatic placement ([`ProbePlacement::Auto`]) captures a dense set of candidates, keeps
+//! those the others cannot reproduce ([`reduce`]), moves each kept one to the nearby candidate
+//! that lowers the error over all candidates ([`relocate`]) and fits the kept ones' SH to every
+//! candidate's capture ([`fit`]); a regular grid with trilinear interpolation
 //! ([`Lattice`], [`ProbeInterpolation::Trilinear`]) is the baseline it is measured against
 //! (`kage bench probe-count`).
 //!
@@ -29,6 +30,7 @@ mod input;
 mod lookup;
 mod predicates;
 mod reduce;
+mod relocate;
 mod rng;
 mod set;
 mod solids;
@@ -48,6 +50,7 @@ pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
 pub use reduce::reduce;
+pub use relocate::relocate;
 pub use set::{
     bounds, capture_at, grid_lattice, is_static, ProbeCounts, ProbeInterpolation, ProbePlacement, ProbeSet,
     ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,

@@ -4,6 +4,7 @@
 use super::capture::{CaptureSettings, InvalidProbe, ProbeCapture};
 use super::fit::fit;
 use super::reduce::{blend, reduce};
+use super::relocate::relocate;
 use super::solids::Solids;
 use super::trilinear::Lattice;
 use super::{TetMesh, Walker};
@@ -38,7 +39,9 @@ pub enum ProbePlacement {
     /// Automatic: the cell centres of a `candidates` grid over the static groups' bounding box
     /// that are not inside a solid ([`Solids`]) are captured, then those that the others
     /// reproduce by tetrahedral interpolation within `tolerance` are dropped (see
-    /// [`super::reduce`]). `None` candidates: [`AUTO_CANDIDATES`] along the box's longest side,
+    /// [`super::reduce`]), the kept ones moved to nearby candidates while that lowers the error
+    /// over all of them ([`super::relocate`]) and their SH fitted to every capture
+    /// ([`super::fit`]). `None` candidates: [`AUTO_CANDIDATES`] along the box's longest side,
     /// proportionally fewer along the others.
     Auto { tolerance: f32, candidates: Option<[u32; 3]> },
 }
@@ -230,9 +233,7 @@ impl ProbeSet {
             positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect::<Result<_>>()?;
         let candidates = positions.len();
         let mut set = match (&settings.placement, settings.interpolation) {
-            (ProbePlacement::Auto { tolerance, .. }, _) => {
-                ProbeSet::reduced(&positions, &sh, *tolerance)?.fitted(&positions, &sh)?
-            }
+            (ProbePlacement::Auto { tolerance, .. }, _) => ProbeSet::placed(&positions, &sh, *tolerance)?,
             (ProbePlacement::Grid(counts), ProbeInterpolation::Trilinear) => {
                 // A lattice needs every corner: a probe left out leaves a hole no weight fills.
                 if let Some(probe) = invalid.first() {
@@ -269,11 +270,22 @@ impl ProbeSet {
         Ok(set)
     }
 
-    /// Tetrahedral interpolation of those of the SH captured at `positions` that automatic
-    /// placement keeps at `tolerance` ([`reduce`]), each with its own capture ([`ProbeSet::fitted`]
-    /// gives them the values that reproduce all of `sh` best).
+    /// Tetrahedral interpolation of those of the SH captured at `positions` that the reduction
+    /// keeps at `tolerance` ([`reduce`]), where it left them and each with its own capture: the
+    /// first step of [`ProbeSet::placed`], measured alone by `kage bench probe-count`.
     pub fn reduced(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<ProbeSet> {
-        let kept = reduce(positions, sh, tolerance)?;
+        ProbeSet::kept(positions, sh, &reduce(positions, sh, tolerance)?)
+    }
+
+    /// Automatic placement at `tolerance` from the SH captured at `positions`, as the engine
+    /// runs it: the probes [`reduce`] keeps, moved by [`relocate`], their SH fitted to `sh`.
+    pub fn placed(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<ProbeSet> {
+        let kept = relocate(positions, sh, reduce(positions, sh, tolerance)?)?;
+        ProbeSet::kept(positions, sh, &kept)?.fitted(positions, sh)
+    }
+
+    /// Tetrahedral interpolation of the SH captured at those of `positions` that `kept` indexes.
+    fn kept(positions: &[DVec3], sh: &[ShRgb9], kept: &[usize]) -> Result<ProbeSet> {
         let points: Vec<DVec3> = kept.iter().map(|&i| positions[i]).collect();
         let mut set = ProbeSet::tetrahedral(&points, kept.iter().map(|&i| sh[i]).collect())?;
         set.candidates = positions.len();
