@@ -82,8 +82,9 @@ pub enum kage_probe_placement {
     Grid = 0,
     /// Candidates at the cell centres of a grid (`probe_candidates`; all 0: 8 along the box's
     /// longest side, proportionally fewer along the others) outside solids are captured, then
-    /// those the others reproduce within `probe_tolerance` are dropped;
-    /// `kage_renderer_get_stats` reports how many remain.
+    /// those the others reproduce within `probe_tolerance` are dropped, the kept ones moved to
+    /// nearby candidates while that lowers the error over all of them and their SH fitted to
+    /// every capture; `kage_renderer_get_stats` reports how many remain.
     Auto = 1,
     /// The `probe_position_count` world positions at `probe_positions`.
     Positions = 2,

@@ -47,7 +47,15 @@ pub fn relocate(positions: &[DVec3], sh: &[ShRgb9], mut kept: Vec<usize>) -> Res
         return Ok(kept);
     }
     let mut is_kept = vec![false; positions.len()];
-    kept.iter().for_each(|&j| is_kept[j] = true);
+    let distinct = kept.iter().all(|&j| j < positions.len() && !std::mem::replace(&mut is_kept[j], true));
+    if !distinct || sh.len() != positions.len() {
+        return Err(Error::InvalidArgument(format!(
+            "probe relocation: the {} kept probes must be distinct indices into the {} candidates, which need one SH each ({} given)",
+            kept.len(),
+            positions.len(),
+            sh.len()
+        )));
+    }
     let mut best = objective(positions, sh, &kept)?;
     for _ in 0..MAX_SWEEPS {
         let mut moved = false;
@@ -56,9 +64,12 @@ pub fn relocate(positions: &[DVec3], sh: &[ShRgb9], mut kept: Vec<usize>) -> Res
             for candidate in nearest_free(positions, &is_kept, positions[kept[slot]]) {
                 let mut trial = kept.clone();
                 trial[slot] = candidate;
-                // A move that leaves the probes in one plane is no placement.
+                // A move that leaves the probes in one plane is no placement, and one whose fit
+                // does not converge is no better than where the probe is.
                 let error = match objective(positions, sh, &trial) {
-                    Err(Error::Probes(ProbeError::Flat { .. } | ProbeError::TooFew { .. })) => continue,
+                    Err(Error::Probes(
+                        ProbeError::Flat { .. } | ProbeError::TooFew { .. } | ProbeError::FitDiverged { .. },
+                    )) => continue,
                     error => error?,
                 };
                 if error < best {
@@ -181,6 +192,16 @@ mod tests {
         let mut sorted = kept.clone();
         sorted.sort_unstable();
         assert_eq!(relocate(&positions, &sh, kept).unwrap(), sorted);
+    }
+
+    #[test]
+    fn bad_indices_are_an_error() {
+        let (positions, sh) = bump_field();
+        for kept in [vec![0, 1, 2, positions.len()], vec![0, 1, 2, 2, 3]] {
+            let error = relocate(&positions, &sh, kept).unwrap_err().to_string();
+            assert!(error.contains("distinct indices"), "{error}");
+        }
+        assert!(relocate(&positions, &sh[1..], vec![0, 1, 2, 3]).is_err());
     }
 
     #[test]
