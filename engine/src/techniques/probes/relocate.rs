@@ -24,6 +24,7 @@
 //! [`MAX_RELOCATED`] stay where the reduction left them: the search took minutes for 300 probes
 //! over 2560 candidates, and from 84 probes on its effect on the benchmark's errors ranged from
 //! 26 % lower to 16 % higher, where up to 69 probes it lowered them by 7–49 % (BENCHMARKS.md).
+use super::reduce::blend;
 use super::set::ProbeSet;
 use super::solids::directions;
 use super::ProbeError;
@@ -107,15 +108,16 @@ fn nearest_free(positions: &[DVec3], is_kept: &[bool], p: DVec3) -> Vec<usize> {
 }
 
 /// The squared irradiance error over every candidate of the probes `kept` fitted to `sh` (see
-/// the module documentation).
+/// the module documentation). The fit's weights at the candidates serve the error too.
 fn objective(positions: &[DVec3], sh: &[ShRgb9], kept: &[usize]) -> Result<f64> {
     let points: Vec<DVec3> = kept.iter().map(|&j| positions[j]).collect();
-    let set = ProbeSet::tetrahedral(&points, kept.iter().map(|&j| sh[j]).collect())?.fitted(positions, sh)?;
+    let set = ProbeSet::tetrahedral(&points, kept.iter().map(|&j| sh[j]).collect())?;
+    let rows = set.rows(positions)?;
+    let set = set.fitted_by(&rows, sh)?;
     let normals = directions();
-    let mut walker = super::Walker::default();
     let mut sum = 0.0;
-    for (p, exact) in positions.iter().zip(sh) {
-        let approx = set.interpolate(&mut walker, p.as_vec3())?;
+    for (row, exact) in rows.iter().zip(sh) {
+        let approx = blend(row.iter().map(|&(i, w)| (&set.sh[i], w)));
         for &n in &normals {
             let (a, e) = (approx.irradiance(n), exact.irradiance(n));
             sum += (0..3).map(|k| f64::from(a[k].max(0.0) - e[k]).powi(2)).sum::<f64>();

@@ -294,13 +294,23 @@ impl ProbeSet {
 
     /// The set with its probes' SH fitted by least squares to `captured`, the SH captured at
     /// each of `positions` (see [`super::fit`]).
-    pub fn fitted(mut self, positions: &[DVec3], captured: &[ShRgb9]) -> Result<ProbeSet> {
+    pub fn fitted(self, positions: &[DVec3], captured: &[ShRgb9]) -> Result<ProbeSet> {
+        let rows = self.rows(positions)?;
+        self.fitted_by(&rows, captured)
+    }
+
+    /// The interpolation's (probe, weight) pairs of weight other than 0 at each of `positions`.
+    pub(super) fn rows(&self, positions: &[DVec3]) -> Result<Vec<Vec<(usize, f64)>>> {
         let mut walker = Walker::default();
-        let rows = positions
+        positions
             .iter()
             .map(|&p| Ok(self.weights(&mut walker, p)?.into_iter().filter(|&(_, w)| w != 0.0).collect()))
-            .collect::<Result<Vec<Vec<_>>>>()?;
-        self.sh = fit(&rows, captured, &self.sh)?;
+            .collect()
+    }
+
+    /// [`ProbeSet::fitted`] to `captured` at the positions whose [`ProbeSet::rows`] are `rows`.
+    pub(super) fn fitted_by(mut self, rows: &[Vec<(usize, f64)>], captured: &[ShRgb9]) -> Result<ProbeSet> {
+        self.sh = fit(rows, captured, &self.sh)?;
         Ok(self)
     }
 
