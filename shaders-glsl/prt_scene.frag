@@ -1,86 +1,133 @@
 #version 460
+#extension GL_EXT_control_flow_attributes : require
 // L = L_s - albedo * sum_i B_i T(p, w_i) V_o(p, w_i) (eq. (15)). V_o sums the filtered shadows of
 // every occluder group for region i; it is clamped to 1 so that two occluders overlapping in
-// one region never subtract the region twice, and L is clamped at 0.
+// one region never subtract the region twice, and L is clamped at 0. Beyond the paper, the
+// dominant lights taken out of the map add albedo / pi * sum_j B_j max(n . w_j, 0) V_j(p).
 #include "constants.glsl"
 #include "layouts.glsl"
 #include "occlusion.glsl"
+#include "sh.glsl"
+#include "envmap.glsl"
 
 layout(set = 0, binding = 3, std140) uniform Energy { vec4 region_energy[KAGE_MAX_REGIONS]; };
 layout(set = 0, binding = 4) uniform sampler2DArray occlusion;
 layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
+layout(set = 0, binding = 6, std140) uniform Dominant { DominantLights dominant; };
+layout(set = 0, binding = 7) uniform sampler2DArrayShadow dominant_shadow;
+layout(set = 0, binding = 8, std140) uniform Sh { ShCoeffs sh; };
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+#include "dominant.glsl"
 layout(push_constant) uniform Push { PrtDrawPush draw; };
 // 0: the paper's fixed penumbra, 1: the adaptive one (a pipeline constant: see GraphicsDesc).
 layout(constant_id = 0) const uint ADAPTIVE_PENUMBRA = 0u;
 // ceil(q / 4), as prt_scene.vert declares it.
 layout(constant_id = 1) const uint REGION_VEC4 = KAGE_MAX_REGIONS / 4;
+// The dominant lights (see dominant.glsl), fixed for the renderer's life.
+layout(constant_id = 3) const uint DOMINANT_LIGHTS = 0u;
+// The cosine per pixel (see prt_scene.vert).
+layout(constant_id = 4) const bool PIXEL_COSINE = false;
 
-layout(location = 0) in vec3 self_shadowed;
+layout(location = 0) in vec3 self_term;
 layout(location = 1) in vec3 world_position;
-layout(location = 2) in vec4 region_transfer[REGION_VEC4];
+layout(location = 2) in vec3 world_normal;
+layout(location = 3) in vec4 region_transfer[REGION_VEC4];
 layout(location = 0) out vec4 color;
 
-// Sums of both channels of a summed-area table layer over the square of half-width `half_width`
-// (uv units) around `uv`. An integral up to edge X (in texels) is the table's value at texel
-// X - 1, so the table is sampled half a texel before each edge; bilinear filtering gives exact
-// integrals between texel edges, and the sampler's black border the zero before the first one.
-vec2 table_box(uint l, vec2 uv, float half_width, float size) {
-    vec2 lo = clamp(uv - half_width, 0.0, 1.0) - 0.5 / size;
-    vec2 hi = clamp(uv + half_width, 0.0, 1.0) - 0.5 / size;
-    float layer = float(l);
-    return textureLod(occlusion, vec3(hi, layer), 0.0).rg - textureLod(occlusion, vec3(lo.x, hi.y, layer), 0.0).rg
-        - textureLod(occlusion, vec3(hi.x, lo.y, layer), 0.0).rg + textureLod(occlusion, vec3(lo, layer), 0.0).rg;
-}
-
-// The adaptive penumbra (beyond the paper): the box width follows this pixel's distance to the
-// occluder along the region's direction, s = sqrt(Omega_i) * distance, as the paper's R does for
-// the group centres. The distance comes from the mean occluder height found in a search box
-// (as in percentage-closer soft shadows); an occluder below the pixel casts nothing on it.
-float adaptive_occlusion(OcclusionLayer layer, uint l, vec2 uv, vec3 offset, float size) {
-    vec2 found = table_box(l, uv, 0.5 * layer.axis_u.w / size, size);
-    if (found.x < 0.5) return 0.0;  // less than half a texel of occluder within reach
-    float height = dot(offset, cross(layer.axis_u.xyz, layer.axis_v.xyz));
-    float distance = found.y / found.x - height;
+// The adaptive penumbra (beyond the paper): a box as wide as sqrt(Omega_i) times this pixel's
+// distance to the occluder along the region's direction, as the paper's R is for the group
+// centres. The distance is the mean occluder height over the widest box (as percentage-closer
+// soft shadows find it) less the pixel's own; an occluder below the pixel casts nothing on it.
+// The filter passes left boxes of 1, the middle and the widest width side by side (R, G, B; A
+// the occluder heights), and the coverage of the wanted width is interpolated between them.
+float adaptive_occlusion(OcclusionLayer layer, vec4 boxes) {
+    if (boxes.b <= 1e-4) return boxes.r;
+    float distance = boxes.a / boxes.b - occlusion_height(layer, world_position);
     if (distance <= 0.0) return 0.0;
-    float half_width = max(0.5 * layer.axis_v.w * distance * layer.centre.w, 0.5 / size);
-    float texels = 2.0 * half_width * size;
-    return clamp(table_box(l, uv, half_width, size).x / (texels * texels), 0.0, 1.0);
+    float width = max(layer.widen * distance, 1.0);
+    float middle = layer.axis_u.w, widest = layer.axis_v.w;
+    return width <= middle
+        ? mix(boxes.r, boxes.g, middle > 1.0 ? (width - 1.0) / (middle - 1.0) : 0.0)
+        : mix(boxes.g, boxes.b, widest > middle ? min((width - middle) / (widest - middle), 1.0) : 0.0);
 }
 
 void main() {
-    // Layers come sorted by region, so each region's V_o is complete when the region changes.
-    vec3 blocked = vec3(0.0);
-    uint region = KAGE_NO_HIT;
+    // The dominant lights' exact cosine and self-shadow: B_j max(n . w_j, 0) v_j (constant
+    // indices), before the other groups' shadows take their share. Two-sided surfaces, as in
+    // scene.frag: the back of an open mesh faces the viewer.
+    vec3 n = normalize(gl_FrontFacing ? world_normal : -world_normal);
+    float lit[KAGE_MAX_DOMINANT_LIGHTS];
+    vec3 dominant_light = vec3(0.0);
+    [[unroll]] for (uint j = 0u; j < DOMINANT_LIGHTS; ++j) {
+        float c = max(dot(n, dominant.lights[j].direction.xyz), 0.0);
+        lit[j] = c > 0.0 ? c * dominant_self_visibility(j, draw.layers.z, world_position, n, c) : 0.0;
+        dominant_light += dominant.lights[j].energy.rgb * lit[j];
+    }
+    // The sources this point receives light from: regions with T > 0, then the dominant lights
+    // that reach it. A layer of any other source would take nothing away, so it is not read.
+    // Constant indices: see prt_scene.vert.
+    uint regions = draw.mesh.w;
+    uvec2 receives = uvec2(0u);
+    [[unroll]] for (uint k = 0u; k < REGION_VEC4; ++k) {
+        [[unroll]] for (uint c = 0u; c < 4u; ++c) {
+            uint r = 4u * k + c;
+            if (region_transfer[k][c] > 0.0) receives[r / 32u] |= 1u << (r % 32u);
+        }
+    }
+    [[unroll]] for (uint j = 0u; j < DOMINANT_LIGHTS; ++j) {
+        uint r = regions + j;
+        if (lit[j] > 0.0) receives[r / 32u] |= 1u << (r % 32u);
+    }
+    // Layers come sorted by source (regions, then dominant lights), so each one's V_o is
+    // complete when the source changes.
+    vec3 blocked = vec3(0.0), dominant_blocked = vec3(0.0);
+    uint source = KAGE_NO_HIT;
     float occluded = 0.0;
     uint first = draw.layers.x, count = draw.layers.y;
     for (uint base = 0u; base < count; base += 32u) {
         // Most of a receiver lies outside any one occluder's shadow. The cheap footprint tests
-        // come first and the texture reads loop over the hits only: a branch around a read would
-        // not save it where the lanes of a SIMD group disagree (llvmpipe runs both sides of
-        // every branch), but a loop ends when all its lanes are done.
+        // come first, over every layer with indices the same for all fragments (llvmpipe loads
+        // such a record once per SIMD group); the texture reads then loop over the hits only:
+        // a branch around a read would not save it where the lanes of a SIMD group disagree
+        // (llvmpipe runs both sides of every branch), but a loop ends when all its lanes are
+        // done.
         uint hits = 0u;
         for (uint k = 0u; k < min(count - base, 32u); ++k) {
-            hits |= uint(within_footprint(layers[first + base + k], world_position)) << k;
+            OcclusionLayer layer = layers[first + base + k];
+            bool receiving = (receives[layer.region / 32u] & (1u << (layer.region % 32u))) != 0u;
+            hits |= uint(receiving && within_footprint(layer, world_position)) << k;
         }
         while (hits != 0u) {
-            uint l = first + base + uint(findLSB(hits));
+            uint k = uint(findLSB(hits));
             hits &= hits - 1u;
+            uint l = first + base + k;
             OcclusionLayer layer = layers[l];
-            if (layer.ids.x != region) {
-                if (region != KAGE_NO_HIT) {
-                    blocked += region_energy[region].rgb * region_transfer[region / 4][region % 4] * min(occluded, 1.0);
+            if (layer.region != source) {
+                // Two occluders overlapping in one source never take it away twice.
+                if (source < regions) {
+                    blocked += region_energy[source].rgb * region_transfer[source / 4u][source % 4u] * min(occluded, 1.0);
+                } else if (source != KAGE_NO_HIT) {
+                    dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
                 }
-                region = layer.ids.x;
+                source = layer.region;
                 occluded = 0.0;
             }
-            vec2 uv = occlusion_uv(layer, world_position);
-            occluded += ADAPTIVE_PENUMBRA == 0u
-                ? textureLod(occlusion, vec3(uv, float(l)), 0.0).r
-                : adaptive_occlusion(layer, l, uv, world_position - layer.centre.xyz, float(draw.layers.w));
+            vec4 boxes = textureLod(occlusion, vec3(occlusion_uv(layer, world_position), float(l)), 0.0);
+            occluded += ADAPTIVE_PENUMBRA == 0u ? boxes.r : adaptive_occlusion(layer, boxes);
         }
     }
-    if (region != KAGE_NO_HIT) {
-        blocked += region_energy[region].rgb * region_transfer[region / 4][region % 4] * min(occluded, 1.0);
+    if (source < regions) {
+        blocked += region_energy[source].rgb * region_transfer[source / 4u][source % 4u] * min(occluded, 1.0);
+    } else if (source != KAGE_NO_HIT) {
+        dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
     }
-    color = vec4(max(self_shadowed - draw.albedo.rgb * blocked, vec3(0.0)), 1.0);
+
+    vec3 self_shadowed = self_term;
+    if (PIXEL_COSINE) {
+        vec3 unshadowed = max(sh9_irradiance(sh.c, env_world_to_map(normalize(world_normal), frame.env_params.y)), vec3(0.0));
+        self_shadowed = draw.albedo.rgb / KAGE_PI * unshadowed - self_term;
+    }
+    vec3 radiance = max(self_shadowed - draw.albedo.rgb * blocked, vec3(0.0))
+        + draw.albedo.rgb / KAGE_PI * max(dominant_light - dominant_blocked, vec3(0.0));
+    color = vec4(radiance, 1.0);
 }

@@ -3,12 +3,19 @@
 // The scene pass of Sloan's PRT and of the Tamura technique. Per vertex: the self-shadowed
 // radiance L_s from its texel of the self-shadow pass, and the transfer T(x, w_i) towards each
 // region, reconstructed from the transfer vector (eq. (15)); the rasterizer interpolates both.
+// With PIXEL_COSINE (beyond the paper), the vertex passes on what its group hides of the
+// unshadowed light instead, albedo / pi E(n) - L_s, and the fragment takes E(n) at its own
+// normal: the cosine is exact per pixel and only the self-shadow is interpolated.
 #include "constants.glsl"
 #include "layouts.glsl"
+#include "sh.glsl"
+#include "envmap.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D self_shadow;
 layout(set = 0, binding = 2, std430) readonly buffer Basis { RegionBasis region_basis[]; };
+// The SH of the light L_s is made of (the map less its dominant lights), in the map's frame.
+layout(set = 0, binding = 8, std140) uniform Sh { ShCoeffs sh; };
 layout(push_constant) uniform Push { PrtDrawPush draw; };
 // Pipeline constants (see GraphicsDesc::constants; id 0 is the fragment shader's): vec4s of
 // region transfers, ceil(q / 4) (at least 1), and of SH coefficients, ceil(bands^2 / 4).
@@ -17,18 +24,21 @@ layout(push_constant) uniform Push { PrtDrawPush draw; };
 // dynamically indexed output costs a select over all of them per write on llvmpipe).
 layout(constant_id = 1) const uint REGION_VEC4 = KAGE_MAX_REGIONS / 4;
 layout(constant_id = 2) const uint BASIS_VEC4 = KAGE_TRANSFER_VEC4;
+layout(constant_id = 4) const bool PIXEL_COSINE = false;
 
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 transfer[KAGE_TRANSFER_VEC4];
 
-layout(location = 0) out vec3 self_shadowed;
+// L_s, or with PIXEL_COSINE albedo / pi E(n) - L_s.
+layout(location = 0) out vec3 self_term;
 layout(location = 1) out vec3 world_position;
-layout(location = 2) out vec4 region_transfer[REGION_VEC4];
+layout(location = 2) out vec3 world_normal;
+layout(location = 3) out vec4 region_transfer[REGION_VEC4];
 
 void main() {
     uint texel = draw.mesh.x + uint(gl_VertexIndex);
-    self_shadowed = texelFetch(self_shadow, ivec2(texel % draw.mesh.y, texel / draw.mesh.y), 0).rgb;
+    self_term = texelFetch(self_shadow, ivec2(texel % draw.mesh.y, texel / draw.mesh.y), 0).rgb;
     uint regions = draw.mesh.w, first = draw.mesh.z * regions;
     // The basis at each region's direction is evaluated exactly on the host once per group and
     // frame (Cartesian real SH, no table); here only the dot products remain.
@@ -41,6 +51,12 @@ void main() {
             }
         }
         region_transfer[k] = t;
+    }
+    // Uniform scale only: the model matrix's upper 3x3 keeps normals perpendicular.
+    world_normal = mat3(draw.model) * normal;
+    if (PIXEL_COSINE) {
+        vec3 unshadowed = max(sh9_irradiance(sh.c, env_world_to_map(normalize(world_normal), frame.env_params.y)), vec3(0.0));
+        self_term = draw.albedo.rgb / KAGE_PI * unshadowed - self_term;
     }
     vec4 world = draw.model * vec4(position, 1.0);
     world_position = world.xyz;

@@ -4,7 +4,8 @@
 // estimator is the mean of v_s(ω_k) y_i(ω_k). The directions are a Hammersley point set
 // (k/N, radical inverse of k) shifted per vertex by a hashed Cranley–Patterson rotation: the
 // unshadowed error falls about as 1/N, and neighbouring vertices do not share one pattern of
-// error. Visibility is tested against the vertex's own group, in its object space.
+// error. Visibility is tested against the vertex's own group, in its object space, or against
+// the whole scene as it stands (the ray taken to world space; the basis stays in object space).
 //
 // One dispatch casts rays [first, first + count) of every vertex in its range and adds their
 // sums to the vertex's running sums (the first dispatch stores), so one invocation never loops
@@ -68,6 +69,9 @@ void main() {
 
     vec4 s0 = vec4(0.0), s1 = vec4(0.0), s2 = vec4(0.0), s3 = vec4(0.0), s4 = vec4(0.0),
          s5 = vec4(0.0), s6 = vec4(0.0);
+    bool whole_scene = p.params.w == 1u;
+    mat4 to_world = bvh_instances[group].object_to_world;
+    vec3 world_origin = (to_world * vec4(origin, 1.0)).xyz;
     uint first = p.params.y;
     uint done = 0u;
     for (uint k = first; k < first + p.params.z; ++k) {
@@ -77,7 +81,10 @@ void main() {
         float phi = 2.0 * KAGE_PI * u.y;
         vec3 dir = normalize(r * cos(phi) * tangent + r * sin(phi) * bitangent
                              + sqrt(max(1.0 - u.x, 0.0)) * n);
-        if (!bvh_occluded_object_space(group, origin, dir, 1e30)) {
+        bool blocked = whole_scene
+            ? bvh_occluded(world_origin, normalize(mat3(to_world) * dir), 1e30)
+            : bvh_occluded_object_space(group, origin, dir, 1e30);
+        if (!blocked) {
             vec4 c0, c1, c2, c3, c4, c5, c6;
             sh25_basis(dir, c0, c1, c2, c3, c4, c5, c6);
             s0 += c0; s1 += c1; s2 += c2; s3 += c3; s4 += c4; s5 += c5; s6 += c6;

@@ -100,10 +100,11 @@ enum kage_technique
    * Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs
    * `kage_precompute`.
    */
-  KAGE_TECHNIQUE_SLOAN = 1,
+  KAGE_TECHNIQUE_SLOAN_SELF = 1,
   /**
    * Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from `regions`
-   * environment regions. Needs `kage_precompute`.
+   * environment regions, the `dominant_lights` brightest small lights of the map (a sun,
+   * lamps) taken out and lit per pixel with soft shadows. Needs `kage_precompute`.
    */
   KAGE_TECHNIQUE_TAMURA = 2,
   /**
@@ -127,6 +128,18 @@ enum kage_technique
    * edges coarser than its pixels, `asm_time_ms` of tile rendering per frame.
    */
   KAGE_TECHNIQUE_ASM = 6,
+  /**
+   * Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT with the whole
+   * scene's visibility at its pose when `kage_precompute` ran (shadows between groups baked
+   * into the vertices; they stay where they were when groups move). Needs `kage_precompute`.
+   */
+  KAGE_TECHNIQUE_SLOAN_SCENE = 7,
+  /**
+   * Tamura, Johan, Nishita as the paper has it: `regions` regions, the fixed penumbra from
+   * each region's solid angle, no dominant lights (`penumbra` and `dominant_lights` are not
+   * read). Needs `kage_precompute`.
+   */
+  KAGE_TECHNIQUE_TAMURA_PAPER = 8,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -195,6 +208,11 @@ typedef struct PrtParams PrtParams;
  * A rectangle of the light's view uv (u right, v down, the unit square the whole view).
  */
 typedef struct UvRect UvRect;
+
+/**
+ * What a vertex's transfer is shadowed by.
+ */
+typedef struct Visibility Visibility;
 
 /**
  * A Vulkan device, queue and memory allocator that scenes are precomputed and rendered with.
@@ -370,6 +388,16 @@ typedef struct {
    * default unshadowed. Sloan's PRT needs `kage_precompute` (with `sh_bands`, `prt_rays`).
    */
   uint32_t probe_statics;
+  /**
+   * Tamura: most dominant lights lit per pixel, 0 to 8 (they count among `regions`);
+   * default 4.
+   */
+  uint32_t dominant_lights;
+  /**
+   * Tamura: side of a group's depth map along a dominant light in texels, 16 to 4096;
+   * default 512.
+   */
+  uint32_t light_map_size;
 } kage_technique_desc;
 
 /**
@@ -757,7 +785,8 @@ kage_result kage_technique_desc_default(uint32_t technique, kage_technique_desc 
 /**
  * Computes on the context's device what `technique` needs before its first frame, and keeps
  * it in the scene for `kage_renderer_create`: for Sloan and Tamura the per-vertex PRT transfer
- * (seconds to minutes: it casts `prt_rays` rays per vertex); for the other techniques nothing.
+ * (seconds to minutes: it casts `prt_rays` rays per vertex; for `KAGE_TECHNIQUE_SLOAN_SCENE`
+ * against the whole scene as its group transforms stand); for the other techniques nothing.
  * A later call replaces what an earlier one computed.
  *
  * The scene keeps no reference to the context.

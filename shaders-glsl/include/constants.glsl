@@ -52,6 +52,11 @@
 #define KAGE_MAX_OCCLUSION_LAYERS 192
 // Invocations per workgroup of the occlusion box filter (one row or column each).
 #define KAGE_BLUR_GROUP 64
+// Most dominant lights (a sun, studio lamps) the Tamura technique lights per pixel beside its
+// regions (see engine/src/techniques/tamura/dominant.rs), and most depth maps of groups along
+// them per frame: their records sit in one uniform buffer (48 + 80 bytes each).
+#define KAGE_MAX_DOMINANT_LIGHTS 8
+#define KAGE_MAX_DOMINANT_MAPS 64
 
 // Most regions the parallel-lights baseline (the paper's Fig. 3) treats as directional lights:
 // one ParallelLight record each in a uniform buffer (96 bytes, 12 KiB in all, within the 16 KiB

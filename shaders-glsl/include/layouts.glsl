@@ -138,7 +138,7 @@ struct PrtVertex {
 // Push constants of the PRT transfer shader; one dispatch covers some rays of some vertices of one mesh.
 struct PrtTransferPush {
     uvec4 range; // x: first vertex (into the vertex buffer), y: vertex count, z: group (BVH instance), w: rays per vertex
-    uvec4 params; // x: coefficients per vertex (bands squared), y: first ray of this dispatch, z: rays in it, w: unused
+    uvec4 params; // x: coefficients per vertex (bands squared), y: first ray of this dispatch, z: rays in it, w: 1 to test visibility against the whole scene (world space), 0 against the vertex's group
 };
 
 // The environment's SH as one group's object space sees it, for the self-shadow pass: one
@@ -165,29 +165,55 @@ struct PrtDrawPush {
     mat4 model;
     vec4 albedo; // rgb: diffuse albedo, a: unused
     uvec4 mesh; // x: first self-shadow texel, y: texture width, z: group, w: regions (0: self-shadow only)
-    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: unused, w: mask size in texels
+    uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: the group's slot among the dominant lights' self-shadow maps plus one (0: none), w: mask size in texels
 };
 
-// One occlusion layer: the shadow of one occluder group on one receiver group for one region,
-// on the plane through the receiver's bounding-sphere centre perpendicular to the region's
-// direction.
+// One occlusion layer: the shadow of one occluder group on one receiver group for one region.
+// The mask is an orthographic view along the region's direction fitted to the occluder: its
+// plane goes through the occluder's bounding-sphere centre, perpendicular to the direction, and
+// its depth runs away from the light over both groups' spheres.
 struct OcclusionLayer {
-    vec4 centre; // xyz: receiver bounding-sphere centre (world), w: 1 / (2 x half-extent of the mask)
-    vec4 axis_u; // xyz: first unit axis of the plane, w: fixed penumbra: box filter width in texels (odd); adaptive: blocker search width in texels
-    vec4 axis_v; // xyz: second unit axis, w: sqrt of the region's solid angle
-    vec4 footprint; // xy: the occluder's centre in mask uv, z: radius in uv beyond which the filtered layer is 0, w: unused
-    uvec4 ids; // x: region, y: receiver group, z: occluder group, w: unused
+    vec4 centre; // xyz: occluder bounding-sphere centre (world), w: 1 / (2 x half-extent of the mask)
+    vec4 axis_u; // xyz: first unit axis of the plane, w: box width in texels (odd): fixed penumbra, the width of eq. (13); adaptive, the middle one
+    vec4 axis_v; // xyz: second unit axis, w: adaptive penumbra: the widest box in texels (odd)
+    vec4 footprint; // the mask uv rectangle beyond which the filtered layer is 0: xy min, zw max
+    uint region; // the region's index
+    uint occluder; // occluder group
+    float widen; // adaptive penumbra: box width in texels per world unit between occluder and receiver, sqrt(Omega_i) / texel size
+    float depth_range; // half the mask's depth range (world units), centred on the plane
 };
 
-// Push constants of the occluder mask pass: one draw per occluder mesh per layer.
+// Push constants of the occluder mask pass: one draw per receiver or occluder mesh per layer.
 struct MaskPush {
     mat4 model;
-    uvec4 layer; // x: occlusion layer index, y, z, w: unused
+    uvec4 layer; // x: occlusion layer index, y: 0 receiver (depth only), 1 occluder, z, w: unused
+    vec4 bias; // x: how far behind the receiver's surface an occluder fragment still counts as behind it (world units), yzw: unused
+};
+
+// A dominant light as the PRT scene pass lights it, with the groups' depth maps along it.
+struct DominantLight {
+    vec4 direction; // xyz: unit world direction towards the light, w: tangent of its angular radius
+    vec4 energy; // rgb: its energy B (radiance integrated over its solid angle), a: unused
+    uvec4 maps; // x: first of its maps in DominantLights.maps (one per group that shadows itself), y: their count, zw: unused
+};
+
+// One group's depth map along a dominant light, for its own shadow: an orthographic view of the
+// group's bounding sphere along the light, depth 0 at the sphere's point nearest the light, 1 at
+// its farthest.
+struct DominantMap {
+    mat4 view_proj; // world to the map's clip space
+    vec4 params; // x: world size of a texel, y: map texels per side, zw: unused
+};
+
+// Every dominant light and map of the frame (a uniform buffer).
+struct DominantLights {
+    DominantLight lights[KAGE_MAX_DOMINANT_LIGHTS];
+    DominantMap maps[KAGE_MAX_DOMINANT_MAPS];
 };
 
 // Push constants of the occlusion box filter.
 struct BlurPush {
-    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: 0 box filter, 1 prefix sums
+    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: 0 the paper's one box, 1 the adaptive penumbra's three boxes (see occlusion_blur.comp)
 };
 
 // One region of the parallel-lights baseline as a directional light with a binary shadow map.

@@ -79,26 +79,49 @@ void env_sample(vec2 u, float total, out vec3 dir, out vec3 radiance, out float 
     pdf = luminance(radiance) / total;
 }
 
+// Candidates of the environment strategy's resampling (see env_irradiance_sample).
+const uint REFERENCE_CANDIDATES = 16u;
+
 // One two-sample estimate of E = integral of L_env(w) V(w) max(dot(n, w), 0) dw at p: one
-// direction from the environment distribution and one cosine-weighted, combined by the power
+// direction from the environment strategy and one cosine-weighted, combined by the power
 // heuristic. `ng` is the geometric normal on the side the light arrives from: directions below
 // it are blocked by the surface itself (with smooth shading normals they exist), and shadow
 // rays leave from p offset along it. total == 0 (a black map) means cosine sampling alone.
+//
+// The environment strategy resamples (Talbot et al. 2005, resampled importance sampling): of
+// REFERENCE_CANDIDATES directions drawn in proportion to luminance, one is kept in proportion
+// to its cosine, so the shadow ray goes where L cos is large. A few bright lamps low over the
+// horizon (studio maps) are drawn as often as their energy says, but light a floor in
+// proportion to their cosine: without resampling most shadow rays went to lamps that light
+// little. The kept direction y contributes f(y) W, W = mean(w) / (luminance(y) cos(y) / total)
+// with w = cos (the candidates' target over their pdf, up to the constant total): unbiased for
+// any target that is positive wherever f is. Its MIS weight takes the luminance pdf: any
+// weights that add up to one per direction keep the sum unbiased.
 vec3 env_irradiance_sample(vec3 p, vec3 n, vec3 ng, float total, inout Rng rng) {
     vec3 origin = offset_ray_origin(p, ng);
     vec3 sum = vec3(0.0);
-    vec2 u_env = vec2(rng_next(rng), rng_next(rng));
-    vec2 u_cos = vec2(rng_next(rng), rng_next(rng));
     if (total > 0.0) {
-        vec3 dir, radiance;
-        float pdf;
-        env_sample(u_env, total, dir, radiance, pdf);
-        float cos_n = dot(n, dir);
-        if (pdf > 0.0 && cos_n > 0.0 && dot(ng, dir) > 0.0
-            && !bvh_occluded(origin, dir, REFERENCE_FAR)) {
-            sum += power_heuristic(pdf, cos_n / REFERENCE_PI) * radiance * (cos_n / pdf);
+        vec3 kept_dir = vec3(0.0), kept_radiance = vec3(0.0);
+        float kept_pdf = 0.0, weights = 0.0;
+        for (uint k = 0u; k < REFERENCE_CANDIDATES; ++k) {
+            vec3 dir, radiance;
+            float pdf;
+            env_sample(vec2(rng_next(rng), rng_next(rng)), total, dir, radiance, pdf);
+            float w = pdf > 0.0 && dot(ng, dir) > 0.0 ? max(dot(n, dir), 0.0) : 0.0;
+            weights += w;
+            if (w > 0.0 && rng_next(rng) * weights < w) {
+                kept_dir = dir;
+                kept_radiance = radiance;
+                kept_pdf = pdf;
+            }
+        }
+        if (weights > 0.0 && !bvh_occluded(origin, kept_dir, REFERENCE_FAR)) {
+            float cos_n = dot(n, kept_dir);
+            sum += power_heuristic(kept_pdf, cos_n / REFERENCE_PI) * kept_radiance
+                * (weights / float(REFERENCE_CANDIDATES) / kept_pdf);
         }
     }
+    vec2 u_cos = vec2(rng_next(rng), rng_next(rng));
     vec3 dir = sample_cosine(n, u_cos);
     float cos_n = dot(n, dir);
     if (cos_n > 0.0 && dot(ng, dir) > 0.0 && !bvh_occluded(origin, dir, REFERENCE_FAR)) {

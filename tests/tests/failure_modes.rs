@@ -105,8 +105,15 @@ fn degenerate_mesh() -> Mesh {
 
 /// Every technique at its cheapest settings; the PRT transfer is computed for `scene`.
 fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, TechniqueChoice)> {
-    let transfer =
-        Arc::new(transfer::precompute(ctx, scene, PrtParams { bands: 3, rays: 16 }, &mut |_, _| {}).unwrap());
+    let transfer = Arc::new(
+        transfer::precompute(
+            ctx,
+            scene,
+            PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
+            &mut |_, _| {},
+        )
+        .unwrap(),
+    );
     let prt = |regions| TechniqueChoice::Prt {
         transfer: transfer.clone(),
         occlusion: OcclusionSettings { regions, mask_size: 16, ..Default::default() },
@@ -296,7 +303,12 @@ fn meshes_without_triangles_are_errors_and_empty_groups_draw_nothing() {
     let expected = ["group 1 (\"hollow\")", "mesh 0", "no triangles"];
     assert_error_says(Renderer::new(&ctx, &empty_mesh, &RenderOptions::default()), &expected);
     assert_error_says(
-        transfer::precompute(&ctx, &empty_mesh, PrtParams { bands: 3, rays: 16 }, &mut |_, _| {}),
+        transfer::precompute(
+            &ctx,
+            &empty_mesh,
+            PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
+            &mut |_, _| {},
+        ),
         &expected,
     );
     assert_error_says(SceneBvh::build(&empty_mesh), &expected);
@@ -473,7 +485,13 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
 
     let scene = scene(vec![group("object", vec![degenerate_mesh()], Vec3::ZERO), room()]);
     let transfer = Arc::new(
-        transfer::precompute(&ctx, &scene, PrtParams { bands: 3, rays: 16 }, &mut |_, _| {}).unwrap(),
+        transfer::precompute(
+            &ctx,
+            &scene,
+            PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
+            &mut |_, _| {},
+        )
+        .unwrap(),
     );
     let occlusion = OcclusionSettings { regions: 64, mask_size: 2048, ..Default::default() };
     let technique = TechniqueChoice::Prt { transfer, occlusion };

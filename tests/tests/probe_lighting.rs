@@ -63,7 +63,7 @@ fn static_groups_keep_their_own_prt_lighting_beside_the_probe_lit_bunny() {
     use std::sync::Arc;
     let ctx = Validated::new();
     let scene = Scene::builtin("probe-room").unwrap();
-    let params = PrtParams { bands: 3, rays: 16 };
+    let params = PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT };
     let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| {}).unwrap());
     let probes = ProbeSettings {
         placement: ProbePlacement::Grid([2, 2, 2]),

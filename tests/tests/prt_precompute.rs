@@ -22,7 +22,7 @@ fn scene_of(groups: Vec<Vec<Mesh>>) -> Scene {
 }
 
 fn precompute(ctx: &Validated, scene: &Scene, bands: u32, rays: u32) -> TransferSet {
-    transfer::precompute(ctx, scene, PrtParams { bands, rays }, &mut |_, _| {}).unwrap()
+    transfer::precompute(ctx, scene, PrtParams { bands, rays, ..PrtParams::DEFAULT }, &mut |_, _| {}).unwrap()
 }
 
 /// An open box (a cup) of half-width 1 and height `height` standing on y = 0, every face a
@@ -186,7 +186,7 @@ fn cache_round_trips_and_detects_every_kind_of_stale_file() {
         vec![shapes::sphere("ball", 1.0, 8, [0.5; 3]).unwrap()],
         vec![cup(1.0), shapes::sphere("small", 0.3, 6, [0.2; 3]).unwrap()],
     ]);
-    let params = PrtParams { bands: 3, rays: 32 };
+    let params = PrtParams { bands: 3, rays: 32, ..PrtParams::DEFAULT };
     let set = transfer::precompute(&ctx, &scene, params, &mut |_, _| {}).unwrap();
     let key = CacheKey::new(&scene, params);
     let path = dir.join(key.file_name(&scene.name));
@@ -212,7 +212,7 @@ fn cache_round_trips_and_detects_every_kind_of_stale_file() {
     let small = regrouped.groups[1].meshes.pop().unwrap();
     regrouped.groups[0].meshes.push(small);
     assert_eq!(cache::load(&path, &CacheKey::new(&regrouped, params)), Err(Stale::Geometry));
-    let other = |bands, rays| CacheKey::new(&scene, PrtParams { bands, rays });
+    let other = |bands, rays| CacheKey::new(&scene, PrtParams { bands, rays, ..PrtParams::DEFAULT });
     assert_eq!(cache::load(&path, &other(4, 32)), Err(Stale::Bands { found: 3, wanted: 4 }));
     assert_eq!(cache::load(&path, &other(3, 64)), Err(Stale::Rays { found: 32, wanted: 64 }));
 
@@ -252,9 +252,14 @@ fn bad_parameters_are_errors_not_panics() {
     let ctx = Validated::new();
     let scene = scene_of(vec![vec![shapes::sphere("ball", 1.0, 4, [0.5; 3]).unwrap()]]);
     for (bands, rays) in [(1, 64), (6, 64), (3, 0), (3, u32::MAX)] {
-        let err = transfer::precompute(&ctx, &scene, PrtParams { bands, rays }, &mut |_, _| {})
-            .unwrap_err()
-            .to_string();
+        let err = transfer::precompute(
+            &ctx,
+            &scene,
+            PrtParams { bands, rays, ..PrtParams::DEFAULT },
+            &mut |_, _| {},
+        )
+        .unwrap_err()
+        .to_string();
         assert!(err.contains("PRT with"), "{err}");
     }
 }

@@ -1,21 +1,20 @@
 //! The Tamura–Johan–Nishita technique and Sloan's PRT on the real driver.
 use glam::{Mat3, Mat4, Vec3};
-use kage::backend::{vk, Binding, BindingKind, Buffer, ComputePipeline, Image, ImageDesc};
+use kage::backend::{vk, Binding, BindingKind, Buffer, ComputePipeline, Edge, Image, ImageDesc, Sampler};
 use kage::layouts::{bytes_of, bytes_of_slice, spirv, BlurPush, OcclusionLayer};
 use kage::pass::{FrameExecutor, Pass};
 use kage::renderer::{GpuScene, RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::Scene;
-use kage::techniques::prt::{transfer, PrtParams, TransferSet};
-use kage::techniques::tamura::occlusion::{group_bounds, Occlusion};
+use kage::techniques::prt::TransferSet;
+use kage::techniques::tamura::occlusion::{group_bounds, Occlusion, RegionSize};
 use kage::techniques::tamura::regions::Regions;
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use kage_tests::Validated;
 use std::sync::Arc;
 
-/// Few rays: these tests look at where shadows fall, not at the transfer's last digits.
 fn transfer_of(ctx: &Validated, scene: &Scene) -> Arc<TransferSet> {
-    Arc::new(transfer::precompute(ctx, scene, PrtParams { bands: 3, rays: 128 }, &mut |_, _| {}).unwrap())
+    kage_tests::shadow_test_transfer(ctx, scene)
 }
 
 fn prt(transfer: &Arc<TransferSet>, regions: usize) -> TechniqueChoice {
@@ -25,31 +24,39 @@ fn prt(transfer: &Arc<TransferSet>, regions: usize) -> TechniqueChoice {
     }
 }
 
-/// Runs the two 1D passes of the occlusion filter (mode 0: box of `width` texels; mode 1:
-/// prefix sums) over one `size`² layer of (coverage, coverage × height) texels.
-fn filter_layer(ctx: &Validated, size: u32, width: u32, mode: u32, texels: &[[f32; 2]]) -> Vec<[f32; 2]> {
-    let image = |name: &str| {
-        let usage = vk::ImageUsageFlags::STORAGE
-            | vk::ImageUsageFlags::TRANSFER_DST
-            | vk::ImageUsageFlags::TRANSFER_SRC;
-        let desc = ImageDesc {
-            name,
-            width: size,
-            height: size,
-            layers: 1,
-            array: true,
-            format: vk::Format::R32G32_SFLOAT,
-            usage,
-        };
-        Image::new(ctx, &desc).unwrap()
+/// Runs the two 1D passes of the occlusion filter over one `size`² layer of (coverage,
+/// coverage × height) mask texels and returns the filtered RGBA texels. `adaptive` false: the
+/// paper's one box of `widths[1]` texels; true: boxes of 1, `widths[0]` and `widths[1]`.
+fn filter_layer(
+    ctx: &Validated,
+    size: u32,
+    widths: [u32; 2],
+    adaptive: bool,
+    texels: &[[f32; 2]],
+) -> Vec<[f32; 4]> {
+    let image = |name: &str, format, usage| {
+        let usage = usage | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC;
+        Image::new(ctx, &ImageDesc::square_array(name, size, 1, format, usage)).unwrap()
     };
-    let (mask, temp, filtered) = (image("mask"), image("temp"), image("filtered"));
+    let (sampled, storage) =
+        (vk::ImageUsageFlags::SAMPLED, vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED);
+    let mask = image("mask", vk::Format::R32G32_SFLOAT, sampled);
+    let (temp, filtered) = (
+        image("temp", vk::Format::R32G32B32A32_SFLOAT, storage),
+        image("filtered", vk::Format::R32G32B32A32_SFLOAT, storage),
+    );
     mask.upload(&texels.iter().flatten().flat_map(|t| t.to_ne_bytes()).collect::<Vec<u8>>()).unwrap();
-    let layer = OcclusionLayer { axis_u: [1.0, 0.0, 0.0, width as f32], ..Default::default() };
+    let (middle, widest) = if adaptive { (widths[0], widths[1]) } else { (widths[1], widths[1]) };
+    let layer = OcclusionLayer {
+        axis_u: [1.0, 0.0, 0.0, middle as f32],
+        axis_v: [0.0, 1.0, 0.0, widest as f32],
+        ..Default::default()
+    };
     let layers =
         Buffer::with_data(ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer]))
             .unwrap();
-    let kinds = [BindingKind::StorageBuffer, BindingKind::StorageImage, BindingKind::StorageImage];
+    let nearest = Sampler::new(ctx, "nearest", false, Edge::Clamp, Edge::Clamp).unwrap();
+    let kinds = [BindingKind::StorageBuffer, BindingKind::SampledImage, BindingKind::StorageImage];
     let blur = ComputePipeline::new(
         ctx,
         "occlusion_blur",
@@ -59,8 +66,9 @@ fn filter_layer(ctx: &Validated, size: u32, width: u32, mode: u32, texels: &[[f3
     )
     .unwrap();
     let filter = |cmd, direction: u32, from: &Image, to: &Image| {
-        let push = BlurPush { params: [direction, size, 1, mode] };
-        let bindings = [Binding::Storage(&layers), Binding::StorageImage(from), Binding::StorageImage(to)];
+        let push = BlurPush { params: [direction, size, 1, adaptive as u32] };
+        let bindings =
+            [Binding::Storage(&layers), Binding::Sampled(from, &nearest), Binding::StorageImage(to)];
         blur.dispatch(cmd, &bindings, bytes_of(&push), [1, 1, 1])
     };
     let mut executor = FrameExecutor::new(ctx, "filter").unwrap();
@@ -75,49 +83,53 @@ fn filter_layer(ctx: &Validated, size: u32, width: u32, mode: u32, texels: &[[f3
         .chunks_exact(4)
         .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
-    floats.chunks_exact(2).map(|c| [c[0], c[1]]).collect()
+    floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
 }
 
-/// The paper's filter on one texel: a w×w box of 1/w² in both channels (sliding sums of zeros
-/// and one value are exact; rounding only in the final scale).
+/// 1/w² inside the w×w box centred on (9, 7), 0 outside.
+fn box_of(width: u32, x: i32, y: i32) -> f32 {
+    let half = width as i32 / 2;
+    if (x - 9).abs() <= half && (y - 7).abs() <= half {
+        1.0 / (width * width) as f32
+    } else {
+        0.0
+    }
+}
+
+/// One mask texel at (9, 7) of coverage 1 and coverage × height 2.5.
+fn point_mask(size: u32) -> Vec<[f32; 2]> {
+    let mut texels = vec![[0.0f32; 2]; (size * size) as usize];
+    texels[(7 * size + 9) as usize] = [1.0, 2.5];
+    texels
+}
+
+/// The paper's filter on one texel: a w×w box of 1/w² in the coverage channel (sliding sums of
+/// zeros and one value are exact; rounding only in the final scale, below 1e-7).
 #[test]
 fn box_filter_of_a_point_is_a_box() {
     let ctx = Validated::new();
     let (size, width) = (16u32, 5u32);
-    let mut texels = vec![[0.0f32; 2]; (size * size) as usize];
-    texels[(7 * size + 9) as usize] = [1.0, 2.5];
-    let out = filter_layer(&ctx, size, width, 0, &texels);
-    let scale = 1.0f32 / (width * width) as f32;
+    let out = filter_layer(&ctx, size, [1, width], false, &point_mask(size));
     for (i, got) in out.iter().enumerate() {
         let (x, y) = (i as i32 % size as i32, i as i32 / size as i32);
-        let inside = (x - 9).abs() <= 2 && (y - 7).abs() <= 2;
-        let expected = if inside { [scale, 2.5 * scale] } else { [0.0, 0.0] };
-        assert!(
-            (got[0] - expected[0]).abs() < 1e-7 && (got[1] - expected[1]).abs() < 1e-6,
-            "({x}, {y}): {got:?}"
-        );
+        assert!((got[0] - box_of(width, x, y)).abs() < 1e-7, "({x}, {y}): {got:?}");
     }
 }
 
-/// The adaptive penumbra's prefix-sum mode: the two passes leave the summed-area table, checked
-/// exactly (small integers sum without rounding in f32).
+/// The adaptive penumbra's filter leaves three boxes side by side: R the coverage itself, G
+/// the middle box, B the widest, A the widest over coverage × height (exact up to the final
+/// scale, as above).
 #[test]
-fn prefix_passes_build_the_summed_area_table() {
+fn adaptive_filter_leaves_three_box_widths_side_by_side() {
     let ctx = Validated::new();
-    let size = 16u32;
-    let texels: Vec<[f32; 2]> = (0..size * size).map(|i| [(i % 3) as f32, ((i * 7) % 5) as f32]).collect();
-    let out = filter_layer(&ctx, size, 1, 1, &texels);
-    for y in 0..size {
-        for x in 0..size {
-            let mut expected = [0.0f32; 2];
-            for j in 0..=y {
-                for i in 0..=x {
-                    let t = texels[(j * size + i) as usize];
-                    expected[0] += t[0];
-                    expected[1] += t[1];
-                }
-            }
-            assert_eq!(out[(y * size + x) as usize], expected, "({x}, {y})");
+    let (size, middle, widest) = (16u32, 3u32, 7u32);
+    let out = filter_layer(&ctx, size, [middle, widest], true, &point_mask(size));
+    for (i, got) in out.iter().enumerate() {
+        let (x, y) = (i as i32 % size as i32, i as i32 / size as i32);
+        let expected =
+            [box_of(1, x, y), box_of(middle, x, y), box_of(widest, x, y), 2.5 * box_of(widest, x, y)];
+        for c in 0..4 {
+            assert!((got[c] - expected[c]).abs() < 1e-6, "({x}, {y}) channel {c}: {got:?} != {expected:?}");
         }
     }
 }
@@ -202,50 +214,57 @@ fn the_teapot_casts_a_contact_shadow_on_the_floor() {
 }
 
 /// The scene pass reads a layer only where a receiver point projects within the layer's
-/// footprint (a circle around the occluder's centre: its bounding sphere, the box's half width
-/// and one texel for bilinear reads). That skip is exact only if every texel a read outside the
-/// circle can touch is 0: checked texel by texel on every layer of the default scene at four
-/// poses of the animation (the teapot standing, sliding, hopping, turned). Texels whose centre
-/// is within one texel of the circle may be touched from inside and are not checked. "0" up to
-/// the rounding of the filter's running sums: a sum of at most 128 values ≤ 1, each addition
-/// and removal off by half an ulp, stays within 128 ε of the exact zero.
+/// footprint (a rectangle of mask uv around the occluder's silhouette, widened by the widest
+/// box's half width and one texel for bilinear reads). That skip is exact only if every texel a
+/// read outside the rectangle can touch is 0, that is every texel whose centre lies more than
+/// one texel inside the rectangle's edge or beyond it: checked texel by texel, every channel, on
+/// every layer of the default scene at four poses of the animation (the teapot standing,
+/// sliding, hopping, turned), with both penumbras. "0" up to the rounding of the filter's
+/// running sums: a sum of at most `size` values ≤ 1, each addition and removal off by half an
+/// ulp, stays within `size` ε of the exact zero.
 #[test]
 fn filtered_layers_are_zero_outside_their_footprint() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
     let size = 128;
-    let regions = Regions::new(&scene.environment, 32).unwrap();
-    let mut occlusion =
-        Occlusion::new(&ctx, regions, 3, group_bounds(&scene), size, 64, Penumbra::Fixed).unwrap();
-    let mut executor = FrameExecutor::new(&ctx, "footprint").unwrap();
+    let texel = 1.0 / size as f32;
     let mut checked = 0usize;
-    for t in [0.0, 0.1, 0.3, 0.6] {
-        let mut transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
-        transforms[0] = pose(&scene.groups[0], t).matrix();
-        occlusion.update(&transforms, Mat3::IDENTITY).unwrap();
-        let layers = occlusion.layers_in_use().to_vec();
-        assert!(!layers.is_empty(), "pose {t}: no occlusion layer");
-        let mut moved = GpuScene::new(&ctx, &scene).unwrap();
-        moved.transforms = transforms;
-        executor.run(&[], occlusion.passes(&ctx, &moved)).unwrap();
-        let texels = occlusion.filtered.read().unwrap();
-        let layer_bytes = (size * size * 8) as usize;
-        for (l, layer) in layers.iter().enumerate() {
-            let [cx, cy, reach, _] = layer.footprint;
-            for y in 0..size {
-                for x in 0..size {
-                    let (u, v) = ((x as f32 + 0.5) / size as f32, (y as f32 + 0.5) / size as f32);
-                    let distance = ((u - cx).powi(2) + (v - cy).powi(2)).sqrt();
-                    if distance <= reach + 1.0 / size as f32 {
-                        continue;
+    for penumbra in [Penumbra::Fixed, Penumbra::Adaptive] {
+        let regions = Regions::new(&scene.environment, 32).unwrap();
+        let bounds = group_bounds(&scene);
+        let mut occlusion =
+            Occlusion::new(&ctx, regions, &[], 3, bounds, size, 64, penumbra, RegionSize::Energy).unwrap();
+        let mut executor = FrameExecutor::new(&ctx, "footprint").unwrap();
+        for t in [0.0, 0.1, 0.3, 0.6] {
+            let mut transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
+            transforms[0] = pose(&scene.groups[0], t).matrix();
+            occlusion.update(&transforms, Mat3::IDENTITY).unwrap();
+            let layers = occlusion.layers_in_use().to_vec();
+            assert!(!layers.is_empty(), "pose {t}: no occlusion layer");
+            let mut moved = GpuScene::new(&ctx, &scene).unwrap();
+            moved.transforms = transforms;
+            executor.run(&[], occlusion.passes(&ctx, &moved)).unwrap();
+            let bytes = occlusion.filtered.read().unwrap();
+            let layer_bytes = (size * size * 16) as usize;
+            for (l, layer) in layers.iter().enumerate() {
+                let [u0, v0, u1, v1] = layer.footprint;
+                for y in 0..size {
+                    for x in 0..size {
+                        let (u, v) = ((x as f32 + 0.5) * texel, (y as f32 + 0.5) * texel);
+                        if u > u0 + texel && u < u1 - texel && v > v0 + texel && v < v1 - texel {
+                            continue;
+                        }
+                        let at = l * layer_bytes + ((y * size + x) * 16) as usize;
+                        for c in 0..4 {
+                            let value =
+                                f32::from_ne_bytes(bytes[at + 4 * c..at + 4 * c + 4].try_into().unwrap());
+                            assert!(
+                                value.abs() <= size as f32 * f32::EPSILON,
+                                "{penumbra:?}, pose {t}, layer {l}, texel ({x}, {y}), channel {c}: {value} outside the footprint"
+                            );
+                        }
+                        checked += 1;
                     }
-                    let at = l * layer_bytes + ((y * size + x) * 8) as usize;
-                    let value = f32::from_ne_bytes(texels[at..at + 4].try_into().unwrap());
-                    assert!(
-                        value.abs() <= size as f32 * f32::EPSILON,
-                        "pose {t}, layer {l}, texel ({x}, {y}): {value} outside the footprint"
-                    );
-                    checked += 1;
                 }
             }
         }

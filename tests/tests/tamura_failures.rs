@@ -15,7 +15,8 @@ use kage::reference::{compare, IrradianceReference, LightMode, ReferenceOptions,
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::{shapes, EnvMap, Group, Scene, Transform};
-use kage::techniques::prt::{transfer, PrtParams, TransferSet};
+use kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
+use kage::techniques::prt::TransferSet;
 use kage::techniques::tamura::technique::OcclusionSettings;
 use kage_tests::Validated;
 use std::path::PathBuf;
@@ -25,7 +26,7 @@ use std::sync::Arc;
 const REGIONS: usize = 32;
 
 fn transfer_of(ctx: &Validated, scene: &Scene) -> Arc<TransferSet> {
-    Arc::new(transfer::precompute(ctx, scene, PrtParams { bands: 3, rays: 128 }, &mut |_, _| {}).unwrap())
+    kage_tests::shadow_test_transfer(ctx, scene)
 }
 
 /// Renders `scene` with the PRT technique (`regions` = 0: Sloan's; otherwise Tamura's), after
@@ -151,22 +152,9 @@ fn masked_relative_rmse(a: &RgbaF32Image, b: &RgbaF32Image, keep: &[bool]) -> f6
     (sq / n as f64).sqrt() / (sum / n as f64)
 }
 
-/// The map `NAME` from tests/assets/ (where the tests' maps are kept), else from the shared
-/// assets (`$KAGE_SHARED_DIR/assets/env`, `shared/` in the checkout or beside it). Missing is a
-/// failure, not a skip.
-fn shared_env(name: &str) -> EnvMap {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let shared = std::env::var_os("KAGE_SHARED_DIR")
-        .map(PathBuf::from)
-        .into_iter()
-        .chain([root.join("shared"), root.join("../shared")])
-        .map(|d| d.join("assets/env").join(name));
-    let candidates: Vec<PathBuf> =
-        std::iter::once(root.join("tests/assets").join(name)).chain(shared).collect();
-    let path = candidates.iter().find(|p| p.exists()).unwrap_or_else(|| {
-        panic!("{name} not found (looked at {candidates:?}); the shared assets are part of the test set-up")
-    });
-    EnvMap::load(path).unwrap()
+/// The map `name` from tests/assets/.
+fn test_env(name: &str) -> EnvMap {
+    EnvMap::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets").join(name)).unwrap()
 }
 
 fn sphere_group(name: &str, radius: f32, centre: Vec3) -> Group {
@@ -284,24 +272,46 @@ fn contact_with_the_floor_darkens_the_floor_beside_the_base() {
 }
 
 /// Case 3: A single tiny, very bright sun (city.exr) on the default scene: nearly all light comes
-/// from a few regions, so the sun's region decides the shadow. Tamura must still beat Sloan's
-/// relative RMSE against the reference (the issue's acceptance criterion, per map).
+/// from the sun, so its shadow decides the error. Against the strongest baseline doing the same
+/// job, parallel lights at the same q, Tamura's default errs 1.26× as much at this size (64²;
+/// 1.02× at 128², BENCHMARKS.md): the bound, 1.4×, catches a regression of a tenth of the
+/// error, and Tamura must stay well below Sloan's error (no shadows between groups), here 3×.
+/// The reference runs to 4096 spp; its noise (printed, about 0.8 %) is taken out of each error
+/// in quadrature (independent noise adds to the squared error).
 #[test]
-fn a_tiny_bright_sun_still_beats_sloan() {
+fn a_tiny_bright_sun_holds_against_parallel_lights() {
     let ctx = Validated::new();
     let mut scene = Scene::builtin("teapot").unwrap();
-    scene.environment = shared_env("city.exr");
+    scene.environment = test_env("city.exr");
     let size = 64;
     let t = transfer_of(&ctx, &scene);
     let tamura = render(&ctx, &scene, &t, REGIONS, size);
     let sloan = render(&ctx, &scene, &t, 0, size);
-    // The sun is importance-sampled, so 512 spp leave ≈ 3 % noise (BENCHMARKS.md), which adds to
-    // both errors alike (in quadrature); the gap measured is much larger.
-    let (reference, noise) = reference(&ctx, &scene, size, 512);
-    let tamura_error = compare(&tamura, &reference).unwrap().relative_rmse;
-    let sloan_error = compare(&sloan, &reference).unwrap().relative_rmse;
-    println!("city.exr: relative RMSE tamura {tamura_error:.4}, sloan {sloan_error:.4} (reference noise {noise:.4})");
-    assert!(tamura_error < sloan_error, "tamura {tamura_error:.4} is not below sloan {sloan_error:.4}");
+    let technique =
+        TechniqueChoice::ParallelLights { regions: REGIONS, shadow_map_size: DEFAULT_SHADOW_MAP_SIZE };
+    let mut renderer =
+        Renderer::new(&ctx, &scene, &RenderOptions { width: size, height: size, technique }).unwrap();
+    renderer.render().unwrap();
+    let parallel = renderer.image().unwrap();
+    let (reference, noise) = reference(&ctx, &scene, size, 4096);
+    let error = |image: &RgbaF32Image| {
+        let e = compare(image, &reference).unwrap().relative_rmse;
+        (e * e - noise * noise).max(0.0).sqrt()
+    };
+    let (tamura_error, parallel_error, sloan_error) = (error(&tamura), error(&parallel), error(&sloan));
+    println!(
+        "city.exr: relative RMSE less the reference's noise: tamura {tamura_error:.4}, parallel lights \
+         {parallel_error:.4}, sloan {sloan_error:.4} (reference noise {noise:.4})"
+    );
+    assert!(noise < 0.25 * parallel_error, "reference noise {noise:.4} too close to the errors it ranks");
+    assert!(
+        tamura_error <= 1.4 * parallel_error,
+        "tamura {tamura_error:.4} is more than 1.4x parallel lights' {parallel_error:.4}"
+    );
+    assert!(
+        tamura_error < 0.5 * sloan_error,
+        "tamura {tamura_error:.4} is not below half sloan's {sloan_error:.4}"
+    );
 }
 
 /// Case 4: The light turning: the environment rotated 0°, 1°, …, 10° about +Y with the scene fixed,
@@ -317,7 +327,7 @@ fn a_tiny_bright_sun_still_beats_sloan() {
 fn a_turning_light_changes_the_picture_without_popping() {
     let ctx = Validated::new();
     let mut scene = Scene::builtin("teapot").unwrap();
-    scene.environment = shared_env("city.exr");
+    scene.environment = test_env("city.exr");
     let size = 64;
     let geometry: Vec<bool> = visible_groups(&scene, size).iter().map(Option::is_some).collect();
     let t = transfer_of(&ctx, &scene);

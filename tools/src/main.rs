@@ -4,6 +4,7 @@ mod bench_asm;
 mod bench_probe_count;
 mod bench_probes;
 mod compare;
+mod env_cmd;
 mod info;
 mod precompute;
 mod probe_image;
@@ -15,7 +16,7 @@ mod sh_cmd;
 mod sweep;
 mod transfer_source;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
 use kage::backend::{Context, ContextDesc};
 use std::sync::Arc;
@@ -64,6 +65,10 @@ pub struct SceneArgs {
     /// Look from keyframe K (from 0) of the scene's camera walkthrough instead of its camera.
     #[arg(long)]
     keyframe: Option<usize>,
+    /// Light the scene with this equirectangular map (.exr or .hdr, 2:1) instead of its own
+    /// (`kage env sun` makes sun maps).
+    #[arg(long)]
+    env: Option<std::path::PathBuf>,
 }
 
 impl SceneArgs {
@@ -78,6 +83,10 @@ impl SceneArgs {
                 );
             };
             scene.camera = *camera;
+        }
+        if let Some(path) = &self.env {
+            scene.environment =
+                kage::scene::EnvMap::load(path).with_context(|| format!("--env {}", path.display()))?;
         }
         report_clamped(&scene.environment);
         Ok(scene)
@@ -116,6 +125,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Print an environment map's 9 SH coefficients per channel (projected on the GPU).
     Sh(sh_cmd::ShArgs),
+    /// Environment-map utilities: synthetic sun maps.
+    #[command(subcommand)]
+    Env(env_cmd::EnvCommand),
     /// Print the device, driver, Vulkan version and each feature Kage uses.
     Info(GpuArgs),
     /// Precompute the PRT transfer of every vertex (cached; prints time and bytes).
@@ -151,6 +163,7 @@ fn main() {
     let result = match cli.command {
         Command::Render(args) => render::run(&args),
         Command::Sh(args) => sh_cmd::run(&args),
+        Command::Env(command) => env_cmd::run(&command),
         Command::Info(args) => info::run(&args),
         Command::Precompute(args) => precompute::run(&args),
         Command::Scene(command) => scene_cmd::run(&command),

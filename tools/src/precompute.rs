@@ -6,7 +6,7 @@ use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use kage::scene::Scene;
-use kage::techniques::prt::TransferSet;
+use kage::techniques::prt::{PrtParams, TransferSet, Visibility};
 
 #[derive(Args)]
 pub struct PrecomputeArgs {
@@ -15,12 +15,26 @@ pub struct PrecomputeArgs {
     scene: String,
     #[command(flatten)]
     prt: PrtArgs,
+    /// Whose shadows the transfer holds: `group` (each group's own: sloan-self, tamura) or
+    /// `scene` (the whole scene at rest: sloan-scene).
+    #[arg(long, value_enum, default_value_t = VisibilityName::Group)]
+    visibility: VisibilityName,
     #[command(flatten)]
     gpu: GpuArgs,
 }
 
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum VisibilityName {
+    Group,
+    Scene,
+}
+
 pub fn run(args: &PrecomputeArgs) -> Result<()> {
-    let params = args.prt.params()?;
+    let visibility = match args.visibility {
+        VisibilityName::Group => Visibility::Group,
+        VisibilityName::Scene => Visibility::Scene,
+    };
+    let params = PrtParams { visibility, ..args.prt.params()? };
     let scene = Scene::from_arg(&args.scene)?;
     println!(
         "scene {}: {} groups, {} meshes, {} vertices; {} SH bands ({} coefficients per vertex), \
@@ -34,7 +48,7 @@ pub fn run(args: &PrecomputeArgs) -> Result<()> {
         params.rays
     );
     let ctx = args.gpu.context()?;
-    let (set, origin) = args.prt.obtain(&ctx, &scene)?;
+    let (set, origin) = args.prt.obtain(&ctx, &scene, params)?;
     match origin {
         Origin::Cached(path) => {
             println!("cache: {} is valid, nothing to compute", path.display());

@@ -24,9 +24,16 @@ pub enum TechniqueName {
     /// SH irradiance, no shadows.
     Unshadowed,
     /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only.
-    Sloan,
-    /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups, q regions.
+    SloanSelf,
+    /// Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT whose
+    /// visibility is the whole scene at rest (shadows between groups baked into the vertices).
+    SloanScene,
+    /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups from q regions, the
+    /// map's few brightest small lights (sun, lamps) lit per pixel with soft shadows.
     Tamura,
+    /// Tamura, Johan, Nishita as the paper has it: q regions, the fixed penumbra from each
+    /// region's solid angle, no dominant lights.
+    TamuraPaper,
     /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
     ParallelLights,
     /// The scene's point and spot lights, one conventional shadow map each (hard shadows).
@@ -98,6 +105,13 @@ pub struct RenderArgs {
     /// Side of a Tamura occlusion mask layer, texels.
     #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
     mask_size: u32,
+    /// Most dominant lights (small, bright parts of the map: a sun, lamps) Tamura takes out of
+    /// the map and lights per pixel with soft shadows, 0 to 8; they count among the regions.
+    #[arg(long, default_value_t = OcclusionSettings::default().dominant_lights)]
+    dominant_lights: usize,
+    /// Side of a group's depth map along a dominant light, texels (16 to 4096).
+    #[arg(long, default_value_t = OcclusionSettings::default().light_map_size)]
+    light_map_size: u32,
     /// Side of a shadow map, texels: parallel-lights 16 to 2048, shadowmap 16 to 8192.
     #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
@@ -198,8 +212,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let settings = TechniqueSettings {
         kind: match args.technique {
             TechniqueName::Unshadowed => TechniqueKind::Unshadowed,
-            TechniqueName::Sloan => TechniqueKind::Sloan,
+            TechniqueName::SloanSelf => TechniqueKind::SloanSelf,
+            TechniqueName::SloanScene => TechniqueKind::SloanScene,
             TechniqueName::Tamura => TechniqueKind::Tamura,
+            TechniqueName::TamuraPaper => TechniqueKind::TamuraPaper,
             TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
             TechniqueName::Probes => TechniqueKind::Probes,
             TechniqueName::Shadowmap => TechniqueKind::ShadowMap,
@@ -208,6 +224,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         prt: args.prt.params()?,
         regions: args.regions,
         mask_size: args.mask_size,
+        dominant_lights: args.dominant_lights,
+        light_map_size: args.light_map_size,
         penumbra: match args.penumbra {
             PenumbraName::Fixed => Penumbra::Fixed,
             PenumbraName::Adaptive => Penumbra::Adaptive,
@@ -243,8 +261,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     .validated()?;
     let transfer = match settings.precomputation() {
         None => None,
-        Some(_) => {
-            let (transfer, origin) = args.prt.obtain(&ctx, &scene)?;
+        Some(params) => {
+            let (transfer, origin) = args.prt.obtain(&ctx, &scene, params)?;
             match origin {
                 Origin::Cached(path) => eprintln!("transfer: from {}", path.display()),
                 Origin::Computed { path, .. } => {

@@ -36,13 +36,19 @@ pub enum Origin {
 
 impl PrtArgs {
     pub fn params(&self) -> Result<PrtParams> {
-        Ok(PrtParams { bands: self.bands, rays: self.rays }.validated()?)
+        Ok(PrtParams { bands: self.bands, rays: self.rays, ..PrtParams::DEFAULT }.validated()?)
     }
 
-    /// The transfer of `scene`: cached when valid (saying why not otherwise), else computed with
-    /// a progress bar and cached.
-    pub fn obtain(&self, ctx: &Arc<Context>, scene: &Scene) -> Result<(TransferSet, Origin)> {
-        let params = self.params()?;
+    /// The transfer of `scene` with `params` (this struct's bands and rays, the visibility the
+    /// technique needs): cached when valid (saying why not otherwise), else computed with a
+    /// progress bar and cached.
+    pub fn obtain(
+        &self,
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        params: PrtParams,
+    ) -> Result<(TransferSet, Origin)> {
+        let params = params.validated()?;
         let dir = match &self.cache {
             Some(dir) => dir.clone(),
             None => cache::default_dir().context(

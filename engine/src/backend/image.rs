@@ -421,8 +421,6 @@ pub enum Edge {
     Repeat,
     /// The edge texel.
     Clamp,
-    /// Transparent black (the zero before a summed-area table's first texel).
-    Black,
 }
 
 impl Edge {
@@ -430,7 +428,6 @@ impl Edge {
         match self {
             Edge::Repeat => vk::SamplerAddressMode::REPEAT,
             Edge::Clamp => vk::SamplerAddressMode::CLAMP_TO_EDGE,
-            Edge::Black => vk::SamplerAddressMode::CLAMP_TO_BORDER,
         }
     }
 }
@@ -447,7 +444,28 @@ impl Sampler {
             .address_mode_u(u.mode())
             .address_mode_v(v.mode())
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .border_color(vk::BorderColor::FLOAT_TRANSPARENT_BLACK)
+            .max_lod(0.0);
+        // SAFETY: valid device and create info.
+        let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
+        ctx.set_name(raw, name);
+        Ok(Sampler { ctx: ctx.clone(), raw })
+    }
+}
+
+impl Sampler {
+    /// A depth-comparison sampler (`sampler2DArrayShadow`): bilinear percentage-closer
+    /// filtering of `reference <= texel` (1 where the reference depth is not behind the
+    /// stored one), clamped at the edges.
+    pub fn comparison(ctx: &Arc<Context>, name: &str) -> Result<Sampler> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .compare_enable(true)
+            .compare_op(vk::CompareOp::LESS_OR_EQUAL)
             .max_lod(0.0);
         // SAFETY: valid device and create info.
         let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;

@@ -167,6 +167,9 @@ pub enum DepthTest {
     Off,
     /// Nearer fragments pass and write their depth.
     Less,
+    /// Fragments nearer than the stored depth pass, writing nothing: a surface drawn earlier
+    /// with `Less` decides where later ones count (an occlusion mask's receiver).
+    Nearer,
     /// Only fragments at exactly the depth a prepass stored pass, writing nothing: one fragment
     /// per pixel is shaded whatever the draw order. The prepass must compute `gl_Position` with
     /// the same operations on the same inputs, `precise` (shaders-glsl/depth_prepass.vert).

@@ -24,9 +24,10 @@ pub enum kage_technique {
     Unshadowed = 0,
     /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs
     /// `kage_precompute`.
-    Sloan = 1,
+    SloanSelf = 1,
     /// Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from `regions`
-    /// environment regions. Needs `kage_precompute`.
+    /// environment regions, the `dominant_lights` brightest small lights of the map (a sun,
+    /// lamps) taken out and lit per pixel with soft shadows. Needs `kage_precompute`.
     Tamura = 2,
     /// Baseline: `regions` environment regions as directional lights with binary shadow maps.
     ParallelLights = 3,
@@ -41,6 +42,14 @@ pub enum kage_technique {
     /// a quadtree of tiles in a page pool of `asm_budget_mb`, refined where the eye sees shadow
     /// edges coarser than its pixels, `asm_time_ms` of tile rendering per frame.
     Asm = 6,
+    /// Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT with the whole
+    /// scene's visibility at its pose when `kage_precompute` ran (shadows between groups baked
+    /// into the vertices; they stay where they were when groups move). Needs `kage_precompute`.
+    SloanScene = 7,
+    /// Tamura, Johan, Nishita as the paper has it: `regions` regions, the fixed penumbra from
+    /// each region's solid angle, no dominant lights (`penumbra` and `dominant_lights` are not
+    /// read). Needs `kage_precompute`.
+    TamuraPaper = 8,
 }
 
 /// What the light probes capture (the values of `kage_technique_desc.probe_light`).
@@ -186,6 +195,12 @@ pub struct kage_technique_desc {
     /// A `kage_static_lighting` value: how the probes technique lights the static groups;
     /// default unshadowed. Sloan's PRT needs `kage_precompute` (with `sh_bands`, `prt_rays`).
     pub probe_statics: u32,
+    /// Tamura: most dominant lights lit per pixel, 0 to 8 (they count among `regions`);
+    /// default 4.
+    pub dominant_lights: u32,
+    /// Tamura: side of a group's depth map along a dominant light in texels, 16 to 4096;
+    /// default 512.
+    pub light_map_size: u32,
 }
 
 impl kage_technique_desc {
@@ -199,8 +214,10 @@ impl kage_technique_desc {
             "technique",
             &[
                 (T::Unshadowed as u32, TechniqueKind::Unshadowed),
-                (T::Sloan as u32, TechniqueKind::Sloan),
+                (T::SloanSelf as u32, TechniqueKind::SloanSelf),
+                (T::SloanScene as u32, TechniqueKind::SloanScene),
                 (T::Tamura as u32, TechniqueKind::Tamura),
+                (T::TamuraPaper as u32, TechniqueKind::TamuraPaper),
                 (T::ParallelLights as u32, TechniqueKind::ParallelLights),
                 (T::ShadowMap as u32, TechniqueKind::ShadowMap),
                 (T::Probes as u32, TechniqueKind::Probes),
@@ -270,10 +287,12 @@ impl kage_technique_desc {
         )?;
         Ok(TechniqueSettings {
             kind,
-            prt: PrtParams { bands: self.sh_bands, rays: self.prt_rays },
+            prt: PrtParams { bands: self.sh_bands, rays: self.prt_rays, ..PrtParams::DEFAULT },
             regions: self.regions as usize,
             mask_size: self.mask_size,
             penumbra,
+            dominant_lights: self.dominant_lights as usize,
+            light_map_size: self.light_map_size,
             shadow_map_size: self.shadow_map_size,
             probes: ProbeSettings {
                 placement,
@@ -341,6 +360,8 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_dering: kage_probe_dering::Off as u32,
             probe_dering_width: 0.0,
             probe_statics: kage_static_lighting::Unshadowed as u32,
+            dominant_lights: d.dominant_lights as u32,
+            light_map_size: d.light_map_size,
         };
         // An unknown technique is reported here already, not at the first use.
         // SAFETY: the default places no probes at positions.
@@ -352,7 +373,8 @@ pub unsafe extern "C" fn kage_technique_desc_default(
 
 /// Computes on the context's device what `technique` needs before its first frame, and keeps
 /// it in the scene for `kage_renderer_create`: for Sloan and Tamura the per-vertex PRT transfer
-/// (seconds to minutes: it casts `prt_rays` rays per vertex); for the other techniques nothing.
+/// (seconds to minutes: it casts `prt_rays` rays per vertex; for `KAGE_TECHNIQUE_SLOAN_SCENE`
+/// against the whole scene as its group transforms stand); for the other techniques nothing.
 /// A later call replaces what an earlier one computed.
 ///
 /// The scene keeps no reference to the context.

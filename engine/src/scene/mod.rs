@@ -35,6 +35,7 @@ mod obj;
 mod probe;
 mod probe_room;
 pub mod shapes;
+mod sun_map;
 mod transform;
 
 pub use builtin::BUILTIN;
@@ -46,6 +47,7 @@ pub use light::{Light, MAX_SPOT_FOV_DEG};
 pub use mesh::Mesh;
 pub use obj::{load_obj, parse_obj, write_obj};
 pub use probe::{ProbeRole, SceneProbe};
+pub use sun_map::SunMap;
 pub use transform::Transform;
 
 #[derive(Debug, Clone, PartialEq)]

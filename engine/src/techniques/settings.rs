@@ -4,7 +4,8 @@
 use super::asm::AsmSettings;
 use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use super::probes::{ProbeSettings, StaticLighting};
-use super::prt::{PrtParams, TransferSet};
+use super::prt::{PrtParams, TransferSet, Visibility};
+use super::tamura::occlusion::RegionSize;
 use super::tamura::technique::{OcclusionSettings, Penumbra};
 use crate::error::{Error, Result};
 use crate::renderer::TechniqueChoice;
@@ -16,9 +17,16 @@ pub enum TechniqueKind {
     #[default]
     Unshadowed,
     /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only.
-    Sloan,
-    /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups, q regions.
+    SloanSelf,
+    /// Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT whose visibility
+    /// is the whole scene at its rest pose (shadows between groups baked into the vertices).
+    SloanScene,
+    /// Tamura, Johan, Nishita, with dominant lights lit per pixel (Kage's default): PRT plus
+    /// per-pixel shadows between groups, q regions.
     Tamura,
+    /// Tamura, Johan, Nishita as the paper has it: q regions, the fixed penumbra of eq. (13)
+    /// from each region's solid angle, no dominant lights.
+    TamuraPaper,
     /// The paper's Fig. 3 baseline: q regions as directional lights with binary shadow maps.
     ParallelLights,
     /// Morishige 2014: light probes captured as SH light the moving group (group 0).
@@ -41,6 +49,10 @@ pub struct TechniqueSettings {
     /// Side of a Tamura occlusion mask layer, texels.
     pub mask_size: u32,
     pub penumbra: Penumbra,
+    /// Most dominant lights Tamura lights per pixel (0 to 8; they count among the q regions).
+    pub dominant_lights: usize,
+    /// Side of a group's depth map along a dominant light, texels.
+    pub light_map_size: u32,
     /// Side of a shadow map (parallel-lights, shadowmap), texels.
     pub shadow_map_size: u32,
     /// Placement and capture of the light probes.
@@ -58,6 +70,8 @@ impl Default for TechniqueSettings {
             regions: occlusion.regions,
             mask_size: occlusion.mask_size,
             penumbra: occlusion.penumbra,
+            dominant_lights: occlusion.dominant_lights,
+            light_map_size: occlusion.light_map_size,
             shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
             probes: ProbeSettings::default(),
             asm: AsmSettings::default(),
@@ -70,8 +84,15 @@ impl TechniqueSettings {
     pub fn precomputation(&self) -> Option<PrtParams> {
         let sloan_statics =
             self.kind == TechniqueKind::Probes && self.probes.statics == StaticLighting::Sloan;
-        (matches!(self.kind, TechniqueKind::Sloan | TechniqueKind::Tamura) || sloan_statics)
-            .then_some(self.prt)
+        let own_group = matches!(
+            self.kind,
+            TechniqueKind::SloanSelf | TechniqueKind::Tamura | TechniqueKind::TamuraPaper
+        );
+        match self.kind {
+            TechniqueKind::SloanScene => Some(PrtParams { visibility: Visibility::Scene, ..self.prt }),
+            _ if own_group || sloan_statics => Some(PrtParams { visibility: Visibility::Group, ..self.prt }),
+            _ => None,
+        }
     }
 
     /// Checks what can be checked before any GPU work (the techniques check the rest when
@@ -87,8 +108,27 @@ impl TechniqueSettings {
             self.asm = self.asm.validated()?;
         }
         // Zero regions would quietly be Sloan's technique (see `TechniqueChoice::Prt`).
-        if self.kind == TechniqueKind::Tamura && self.regions == 0 {
+        let tamura = matches!(self.kind, TechniqueKind::Tamura | TechniqueKind::TamuraPaper);
+        if tamura && self.regions == 0 {
             return Err(Error::InvalidArgument("regions must be at least 1 for the Tamura technique".into()));
+        }
+        if self.kind == TechniqueKind::Tamura {
+            let max = crate::layouts::constants::MAX_DOMINANT_LIGHTS as usize;
+            if self.dominant_lights > max {
+                return Err(Error::InvalidArgument(format!(
+                    "dominant lights: {} is more than the {max} Tamura lights per pixel",
+                    self.dominant_lights
+                )));
+            }
+            let sizes = super::tamura::dominant_maps::MAP_SIZES;
+            if !sizes.contains(&self.light_map_size) {
+                return Err(Error::InvalidArgument(format!(
+                    "light map size {} must be {} to {} texels",
+                    self.light_map_size,
+                    sizes.start(),
+                    sizes.end()
+                )));
+            }
         }
         Ok(self)
     }
@@ -108,23 +148,40 @@ impl TechniqueSettings {
                     transfer.params.bands, settings.prt.bands
                 )))
             }
+            Some(transfer)
+                if Some(transfer.params.visibility) != settings.precomputation().map(|p| p.visibility) =>
+            {
+                Err(Error::InvalidArgument(format!(
+                    "the transfer was precomputed with {:?} visibility, the {:?} technique needs {:?}",
+                    transfer.params.visibility,
+                    settings.kind,
+                    settings.precomputation().map(|p| p.visibility)
+                )))
+            }
             Some(transfer) => Ok(transfer.clone()),
         };
-        let prt = |regions| {
-            Ok(TechniqueChoice::Prt {
-                transfer: transfer()?,
-                occlusion: OcclusionSettings {
-                    regions,
-                    mask_size: settings.mask_size,
-                    penumbra: settings.penumbra,
-                    ..OcclusionSettings::default()
-                },
-            })
+        let prt = |occlusion| Ok(TechniqueChoice::Prt { transfer: transfer()?, occlusion });
+        let occlusion = OcclusionSettings {
+            regions: settings.regions,
+            mask_size: settings.mask_size,
+            penumbra: settings.penumbra,
+            size: RegionSize::Energy,
+            dominant_lights: settings.dominant_lights,
+            light_map_size: settings.light_map_size,
+            ..OcclusionSettings::default()
         };
+        let sloan = OcclusionSettings { regions: 0, dominant_lights: 0, pixel_cosine: false, ..occlusion };
         match settings.kind {
             TechniqueKind::Unshadowed => Ok(TechniqueChoice::Unshadowed),
-            TechniqueKind::Sloan => prt(0),
-            TechniqueKind::Tamura => prt(settings.regions),
+            TechniqueKind::SloanSelf | TechniqueKind::SloanScene => prt(sloan),
+            TechniqueKind::Tamura => prt(occlusion),
+            TechniqueKind::TamuraPaper => prt(OcclusionSettings {
+                penumbra: Penumbra::Fixed,
+                size: RegionSize::Geometric,
+                dominant_lights: 0,
+                pixel_cosine: false,
+                ..occlusion
+            }),
             TechniqueKind::ParallelLights => Ok(TechniqueChoice::ParallelLights {
                 regions: settings.regions,
                 shadow_map_size: settings.shadow_map_size,
@@ -147,7 +204,11 @@ mod tests {
     use super::*;
 
     fn transfer(bands: u32) -> Option<Arc<TransferSet>> {
-        Some(Arc::new(TransferSet { params: PrtParams { bands, rays: 1 }, seconds: 0.0, meshes: vec![] }))
+        Some(Arc::new(TransferSet {
+            params: PrtParams { bands, rays: 1, ..PrtParams::DEFAULT },
+            seconds: 0.0,
+            meshes: vec![],
+        }))
     }
 
     fn error(settings: TechniqueSettings, transfer: Option<Arc<TransferSet>>) -> String {
@@ -158,7 +219,7 @@ mod tests {
     fn each_kind_becomes_its_choice() {
         let of = |kind| TechniqueSettings { kind, regions: 4, ..Default::default() };
         assert!(matches!(of(TechniqueKind::Unshadowed).choice(None), Ok(TechniqueChoice::Unshadowed)));
-        let sloan = of(TechniqueKind::Sloan).choice(transfer(3)).unwrap();
+        let sloan = of(TechniqueKind::SloanSelf).choice(transfer(3)).unwrap();
         assert!(matches!(sloan, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 0));
         let tamura = of(TechniqueKind::Tamura).choice(transfer(3)).unwrap();
         assert!(matches!(tamura, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 4));

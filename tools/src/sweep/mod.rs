@@ -4,6 +4,7 @@
 //! time against error in `DIR/pareto.png`; and, asked, the setting to pick under a bound.
 mod asm;
 pub(crate) mod chart;
+mod converged;
 pub(crate) mod pick;
 mod probes;
 
@@ -13,24 +14,23 @@ use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use kage::backend::Context;
-use kage::imageio::RgbaF32Image;
 use kage::pass::TimingTable;
-use kage::reference::{compare, LightMode, ReferenceOptions, ReferenceRenderer};
+use kage::reference::compare;
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
-use kage::techniques::prt::PrtParams;
+use kage::techniques::prt::{PrtParams, TransferSet};
 use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use pick::Point;
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SweptTechnique {
-    /// Unshadowed SH irradiance; Sloan's PRT at 2 to 5 bands; Tamura at q = 4 to 64;
-    /// parallel lights at q = 32, 64, 128 (the paper's Fig. 3).
+    /// Unshadowed SH irradiance; Sloan's PRT at 2 to 5 bands (self-shadowing only) and with the
+    /// whole scene's visibility at rest; Tamura as the paper has it at q = 32 and Kage's default
+    /// at q = 4 to 64; parallel lights at q = 32, 64, 128 (the paper's Fig. 3).
     Prt,
     /// Adaptive shadow maps at 4, 8, 16 MB against conventional maps of 1024², 2048², 4096²
     /// over the scene's camera walkthrough (`kage bench asm`'s measurement).
@@ -55,16 +55,24 @@ pub struct SweepArgs {
     /// 0 is the scene pose (the teapot standing on the floor: contact).
     #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.125, 0.6])]
     poses: Vec<f32>,
-    /// Only these settings, e.g. `unshadowed,sloan:3,tamura:32,parallel-lights:64` (prt) or
+    /// Only these settings, e.g. `unshadowed,sloan-self:3,tamura:32,parallel-lights:32` (prt) or
     /// `shadowmap:2048,asm:8` (asm).
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Side of the images compared with the reference, pixels (asm: also of the timed frames).
     #[arg(long, default_value_t = 128)]
     size: u32,
-    /// Reference samples per pixel.
-    #[arg(long, default_value_t = 512)]
-    spp: u32,
+    /// probes: reference samples per test point (default 512). The prt sweep runs its
+    /// references to `--noise` instead.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// prt: each reference runs until its relative standard error is at most this (it is
+    /// printed beside every error), and is cached under the cache folder.
+    #[arg(long, default_value_t = 0.005)]
+    noise: f64,
+    /// prt: the most samples per pixel a reference may take to reach `--noise`.
+    #[arg(long, default_value_t = 65536)]
+    max_spp: u32,
     /// prt: frames timed per setting while the scene moves (the median is reported; 0: no
     /// timing). asm: samples of the walkthrough (each also timed).
     #[arg(long, default_value_t = 100)]
@@ -75,7 +83,8 @@ pub struct SweepArgs {
     /// Visibility rays per vertex of the PRT precomputation.
     #[arg(long, default_value_t = PrtParams::DEFAULT.rays)]
     rays: u32,
-    /// Cache folder of the PRT transfers (as `kage precompute --cache`).
+    /// Cache folder of the PRT transfers (as `kage precompute --cache`) and, in `references/`,
+    /// of the prt sweep's references.
     #[arg(long)]
     cache: Option<PathBuf>,
     /// Output folder (created if missing).
@@ -106,7 +115,9 @@ pub struct SweepArgs {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Setting {
     Unshadowed,
-    Sloan { bands: u32 },
+    SloanSelf { bands: u32 },
+    SloanScene,
+    TamuraPaper { regions: usize },
     Tamura { regions: usize },
     ParallelLights { regions: usize },
 }
@@ -115,7 +126,8 @@ impl Setting {
     /// The PRT sweep's settings.
     fn all() -> Vec<Setting> {
         std::iter::once(Setting::Unshadowed)
-            .chain((2..=5).map(|bands| Setting::Sloan { bands }))
+            .chain((2..=5).map(|bands| Setting::SloanSelf { bands }))
+            .chain([Setting::SloanScene, Setting::TamuraPaper { regions: 32 }])
             .chain([4, 8, 16, 32, 64].map(|regions| Setting::Tamura { regions }))
             .chain([32, 64, 128].map(|regions| Setting::ParallelLights { regions }))
             .collect()
@@ -125,7 +137,9 @@ impl Setting {
     fn describe(self) -> (&'static str, &'static str, String) {
         match self {
             Setting::Unshadowed => ("unshadowed", "", String::new()),
-            Setting::Sloan { bands } => ("sloan", "bands", bands.to_string()),
+            Setting::SloanSelf { bands } => ("sloan-self", "bands", bands.to_string()),
+            Setting::SloanScene => ("sloan-scene", "", String::new()),
+            Setting::TamuraPaper { regions } => ("tamura-paper", "regions", regions.to_string()),
             Setting::Tamura { regions } => ("tamura", "regions", regions.to_string()),
             Setting::ParallelLights { regions } => ("parallel-lights", "regions", regions.to_string()),
         }
@@ -143,16 +157,20 @@ impl Setting {
         let defaults = TechniqueSettings::default();
         let (kind, prt, regions) = match self {
             Setting::Unshadowed => (TechniqueKind::Unshadowed, defaults.prt, defaults.regions),
-            Setting::Sloan { bands } => (TechniqueKind::Sloan, PrtParams { bands, ..defaults.prt }, 0),
+            Setting::SloanSelf { bands } => {
+                (TechniqueKind::SloanSelf, PrtParams { bands, ..defaults.prt }, 0)
+            }
+            Setting::SloanScene => (TechniqueKind::SloanScene, defaults.prt, 0),
+            Setting::TamuraPaper { regions } => (TechniqueKind::TamuraPaper, defaults.prt, regions),
             Setting::Tamura { regions } => (TechniqueKind::Tamura, defaults.prt, regions),
             Setting::ParallelLights { regions } => (TechniqueKind::ParallelLights, defaults.prt, regions),
         };
         TechniqueSettings { kind, prt, regions, ..defaults }
     }
 
-    /// SH bands of the PRT transfer it needs, if any.
-    fn bands(self) -> Option<u32> {
-        self.technique().precomputation().map(|p| p.bands)
+    /// The PRT transfer it needs, if any.
+    fn precomputation(self) -> Option<PrtParams> {
+        self.technique().precomputation()
     }
 }
 
@@ -173,6 +191,8 @@ struct Row {
     env: String,
     setting: Setting,
     errors: Vec<f64>,
+    /// The reference's relative standard error at each pose.
+    noise: Vec<f64>,
     frame_ms: Option<f64>,
     precompute_s: Option<f64>,
     memory_mb: f64,
@@ -189,7 +209,9 @@ impl Row {
         let error = Some(self.mean_error()).filter(|e| *e > 0.0)?;
         let series = match self.setting {
             Setting::Unshadowed => "unshadowed",
-            Setting::Sloan { .. } => "sloan (SH bands)",
+            Setting::SloanSelf { .. } => "sloan self (SH bands)",
+            Setting::SloanScene => "sloan whole scene",
+            Setting::TamuraPaper { .. } => "tamura as published (q)",
             Setting::Tamura { .. } => "tamura (q)",
             Setting::ParallelLights { .. } => "parallel lights (q)",
         };
@@ -202,8 +224,14 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     if args.poses.is_empty() || args.poses.iter().any(|t| !t.is_finite()) {
         bail!("--poses must list finite times, e.g. 0,0.125,0.6");
     }
-    if args.size == 0 || args.time_size == 0 || args.spp == 0 {
-        bail!("--size, --time-size and --spp must be at least 1");
+    if args.size == 0 || args.time_size == 0 || args.spp == Some(0) || args.max_spp == 0 {
+        bail!("--size, --time-size, --spp and --max-spp must be at least 1");
+    }
+    if !(args.noise.is_finite() && args.noise > 0.0) {
+        bail!("--noise must be a positive fraction, e.g. 0.005 (0.5 %); got {}", args.noise);
+    }
+    if args.spp.is_some() && args.technique == SweptTechnique::Prt {
+        bail!("--spp: the prt sweep runs each reference to --noise (default 0.005), up to --max-spp");
     }
     if args.pick && args.max_error.is_none() && args.max_ms.is_none() && args.max_probes.is_none() {
         bail!("--pick needs a bound: --max-error E, --max-ms T (--max-probes N for probes), or both");
@@ -254,15 +282,22 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let ctx = args.gpu.context()?;
 
-    // Transfers depend on the geometry only: one per band count, shared by every map.
-    let mut transfers = BTreeMap::new();
-    for bands in settings.iter().filter_map(|s| s.bands()) {
-        if let std::collections::btree_map::Entry::Vacant(slot) = transfers.entry(bands) {
-            let source = PrtArgs { rays: args.rays, bands, cache: args.cache.clone(), force: false };
-            let (transfer, _) = source.obtain(&ctx, &scene)?;
-            slot.insert(Arc::new(transfer));
+    // Transfers depend on the geometry only: one per precomputation, shared by every map.
+    let mut transfers: Vec<(PrtParams, Arc<TransferSet>)> = Vec::new();
+    for params in settings.iter().filter_map(|s| s.precomputation()) {
+        let params = PrtParams { rays: args.rays, ..params };
+        if !transfers.iter().any(|(p, _)| *p == params) {
+            let source =
+                PrtArgs { rays: args.rays, bands: params.bands, cache: args.cache.clone(), force: false };
+            let (transfer, _) = source.obtain(&ctx, &scene, params)?;
+            transfers.push((params, Arc::new(transfer)));
         }
     }
+    let transfer_of = |setting: Setting| {
+        let wanted = PrtParams { rays: args.rays, ..setting.precomputation()? };
+        transfers.iter().find(|(p, _)| *p == wanted).map(|(_, t)| t.clone())
+    };
+    let reference_dir = converged::folder(args.cache.as_deref())?;
 
     let timed = if args.frames > 0 { 1 } else { 0 };
     let steps = envs.len() * (args.poses.len() + settings.len() * (args.poses.len() + timed));
@@ -274,19 +309,39 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
     for (env_name, map) in &envs {
         let mut lit = scene.clone();
         lit.environment = map.clone();
-        let references: Vec<RgbaF32Image> = args
+        let references: Vec<converged::Reference> = args
             .poses
             .iter()
             .map(|&t| {
                 bar.set_message(format!("{env_name}: reference at t = {t}"));
-                let image = reference(&ctx, &posed(&lit, t), args.size, args.spp);
+                let mut progress = |spp: u32, noise: f64| {
+                    bar.set_message(format!(
+                        "{env_name}: reference at t = {t}, {spp} spp, noise {:.2} %",
+                        100.0 * noise
+                    ))
+                };
+                let reference = converged::reference(
+                    &ctx,
+                    &posed(&lit, t),
+                    args.size,
+                    args.noise,
+                    args.max_spp,
+                    &reference_dir,
+                    &mut progress,
+                );
                 bar.inc(1);
-                image
+                if let Ok(r) = &reference {
+                    let noise = 100.0 * r.noise;
+                    bar.suspend(|| {
+                        println!("{env_name}: reference at t = {t}: {} spp, noise {noise:.2} %", r.spp)
+                    });
+                }
+                reference
             })
             .collect::<Result<_>>()?;
         for &setting in &settings {
             bar.set_message(format!("{env_name}: {}", setting.name()));
-            let transfer = setting.bands().map(|b| transfers[&b].clone());
+            let transfer = transfer_of(setting);
             let before = ctx.allocated_bytes();
             let mut renderer = Renderer::new(
                 &ctx,
@@ -303,7 +358,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             for (&t, reference) in args.poses.iter().zip(&references) {
                 renderer.set_group_transform(0, pose(&lit.groups[0], t).matrix())?;
                 renderer.render()?;
-                errors.push(compare(&renderer.image()?, reference)?.relative_rmse);
+                errors.push(compare(&renderer.image()?, &reference.image)?.relative_rmse);
                 bar.inc(1);
             }
             drop(renderer);
@@ -319,6 +374,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
                 env: env_name.clone(),
                 setting,
                 errors,
+                noise: references.iter().map(|r| r.noise).collect(),
                 frame_ms,
                 precompute_s: transfer.map(|t| t.seconds),
                 memory_mb,
@@ -341,9 +397,15 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
         }
         let file = if e == 0 { "pareto.png".to_string() } else { format!("pareto-{env}.png") };
         let lit_by = if env == "scene" { "its own map" } else { env.as_str() };
+        let noise =
+            rows.iter().filter(|r| &r.env == env).flat_map(|r| r.noise.iter().copied()).fold(0.0, f64::max);
         let title = format!(
-            "{} under {lit_by}: {} frames at {}², error at {}²",
-            scene.name, args.frames, args.time_size, args.size
+            "{} under {lit_by}: {} frames at {}², error at {}² (reference noise ≤ {:.2} %)",
+            scene.name,
+            args.frames,
+            args.time_size,
+            args.size,
+            100.0 * noise
         );
         chart::write(
             &args.out.join(&file),
@@ -439,13 +501,6 @@ fn posed(scene: &Scene, t: f32) -> Scene {
     scene
 }
 
-fn reference(ctx: &Arc<Context>, scene: &Scene, size: u32, spp: u32) -> Result<RgbaF32Image> {
-    let options = ReferenceOptions { width: size, height: size, light: LightMode::Environment, seed: 0 };
-    let mut renderer = ReferenceRenderer::new(ctx, scene, &options).context("setting up the reference")?;
-    renderer.run_batch(spp)?;
-    Ok(renderer.image()?)
-}
-
 /// Median GPU milliseconds per frame over `frames` frames of the scripted motion.
 fn frame_time(
     ctx: &Arc<Context>,
@@ -469,11 +524,13 @@ fn frame_time(
 fn summary(row: &Row) -> String {
     let mean = row.mean_error();
     let ms = row.frame_ms.map_or_else(|| "-".to_string(), |ms| format!("{ms:.2} ms"));
+    let noise = row.noise.iter().copied().fold(0.0, f64::max);
     format!(
-        "{:<12} {:<20} relative RMSE {mean:.4} (per pose {:.4?}), {ms}, {:.1} MB",
+        "{:<12} {:<20} relative RMSE {mean:.4} (per pose {:.4?}; reference noise ≤ {:.4}), {ms}, {:.1} MB",
         row.env,
         row.setting.name(),
         row.errors,
+        noise,
         row.memory_mb
     )
 }
@@ -483,6 +540,9 @@ fn csv(scene: &str, poses: &[f32], rows: &[Row]) -> String {
     for t in poses {
         write!(out, ",error_t{t}").expect("writing to a String");
     }
+    for t in poses {
+        write!(out, ",reference_noise_t{t}").expect("writing to a String");
+    }
     out.push_str(",frame_ms,precompute_s,memory_mb\n");
     let optional = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:.4}"));
     for row in rows {
@@ -490,7 +550,7 @@ fn csv(scene: &str, poses: &[f32], rows: &[Row]) -> String {
         let mean = row.mean_error();
         write!(out, "{scene},{},{technique},{parameter},{value},{mean:.5}", row.env)
             .expect("writing to a String");
-        for e in &row.errors {
+        for e in row.errors.iter().chain(&row.noise) {
             write!(out, ",{e:.5}").expect("writing to a String");
         }
         writeln!(out, ",{},{},{:.2}", optional(row.frame_ms), optional(row.precompute_s), row.memory_mb)
@@ -499,15 +559,28 @@ fn csv(scene: &str, poses: &[f32], rows: &[Row]) -> String {
     out
 }
 
-/// Frame-time ratios to Sloan's PRT at the default bands, measured in this run.
+/// Each setting against parallel lights at the same q (the strongest baseline that does the
+/// same job), or at q = 32 for the settings without one: error and frame-time ratios, measured
+/// in this run.
 fn print_ratios(rows: &[Row]) {
-    let sloan = Setting::Sloan { bands: PrtParams::DEFAULT.bands };
-    for (env, base) in rows.iter().filter(|r| r.setting == sloan).filter_map(|r| Some((&r.env, r.frame_ms?)))
-    {
-        for row in rows.iter().filter(|r| &r.env == env && r.setting != sloan) {
-            if let Some(ms) = row.frame_ms {
-                println!("{env}: {} / {} frame time: {:.2}", row.setting.name(), sloan.name(), ms / base);
-            }
-        }
+    for row in rows {
+        let q = match row.setting {
+            Setting::Tamura { regions } | Setting::TamuraPaper { regions } => regions,
+            Setting::ParallelLights { .. } => continue,
+            _ => 32,
+        };
+        let baseline = Setting::ParallelLights { regions: q };
+        let Some(base) = rows.iter().find(|r| r.env == row.env && r.setting == baseline) else { continue };
+        let frame = match (row.frame_ms, base.frame_ms) {
+            (Some(ms), Some(base)) if base > 0.0 => format!(", frame time {:.2}x", ms / base),
+            _ => String::new(),
+        };
+        println!(
+            "{}: {} / {}: error {:.2}x{frame}",
+            row.env,
+            row.setting.name(),
+            baseline.name(),
+            row.mean_error() / base.mean_error()
+        );
     }
 }

@@ -40,6 +40,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let ctx = args.gpu.context()?;
     let cache = args.out.join("reference-cache");
     let test_region = args.test_region.unwrap_or(TestRegion::Path);
+    let spp = args.spp.unwrap_or(512);
     let params = Params {
         test_region,
         grids: &DEFAULT_GRIDS,
@@ -47,7 +48,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         tolerances: if test_region == TestRegion::Box { &BOX_TOLERANCES } else { &DEFAULT_TOLERANCES },
         points: POINTS,
         normals: NORMALS,
-        spp: args.spp,
+        spp,
         capture: CaptureSettings {
             cube_size: CUBE_SIZE,
             light: ProbeLightName::Sky.captured(),
@@ -60,7 +61,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         "scene {}: {} test points x {NORMALS} normals, reference {} spp (noise {:.4} of the RMS irradiance), a probe at each point {:.4}, capture {:.1} ms per probe, {}",
         scene.name,
         m.test_points,
-        args.spp,
+        spp,
         m.reference_noise,
         m.capture_floor,
         m.capture_ms_per_probe,

@@ -14,27 +14,31 @@
 //! | 32 | 8 | seconds the precomputation took (f64) |
 //! | 40 | 16 | geometry hash ([`geometry_hash`]) |
 //! | 56 | 8 | FNV-1a 64 checksum of the coefficient bytes |
-//! | 64 | 12·M | per mesh: group index, mesh index, vertex count (u32 each) |
-//! | 64 + 12·M | 4·V·bands² | coefficients (f32), mesh after mesh, vertex-major |
+//! | 64 | 4 | visibility: 0 the vertex's group, 1 the whole scene at rest |
+//! | 68 | 4 | zero |
+//! | 72 | 12·M | per mesh: group index, mesh index, vertex count (u32 each) |
+//! | 72 + 12·M | 4·V·bands² | coefficients (f32), mesh after mesh, vertex-major |
 //!
 //! The geometry hash covers what the transfer depends on: every mesh's positions, normals and
-//! indices and which group it belongs to. Not the group transforms (the transfer is in object
-//! space) and not the albedo (the transfer leaves it out, see the module above).
+//! indices and which group it belongs to; with the whole scene's visibility, the group
+//! transforms too (each group's own transfer is in object space, but what shadows it is where
+//! the others stand). Not the albedo (the transfer leaves it out, see the module above).
 //! [`FORMAT_VERSION`] changes whenever the layout or the meaning of the numbers does (the
 //! estimator or its point set included), so a file from another Kage is rebuilt.
 use std::fmt;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet};
+use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
 use crate::scene::Scene;
 
 pub const MAGIC: [u8; 8] = *b"KAGEPRT\0";
 /// Version 1: Hammersley points with a per-vertex Cranley–Patterson shift, cosine-weighted.
-pub const FORMAT_VERSION: u32 = 1;
+/// Version 2: the visibility field.
+pub const FORMAT_VERSION: u32 = 2;
 /// File name extension of cache files.
 pub const EXTENSION: &str = "kageprt";
-const HEADER_BYTES: usize = 64;
+const HEADER_BYTES: usize = 72;
 const MESH_ENTRY_BYTES: usize = 12;
 
 /// Why a cache file was not used.
@@ -48,6 +52,7 @@ pub enum Stale {
     TrailingBytes { bytes: usize, expected: usize },
     Bands { found: u32, wanted: u32 },
     Rays { found: u32, wanted: u32 },
+    Visibility { found: u32, wanted: u32 },
     Geometry,
     Meshes(String),
     Checksum,
@@ -74,6 +79,12 @@ impl fmt::Display for Stale {
             Stale::Rays { found, wanted } => {
                 write!(f, "it was made with {found} rays per vertex; {wanted} were asked for")
             }
+            Stale::Visibility { found, wanted } => write!(
+                f,
+                "it holds visibility {} ({found}); {} ({wanted}) was asked for",
+                visibility_name(*found),
+                visibility_name(*wanted)
+            ),
             Stale::Geometry => write!(f, "the scene's geometry changed since it was made"),
             Stale::Meshes(what) => write!(f, "its meshes do not match the scene: {what}"),
             Stale::Checksum => write!(f, "its coefficients are corrupt (checksum mismatch)"),
@@ -101,7 +112,17 @@ pub struct CacheKey {
 
 impl CacheKey {
     pub fn new(scene: &Scene, params: PrtParams) -> CacheKey {
-        CacheKey { params, geometry: geometry_hash(scene), layout: mesh_layout(scene) }
+        let mut geometry = geometry_hash(scene);
+        if params.visibility == Visibility::Scene {
+            let mut h = Fnv128(geometry);
+            for group in &scene.groups {
+                for v in group.transform.matrix().to_cols_array() {
+                    h.write(&v.to_le_bytes());
+                }
+            }
+            geometry = h.finish();
+        }
+        CacheKey { params, geometry, layout: mesh_layout(scene) }
     }
 
     /// `<scene name>-<16 hex digits>.kageprt`: the digits hash the geometry, the parameters and
@@ -112,6 +133,7 @@ impl CacheKey {
         h.write(&self.geometry.to_le_bytes());
         h.write(&self.params.bands.to_le_bytes());
         h.write(&self.params.rays.to_le_bytes());
+        h.write(&visibility_code(self.params.visibility).to_le_bytes());
         h.write(&FORMAT_VERSION.to_le_bytes());
         let name: String = scene_name
             .chars()
@@ -119,6 +141,21 @@ impl CacheKey {
             .collect();
         let name = if name.is_empty() { "scene" } else { &name };
         format!("{name}-{:016x}.{EXTENSION}", h.finish())
+    }
+}
+
+fn visibility_code(visibility: Visibility) -> u32 {
+    match visibility {
+        Visibility::Group => 0,
+        Visibility::Scene => 1,
+    }
+}
+
+fn visibility_name(code: u32) -> &'static str {
+    match code {
+        0 => "of each vertex's group",
+        1 => "of the whole scene at rest",
+        _ => "unknown",
     }
 }
 
@@ -185,12 +222,18 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
     let seconds = f64::from_bits(r.u64().unwrap_or_default());
     let geometry = r.u128().unwrap_or_default();
     let checksum = r.u64().unwrap_or_default();
+    let visibility = r.u32().unwrap_or_default();
+    let _zero = r.u32();
 
     if bands != key.params.bands {
         return Err(Stale::Bands { found: bands, wanted: key.params.bands });
     }
     if rays != key.params.rays {
         return Err(Stale::Rays { found: rays, wanted: key.params.rays });
+    }
+    let wanted = visibility_code(key.params.visibility);
+    if visibility != wanted {
+        return Err(Stale::Visibility { found: visibility, wanted });
     }
     if geometry != key.geometry {
         return Err(Stale::Geometry);
@@ -288,6 +331,8 @@ fn encode(set: &TransferSet, key: &CacheKey) -> Vec<u8> {
     out.extend_from_slice(&set.seconds.to_le_bytes());
     out.extend_from_slice(&key.geometry.to_le_bytes());
     out.extend_from_slice(&checksum.finish().to_le_bytes());
+    out.extend_from_slice(&visibility_code(set.params.visibility).to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
     let coeffs = set.params.coeffs().max(1);
     for m in &set.meshes {
         let vertices = m.coefficients.len() / coeffs;
@@ -379,7 +424,11 @@ mod tests {
 
     #[test]
     fn file_names_are_safe_and_keyed() {
-        let key = |bands| CacheKey { params: PrtParams { bands, rays: 64 }, geometry: 7, layout: Vec::new() };
+        let key = |bands| CacheKey {
+            params: PrtParams { bands, rays: 64, ..PrtParams::DEFAULT },
+            geometry: 7,
+            layout: Vec::new(),
+        };
         let name = key(3).file_name("../my scene");
         assert!(name.starts_with("___my_scene-") && name.ends_with(".kageprt"), "{name}");
         assert_ne!(name, key(4).file_name("../my scene"));

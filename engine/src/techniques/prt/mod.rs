@@ -3,7 +3,8 @@
 //!
 //! For vertex `x` with normal `n`, coefficient `i = l(l + 1) + m` of its transfer vector is
 //! `T_i(x) = ∫ (1/π) v_s(x, ω) max(ω·n, 0) y_i(ω) dω` (the paper's eq. (5) with ρ = 1), where
-//! `v_s` is binary visibility against the vertex's own group only, in that group's object space.
+//! `v_s` is binary visibility against the vertex's own group only ([`Visibility::Group`]), or
+//! against the whole scene at rest ([`Visibility::Scene`]), in the group's object space.
 //!
 //! Two choices keep the data small and reusable:
 //! - The albedo is left out (ρ = 1): a mesh has one RGB albedo, so the shader multiplies it in
@@ -28,6 +29,19 @@ pub const MAX_BANDS: u32 = crate::sh::MAX_BANDS as u32;
 /// enough that a typo cannot ask for days of work.
 pub const MAX_RAYS: u32 = 1 << 20;
 
+/// What a vertex's transfer is shadowed by.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Visibility {
+    /// Its own group only: the transfer holds whatever pose the groups take (Sloan's PRT as
+    /// the Tamura technique uses it).
+    #[default]
+    Group,
+    /// The whole scene at its rest pose (the groups' transforms in the scene): Sloan's PRT as
+    /// the paper compares against, the shadows between groups baked into the receivers'
+    /// vertices, and wrong once a group moves.
+    Scene,
+}
+
 /// What to precompute.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PrtParams {
@@ -35,12 +49,13 @@ pub struct PrtParams {
     pub bands: u32,
     /// Visibility rays per vertex.
     pub rays: u32,
+    pub visibility: Visibility,
 }
 
 impl PrtParams {
     /// 3 bands as in the paper; 2048 rays keep the unshadowed error of every coefficient below
     /// 1e-3 (the quasi-Monte Carlo error falls about as 1/N: ~5e-4 at 1024, ~1e-4 at 4096).
-    pub const DEFAULT: PrtParams = PrtParams { bands: 3, rays: 2048 };
+    pub const DEFAULT: PrtParams = PrtParams { bands: 3, rays: 2048, visibility: Visibility::Group };
 
     pub fn validated(self) -> Result<PrtParams> {
         if !(MIN_BANDS..=MAX_BANDS).contains(&self.bands) {

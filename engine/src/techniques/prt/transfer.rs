@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet};
+use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
 use crate::backend::MemoryLocation;
 use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context};
 use crate::error::{Error, Result};
@@ -121,7 +121,10 @@ fn run_jobs(
                 }
                 let count = RAYS_PER_DISPATCH.min(params.rays - first_ray);
                 for push in &batch {
-                    let push = PrtTransferPush { params: [push.params[0], first_ray, count, 0], ..*push };
+                    let push = PrtTransferPush {
+                        params: [push.params[0], first_ray, count, push.params[3]],
+                        ..*push
+                    };
                     let groups = push.range[1].div_ceil(constants::PRT_GROUP);
                     pipeline.dispatch(cmd, &bindings, bytes_of(&push), [groups, 1, 1]);
                 }
@@ -163,7 +166,7 @@ fn submissions(layout: &[(usize, usize, usize)], params: PrtParams) -> Vec<Vec<P
             batch.push(PrtTransferPush {
                 range: [first as u32, count as u32, group as u32, params.rays],
                 // The ray range is filled in per dispatch.
-                params: [params.coeffs() as u32, 0, 0, 0],
+                params: [params.coeffs() as u32, 0, 0, (params.visibility == Visibility::Scene) as u32],
             });
             first += count;
             left -= count;
@@ -186,7 +189,7 @@ mod tests {
 
     #[test]
     fn submissions_cover_every_vertex_once_within_budget() {
-        let params = PrtParams { bands: 3, rays: (RAYS_PER_SUBMISSION / 100) as u32 };
+        let params = PrtParams { bands: 3, rays: (RAYS_PER_SUBMISSION / 100) as u32, ..PrtParams::DEFAULT };
         let layout = [(0, 0, 250), (0, 1, 30), (1, 0, 5), (2, 0, 101)];
         let batches = submissions(&layout, params);
         let mut next = 0;
@@ -207,7 +210,7 @@ mod tests {
 
     #[test]
     fn more_rays_than_the_budget_still_make_progress() {
-        let params = PrtParams { bands: 2, rays: (RAYS_PER_SUBMISSION * 2) as u32 };
+        let params = PrtParams { bands: 2, rays: (RAYS_PER_SUBMISSION * 2) as u32, ..PrtParams::DEFAULT };
         let batches = submissions(&[(0, 0, 3)], params);
         assert_eq!(batches.len(), 3);
         assert!(batches.iter().all(|b| b.len() == 1 && b[0].range[1] == 1));

@@ -1,37 +1,39 @@
 //! Occlusion between groups (section 3.3.2): for each receiver group, occluder group and region,
-//! the occluder is projected along the region's direction onto a plane at the receiver (a mask
-//! layer), then box-filtered in two 1D passes with the width s = sqrt(Ω_i)·R of eq. (13); the
-//! result V_o is looked up per pixel in the scene pass. With [`Penumbra::Adaptive`] the same two
-//! passes build a summed-area table instead and the scene pass picks the width per pixel.
+//! the occluder is projected along the region's direction onto a plane (a mask layer), then
+//! box-filtered in two 1D passes with the width s = sqrt(Ω_i)·R of eq. (13); the result V_o is
+//! looked up per pixel in the scene pass. With [`Penumbra::Adaptive`] the same two passes leave
+//! boxes of three widths side by side and the scene pass interpolates the width it wants per
+//! pixel.
 //!
-//! Two choices differ from the paper's text, on purpose:
-//! - The plane goes through the receiver's bounding-sphere centre, not along the sphere's tangent
-//!   plane. Projections along ω_i onto parallel planes give the same mask; only R differs, and
-//!   for a large flat receiver (the floor) the tangent plane lies far from the surface, which
-//!   would blur every contact shadow. R is the distance from the occluder's centre to that plane
-//!   along ω_i.
-//! - Occluder parts behind the receiver's plane (farther from the light than the receiver's
-//!   centre) are clipped from the mask: a flat mask has no depth, and without the clip a floor
-//!   would shadow, from above, what stands on it. For a receiver thick along ω_i this misses
-//!   occluders between its centre and its far side; measured against the reference in
-//!   BENCHMARKS.md.
+//! Where this differs from the paper's text, on purpose:
+//! - Each mask is fitted to the occluder, not to the receiver: its plane goes through the
+//!   occluder's bounding-sphere centre and it covers the occluder's projected box plus the
+//!   filter's reach. Only there can its shadow fall, and a large receiver (the floor) would
+//!   otherwise spread the mask's texels over the whole floor.
+//! - Masks have depth (the paper's tangent-plane construction never covered contact): the
+//!   receiver is drawn first, depth only, and the occluder marks only the texels where it lies
+//!   in front of the receiver's surface towards the light. So a teapot standing on the floor
+//!   shadows the floor beside it under any light, and a floor never shadows what stands on it.
+//! - The box width can come from the spread of the region's energy ([`Region::spread`]) rather
+//!   than its solid angle: a sun alone in a large region of black sky casts a sharp shadow.
 //! - Pairs and regions that cannot cast a shadow are skipped: black regions; regions no
-//!   receiver normal faces (light from below for a floor); occluders whose bounding box lies
-//!   wholly behind the receiver's plane; occluders whose shadow cylinder misses the receiver's
-//!   sphere. A group alone runs no occlusion pass at all.
-use super::regions::Regions;
+//!   receiver normal faces (light from below for a floor); occluders lying wholly farther from
+//!   the light than the receiver; occluders whose shadow cylinder misses the receiver's sphere.
+//!   A group alone runs no occlusion pass at all.
+use super::dominant::DominantLight;
+use super::regions::{Region, Regions};
 use super::self_shadow::rotation_of;
 use super::technique::Penumbra;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, DepthTest, Edge, GraphicsDesc,
-    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
+    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
+    GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
 use crate::error::Result;
 use crate::layouts::{
     bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
 };
 use crate::pass::Pass;
-use crate::renderer::GpuScene;
+use crate::renderer::{GpuScene, DEPTH_FORMAT};
 use crate::sh;
 use crate::techniques::unshadowed::MESH_POSITIONS;
 use glam::{Mat3, Mat4, Vec3};
@@ -54,24 +56,28 @@ pub struct GroupBounds {
 
 impl GroupBounds {
     /// Whether no vertex of the group can receive light from object-space direction `w`.
-    fn faces_away_from(&self, w: Vec3) -> bool {
+    pub fn faces_away_from(&self, w: Vec3) -> bool {
         let angle = self.normal_axis.dot(w).clamp(-1.0, 1.0).acos();
         angle >= std::f32::consts::FRAC_PI_2 + self.normal_spread
     }
 
-    /// The largest signed distance along `w` of the box's corners from `origin` (world space,
-    /// with `transform` placing the group).
-    fn reach_along(&self, transform: &Mat4, origin: Vec3, w: Vec3) -> f32 {
-        (0..8)
-            .map(|c| {
-                let corner = Vec3::new(
-                    if c & 1 == 0 { self.min.x } else { self.max.x },
-                    if c & 2 == 0 { self.min.y } else { self.max.y },
-                    if c & 4 == 0 { self.min.z } else { self.max.z },
-                );
-                (transform.transform_point3(corner) - origin).dot(w)
-            })
-            .fold(f32::NEG_INFINITY, f32::max)
+    /// The world positions of the box's corners, with `transform` placing the group.
+    fn corners(&self, transform: &Mat4) -> [Vec3; 8] {
+        std::array::from_fn(|c| {
+            transform.transform_point3(Vec3::new(
+                if c & 1 == 0 { self.min.x } else { self.max.x },
+                if c & 2 == 0 { self.min.y } else { self.max.y },
+                if c & 4 == 0 { self.min.z } else { self.max.z },
+            ))
+        })
+    }
+
+    /// The smallest and largest signed distance along `w` of the box's corners from `origin`.
+    pub fn extent_along(&self, transform: &Mat4, origin: Vec3, w: Vec3) -> (f32, f32) {
+        self.corners(transform)
+            .iter()
+            .map(|c| (*c - origin).dot(w))
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
     }
 }
 
@@ -81,20 +87,49 @@ struct Job {
     weight: f64,
 }
 
+/// How wide a region's shadows are: which solid angle Ω_i eq. (13) takes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RegionSize {
+    /// The paper's: the region's solid angle.
+    Geometric,
+    /// The solid angle its energy spreads over ([`Region::spread`]).
+    #[default]
+    Energy,
+}
+
+impl RegionSize {
+    fn of(self, region: &Region) -> f64 {
+        match self {
+            RegionSize::Geometric => region.solid_angle,
+            RegionSize::Energy => region.spread,
+        }
+    }
+}
+
 pub struct Occlusion {
-    regions: Regions,
+    /// The light sources whose shadows the layers hold: the q regions, then the dominant
+    /// lights as area lights (their layers' region index is q + the light's).
+    sources: Vec<Region>,
+    /// q.
+    regions: usize,
     bands: usize,
     bounds: Vec<GroupBounds>,
     pub resolution: u32,
     capacity: u32,
     pub penumbra: Penumbra,
+    size: RegionSize,
+    /// The receiver's depth, then the occluder's coverage in front of it.
+    receiver_pipeline: GraphicsPipeline,
     mask_pipeline: GraphicsPipeline,
     blur: ComputePipeline,
     mask: Image,
+    mask_depth: Image,
     temp: Image,
     /// V_o, one layer per (receiver, occluder, region) in use this frame.
     pub filtered: Image,
     pub sampler: Sampler,
+    /// The filter passes' texel fetches.
+    nearest: Sampler,
     /// `OcclusionLayer`s, sorted by receiver then region (a storage buffer for the mask and
     /// filter passes, a uniform buffer for the scene pass).
     pub layers: Buffer,
@@ -106,26 +141,38 @@ pub struct Occlusion {
     pub ranges: Vec<(u32, u32)>,
     /// The layers in use this frame, as uploaded to `layers`.
     in_use: Vec<OcclusionLayer>,
+    /// The receiver group of each layer in use.
+    receivers: Vec<usize>,
     /// Pairs that were wanted but did not fit in `capacity` this frame (least energy first).
     pub dropped: usize,
 }
 
+/// The masks: coverage, and coverage × occluder height.
 const MASK_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
+/// The filtered layers: up to three box widths side by side, and the occluder heights.
+const FILTERED_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 // The scene pass reads the layers from a uniform buffer (16 KiB on every device) and keeps one
 // bit per layer in 32-bit words.
 const _: () = assert!(constants::MAX_OCCLUSION_LAYERS as usize * size_of::<OcclusionLayer>() <= 16 * 1024);
 const _: () = assert!(constants::MAX_OCCLUSION_LAYERS % 32 == 0);
+/// Texels of margin on each side of a mask beyond the occluder and its filter's reach.
+const MASK_MARGIN_TEXELS: f32 = 1.5;
+/// How far behind the receiver's surface, in mask texels, an occluder fragment still counts as
+/// behind it: surfaces that touch (a teapot's base on the floor) must not shadow each other.
+const CONTACT_BIAS_TEXELS: f32 = 0.25;
 
+/// `layers` square layers of `size`² texels of `format`, read by the filter passes' texel fetches.
 fn layered(
     ctx: &Arc<Context>,
     name: &str,
     size: u32,
     layers: u32,
+    format: vk::Format,
     usage: vk::ImageUsageFlags,
 ) -> Result<Image> {
     Image::new(
         ctx,
-        &ImageDesc::square_array(name, size, layers, MASK_FORMAT, usage | vk::ImageUsageFlags::STORAGE),
+        &ImageDesc::square_array(name, size, layers, format, usage | vk::ImageUsageFlags::SAMPLED),
     )
 }
 
@@ -142,10 +189,31 @@ fn host_buffer(ctx: &Arc<Context>, name: &str, size: usize) -> Result<Buffer> {
 }
 
 /// Two unit vectors completing `w` to an orthonormal basis.
-fn plane_axes(w: Vec3) -> (Vec3, Vec3) {
+pub fn plane_axes(w: Vec3) -> (Vec3, Vec3) {
     let helper = if w.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
     let u = helper.cross(w).normalize();
     (u, w.cross(u))
+}
+
+/// The mask pipelines: `depth` Less for the receiver's surface, Nearer for the occluder.
+fn mask_pipeline(ctx: &Arc<Context>, name: &str, depth: DepthTest) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        ctx,
+        &GraphicsDesc {
+            name,
+            vertex_spirv: spirv::OCCLUDER_MASK_VERT,
+            fragment_spirv: spirv::OCCLUDER_MASK_FRAG,
+            bindings: &[BindingKind::StorageBuffer],
+            push_size: size_of::<MaskPush>() as u32,
+            vertex_buffers: &[MESH_POSITIONS],
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[MASK_FORMAT],
+            depth_format: Some(DEPTH_FORMAT),
+            depth,
+            additive: false,
+            constants: &[],
+        },
+    )
 }
 
 impl Occlusion {
@@ -154,13 +222,23 @@ impl Occlusion {
     pub fn new(
         ctx: &Arc<Context>,
         regions: Regions,
+        lights: &[DominantLight],
         bands: usize,
         bounds: Vec<GroupBounds>,
         resolution: u32,
         capacity: u32,
         penumbra: Penumbra,
+        size: RegionSize,
     ) -> Result<Occlusion> {
         let q = regions.regions.len();
+        // A dominant light as an area light: a disk of its radius, its energy's spread.
+        let disks = lights.iter().map(|l| Region {
+            energy: l.energy,
+            direction: l.direction,
+            solid_angle: std::f64::consts::TAU * (1.0 - l.radius.cos()),
+            spread: std::f64::consts::PI * l.radius * l.radius,
+        });
+        let sources: Vec<Region> = regions.regions.iter().cloned().chain(disks).collect();
         let groups = bounds.len();
         let layer_count = capacity.max(1);
         // Sized for the shader's whole array: the scene pass reads it as uniforms.
@@ -173,28 +251,13 @@ impl Occlusion {
             .collect();
         energy.write(0, &rgb)?;
         Ok(Occlusion {
-            mask_pipeline: GraphicsPipeline::new(
-                ctx,
-                &GraphicsDesc {
-                    name: "occluder_mask",
-                    vertex_spirv: spirv::OCCLUDER_MASK_VERT,
-                    fragment_spirv: spirv::OCCLUDER_MASK_FRAG,
-                    bindings: &[BindingKind::StorageBuffer],
-                    push_size: size_of::<MaskPush>() as u32,
-                    vertex_buffers: &[MESH_POSITIONS],
-                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                    color_formats: &[MASK_FORMAT],
-                    depth_format: None,
-                    depth: DepthTest::Off,
-                    additive: false,
-                    constants: &[],
-                },
-            )?,
+            receiver_pipeline: mask_pipeline(ctx, "occluder_mask.receiver", DepthTest::Less)?,
+            mask_pipeline: mask_pipeline(ctx, "occluder_mask", DepthTest::Nearer)?,
             blur: ComputePipeline::new(
                 ctx,
                 "occlusion_blur",
                 spirv::OCCLUSION_BLUR_COMP,
-                &[BindingKind::StorageBuffer, BindingKind::StorageImage, BindingKind::StorageImage],
+                &[BindingKind::StorageBuffer, BindingKind::SampledImage, BindingKind::StorageImage],
                 size_of::<BlurPush>() as u32,
             )?,
             mask: layered(
@@ -202,30 +265,48 @@ impl Occlusion {
                 "occlusion.mask",
                 resolution,
                 layer_count,
+                MASK_FORMAT,
                 vk::ImageUsageFlags::COLOR_ATTACHMENT,
             )?,
-            temp: layered(ctx, "occlusion.temp", resolution, layer_count, vk::ImageUsageFlags::empty())?,
+            mask_depth: Image::new(
+                ctx,
+                &ImageDesc::square_array(
+                    "occlusion.mask_depth",
+                    resolution,
+                    layer_count,
+                    DEPTH_FORMAT,
+                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                ),
+            )?,
+            temp: layered(
+                ctx,
+                "occlusion.temp",
+                resolution,
+                layer_count,
+                FILTERED_FORMAT,
+                vk::ImageUsageFlags::STORAGE,
+            )?,
             filtered: layered(
                 ctx,
                 "occlusion.filtered",
                 resolution,
                 layer_count,
-                vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC,
+                FILTERED_FORMAT,
+                vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC,
             )?,
-            // The fixed penumbra samples filtered coverage (the edge texel continues it); the
-            // adaptive one a summed-area table (zero before its first texel).
-            sampler: match penumbra {
-                Penumbra::Fixed => Sampler::new(ctx, "occlusion.sampler", true, Edge::Clamp, Edge::Clamp)?,
-                Penumbra::Adaptive => Sampler::new(ctx, "occlusion.sampler", true, Edge::Black, Edge::Black)?,
-            },
+            sampler: Sampler::new(ctx, "occlusion.sampler", true, Edge::Clamp, Edge::Clamp)?,
+            nearest: Sampler::new(ctx, "occlusion.nearest", false, Edge::Clamp, Edge::Clamp)?,
             penumbra,
+            size,
             layers: host_buffer(ctx, "occlusion.layers", layer_count as usize * size_of::<OcclusionLayer>())?,
             energy,
             region_basis: host_buffer(ctx, "occlusion.region_basis", groups * q * size_of::<RegionBasis>())?,
             ranges: vec![(0, 0); groups],
             in_use: Vec::new(),
+            receivers: Vec::new(),
             dropped: 0,
-            regions,
+            sources,
+            regions: q,
             bands,
             bounds,
             resolution,
@@ -239,71 +320,107 @@ impl Occlusion {
     }
 
     pub fn region_count(&self) -> usize {
-        self.regions.regions.len()
+        self.regions
+    }
+
+    /// The layer of `region` (world direction `w`) for the occluder group `o` over the
+    /// receiver group `r`, or `None` when `o` cannot shadow `r` from there.
+    fn layer(
+        &self,
+        transforms: &[Mat4],
+        r: usize,
+        o: usize,
+        region: usize,
+        w: Vec3,
+    ) -> Option<OcclusionLayer> {
+        let place = |g: usize| {
+            let t = &transforms[g];
+            (t.transform_point3(self.bounds[g].centre), self.bounds[g].radius * t.x_axis.truncate().length())
+        };
+        let ((receiver_centre, receiver_radius), (centre, radius)) = (place(r), place(o));
+        // Distances along w (towards the light) from the occluder's centre.
+        let (occluder_low, occluder_high) = self.bounds[o].extent_along(&transforms[o], centre, w);
+        let (receiver_low, receiver_high) = self.bounds[r].extent_along(&transforms[r], centre, w);
+        if occluder_high <= receiver_low {
+            return None; // wholly farther from the light than the receiver
+        }
+        let offset = centre - receiver_centre;
+        let along = offset.dot(w);
+        let root_omega = (self.size.of(&self.sources[region]) as f32).sqrt();
+        // The widest shadow: from the occluder's top to the receiver's bottom (adaptive); the
+        // paper's one width, R from the occluder's centre to the plane through the receiver's.
+        let width = match self.penumbra {
+            Penumbra::Fixed => root_omega * along.max(0.0),
+            Penumbra::Adaptive => root_omega * (occluder_high - receiver_low),
+        };
+        if (offset - along * w).length() > radius + receiver_radius + 0.5 * width {
+            return None; // the shadow cylinder misses the receiver
+        }
+        let (u, v) = plane_axes(w);
+        let corners = self.bounds[o].corners(&transforms[o]);
+        let (mut lo, mut hi) = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
+        for c in corners {
+            let p = glam::Vec2::new((c - centre).dot(u), (c - centre).dot(v));
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        // Every vertex lies in the bounding sphere too.
+        let (lo, hi) = (lo.max(glam::Vec2::splat(-radius)), hi.min(glam::Vec2::splat(radius)));
+        let res = self.resolution as f32;
+        let reach = lo.abs().max(hi.abs()).max_element();
+        let half_extent = (reach + 0.5 * width) / (1.0 - 2.0 * MASK_MARGIN_TEXELS / res);
+        let scale = 1.0 / (2.0 * half_extent);
+        let odd = |texels: f32| 2.0 * (0.5 * texels).round() + 1.0;
+        let widest = odd(width * scale * res);
+        // Adaptive: boxes of 1, the geometric mean and the widest side by side (see
+        // occlusion_blur.comp); fixed: the one box.
+        let middle = match self.penumbra {
+            Penumbra::Fixed => widest,
+            Penumbra::Adaptive => odd(widest.sqrt()),
+        };
+        // The box reaches half its odd width beyond the occluder's silhouette, and bilinear
+        // filtering one texel more.
+        let filter = (0.5 * widest + 1.0) / res;
+        let depth_range = [occluder_low, occluder_high, receiver_low, receiver_high]
+            .iter()
+            .fold(0.0f32, |m, d| m.max(d.abs()))
+            * 1.01
+            + 1e-6;
+        Some(OcclusionLayer {
+            centre: centre.extend(scale).to_array(),
+            axis_u: u.extend(middle).to_array(),
+            axis_v: v.extend(widest).to_array(),
+            footprint: [
+                lo.x * scale + 0.5 - filter,
+                lo.y * scale + 0.5 - filter,
+                hi.x * scale + 0.5 + filter,
+                hi.y * scale + 0.5 + filter,
+            ],
+            region: region as u32,
+            occluder: o as u32,
+            widen: root_omega * scale * res,
+            depth_range,
+        })
     }
 
     /// Chooses this frame's layers and uploads them, with each group's region basis.
     pub fn update(&mut self, transforms: &[Mat4], env: Mat3) -> Result<()> {
         let q = self.region_count();
-        let world: Vec<(Vec3, f32)> = self
-            .bounds
-            .iter()
-            .zip(transforms)
-            .map(|(b, t)| (t.transform_point3(b.centre), b.radius * t.x_axis.truncate().length()))
-            .collect();
         let directions: Vec<Vec3> =
-            self.regions.regions.iter().map(|r| env * r.direction.as_vec3()).collect();
+            self.sources.iter().map(|r| (env * r.direction.as_vec3()).normalize()).collect();
 
         let mut jobs = Vec::new();
-        for (r, &(receiver_centre, receiver_radius)) in world.iter().enumerate() {
+        for r in 0..transforms.len() {
             let to_object = rotation_of(&transforms[r]).transpose();
-            for (i, region) in self.regions.regions.iter().enumerate() {
+            for (i, region) in self.sources.iter().enumerate() {
                 let energy = region.energy.iter().sum::<f64>();
                 let w = directions[i];
                 if energy <= 0.0 || self.bounds[r].faces_away_from(to_object * w) {
                     continue;
                 }
-                for (o, &(occluder_centre, occluder_radius)) in
-                    world.iter().enumerate().filter(|&(o, _)| o != r)
-                {
-                    if self.bounds[o].reach_along(&transforms[o], receiver_centre, w) <= 0.0 {
-                        continue;
+                for o in (0..transforms.len()).filter(|&o| o != r) {
+                    if let Some(layer) = self.layer(transforms, r, o, i, w) {
+                        jobs.push(Job { receiver: r, weight: energy, layer });
                     }
-                    let offset = occluder_centre - receiver_centre;
-                    let along = offset.dot(w);
-                    let root_omega = (region.solid_angle as f32).sqrt();
-                    // Fixed: the box width of eq. (13). Adaptive: the widest box a pixel can
-                    // ask for (blocker search), from the occluder's top to the receiver's bottom.
-                    let width = match self.penumbra {
-                        Penumbra::Fixed => root_omega * along.max(0.0),
-                        Penumbra::Adaptive => {
-                            root_omega
-                                * (self.bounds[o].reach_along(&transforms[o], receiver_centre, w)
-                                    + receiver_radius)
-                        }
-                    };
-                    if (offset - along * w).length() > occluder_radius + receiver_radius + 0.5 * width {
-                        continue;
-                    }
-                    let half_extent = receiver_radius + 0.5 * width;
-                    let texels = width / (2.0 * half_extent) * self.resolution as f32;
-                    let odd = 2.0 * (0.5 * texels).round() + 1.0;
-                    let (u, v) = plane_axes(w);
-                    let scale = 1.0 / (2.0 * half_extent);
-                    // The box (or blocker search) reaches half its odd width beyond the
-                    // occluder's silhouette, and bilinear filtering one texel more.
-                    let reach = occluder_radius * scale + (0.5 * odd + 1.0) / self.resolution as f32;
-                    jobs.push(Job {
-                        receiver: r,
-                        weight: energy,
-                        layer: OcclusionLayer {
-                            centre: receiver_centre.extend(scale).to_array(),
-                            axis_u: u.extend(odd).to_array(),
-                            axis_v: v.extend(root_omega).to_array(),
-                            footprint: [offset.dot(u) * scale + 0.5, offset.dot(v) * scale + 0.5, reach, 0.0],
-                            ids: [i as u32, r as u32, o as u32, 0],
-                        },
-                    });
                 }
             }
         }
@@ -316,7 +433,7 @@ impl Occlusion {
             self.dropped = 0;
         }
         // The scene pass walks a receiver's layers region by region.
-        jobs.sort_by_key(|j| (j.receiver, j.layer.ids[0]));
+        jobs.sort_by_key(|j| (j.receiver, j.layer.region));
         self.ranges.iter_mut().for_each(|r| *r = (0, 0));
         for (l, job) in jobs.iter().enumerate() {
             let range = &mut self.ranges[job.receiver];
@@ -326,6 +443,7 @@ impl Occlusion {
             range.1 += 1;
         }
         self.in_use = jobs.iter().map(|j| j.layer).collect();
+        self.receivers = jobs.iter().map(|j| j.receiver).collect();
         if !self.in_use.is_empty() {
             self.layers.write(0, bytes_of_slice(&self.in_use))?;
         }
@@ -335,7 +453,7 @@ impl Occlusion {
         let mut y = [0.0f32; 25];
         for transform in transforms {
             let to_object = rotation_of(transform).transpose();
-            for w in &directions {
+            for w in &directions[..q] {
                 sh::eval_basis(self.bands, (to_object * *w).normalize(), &mut y);
                 let mut b = RegionBasis::default();
                 for (k, value) in y.iter().take(self.bands * self.bands).enumerate() {
@@ -364,28 +482,35 @@ impl Occlusion {
                 cmd,
                 &[
                     Binding::Storage(&self.layers),
-                    Binding::StorageImage(source),
+                    Binding::Sampled(source, &self.nearest),
                     Binding::StorageImage(target),
                 ],
                 bytes_of(&push),
                 groups,
             );
         };
+        let draw = move |cmd, pipeline: &GraphicsPipeline, l: usize, group: usize, role: u32| {
+            let layer = &self.in_use[l];
+            let bias = CONTACT_BIAS_TEXELS / (layer.centre[3] * self.resolution as f32);
+            pipeline.bind(cmd, &[Binding::Storage(&self.layers)]);
+            for mesh in scene.meshes.iter().filter(|m| m.group == group) {
+                let push = MaskPush {
+                    model: scene.transforms[group].to_cols_array_2d(),
+                    layer: [l as u32, role, 0, 0],
+                    bias: [bias, 0.0, 0.0, 0.0],
+                };
+                pipeline.push(cmd, bytes_of(&push));
+                ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+            }
+        };
         vec![
             Pass::new("occluder_masks", &[], &["occlusion_masks"], move |cmd| {
-                for (l, layer) in self.in_use.iter().enumerate() {
-                    let occluder = layer.ids[2] as usize;
+                for (l, (layer, &receiver)) in self.in_use.iter().zip(&self.receivers).enumerate() {
                     let target = Target { image: &self.mask, layer: l as u32 };
-                    ctx.begin_rendering(cmd, Some(target), Some([0.0; 4]), None);
-                    self.mask_pipeline.bind(cmd, &[Binding::Storage(&self.layers)]);
-                    for mesh in scene.meshes.iter().filter(|m| m.group == occluder) {
-                        let push = MaskPush {
-                            model: scene.transforms[occluder].to_cols_array_2d(),
-                            layer: [l as u32, 0, 0, 0],
-                        };
-                        self.mask_pipeline.push(cmd, bytes_of(&push));
-                        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
-                    }
+                    let depth = Depth::Clear(Target { image: &self.mask_depth, layer: l as u32 });
+                    ctx.begin_rendering(cmd, Some(target), Some([0.0; 4]), Some(depth));
+                    draw(cmd, &self.receiver_pipeline, l, receiver, 0);
+                    draw(cmd, &self.mask_pipeline, l, layer.occluder as usize, 1);
                     ctx.end_rendering(cmd);
                 }
             }),

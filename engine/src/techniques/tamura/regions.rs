@@ -28,6 +28,11 @@ pub struct Region {
     pub direction: DVec3,
     /// Ω_i in steradians.
     pub solid_angle: f64,
+    /// The solid angle its energy spreads over: 2π·E[θ²], θ the angle to `direction` weighted
+    /// by luminance × solid angle, which is πr² for a uniform disk of angular radius r; the
+    /// geometric `solid_angle` for a black region. A sun in a large region of black sky is a
+    /// small light: its shadows are sharp however large the region is.
+    pub spread: f64,
 }
 
 /// The decomposition of one map.
@@ -198,8 +203,6 @@ impl Regions {
             )));
         }
         let samples = relaxation_samples(map);
-        let sites = relax(&samples, initial_sites(&samples, q));
-
         let (w, h) = (map.width(), map.height());
         let texels: Vec<(DVec3, f64, [f64; 3])> = (0..w * h)
             .map(|t| {
@@ -208,7 +211,8 @@ impl Regions {
                 (dir, equirect_texel_solid_angle(w, h, y), map.pixels()[t as usize].map(f64::from))
             })
             .collect();
-        let (sites, texel_region) = assign_without_empty_regions(&texels, sites);
+        let (sites, texel_region) =
+            assign_without_empty_regions(&texels, relax(&samples, initial_sites(&samples, q)));
 
         let mut energy = vec![[0.0f64; 3]; q];
         let mut weighted_dir = vec![DVec3::ZERO; q];
@@ -221,15 +225,34 @@ impl Regions {
             weighted_dir[i] += dir * luminance(l) * d_omega;
             solid_angle[i] += d_omega;
         }
+        let directions: Vec<DVec3> =
+            (0..q)
+                .map(|i| {
+                    if weighted_dir[i].length_squared() > 0.0 {
+                        weighted_dir[i].normalize()
+                    } else {
+                        sites[i]
+                    }
+                })
+                .collect();
+        let mut moment = vec![0.0f64; q];
+        let mut weight = vec![0.0f64; q];
+        for (&(dir, d_omega, l), &i) in texels.iter().zip(&texel_region) {
+            let (i, w) = (i as usize, luminance(l) * d_omega);
+            let theta = dir.dot(directions[i]).clamp(-1.0, 1.0).acos();
+            moment[i] += w * theta * theta;
+            weight[i] += w;
+        }
         let regions = (0..q)
             .map(|i| Region {
                 energy: energy[i],
-                direction: if weighted_dir[i].length_squared() > 0.0 {
-                    weighted_dir[i].normalize()
-                } else {
-                    sites[i]
-                },
+                direction: directions[i],
                 solid_angle: solid_angle[i],
+                spread: if weight[i] > 0.0 {
+                    2.0 * std::f64::consts::PI * moment[i] / weight[i]
+                } else {
+                    solid_angle[i]
+                },
             })
             .collect();
         Ok(Regions { regions, texel_region })
@@ -242,11 +265,12 @@ impl Regions {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::f64::consts::PI;
 
-    fn map_energy(map: &EnvMap) -> [f64; 3] {
+    /// Σ L dΩ over the map's texels, per channel.
+    pub(crate) fn map_energy(map: &EnvMap) -> [f64; 3] {
         let mut total = [0.0; 3];
         for (t, p) in map.pixels().iter().enumerate() {
             let d_omega = equirect_texel_solid_angle(map.width(), map.height(), t as u32 / map.width());

@@ -1,6 +1,8 @@
 //! The PRT scene technique: self-shadowed radiance per vertex (Sloan et al.), minus, with
 //! regions, the light other groups block (Tamura et al. eq. (15)).
-use super::occlusion::{group_bounds, Occlusion};
+use super::dominant;
+use super::dominant_maps::{self, DominantMaps};
+use super::occlusion::{group_bounds, Occlusion, RegionSize};
 use super::regions::Regions;
 use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::backend::{
@@ -8,12 +10,12 @@ use crate::backend::{
     Sampler, VertexBuffer,
 };
 use crate::error::{Error, Result};
-use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush};
+use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush, ShCoeffs};
 use crate::pass::Pass;
 use crate::renderer::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::scene::Scene;
 use crate::techniques::prt::TransferSet;
-use crate::techniques::unshadowed::MESH_POSITIONS;
+use crate::techniques::unshadowed::MESH_VERTICES;
 use crate::techniques::{FrameInputs, FrameState, Technique};
 use std::sync::Arc;
 
@@ -24,9 +26,9 @@ pub enum Penumbra {
     /// measured between the group centres (eqs. (12)–(13)).
     #[default]
     Fixed,
-    /// Beyond the paper: the same two 1D passes build a summed-area table, and each pixel takes
-    /// a box as wide as sqrt(Ω_i) times its own distance to the occluder, so shadows fade with
-    /// distance from their occluder.
+    /// Beyond the paper: the same two 1D passes leave boxes of three widths, and each pixel
+    /// takes a box as wide as sqrt(Ω_i) times its own distance to the occluder (interpolated
+    /// between them), so shadows sharpen at contact and soften with distance.
     Adaptive,
 }
 
@@ -40,6 +42,16 @@ pub struct OcclusionSettings {
     /// Most layers filtered per frame.
     pub max_layers: u32,
     pub penumbra: Penumbra,
+    /// Which solid angle sets a region's box width.
+    pub size: RegionSize,
+    /// Most dominant lights taken out of the map and lit per pixel (0: the paper's technique;
+    /// they count among the q regions).
+    pub dominant_lights: usize,
+    /// Side of a group's depth map along a dominant light, texels.
+    pub light_map_size: u32,
+    /// The unshadowed cosine per pixel, only the self-shadow interpolated from the vertices
+    /// (beyond the paper, whose L_s is per vertex).
+    pub pixel_cosine: bool,
 }
 
 impl Default for OcclusionSettings {
@@ -49,6 +61,10 @@ impl Default for OcclusionSettings {
             mask_size: 128,
             max_layers: constants::MAX_OCCLUSION_LAYERS,
             penumbra: Penumbra::Fixed,
+            size: RegionSize::Energy,
+            dominant_lights: 4,
+            light_map_size: dominant_maps::DEFAULT_MAP_SIZE,
+            pixel_cosine: true,
         }
     }
 }
@@ -58,8 +74,11 @@ pub struct PrtTechnique {
     drawn: fn(usize) -> bool,
     self_shadow: SelfShadow,
     occlusion: Occlusion,
+    dominant: DominantMaps,
     scene_pipeline: GraphicsPipeline,
     nearest: Sampler,
+    /// The first 9 SH coefficients of the light L_s is made of (`ShCoeffs`, the map's frame).
+    light_sh: Buffer,
 }
 
 impl PrtTechnique {
@@ -90,24 +109,38 @@ impl PrtTechnique {
                 settings.mask_size
             )));
         }
+        if settings.dominant_lights > constants::MAX_DOMINANT_LIGHTS as usize {
+            return Err(Error::InvalidArgument(format!(
+                "{} dominant lights: the Tamura technique lights at most {} per pixel",
+                settings.dominant_lights,
+                constants::MAX_DOMINANT_LIGHTS
+            )));
+        }
         let bands = transfer.params.bands as usize;
-        let env = crate::sh::project_equirect(
-            scene.environment.width(),
-            scene.environment.height(),
-            scene.environment.pixels(),
-            bands,
-        )?;
-        let regions = if settings.regions == 0 {
+        // Without regions (Sloan's PRT) the whole map is the self-shadowed light.
+        let max_lights = if settings.regions == 0 { 0 } else { settings.dominant_lights };
+        let split = dominant::split(&scene.environment, max_lights);
+        let residual = &split.residual;
+        let env = crate::sh::project_equirect(residual.width(), residual.height(), residual.pixels(), bands)?;
+        let region_count = settings.regions.saturating_sub(split.lights.len());
+        let regions = if region_count == 0 {
             Regions { regions: Vec::new(), texel_region: Vec::new() }
         } else {
-            Regions::new(&scene.environment, settings.regions)?
+            Regions::new(residual, region_count)?
         };
         // Layer images hold no more layers than the scene can ask for: one per ordered pair of
         // groups and region (the two-group default scene at q = 32 needs 64, not 256).
         let groups = scene.groups.len();
-        let wanted = (groups * groups.saturating_sub(1) * settings.regions).min(u32::MAX as usize) as u32;
+        let sources = region_count + split.lights.len();
+        let wanted = (groups * groups.saturating_sub(1) * sources).min(u32::MAX as usize) as u32;
         let capacity = wanted.min(settings.max_layers);
+        let lights = split.lights.len() as u32;
+        let mut light_sh = ShCoeffs::default();
+        for (c, rgb) in light_sh.c.iter_mut().zip(&env) {
+            *c = [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 0.0];
+        }
         let transfer_attributes = transfer_vertex_buffer(2);
+        let bounds = group_bounds(scene);
         // prt_scene.vert's pipeline constants: vec4s of region transfers and of SH coefficients.
         let region_vec4 = regions.regions.len().div_ceil(4).max(1) as u32;
         let basis_vec4 = (bands * bands).div_ceil(4) as u32;
@@ -117,12 +150,15 @@ impl PrtTechnique {
             occlusion: Occlusion::new(
                 ctx,
                 regions,
+                &split.lights,
                 bands,
-                group_bounds(scene),
+                bounds.clone(),
                 settings.mask_size,
                 capacity,
                 settings.penumbra,
+                settings.size,
             )?,
+            dominant: DominantMaps::new(ctx, split.lights, bounds, settings.light_map_size)?,
             scene_pipeline: GraphicsPipeline::new(
                 ctx,
                 &GraphicsDesc {
@@ -136,10 +172,13 @@ impl PrtTechnique {
                         BindingKind::UniformBuffer,
                         BindingKind::SampledImage,
                         BindingKind::UniformBuffer,
+                        BindingKind::UniformBuffer,
+                        BindingKind::SampledImage,
+                        BindingKind::UniformBuffer,
                     ],
                     push_size: size_of::<PrtDrawPush>() as u32,
                     vertex_buffers: &[
-                        MESH_POSITIONS,
+                        MESH_VERTICES,
                         VertexBuffer { stride: TRANSFER_STRIDE, attributes: &transfer_attributes },
                     ],
                     topology: vk::PrimitiveTopology::TRIANGLE_LIST,
@@ -147,36 +186,50 @@ impl PrtTechnique {
                     depth_format: Some(DEPTH_FORMAT),
                     depth: DepthTest::Less,
                     additive: false,
-                    constants: &[(settings.penumbra == Penumbra::Adaptive) as u32, region_vec4, basis_vec4],
+                    constants: &[
+                        (settings.penumbra == Penumbra::Adaptive) as u32,
+                        region_vec4,
+                        basis_vec4,
+                        lights,
+                        settings.pixel_cosine as u32,
+                    ],
                 },
             )?,
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
+            light_sh: Buffer::with_data(
+                ctx,
+                "prt.light_sh",
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                bytes_of(&light_sh),
+            )?,
         })
     }
 }
 
 impl Technique for PrtTechnique {
     fn dropped_layers(&self) -> usize {
-        self.occlusion.dropped
+        self.occlusion.dropped + self.dominant.dropped
     }
 
     fn update(&mut self, state: &FrameState) -> Result<()> {
         let env = env_rotation(state.env_rotation);
         self.self_shadow.update(state.transforms, env, self.drawn)?;
+        self.dominant.update(state.transforms, env)?;
         self.occlusion.update(state.transforms, env)
     }
 
     fn persistent(&self) -> &'static [&'static str] {
-        &["self_shadow"]
+        &["self_shadow", "dominant_maps"]
     }
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
         let mut passes = self.prepasses(ctx, scene);
+        // What the scene pass reads: the frame's layers, where there are any.
         let reads: &'static [&'static str] = if passes.iter().any(|p| p.name == "blur_vertical") {
-            &["frame_uniforms", "self_shadow", "occlusion", "color"]
+            &["frame_uniforms", "self_shadow", "occlusion", "dominant_maps", "color"]
         } else {
-            &["frame_uniforms", "self_shadow", "color"]
+            &["frame_uniforms", "self_shadow", "dominant_maps", "color"]
         };
         passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
             ctx.begin_rendering(
@@ -203,6 +256,7 @@ impl PrtTechnique {
     /// the occlusion layers between groups (none for Sloan's PRT).
     pub fn prepasses<'a>(&'a self, ctx: &'a Arc<Context>, scene: &'a GpuScene) -> Vec<Pass<'a>> {
         let mut passes: Vec<Pass> = self.self_shadow.pass(ctx, scene).into_iter().collect();
+        passes.extend(self.dominant.pass(ctx, scene));
         passes.extend(self.occlusion.passes(ctx, scene));
         passes
     }
@@ -211,6 +265,7 @@ impl PrtTechnique {
     /// (Sloan's PRT where there are no regions).
     pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, uniforms: &Buffer, scene: &GpuScene) {
         let (occlusion, self_shadow) = (&self.occlusion, &self.self_shadow);
+        let [lights, shadow] = self.dominant.bindings();
         self.scene_pipeline.bind(
             cmd,
             &[
@@ -220,6 +275,9 @@ impl PrtTechnique {
                 Binding::Uniform(&occlusion.energy),
                 Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
                 Binding::Uniform(&occlusion.layers),
+                lights,
+                shadow,
+                Binding::Uniform(&self.light_sh),
             ],
         );
         let q = occlusion.region_count() as u32;
@@ -229,7 +287,7 @@ impl PrtTechnique {
                 model: scene.transforms[mesh.group].to_cols_array_2d(),
                 albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
                 mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
-                layers: [first_layer, layer_count, 0, occlusion.resolution],
+                layers: [first_layer, layer_count, self.dominant.slot(mesh.group), occlusion.resolution],
             };
             self.scene_pipeline.push(cmd, bytes_of(&push));
             ctx.draw_indexed(
