@@ -33,7 +33,6 @@ static VkDevice make_device(VkPhysicalDevice physical, uint32_t family, int for_
   VkPhysicalDeviceDynamicRenderingFeatures dynamic_rendering = {
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES, NULL, VK_TRUE};
   VkPhysicalDeviceFeatures features = {0};
-  features.shaderClipDistance = VK_TRUE;
   features.shaderStorageImageExtendedFormats = VK_TRUE;
   VkDeviceCreateInfo info = {.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.queueCreateInfoCount = 1;

@@ -232,8 +232,14 @@ fn filtered_layers_are_zero_outside_their_footprint() {
     for penumbra in [Penumbra::Fixed, Penumbra::Adaptive] {
         let regions = Regions::new(&scene.environment, 32).unwrap();
         let bounds = group_bounds(&scene);
-        let mut occlusion =
-            Occlusion::new(&ctx, regions, &[], 3, bounds, size, 64, penumbra, RegionSize::Energy).unwrap();
+        let settings = OcclusionSettings {
+            mask_size: size,
+            max_layers: 64,
+            penumbra,
+            size: RegionSize::Energy,
+            ..Default::default()
+        };
+        let mut occlusion = Occlusion::new(&ctx, regions, &[], 3, bounds, &settings).unwrap();
         let mut executor = FrameExecutor::new(&ctx, "footprint").unwrap();
         for t in [0.0, 0.1, 0.3, 0.6] {
             let mut transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();

@@ -22,8 +22,8 @@ pub struct ContextDesc {
 /// A host's Vulkan objects for [`Context::adopt`]: Kage uses them and never destroys them.
 ///
 /// The device must have been created with `VK_KHR_dynamic_rendering` and
-/// `VK_KHR_push_descriptor` enabled and the features `dynamicRendering`, `shaderClipDistance`
-/// and `shaderStorageImageExtendedFormats` on, from an instance of API version 1.2 or later.
+/// `VK_KHR_push_descriptor` enabled and the features `dynamicRendering` and
+/// `shaderStorageImageExtendedFormats` on, from an instance of API version 1.2 or later.
 #[derive(Clone, Copy, Debug)]
 pub struct HostVulkan {
     pub instance: vk::Instance,
@@ -177,7 +177,6 @@ impl Context {
         let mut dynamic_rendering_features =
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
         let enabled = vk::PhysicalDeviceFeatures::default()
-            .shader_clip_distance(true)
             .geometry_shader(info.has(device::GEOMETRY_SHADER))
             .fragment_stores_and_atomics(info.has(device::FRAGMENT_STORES))
             .shader_storage_image_extended_formats(true);

@@ -85,7 +85,6 @@ pub(crate) fn probe(
                 "VK_LAYER_KHRONOS_validation (installed)",
                 layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)),
             ),
-            ("shaderClipDistance (required)", features.shader_clip_distance == vk::TRUE),
             (
                 "shaderStorageImageExtendedFormats (required)",
                 features.shader_storage_image_extended_formats == vk::TRUE,

@@ -76,7 +76,7 @@ pub struct kage_vulkan_handles {
     /// The VkPhysicalDevice the device was created on.
     pub physical_device: *mut c_void,
     /// The VkDevice, created with the device extensions VK_KHR_dynamic_rendering and
-    /// VK_KHR_push_descriptor enabled and the features dynamicRendering, shaderClipDistance and
+    /// VK_KHR_push_descriptor enabled and the features dynamicRendering and
     /// shaderStorageImageExtendedFormats on.
     pub device: *mut c_void,
     /// A queue family with graphics and compute; Kage's command pool is made for it.

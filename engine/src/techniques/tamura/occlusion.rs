@@ -23,7 +23,7 @@
 use super::dominant::DominantLight;
 use super::regions::{Region, Regions};
 use super::self_shadow::rotation_of;
-use super::technique::Penumbra;
+use super::technique::{OcclusionSettings, Penumbra};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
     GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
@@ -217,20 +217,24 @@ fn mask_pipeline(ctx: &Arc<Context>, name: &str, depth: DepthTest) -> Result<Gra
 }
 
 impl Occlusion {
-    /// `regions` may be empty (Sloan's PRT: no occlusion between groups); `resolution` is the
-    /// side of a mask layer in texels; at most `capacity` layers are filtered per frame.
+    /// `regions` may be empty (Sloan's PRT: no occlusion between groups). Of `settings`: the
+    /// mask size, the most layers, the penumbra and the region size.
     pub fn new(
         ctx: &Arc<Context>,
         regions: Regions,
         lights: &[DominantLight],
         bands: usize,
         bounds: Vec<GroupBounds>,
-        resolution: u32,
-        capacity: u32,
-        penumbra: Penumbra,
-        size: RegionSize,
+        settings: &OcclusionSettings,
     ) -> Result<Occlusion> {
+        let (resolution, penumbra, size) = (settings.mask_size, settings.penumbra, settings.size);
         let q = regions.regions.len();
+        // Layer images hold no more layers than the scene can ask for: one per ordered pair of
+        // groups and source (the two-group default scene at q = 32 needs 64, not 192), within
+        // the settings' budget.
+        let groups = bounds.len();
+        let wanted = groups * groups.saturating_sub(1) * (q + lights.len());
+        let capacity = wanted.min(settings.max_layers as usize) as u32;
         // A dominant light as an area light: a disk of its radius, its energy's spread.
         let disks = lights.iter().map(|l| Region {
             energy: l.energy,
@@ -239,7 +243,6 @@ impl Occlusion {
             spread: std::f64::consts::PI * l.radius * l.radius,
         });
         let sources: Vec<Region> = regions.regions.iter().cloned().chain(disks).collect();
-        let groups = bounds.len();
         let layer_count = capacity.max(1);
         // Sized for the shader's whole array: the scene pass reads it as uniforms.
         let mut energy = host_buffer(ctx, "occlusion.region_energy", constants::MAX_REGIONS as usize * 16)?;

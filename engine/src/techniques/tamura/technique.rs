@@ -128,12 +128,6 @@ impl PrtTechnique {
         } else {
             Regions::new(residual, region_count)?
         };
-        // Layer images hold no more layers than the scene can ask for: one per ordered pair of
-        // groups and region (the two-group default scene at q = 32 needs 64, not 256).
-        let groups = scene.groups.len();
-        let sources = region_count + split.lights.len();
-        let wanted = (groups * groups.saturating_sub(1) * sources).min(u32::MAX as usize) as u32;
-        let capacity = wanted.min(settings.max_layers);
         let lights = split.lights.len() as u32;
         let mut light_sh = ShCoeffs::default();
         for (c, rgb) in light_sh.c.iter_mut().zip(&env) {
@@ -147,17 +141,7 @@ impl PrtTechnique {
         Ok(PrtTechnique {
             drawn: |_| true,
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
-            occlusion: Occlusion::new(
-                ctx,
-                regions,
-                &split.lights,
-                bands,
-                bounds.clone(),
-                settings.mask_size,
-                capacity,
-                settings.penumbra,
-                settings.size,
-            )?,
+            occlusion: Occlusion::new(ctx, regions, &split.lights, bands, bounds.clone(), &settings)?,
             dominant: DominantMaps::new(ctx, split.lights, bounds, settings.light_map_size)?,
             scene_pipeline: GraphicsPipeline::new(
                 ctx,
