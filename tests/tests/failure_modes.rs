@@ -555,11 +555,12 @@ fn rss_bytes() -> u64 {
 
 /// Renders `frames` animated frames at 16² with the unshadowed and the shadowmap technique and
 /// checks that memory stays flat: device memory (`Context::allocated_bytes`) exactly, resident
-/// host memory within `RSS_SLACK` after a warm-up of 100 frames (allocator pools and the
+/// host memory within `RSS_SLACK` after a warm-up of 1,000 frames (allocator pools and the
 /// validation layer's first-use tables settle there). A leak of one 16² readback per frame
 /// (4 KiB) would add 16 MiB in 4,000 frames.
 fn memory_stays_flat(frames: usize) {
     const RSS_SLACK: u64 = 2 << 20;
+    const WARM_UP: usize = 1000;
     let _alone = ALONE.write().unwrap_or_else(|e| e.into_inner());
     let ctx = Validated::new();
     let scene = scene(vec![group("object", vec![degenerate_mesh()], Vec3::ZERO), room()]);
@@ -573,10 +574,10 @@ fn memory_stays_flat(frames: usize) {
             renderer.set_group_transform(0, Mat4::from_rotation_translation(turn, Vec3::ZERO)).unwrap();
             renderer.render().unwrap();
         };
-        (0..100).for_each(&mut frame);
+        (0..WARM_UP).for_each(&mut frame);
         let (device, rss) = (ctx.allocated_bytes(), rss_bytes());
         let start = std::time::Instant::now();
-        (100..100 + frames).for_each(&mut frame);
+        (WARM_UP..WARM_UP + frames).for_each(&mut frame);
         let seconds = start.elapsed().as_secs_f64();
         let (device_after, rss_after) = (ctx.allocated_bytes(), rss_bytes());
         println!(
