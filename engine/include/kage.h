@@ -260,7 +260,7 @@ typedef struct {
   void *physical_device;
   /**
    * The VkDevice, created with the device extensions VK_KHR_dynamic_rendering and
-   * VK_KHR_push_descriptor enabled and the features dynamicRendering, shaderClipDistance and
+   * VK_KHR_push_descriptor enabled and the features dynamicRendering and
    * shaderStorageImageExtendedFormats on.
    */
   void *device;
