@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the speed-against-accuracy charts shown in README.md (docs/sweep-*.png) with
 # `kage sweep`, and keeps each sweep's CSV beside its chart. Run by hand, not in CI: the PRT
-# sweep (under the courtyard, a 2° sun 45° up and studio.exr: docs/sweep-prt.png,
-# docs/sweep-prt-sun.png, docs/sweep-prt-studio.png) takes about 40 minutes on a 2-core lavapipe
-# machine the first time (its references, run to 0.5 % noise, are cached for later runs), the ASM sweep about 2 (references cached; 5 more to ray-cast them) and the
+# sweep takes about 15 minutes on a 2-core lavapipe machine once its references are cached
+# (run to 0.5 % noise, they take about 10 more the first time), the ASM sweep about 2 (references cached; 5 more to ray-cast them) and the
 # probe sweeps (probe-room and atrium) about 5 each. Frame times are only as good as the
 # machine is quiet: run it with nothing else busy.
 set -euo pipefail
@@ -20,11 +19,7 @@ sweep() {
   cp "$work/$name/sweep.csv" "docs/sweep-$name.csv"
   echo "wrote docs/sweep-$name.png docs/sweep-$name.csv"
 }
-sweep prt --technique prt --env engine/assets/courtyard.exr --env tests/assets/sun/sun2-45.exr \
-  --env tests/assets/studio.exr
-cp "$work/prt/pareto-sun2-45.exr.png" docs/sweep-prt-sun.png
-cp "$work/prt/pareto-studio.exr.png" docs/sweep-prt-studio.png
-echo "wrote docs/sweep-prt-sun.png docs/sweep-prt-studio.png"
+sweep prt --technique prt
 sweep asm --technique asm --size 256 --frames 200
 sweep probes-room --technique probes --scene probe-room --spp 8192
 sweep probes-atrium --technique probes --scene atrium --spp 8192
