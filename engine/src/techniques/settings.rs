@@ -258,6 +258,15 @@ mod tests {
         assert!(error(tamura.clone(), None).contains("precompute it first"));
         assert!(error(tamura.clone(), transfer(4)).contains("4 SH bands"));
         assert!(error(TechniqueSettings { regions: 0, ..tamura.clone() }, transfer(3)).contains("at least 1"));
+        let dominant = TechniqueSettings { dominant_lights: 9, ..tamura.clone() };
+        assert!(error(dominant, transfer(3)).contains("dominant lights: 9"));
+        let light_map = TechniqueSettings { light_map_size: 8, ..tamura.clone() };
+        assert!(error(light_map, transfer(3)).contains("light map size 8"));
+        let paper = TechniqueSettings { kind: TechniqueKind::TamuraPaper, regions: 0, ..tamura.clone() };
+        assert!(error(paper, transfer(3)).contains("at least 1"));
+        // Sloan's whole-scene variant needs a transfer with the whole scene's visibility.
+        let scene = TechniqueSettings { kind: TechniqueKind::SloanScene, ..tamura.clone() };
+        assert!(error(scene, transfer(3)).contains("Group visibility"));
         let bands = PrtParams { bands: 9, ..PrtParams::DEFAULT };
         assert!(error(TechniqueSettings { prt: bands, ..tamura }, transfer(9)).contains("9 SH bands"));
         let mut probes = TechniqueSettings { kind: TechniqueKind::Probes, ..Default::default() };
