@@ -169,7 +169,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
-    let cases: [(&[&str], &str); 12] = [
+    let cases: [(&[&str], &str); 15] = [
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", "asm", "--keyframe", "5"], "scene asm has 5 walkthrough keyframes"),
         (&["reference", "--keyframe", "1", "--out", "x.exr"], "scene teapot has 0 walkthrough keyframes"),
@@ -177,8 +177,14 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["render", "--width", "0"], "image size"),
         (&["render", "--out", "picture.jpg", "--width", "8", "--height", "8"], "picture.jpg"),
         (&["sh", "/nonexistent/map.exr"], "/nonexistent/map.exr"),
-        (&["sweep", "--technique", "prt", "--only", "tamura:3", "--out", "x"], "sloan:2, sloan:3"),
+        (&["sweep", "--technique", "prt", "--only", "tamura:3", "--out", "x"], "sloan-self:2, sloan-self:3"),
         (&["sweep", "--technique", "prt", "--poses", "nan", "--out", "x"], "--poses"),
+        (&["sweep", "--technique", "prt", "--spp", "64", "--out", "x"], "runs each reference to --noise"),
+        (
+            &["sweep", "--technique", "prt", "--noise", "0", "--out", "x"],
+            "--noise must be a positive fraction",
+        ),
+        (&["env", "sun", "--radius", "0", "--out", "x.exr"], "radius"),
         (&["sweep", "--technique", "prt", "--pick", "--out", "x"], "--pick needs a bound"),
         (&["sweep", "--technique", "asm", "--test-region", "box", "--out", "x"], "--test-region places"),
         (&["bench", "probe-count", "--scenes", "probe-room", "--candidates", "1"], "grid level 1"),
@@ -278,8 +284,8 @@ fn sweep_writes_one_csv_row_per_setting() {
             "0,0.3",
             "--size",
             "32",
-            "--spp",
-            "64",
+            "--noise",
+            "0.05",
             "--frames",
             "2",
             "--time-size",
@@ -296,16 +302,24 @@ fn sweep_writes_one_csv_row_per_setting() {
     assert!(stdout.contains("scene: no setting runs within 0.000001 ms"), "{stdout}");
     let (csv, fields) = sweep_outputs(
         &dir,
-        "scene,env,technique,parameter,value,error_mean,error_t0,error_t0.3,frame_ms,precompute_s,memory_mb",
+        "scene,env,technique,parameter,value,error_mean,error_t0,error_t0.3,reference_noise_t0,\
+         reference_noise_t0.3,frame_ms,precompute_s,memory_mb",
     );
     assert_eq!(fields.len(), 2, "{csv}");
     assert_eq!((&*fields[0][2], &*fields[1][2], &*fields[1][4]), ("unshadowed", "tamura", "8"));
     for row in &fields {
         assert!((0.0..1.0).contains(&number(row, 5)), "{row:?}");
-        assert!(number(row, 8) > 0.0 && number(row, 10) > 0.0, "{row:?}");
+        // Each reference ran to the noise asked for.
+        assert!((0.0..=0.05).contains(&number(row, 8)) && (0.0..=0.05).contains(&number(row, 9)), "{row:?}");
+        assert!(number(row, 10) > 0.0 && number(row, 12) > 0.0, "{row:?}");
     }
     assert!(number(&fields[1], 5) < number(&fields[0], 5), "{csv}");
-    assert!(number(&fields[1], 9) > 0.0 && fields[0][9].is_empty(), "precompute seconds only for PRT: {csv}");
+    assert!(
+        number(&fields[1], 11) > 0.0 && fields[0][11].is_empty(),
+        "precompute seconds only for PRT: {csv}"
+    );
+    // The references are cached under the cache folder, an EXR and its noise for each pose.
+    assert_eq!(std::fs::read_dir(cache.join("references")).unwrap().count(), 4);
 }
 
 #[test]
