@@ -28,14 +28,14 @@
 #
 # Run by hand (not in CI), from anywhere: bash scripts/docs-images.sh
 # Needs only the kage binary (built here with cargo) and a Vulkan device (lavapipe will do).
-# Environment: SIZE (default 256, pixels per side), SPP (default 4096, reference samples per
-# pixel), KAGE_DEVICE (device name substring). At 256×256 and 4096 spp each reference takes a
+# Environment: SIZE (default 256, pixels per side), SPP (default 2048, reference samples per
+# pixel), KAGE_DEVICE (device name substring). At 256×256 and 2048 spp each reference takes a
 # few minutes on a 2-core lavapipe machine, and it runs twice (see below).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 SIZE="${SIZE:-256}"
-SPP="${SPP:-4096}"
+SPP="${SPP:-2048}"
 cargo build --release -p kage-tools
 kage=target/release/kage
 work="$(mktemp -d)"
