@@ -274,8 +274,9 @@ fn contact_with_the_floor_darkens_the_floor_beside_the_base() {
 /// Case 3: A single tiny, very bright sun (city.exr) on the default scene: nearly all light comes
 /// from the sun, so its shadow decides the error. Against the strongest baseline doing the same
 /// job, parallel lights at the same q, Tamura's default errs 1.26× as much at this size (64²;
-/// 1.02× at 128², BENCHMARKS.md): the bound, 1.4×, catches a regression of a tenth of the
-/// error, and Tamura must stay well below Sloan's error (no shadows between groups), here 3×.
+/// 1.18× at 128² over three poses, BENCHMARKS.md): the bound, 1.4×, catches a regression of a
+/// tenth of the error, and Tamura must stay well below Sloan's error (no shadows between
+/// groups), here 3×.
 /// The reference runs to 4096 spp; its noise (printed, about 0.8 %) is taken out of each error
 /// in quadrature (independent noise adds to the squared error).
 #[test]
