@@ -72,6 +72,30 @@ impl GroupBounds {
         })
     }
 
+    /// Whether this group (placed by `transform`) lies wholly on the far side of a world axis
+    /// plane from `receiver`, with the light `w` on the receiver's side: then no ray from the
+    /// receiver towards the light can meet it (a floor under anything lit from above). Such a
+    /// pair must not get a layer: where the receiver is absent from a mask texel the occluder
+    /// counts as in front of it, and the box filter would carry that into the receiver's
+    /// silhouette as seen from the light, a false shadow along its terminator.
+    pub fn behind_along_an_axis(
+        &self,
+        transform: &Mat4,
+        receiver: &GroupBounds,
+        placed: &Mat4,
+        w: Vec3,
+    ) -> bool {
+        let world = |b: &GroupBounds, t: &Mat4| {
+            b.corners(t)
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(*c), hi.max(*c)))
+        };
+        let ((lo, hi), (r_lo, r_hi)) = (world(self, transform), world(receiver, placed));
+        // Touching counts as behind (contact; the masks' contact bias already ignores it).
+        let slack = 1e-4 * (r_hi - r_lo).max_element().max(1e-6);
+        (0..3).any(|k| (hi[k] <= r_lo[k] + slack && w[k] >= 0.0) || (lo[k] >= r_hi[k] - slack && w[k] <= 0.0))
+    }
+
     /// The smallest and largest signed distance along `w` of the box's corners from `origin`.
     pub fn extent_along(&self, transform: &Mat4, origin: Vec3, w: Vec3) -> (f32, f32) {
         self.corners(transform)
@@ -346,6 +370,9 @@ impl Occlusion {
         let (receiver_low, receiver_high) = self.bounds[r].extent_along(&transforms[r], centre, w);
         if occluder_high <= receiver_low {
             return None; // wholly farther from the light than the receiver
+        }
+        if self.bounds[o].behind_along_an_axis(&transforms[o], &self.bounds[r], &transforms[r], w) {
+            return None;
         }
         let offset = centre - receiver_centre;
         let along = offset.dot(w);
