@@ -277,3 +277,35 @@ fn filtered_layers_are_zero_outside_their_footprint() {
     }
     println!("{checked} texels outside footprints checked");
 }
+
+/// A floor never shadows what stands on it from a light above the horizon: the default scene's
+/// teapot gets no layer of the floor for any source with w · Y ≥ 0 (such a layer put a false dark
+/// band along the teapot's terminator: see `GroupBounds::behind_along_an_axis`), while the
+/// teapot keeps its layers on the floor for those sources. w is the layer plane's normal,
+/// axis_u × axis_v.
+#[test]
+fn the_floor_gets_no_layer_over_the_teapot_from_above() {
+    let ctx = Validated::new();
+    let scene = Scene::builtin("teapot").unwrap();
+    let (teapot, floor) = (0usize, 1usize);
+    let regions = Regions::new(&scene.environment, 32).unwrap();
+    let settings = OcclusionSettings { mask_size: 16, ..Default::default() };
+    let mut occlusion = Occlusion::new(&ctx, regions, &[], 3, group_bounds(&scene), &settings).unwrap();
+    let transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
+    occlusion.update(&transforms, Mat3::IDENTITY).unwrap();
+    let layers = occlusion.layers_in_use();
+    let of = |receiver: usize| {
+        let (first, count) = occlusion.ranges[receiver];
+        &layers[first as usize..(first + count) as usize]
+    };
+    let w = |l: &OcclusionLayer| Vec3::from_slice(&l.axis_u[..3]).cross(Vec3::from_slice(&l.axis_v[..3]));
+    for layer in of(teapot) {
+        assert!(
+            layer.occluder as usize != floor || w(layer).y < 0.0,
+            "the floor shadows the teapot from above (w = {})",
+            w(layer)
+        );
+    }
+    let from_above = of(floor).iter().filter(|l| l.occluder as usize == teapot && w(l).y > 0.0).count();
+    assert!(from_above >= 16, "only {from_above} layers of the teapot on the floor from above");
+}
