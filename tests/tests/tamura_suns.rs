@@ -81,6 +81,23 @@ fn floor_pixels(scene: &Scene, floor_group: usize) -> Vec<bool> {
         .collect()
 }
 
+/// The pixels whose whole (2 `radius` + 1)² neighbourhood, inside the image, satisfies `keep`.
+fn eroded(keep: impl Fn(usize) -> bool, radius: i32) -> Vec<usize> {
+    let s = SIZE as i32;
+    (0..s * s)
+        .filter(|&i| {
+            let (x, y) = (i % s, i / s);
+            (-radius..=radius).all(|dy| {
+                (-radius..=radius).all(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    (0..s).contains(&u) && (0..s).contains(&v) && keep((v * s + u) as usize)
+                })
+            })
+        })
+        .map(|i| i as usize)
+        .collect()
+}
+
 struct Case {
     /// Per pixel: whether the camera ray's first hit is the floor.
     floor: Vec<bool>,
@@ -137,18 +154,7 @@ impl Case {
     /// Floor pixels whose 8 neighbours are floor too (silhouettes against the teapot are not
     /// the floor's shadow).
     fn inner_floor(&self) -> Vec<usize> {
-        let s = SIZE as i32;
-        (0..self.floor.len())
-            .filter(|&i| {
-                let (x, y) = (i as i32 % s, i as i32 / s);
-                (-1..=1).all(|dy| {
-                    (-1..=1).all(|dx| {
-                        let (u, v) = (x + dx, y + dy);
-                        (0..s).contains(&u) && (0..s).contains(&v) && self.floor[(v * s + u) as usize]
-                    })
-                })
-            })
-            .collect()
+        eroded(|i| self.floor[i], 1)
     }
 
     /// The reference's shadowed floor pixels with a lit 4-neighbour.
@@ -179,19 +185,7 @@ impl Case {
     /// Pixels strictly inside the reference's umbra: their radiance in the reference is within
     /// 5 % of the sun's part above the sky's, and so are their 24 neighbours within 2 pixels.
     fn deep_umbra(&self) -> Vec<usize> {
-        let s = SIZE as i32;
-        let dark = |i: usize| self.floor[i] && self.reference[i] < self.sky + 0.05 * self.sun;
-        (0..self.floor.len())
-            .filter(|&i| {
-                let (x, y) = (i as i32 % s, i as i32 / s);
-                (-2..=2).all(|dy| {
-                    (-2..=2).all(|dx| {
-                        let (u, v) = (x + dx, y + dy);
-                        (0..s).contains(&u) && (0..s).contains(&v) && dark((v * s + u) as usize)
-                    })
-                })
-            })
-            .collect()
+        eroded(|i| self.floor[i] && self.reference[i] < self.sky + 0.05 * self.sun, 2)
     }
 
     /// Floor pixels between 20 % and 80 % of the way from shadow to sun, per pixel of the
