@@ -75,6 +75,11 @@ enum kage_result
    * Kage hit an internal error (a bug); the message holds the panic message.
    */
   KAGE_RESULT_PANIC = 12,
+  /**
+   * Kage found an internal error (a bug) without panicking, such as a pass reading what no
+   * earlier pass wrote; the message names it.
+   */
+  KAGE_RESULT_INTERNAL = 13,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L

@@ -1,5 +1,7 @@
-//! The engine's error type. Every `vk::Result` is mapped by [`Error::vk`] so that the failure
-//! classes a host cares about (out of memory, device lost) stay distinguishable.
+//! The engine's error type. Each variant says whose fault the failure is ([`Error::fault`]): the
+//! caller's values, a file's content, the device, or a bug in Kage. Every `vk::Result` is mapped
+//! by [`Error::vk`] so that the failure classes a host cares about (out of memory, device lost)
+//! stay distinguishable.
 use ash::vk;
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
@@ -33,12 +35,49 @@ pub enum Error {
     #[error(transparent)]
     Image(#[from] crate::imageio::ImageIoError),
     #[error(transparent)]
-    Probes(#[from] crate::techniques::probes::ProbeError),
+    Probes(#[from] ProbeError),
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// A bug in Kage, not in what it was given: a pass reading what no pass wrote, a write past
+    /// a buffer the engine sized itself.
+    #[error("internal error (please report): {0}")]
+    Internal(String),
+}
+
+/// Whose fault a failure is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// A value the caller passed (an argument, a scene built in code).
+    Caller,
+    /// A file that could not be read or is malformed.
+    File,
+    /// The Vulkan loader or device: missing, lacking a feature, out of memory, lost.
+    Device,
+    /// Kage itself.
+    Internal,
 }
 
 impl Error {
+    pub fn fault(&self) -> Fault {
+        match self {
+            Error::Loader(_)
+            | Error::NoDevice(_)
+            | Error::Unsupported(_)
+            | Error::OutOfDeviceMemory { .. }
+            | Error::OutOfHostMemory { .. }
+            | Error::OutOfDeviceMemoryFor { .. }
+            | Error::DeviceLost { .. }
+            | Error::Vulkan { .. }
+            | Error::Allocation { .. }
+            | Error::Timeout(_) => Fault::Device,
+            Error::Scene(e) if e.file().is_some() => Fault::File,
+            Error::Image(_) => Fault::File,
+            Error::Probes(ProbeError::FitDiverged { .. }) => Fault::Internal,
+            Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) => Fault::Caller,
+            Error::Internal(_) => Fault::Internal,
+        }
+    }
+
     /// Maps a failed Vulkan call: out-of-memory results and device loss get their own variants,
     /// everything else keeps its `vk::Result`.
     pub fn vk(call: &'static str) -> impl FnOnce(vk::Result) -> Error {
@@ -50,4 +89,23 @@ impl Error {
             result => Error::Vulkan { call, result },
         }
     }
+}
+
+/// What can be wrong with a light probe set or a lookup point (the probes technique).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProbeError {
+    #[error("probe {index} at {position:?}: {problem}")]
+    BadPosition { index: usize, position: [f64; 3], problem: &'static str },
+    #[error("lookup point {position:?}: {problem}")]
+    BadPoint { position: [f64; 3], problem: &'static str },
+    #[error(
+        "{distinct} distinct probe position(s) among the {total} given: a tetrahedralization needs at least 4"
+    )]
+    TooFew { distinct: usize, total: usize },
+    #[error("all {distinct} distinct probe positions lie {shape}: a tetrahedralization needs 4 that do not lie in one plane")]
+    Flat { distinct: usize, shape: &'static str },
+    #[error("the least-squares fit of {probes} probes' SH did not converge")]
+    FitDiverged { probes: usize },
+    #[error("{total} probes given: at most {max} are supported")]
+    TooMany { total: usize, max: usize },
 }

@@ -16,9 +16,11 @@
 pub mod backend;
 pub mod capi;
 pub mod error;
+pub mod frame;
 pub mod imageio;
 pub mod layouts;
 pub mod pass;
+pub mod prt;
 pub mod raycast;
 pub mod reference;
 pub mod renderer;

@@ -1,152 +1,28 @@
 //! The renderer: a scene on the GPU, its render targets, and the frame loop that runs a
 //! technique's passes and reads the picture back.
-use crate::backend::{vk, Buffer, BufferDesc, Context, Image, ImageDesc, MemoryLocation};
+use crate::backend::{vk, Buffer, BufferDesc, Context, MemoryLocation};
 use crate::error::{Error, Result};
+use crate::frame::background::Background;
+use crate::frame::environment::GpuEnvironment;
+use crate::frame::sh_projection::ShProjection;
+use crate::frame::{FrameInputs, FrameState, GpuScene, Targets};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
-use crate::scene::clusters::{clustered, Cluster};
+use crate::prt::TransferSet;
 use crate::scene::{Light, Scene};
 use crate::techniques::asm::technique::Asm;
 use crate::techniques::asm::{AsmSettings, AsmStats};
-use crate::techniques::background::Background;
-use crate::techniques::environment::GpuEnvironment;
 use crate::techniques::parallel_lights::ParallelLights;
 use crate::techniques::probes::technique::ProbeTechnique;
 use crate::techniques::probes::ProbeSettings;
-use crate::techniques::prt::TransferSet;
-use crate::techniques::sh_projection::ShProjection;
 use crate::techniques::shadow_map::ShadowMap;
 use crate::techniques::tamura::technique::OcclusionSettings;
 use crate::techniques::tamura::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
-use crate::techniques::{FrameInputs, FrameState, Technique};
+use crate::techniques::Technique;
 use glam::Mat4;
 use std::sync::Arc;
-
-/// Linear radiance, 32-bit float per channel: the picture is compared against the ray-traced
-/// reference pixel by pixel, so no precision is given away before the output file.
-pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
-
-/// The largest image side Kage renders (lavapipe and current GPUs allow 16384; 8192 keeps the
-/// colour target and its readback within 2 GiB).
-pub const MAX_SIZE: u32 = 8192;
-
-pub struct GpuMesh {
-    /// `group.mesh`, for names and messages.
-    pub name: String,
-    pub vertices: Buffer,
-    pub indices: Buffer,
-    pub index_count: u32,
-    pub vertex_count: u32,
-    pub albedo: [f32; 3],
-    pub group: usize,
-    /// Index of the mesh within its group.
-    pub mesh: usize,
-    /// The index buffer's runs of triangles and their object-space bounds (the buffer holds the
-    /// triangles in cluster order, `scene::clusters`).
-    pub clusters: Vec<Cluster>,
-}
-
-/// Geometry on the GPU: one vertex and index buffer per mesh, one transform per group.
-pub struct GpuScene {
-    pub meshes: Vec<GpuMesh>,
-    pub transforms: Vec<Mat4>,
-}
-
-impl GpuScene {
-    pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
-        let mut meshes = Vec::new();
-        for (g, group) in scene.groups.iter().enumerate() {
-            for (m, mesh) in group.meshes.iter().enumerate() {
-                let vertices: Vec<u8> = mesh
-                    .positions
-                    .iter()
-                    .zip(&mesh.normals)
-                    .flat_map(|(p, n)| [p[0], p[1], p[2], n[0], n[1], n[2]])
-                    .flat_map(f32::to_ne_bytes)
-                    .collect();
-                let (indices, clusters) = clustered(mesh);
-                let indices: Vec<u8> = indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
-                let name = format!("{}.{}", group.name, mesh.name);
-                meshes.push(GpuMesh {
-                    name: name.clone(),
-                    vertices: Buffer::with_data(
-                        ctx,
-                        &format!("{name}.vertices"),
-                        vk::BufferUsageFlags::VERTEX_BUFFER,
-                        &vertices,
-                    )?,
-                    indices: Buffer::with_data(
-                        ctx,
-                        &format!("{name}.indices"),
-                        vk::BufferUsageFlags::INDEX_BUFFER,
-                        &indices,
-                    )?,
-                    index_count: mesh.indices.len() as u32,
-                    vertex_count: mesh.positions.len() as u32,
-                    mesh: m,
-                    albedo: mesh.albedo,
-                    group: g,
-                    clusters,
-                });
-            }
-        }
-        Ok(GpuScene { meshes, transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect() })
-    }
-}
-
-pub struct Targets {
-    pub color: Image,
-    pub depth: Image,
-    readback: Buffer,
-}
-
-impl Targets {
-    fn new(ctx: &Arc<Context>, width: u32, height: u32) -> Result<Targets> {
-        if !(1..=MAX_SIZE).contains(&width) || !(1..=MAX_SIZE).contains(&height) {
-            return Err(Error::InvalidArgument(format!(
-                "image size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
-            )));
-        }
-        let color = Image::new(
-            ctx,
-            &ImageDesc {
-                name: "color",
-                width,
-                height,
-                layers: 1,
-                array: false,
-                format: COLOR_FORMAT,
-                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-            },
-        )?;
-        let depth = Image::new(
-            ctx,
-            &ImageDesc {
-                name: "depth",
-                width,
-                height,
-                layers: 1,
-                array: false,
-                format: DEPTH_FORMAT,
-                // Sampled: the ASM refinement analysis reads the visible surfaces back.
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
-            },
-        )?;
-        let readback = Buffer::new(
-            ctx,
-            &BufferDesc {
-                name: "color.readback",
-                size: color.byte_size()?,
-                usage: vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuToCpu,
-            },
-        )?;
-        Ok(Targets { color, depth, readback })
-    }
-}
 
 /// Which technique lights the scene.
 #[derive(Clone, Debug, Default)]
@@ -337,9 +213,7 @@ impl Renderer {
         passes.push(self.background.pass(&inputs));
         passes.extend(self.technique.passes(&inputs));
         let targets = &self.targets;
-        passes.push(Pass::new("readback", &["color"], &[], move |cmd| {
-            targets.color.record_copy_to(cmd, &targets.readback)
-        }));
+        passes.push(Pass::new("readback", &["color"], &[], move |cmd| targets.record_readback(cmd)));
         let frame = self.executor.run(&imports, passes)?;
         self.technique.timed(&frame);
         timings.extend(frame);
@@ -373,16 +247,7 @@ impl Renderer {
 
     /// The last rendered frame: linear radiance, row 0 at the top.
     pub fn image(&self) -> Result<RgbaF32Image> {
-        let bytes = self.targets.readback.read()?;
-        let pixels = bytes
-            .chunks_exact(16)
-            .map(|t| {
-                std::array::from_fn(|k| {
-                    f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])
-                })
-            })
-            .collect();
-        Ok(RgbaF32Image { width: self.targets.color.width, height: self.targets.color.height, pixels })
+        self.targets.read()
     }
 
     /// The environment's SH coefficients as the renderer uses them.

@@ -75,8 +75,8 @@ pub fn render_once(
 
 /// Each group's own PRT transfer of `scene` at 3 bands with few rays (128): for tests that look
 /// at where shadows fall, not at the transfer's last digits.
-pub fn shadow_test_transfer(ctx: &Arc<Context>, scene: &Scene) -> Arc<kage::techniques::prt::TransferSet> {
-    use kage::techniques::prt::{transfer, PrtParams};
+pub fn shadow_test_transfer(ctx: &Arc<Context>, scene: &Scene) -> Arc<kage::prt::TransferSet> {
+    use kage::prt::{transfer, PrtParams};
     let params = PrtParams { bands: 3, rays: 128, ..PrtParams::DEFAULT };
     Arc::new(transfer::precompute(ctx, scene, params, &mut |_, _| {}).expect("transfer"))
 }

@@ -12,15 +12,16 @@
 use glam::{Mat4, Quat, Vec3};
 use kage::backend::{vk, Buffer, BufferDesc, Context, MemoryLocation};
 use kage::capi::{self, kage_result};
+use kage::frame::MAX_SIZE;
 use kage::imageio::RgbaF32Image;
 use kage::layouts::{constants, CastRay};
+use kage::prt::{transfer, PrtParams};
 use kage::raycast::{closest_hit_brute_force, GpuBvh, GpuRays, Query, RayCaster, SceneBvh};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice, MAX_SIZE};
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::envmap::MAX_RADIANCE;
 use kage::scene::{shapes, Camera, EnvMap, Group, Light, Mesh, Scene, Transform};
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSettings};
-use kage::techniques::prt::{transfer, PrtParams};
 use kage::techniques::tamura::technique::OcclusionSettings;
 use kage::Error;
 use kage_tests::{scratch_dir, Validated};

@@ -1,8 +1,8 @@
 //! SH projection on the GPU and the first rendering, checked against what the maths says.
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use kage::frame::sh_projection;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, uv_to_direction, Camera, EnvMap, Scene};
-use kage::techniques::sh_projection;
 use kage_tests::{render_once, single_mesh_scene, Validated};
 use std::f32::consts::PI;
 

@@ -1,9 +1,9 @@
 //! The parallel-lights baseline (the paper's Fig. 3): q regions as directional lights with
 //! binary shadow maps.
 use glam::Vec3;
+use kage::frame::regions::Regions;
 use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::{shapes, Camera, EnvMap, Scene};
-use kage::techniques::tamura::regions::Regions;
 use kage_tests::{single_mesh_scene, Validated};
 
 fn parallel(regions: usize) -> TechniqueChoice {

@@ -1,7 +1,7 @@
 //! Light probe capture on the GPU: cube maps of the scene projected to SH, checked against what
 //! the maths says.
 use glam::Vec3;
-use kage::renderer::GpuScene;
+use kage::frame::GpuScene;
 use kage::scene::{Camera, EnvMap, Light, Scene};
 use kage::techniques::probes::{CaptureSettings, CapturedLight, ProbeCapture};
 use kage_tests::Validated;

@@ -84,7 +84,7 @@ fn a_tiny_sun_rings_negative_the_shading_clamps_it_and_deringing_removes_it() {
     // The probe at the ball's centre (index 4) sees the sun unblocked: its E(n) is the sun's
     // power times k₂(n·s), whose minimum is −0.0396 against a peak of 1.0625 (dering.rs): −3.7%.
     let capture = |dering| {
-        let gpu = kage::renderer::GpuScene::new(&ctx, &scene).unwrap();
+        let gpu = kage::frame::GpuScene::new(&ctx, &scene).unwrap();
         let set = kage::techniques::probes::ProbeSet::capture(&ctx, &scene, &gpu, &probes(dering)).unwrap();
         irradiance_range(&set.sh[4])
     };
@@ -140,7 +140,7 @@ fn a_probe_inside_a_wall_is_detected_and_left_out() {
     assert!(fraction > 0.75, "{fraction}");
     assert!(positions[..8].iter().all(|p| capture.back_faces(p.as_vec3()) == 0.0));
 
-    let gpu = kage::renderer::GpuScene::new(&ctx, &scene).unwrap();
+    let gpu = kage::frame::GpuScene::new(&ctx, &scene).unwrap();
     let set = kage::techniques::probes::ProbeSet::capture(&ctx, &scene, &gpu, &settings).unwrap();
     assert_eq!(set.invalid.len(), 1);
     assert_eq!((set.invalid[0].index, set.invalid[0].position), (8, inside));

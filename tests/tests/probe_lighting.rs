@@ -1,9 +1,10 @@
 //! Light probes in use: the probes technique renders, and probe-interpolated irradiance in
 //! probe-room checked against the ray-cast ground truth with a bound derived per point.
 use glam::{Mat4, Vec3};
+use kage::frame::GpuScene;
 use kage::reference::irradiance::Point;
 use kage::reference::{surface_radiance, IrradianceReference};
-use kage::renderer::{GpuScene, RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::{Light, Scene};
 use kage::techniques::probes::{
     is_static, CaptureSettings, CapturedLight, ProbeCapture, ProbePlacement, ProbeSet, ProbeSettings, Walker,
@@ -57,8 +58,8 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
 /// and both kinds occur.
 #[test]
 fn static_groups_keep_their_own_prt_lighting_beside_the_probe_lit_bunny() {
+    use kage::prt::{transfer, PrtParams};
     use kage::techniques::probes::StaticLighting;
-    use kage::techniques::prt::{transfer, PrtParams};
     use kage::techniques::tamura::technique::OcclusionSettings;
     use std::sync::Arc;
     let ctx = Validated::new();

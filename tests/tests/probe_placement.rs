@@ -1,7 +1,8 @@
 //! Automatic probe placement and the trilinear grid baseline, end to end at a tiny size: real
 //! captures (8² faces) in the built-in scenes.
 use glam::Vec3;
-use kage::renderer::{GpuScene, RenderOptions, Renderer, TechniqueChoice};
+use kage::frame::GpuScene;
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::Scene;
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings, Solids,

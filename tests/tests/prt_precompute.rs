@@ -1,10 +1,10 @@
 //! PRT precomputation (issue 3): the GPU transfer against closed forms, under rotation, and the
 //! cache's detection of every kind of stale file.
 use glam::{DVec3, Quat, Vec3};
+use kage::prt::cache::{self, CacheKey, Stale};
+use kage::prt::{lobe, transfer, PrtParams, TransferSet};
 use kage::scene::{shapes, Camera, EnvMap, Group, Mesh, Scene, Transform};
 use kage::sh;
-use kage::techniques::prt::cache::{self, CacheKey, Stale};
-use kage::techniques::prt::{lobe, transfer, PrtParams, TransferSet};
 use kage_tests::{scratch_dir, single_mesh_scene, Validated};
 
 fn scene_of(groups: Vec<Vec<Mesh>>) -> Scene {

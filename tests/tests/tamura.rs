@@ -1,14 +1,16 @@
 //! The Tamura–Johan–Nishita technique and Sloan's PRT on the real driver.
 use glam::{Mat3, Mat4, Vec3};
 use kage::backend::{vk, Binding, BindingKind, Buffer, ComputePipeline, Edge, Image, ImageDesc, Sampler};
+use kage::frame::bounds::group_bounds;
+use kage::frame::regions::Regions;
+use kage::frame::GpuScene;
 use kage::layouts::{bytes_of, bytes_of_slice, spirv, BlurPush, OcclusionLayer};
 use kage::pass::{FrameExecutor, Pass};
-use kage::renderer::{GpuScene, RenderOptions, Renderer, TechniqueChoice};
+use kage::prt::TransferSet;
+use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::Scene;
-use kage::techniques::prt::TransferSet;
-use kage::techniques::tamura::occlusion::{group_bounds, Occlusion, RegionSize};
-use kage::techniques::tamura::regions::Regions;
+use kage::techniques::tamura::occlusion::{Occlusion, RegionSize};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use kage_tests::Validated;
 use std::sync::Arc;

@@ -9,6 +9,7 @@
 //! measured. Every tolerance says where it comes from.
 use glam::{Quat, Vec3};
 use kage::imageio::RgbaF32Image;
+use kage::prt::TransferSet;
 use kage::raycast::closest_hit_brute_force;
 use kage::reference::irradiance::Point;
 use kage::reference::{compare, IrradianceReference, LightMode, ReferenceOptions, ReferenceRenderer};
@@ -16,7 +17,6 @@ use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::{shapes, EnvMap, Group, Scene, Transform};
 use kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
-use kage::techniques::prt::TransferSet;
 use kage::techniques::tamura::technique::OcclusionSettings;
 use kage_tests::Validated;
 use std::path::PathBuf;

@@ -15,7 +15,7 @@ use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
 use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
 use kage::sh::{equirect_direction, equirect_texel_solid_angle};
-use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
+use kage::techniques::description::{TechniqueKind, TechniqueSettings};
 use kage_tests::Validated;
 use std::path::Path;
 use std::sync::Arc;

@@ -21,9 +21,9 @@ use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use glam::{DVec3, Vec3};
 use kage::backend::Context;
+use kage::frame::GpuScene;
 use kage::reference::irradiance::{IrradianceFile, Point};
 use kage::reference::IrradianceReference;
-use kage::renderer::GpuScene;
 use kage::scene::{animation, Scene};
 use kage::sh::ShRgb9;
 use kage::techniques::probes::{

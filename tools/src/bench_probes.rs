@@ -96,10 +96,7 @@ fn lattice(size: usize) -> Vec<DVec3> {
 /// Lookups per second and mean steps per lookup.
 fn time_lookups(
     points: &[DVec3],
-    mut locate: impl FnMut(
-        DVec3,
-    )
-        -> Result<kage::techniques::probes::Location, kage::techniques::probes::ProbeError>,
+    mut locate: impl FnMut(DVec3) -> Result<kage::techniques::probes::Location, kage::error::ProbeError>,
 ) -> Result<(f64, f64)> {
     let start = Instant::now();
     let mut steps = 0u64;

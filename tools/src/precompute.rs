@@ -5,8 +5,8 @@ use crate::transfer_source::{Origin, PrtArgs};
 use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
+use kage::prt::{PrtParams, TransferSet, Visibility};
 use kage::scene::Scene;
-use kage::techniques::prt::{PrtParams, TransferSet, Visibility};
 
 #[derive(Args)]
 pub struct PrecomputeArgs {

@@ -48,7 +48,7 @@ pub fn run(args: &CaptureImageArgs) -> Result<()> {
     let map = EnvMap::load(&args.image)?;
     crate::report_clamped(&map);
     let ctx = args.gpu.context()?;
-    let sh = kage::techniques::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
+    let sh = kage::frame::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
     let sh: ShRgb9 = dering.apply(&sh);
     crate::sh_cmd::print_coefficients(&sh);
     let irradiance: Vec<(&str, [f32; 3])> = AXES.iter().map(|&(name, n)| (name, sh.irradiance(n))).collect();

@@ -3,7 +3,7 @@
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
 use glam::DVec3;
-use kage::renderer::GpuScene;
+use kage::frame::GpuScene;
 use kage::scene::Scene;
 use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker};
 use serde::{Deserialize, Serialize};

@@ -9,11 +9,11 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::AsmSettings;
+use kage::techniques::description::{TechniqueKind, TechniqueSettings};
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
     DEFAULT_TOLERANCE,
 };
-use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
 use std::time::Instant;

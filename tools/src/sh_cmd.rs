@@ -24,7 +24,7 @@ pub fn run(args: &ShArgs) -> Result<()> {
     let map = EnvMap::load(&args.map)?;
     crate::report_clamped(&map);
     let ctx = args.gpu.context()?;
-    let sh = kage::techniques::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
+    let sh = kage::frame::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
     print_coefficients(&sh);
     if let Some(n) = args.irradiance {
         if n.length_squared() == 0.0 {

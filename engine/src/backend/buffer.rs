@@ -104,7 +104,7 @@ impl Buffer {
     /// Writes into a host-visible buffer at `offset`.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
         let end = offset.checked_add(data.len() as u64).filter(|&e| e <= self.size).ok_or_else(|| {
-            Error::InvalidArgument(format!(
+            Error::Internal(format!(
                 "write of {} bytes at {offset} past the end of buffer {} ({} bytes)",
                 data.len(),
                 self.name,
@@ -116,7 +116,7 @@ impl Buffer {
             .allocation
             .as_mut()
             .and_then(|a| a.mapped_slice_mut())
-            .ok_or_else(|| Error::InvalidArgument(format!("buffer {name} is not host-visible")))?;
+            .ok_or_else(|| Error::Internal(format!("buffer {name} is not host-visible")))?;
         slice[offset as usize..end as usize].copy_from_slice(data);
         Ok(())
     }
@@ -124,7 +124,7 @@ impl Buffer {
     /// Copies `data` into this buffer: directly when mapped, else through a staging buffer.
     pub fn upload(&self, data: &[u8]) -> Result<()> {
         if data.len() as u64 > self.size {
-            return Err(Error::InvalidArgument(format!(
+            return Err(Error::Internal(format!(
                 "upload of {} bytes into buffer {} of {} bytes",
                 data.len(),
                 self.name,
@@ -176,7 +176,7 @@ impl Buffer {
         staging
             .mapped()
             .map(<[u8]>::to_vec)
-            .ok_or_else(|| Error::InvalidArgument(format!("{} readback memory is not mapped", self.name)))
+            .ok_or_else(|| Error::Internal(format!("{} readback memory is not mapped", self.name)))
     }
 }
 

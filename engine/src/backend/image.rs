@@ -253,9 +253,8 @@ impl Image {
 
     /// Bytes of the whole image in a tightly packed buffer.
     pub fn byte_size(&self) -> Result<u64> {
-        let texel = texel_bytes(self.format).ok_or_else(|| {
-            Error::InvalidArgument(format!("no host copies of {:?} ({})", self.format, self.name))
-        })?;
+        let texel = texel_bytes(self.format)
+            .ok_or_else(|| Error::Internal(format!("no host copies of {:?} ({})", self.format, self.name)))?;
         Ok(texel * self.width as u64 * self.height as u64 * self.layers as u64)
     }
 
@@ -333,7 +332,7 @@ impl Image {
     pub fn upload(&self, data: &[u8]) -> Result<()> {
         let expected = self.byte_size()?;
         if data.len() as u64 != expected {
-            return Err(Error::InvalidArgument(format!(
+            return Err(Error::Internal(format!(
                 "upload of {} bytes into image {} of {expected} bytes",
                 data.len(),
                 self.name

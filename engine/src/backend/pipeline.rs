@@ -59,7 +59,7 @@ struct Module<'a> {
 impl<'a> Module<'a> {
     fn new(ctx: &'a Context, name: &str, spirv: &[u8]) -> Result<Module<'a>> {
         let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
-            .map_err(|e| Error::InvalidArgument(format!("SPIR-V of {name}: {e}")))?;
+            .map_err(|e| Error::Internal(format!("SPIR-V of {name}: {e}")))?;
         let info = vk::ShaderModuleCreateInfo::default().code(&words);
         // SAFETY: the words are SPIR-V compiled by build.rs.
         let raw = unsafe { ctx.device.create_shader_module(&info, None) }

@@ -38,6 +38,9 @@ pub enum kage_result {
     Validation = 11,
     /// Kage hit an internal error (a bug); the message holds the panic message.
     Panic = 12,
+    /// Kage found an internal error (a bug) without panicking, such as a pass reading what no
+    /// earlier pass wrote; the message names it.
+    Internal = 13,
 }
 
 /// A failure on its way to the host: the code and the message for `kage_last_error_message`.
@@ -77,6 +80,9 @@ fn code_of(error: &Error) -> kage_result {
         // A scene error names a file when one was read; otherwise the host's data is at fault.
         Error::Scene(e) if e.file().is_some() => kage_result::File,
         Error::Image(_) => kage_result::File,
+        Error::Probes(crate::error::ProbeError::FitDiverged { .. }) | Error::Internal(_) => {
+            kage_result::Internal
+        }
         Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) => kage_result::InvalidValue,
     }
 }

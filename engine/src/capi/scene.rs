@@ -2,8 +2,8 @@
 use super::args;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
+use crate::prt::TransferSet;
 use crate::scene::{Camera, EnvMap, Group, Mesh, Scene, SceneError, Transform};
-use crate::techniques::prt::TransferSet;
 use glam::{Quat, Vec3};
 use std::ffi::c_char;
 use std::sync::Arc;

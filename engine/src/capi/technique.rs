@@ -4,14 +4,14 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
+use crate::prt::{transfer, PrtParams};
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
+use crate::techniques::description::{TechniqueKind, TechniqueSettings};
 use crate::techniques::probes::{
     CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
     StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
-use crate::techniques::prt::{transfer, PrtParams};
-use crate::techniques::settings::{TechniqueKind, TechniqueSettings};
 use crate::techniques::tamura::technique::Penumbra;
 use glam::DVec3;
 use std::sync::Arc;

@@ -77,7 +77,7 @@ impl Failed {
     fn error(&self) -> Error {
         match self.device_lost {
             true => Error::DeviceLost { call: "a frame after the device was lost" },
-            false => Error::InvalidArgument(format!(
+            false => Error::Internal(format!(
                 "the frame executor cannot run after an earlier failure: {}",
                 self.message
             )),
@@ -167,7 +167,7 @@ fn check_data_flow(imports: &[&'static str], passes: &[Pass<'_>]) -> Result<()> 
     let mut available: Vec<&str> = imports.to_vec();
     for pass in passes {
         if let Some(missing) = pass.inputs.iter().find(|i| !available.contains(i)) {
-            return Err(Error::InvalidArgument(format!(
+            return Err(Error::Internal(format!(
                 "pass {} reads {missing}, which no earlier pass writes and the frame does not import",
                 pass.name
             )));

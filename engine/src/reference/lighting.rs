@@ -5,10 +5,10 @@ use super::env_sampling::EnvDistribution;
 use super::render::reference_light;
 use crate::backend::{vk, Binding, BindingKind, Buffer, Context};
 use crate::error::Result;
+use crate::frame::environment::GpuEnvironment;
 use crate::layouts::{bytes_of_slice, ReferenceLight};
 use crate::raycast::{GpuBvh, SceneBvh};
 use crate::scene::Scene;
-use crate::techniques::environment::GpuEnvironment;
 use std::sync::Arc;
 
 /// Resources the passes import: written before the first batch, read by every batch.

@@ -8,10 +8,10 @@ use super::lighting::{ReferenceLighting, IMPORTS};
 use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
+use crate::frame::MAX_SIZE;
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, constants, spirv, ReferenceLight, ReferencePush};
 use crate::pass::{FrameExecutor, Pass};
-use crate::renderer::MAX_SIZE;
 use crate::scene::{Camera, Light, Scene};
 use std::sync::Arc;
 

@@ -1,52 +1,16 @@
-//! Lighting techniques, each built from passes. `environment`, `sh_projection` and `background` are
-//! shared by all of them: the environment map on the GPU, its SH projection, and the pass that
-//! shows it behind the scene.
+//! Lighting techniques, one file or folder each, built from passes over the frame layer
+//! (`crate::frame`); `description` names them with their parameters.
 pub mod asm;
-pub mod background;
-pub mod environment;
+pub mod description;
 pub mod parallel_lights;
 pub mod probes;
-pub mod prt;
-pub mod scene_pass;
-pub mod settings;
-pub mod sh_projection;
-pub mod shadow_depth;
 pub mod shadow_map;
 pub mod tamura;
 pub mod unshadowed;
 
-use crate::backend::{Buffer, Context};
 use crate::error::Result;
+use crate::frame::{FrameInputs, FrameState};
 use crate::pass::{Pass, PassTiming};
-use crate::renderer::{GpuScene, Targets};
-use crate::scene::Light;
-use environment::GpuEnvironment;
-use glam::Mat4;
-use std::sync::Arc;
-
-/// What every technique may read while recording a frame.
-pub struct FrameInputs<'a> {
-    pub ctx: &'a Arc<Context>,
-    /// `FrameUniforms` of this frame.
-    pub uniforms: &'a Buffer,
-    pub environment: &'a GpuEnvironment,
-    /// The environment's 9 SH coefficients per channel (`ShCoeffs`), in the map's frame.
-    pub env_sh: &'a Buffer,
-    pub scene: &'a GpuScene,
-    pub targets: &'a Targets,
-}
-
-/// The state of the frame about to be recorded.
-pub struct FrameState<'a> {
-    /// World to the camera's clip space.
-    pub view_proj: Mat4,
-    /// Object-to-world transform of every group.
-    pub transforms: &'a [Mat4],
-    /// The environment's rotation about +Y, in radians (counter-clockwise seen from above).
-    pub env_rotation: f32,
-    /// The scene's point and spot lights as they are this frame (`Renderer::set_light`).
-    pub lights: &'a [Light],
-}
 
 /// A lighting technique: host-side updates, then the passes that draw the scene over the
 /// background (the colour target is cleared and holds the environment when they start).

@@ -19,16 +19,17 @@
 //! moves the lookup off the surface by a distance tied to the map's texel size. It also keeps
 //! `GraphicsDesc` free of a setting only this baseline would use. A small constant depth bias
 //! covers curved surfaces, where the texel's depth varies inside the texel.
-use super::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
-use super::shadow_depth::ShadowMaps;
-use super::tamura::occlusion::{group_bounds, GroupBounds};
-use super::tamura::regions::Regions;
-use super::tamura::self_shadow::env_rotation;
-use super::{FrameInputs, FrameState, Technique};
+use super::Technique;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
+use crate::frame::bounds::env_rotation;
+use crate::frame::bounds::{group_bounds, scene_sphere, GroupBounds};
+use crate::frame::regions::Regions;
+use crate::frame::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use crate::frame::shadow_depth::ShadowMaps;
+use crate::frame::{FrameInputs, FrameState};
 use crate::layouts::{bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight};
 use crate::pass::Pass;
 use crate::scene::Scene;
@@ -112,25 +113,6 @@ impl ParallelLights {
     pub fn regions(&self) -> &Regions {
         &self.regions
     }
-}
-
-/// The smallest sphere around the groups' bounding spheres that this simple construction finds
-/// (centred on their box): each map covers all of it, so every group casts into every map.
-pub(super) fn scene_sphere(bounds: &[GroupBounds], transforms: &[Mat4]) -> (Vec3, f32) {
-    let spheres: Vec<(Vec3, f32)> = bounds
-        .iter()
-        .zip(transforms)
-        .map(|(b, t)| (t.transform_point3(b.centre), b.radius * t.x_axis.truncate().length()))
-        .collect();
-    let (lo, hi) = spheres
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &(c, r)| (lo.min(c - r), hi.max(c + r)));
-    if spheres.is_empty() {
-        return (Vec3::ZERO, 1.0);
-    }
-    let centre = 0.5 * (lo + hi);
-    let radius = spheres.iter().map(|&(c, r)| c.distance(centre) + r).fold(0.0, f32::max);
-    (centre, radius.max(1e-3))
 }
 
 impl Technique for ParallelLights {

@@ -16,21 +16,22 @@
 //! slope-scaled bias in texels of the receiver's depth: a surface at angle θ to the light spans
 //! a depth of tan θ per unit of width inside a texel, so the bias grows with tan θ (capped:
 //! grazing surfaces would otherwise detach their shadows entirely).
-use super::parallel_lights::scene_sphere;
-use super::scene_pass::{
-    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
-};
-use super::shadow_depth::ShadowMaps;
-use super::tamura::occlusion::{group_bounds, GroupBounds};
-use super::{FrameInputs, FrameState, Technique};
+use super::Technique;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
+use crate::frame::bounds::scene_sphere;
+use crate::frame::bounds::{group_bounds, GroupBounds};
+use crate::frame::scene_pass::{
+    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
+};
+use crate::frame::shadow_depth::ShadowMaps;
+use crate::frame::{FrameInputs, FrameState};
+use crate::frame::{GpuMesh, MAX_SIZE};
 use crate::layouts::{bytes_of_slice, constants, spirv, LocalDrawPush, ShadowLight};
 use crate::pass::Pass;
 use crate::reference::render::reference_light;
-use crate::renderer::{GpuMesh, MAX_SIZE};
 use crate::scene::{Light, Scene};
 use glam::{Mat4, Vec3};
 use std::sync::Arc;

@@ -1,27 +1,13 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
-use super::scene_pass;
-use super::{FrameInputs, FrameState, Technique};
-use crate::backend::{
-    vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, GraphicsPipeline, VertexAttribute,
-    VertexBuffer,
-};
+use super::Technique;
+use crate::backend::{vk, Binding, Buffer, Context, Depth, GraphicsPipeline};
 use crate::error::Result;
-use crate::layouts::{bytes_of, spirv, DrawPush};
+use crate::frame::scene_pass::{draw_lit_meshes, lighting_pipeline};
+use crate::frame::{FrameInputs, FrameState};
+use crate::frame::{GpuMesh, GpuScene};
+use crate::layouts::spirv;
 use crate::pass::Pass;
-use crate::renderer::{GpuMesh, GpuScene};
 use std::sync::Arc;
-
-/// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
-pub const VERTEX_STRIDE: u32 = 24;
-pub const MESH_ATTRIBUTES: [VertexAttribute; 2] = [
-    VertexAttribute { location: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
-    VertexAttribute { location: 1, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
-];
-pub const MESH_VERTICES: VertexBuffer<'static> =
-    VertexBuffer { stride: VERTEX_STRIDE, attributes: &MESH_ATTRIBUTES };
-/// The same buffers read by shaders that need positions only.
-pub const MESH_POSITIONS: VertexBuffer<'static> =
-    VertexBuffer { stride: VERTEX_STRIDE, attributes: MESH_ATTRIBUTES.split_at(1).0 };
 
 pub struct Unshadowed {
     scene: GraphicsPipeline,
@@ -29,40 +15,7 @@ pub struct Unshadowed {
 
 impl Unshadowed {
     pub fn new(ctx: &Arc<Context>) -> Result<Unshadowed> {
-        Ok(Unshadowed { scene: scene_pipeline(ctx, "scene_unshadowed", spirv::SCENE_FRAG)? })
-    }
-}
-
-/// A pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
-/// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1) and a `DrawPush`.
-pub fn scene_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> Result<GraphicsPipeline> {
-    let bindings = [BindingKind::UniformBuffer, BindingKind::UniformBuffer];
-    scene_pass::scene_pipeline(
-        ctx,
-        name,
-        (spirv::SCENE_VERT, fragment_spirv),
-        &bindings,
-        size_of::<DrawPush>(),
-        DepthTest::Less,
-    )
-}
-
-/// Draws, with `pipeline` bound, the meshes of `scene` for which `albedo` gives an albedo
-/// (`None` leaves a mesh out), each with its group's transform.
-pub fn draw_meshes(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    pipeline: &GraphicsPipeline,
-    scene: &GpuScene,
-    albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
-) {
-    for (mesh, albedo) in scene.meshes.iter().filter_map(|m| Some((m, albedo(m)?))) {
-        let push = DrawPush {
-            model: scene.transforms[mesh.group].to_cols_array_2d(),
-            albedo: [albedo[0], albedo[1], albedo[2], 0.0],
-        };
-        pipeline.push(cmd, bytes_of(&push));
-        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        Ok(Unshadowed { scene: lighting_pipeline(ctx, "scene_unshadowed", spirv::SCENE_FRAG)? })
     }
 }
 
@@ -102,6 +55,6 @@ impl Unshadowed {
         albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
     ) {
         self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(sh)]);
-        draw_meshes(ctx, cmd, &self.scene, scene, albedo);
+        draw_lit_meshes(ctx, cmd, &self.scene, scene, albedo);
     }
 }

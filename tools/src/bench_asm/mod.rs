@@ -16,13 +16,14 @@ use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use kage::frame::MAX_SIZE;
 use kage::imageio::RgbaF32Image;
 use kage::reference::{shadow_flips, shadow_mismatch, SHADOW_THRESHOLD};
-use kage::renderer::{RenderOptions, Renderer, MAX_SIZE};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
 use kage::techniques::asm::technique::AsmTest;
 use kage::techniques::asm::AsmSettings;
-use kage::techniques::settings::{TechniqueKind, TechniqueSettings};
+use kage::techniques::description::{TechniqueKind, TechniqueSettings};
 use report::{FrameRow, Series};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -256,10 +257,7 @@ pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
     for renderer in &mut renderers {
         renderer.render()?;
     }
-    let cache = args
-        .cache
-        .clone()
-        .or_else(|| kage::techniques::prt::cache::default_dir().map(|d| d.join("references")));
+    let cache = args.cache.clone().or_else(|| kage::prt::cache::default_dir().map(|d| d.join("references")));
     let mut references = references::References::new(&ctx, &scene, args.size, cache.clone())?;
 
     let (series, rows) = walk(&plan, &mut renderers, &mut references, args)?;

@@ -9,9 +9,9 @@
 use anyhow::{Context as _, Result};
 use kage::backend::Context;
 use kage::imageio::RgbaF32Image;
+use kage::prt::cache::{geometry_hash, Fnv64};
 use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
 use kage::scene::{Camera, Scene};
-use kage::techniques::prt::cache::{geometry_hash, Fnv64};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 

@@ -4,9 +4,9 @@
 use anyhow::{Context as _, Result};
 use kage::backend::Context;
 use kage::imageio::{self, RgbaF32Image};
+use kage::prt::cache;
 use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
 use kage::scene::Scene;
-use kage::techniques::prt::cache;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 

@@ -14,11 +14,11 @@ use crate::backend::{
     Target,
 };
 use crate::error::{Error, Result};
+use crate::frame::gpu_scene::MESH_POSITIONS;
+use crate::frame::shadow_depth::ShadowMaps;
+use crate::frame::{GpuScene, DEPTH_FORMAT};
 use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
 use crate::layouts::{bytes_of, spirv, AsmTilePush};
-use crate::renderer::{GpuScene, DEPTH_FORMAT};
-use crate::techniques::shadow_depth::ShadowMaps;
-use crate::techniques::unshadowed::MESH_POSITIONS;
 use glam::Mat4;
 use std::sync::Arc;
 

@@ -33,18 +33,19 @@ use crate::backend::{
     GraphicsPipeline, MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
-use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, LocalDrawPush, ShadowLight};
-use crate::pass::{FrameExecutor, Pass, PassTiming};
-use crate::renderer::{GpuMesh, GpuScene};
-use crate::scene::clusters::Cluster;
-use crate::scene::{Light, Scene};
-use crate::techniques::parallel_lights::scene_sphere;
-use crate::techniques::scene_pass::{
+use crate::frame::bounds::scene_sphere;
+use crate::frame::bounds::{group_bounds, GroupBounds};
+use crate::frame::scene_pass::{
     depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
 };
+use crate::frame::{FrameInputs, FrameState};
+use crate::frame::{GpuMesh, GpuScene};
+use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, LocalDrawPush, ShadowLight};
+use crate::pass::{FrameExecutor, Pass, PassTiming};
+use crate::scene::clusters::Cluster;
+use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
-use crate::techniques::tamura::occlusion::{group_bounds, GroupBounds};
-use crate::techniques::{FrameInputs, FrameState, Technique};
+use crate::techniques::Technique;
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;

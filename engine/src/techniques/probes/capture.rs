@@ -28,19 +28,19 @@ use crate::backend::{
     ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
 };
 use crate::error::{Error, Result};
+use crate::frame::background::Background;
+use crate::frame::environment::GpuEnvironment;
+use crate::frame::gpu_scene::MESH_POSITIONS;
+use crate::frame::scene_pass::scene_pipeline_with;
+use crate::frame::sh_projection::{Mapping, ProjectionNames, ShProjection};
+use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::ReferenceLight;
 use crate::layouts::{bytes_of, spirv, DrawPush, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass};
 use crate::raycast::SceneBvh;
 use crate::reference::{irradiance::check_bounces, surface_radiance};
-use crate::renderer::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::scene::{Camera, Scene};
 use crate::sh::{eval_basis, ShRgb9};
-use crate::techniques::background::Background;
-use crate::techniques::environment::GpuEnvironment;
-use crate::techniques::scene_pass::scene_pipeline_with;
-use crate::techniques::sh_projection::{Mapping, ProjectionNames, ShProjection};
-use crate::techniques::unshadowed::MESH_POSITIONS;
 use glam::{DVec3, Mat3, Vec3};
 use std::ops::RangeInclusive;
 use std::sync::Arc;

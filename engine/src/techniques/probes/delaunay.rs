@@ -5,10 +5,10 @@
 //! cells are the hull faces it sees). Unlike a finite enclosing tetrahedron, this needs no
 //! coordinates larger than the input's, which keeps the exact predicates cheap and the result
 //! exactly the Delaunay tetrahedralization of the convex hull, whatever the coordinates' range.
-use super::error::ProbeError;
 use super::predicates::{collinear, inside_circle, inside_sphere, orient_at};
 use super::rng::XorShift;
 use super::spatial_sort::insertion_order;
+use crate::error::ProbeError;
 use glam::DVec3;
 
 /// The vertex at infinity.

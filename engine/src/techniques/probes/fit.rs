@@ -15,7 +15,7 @@
 //! Solved by conjugate gradients on the normal equations, matrix-free (each candidate's row has
 //! the 4 or 8 weights of its cell), with a Jacobi preconditioner: memory linear in the
 //! candidates, where a dense solve would take the square of the kept probes.
-use super::error::ProbeError;
+use crate::error::ProbeError;
 use crate::error::{Error, Result};
 use crate::sh::ShRgb9;
 

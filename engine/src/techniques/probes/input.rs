@@ -1,5 +1,5 @@
 //! Probe positions as the tetrahedralization takes them: validated, duplicates merged.
-use super::error::ProbeError;
+use crate::error::ProbeError;
 use glam::DVec3;
 
 /// The most probes a set may have, so that tetrahedra (about 6.5 per point) fit u32 numbers.

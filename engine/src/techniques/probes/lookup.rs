@@ -1,9 +1,9 @@
 //! Finding the tetrahedron that holds a point, by walking from where the last lookup ended.
-use super::error::ProbeError;
 use super::input::usable;
 use super::predicates::orient;
 use super::rng::XorShift;
 use super::tetmesh::{Across, TetMesh};
+use crate::error::ProbeError;
 use glam::DVec3;
 
 /// Where a point lies: its tetrahedron's probes and their weights (non-negative, summing to 1,

@@ -23,7 +23,6 @@
 mod capture;
 mod delaunay;
 mod dering;
-mod error;
 mod extrapolate;
 pub mod fit;
 mod input;
@@ -46,7 +45,6 @@ pub use capture::{
     DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES, MAX_BACK_FACES, RADIANCE_SEED,
 };
 pub use dering::Dering;
-pub use error::ProbeError;
 pub use input::Merged;
 pub use lookup::{Location, Walker};
 pub use reduce::reduce;

@@ -27,7 +27,7 @@
 use super::reduce::blend;
 use super::set::ProbeSet;
 use super::solids::directions;
-use super::ProbeError;
+use crate::error::ProbeError;
 use crate::error::{Error, Result};
 use crate::sh::ShRgb9;
 use glam::DVec3;

@@ -10,7 +10,7 @@ use super::trilinear::Lattice;
 use super::{TetMesh, Walker};
 use crate::backend::Context;
 use crate::error::{Error, Result};
-use crate::renderer::GpuScene;
+use crate::frame::GpuScene;
 use crate::scene::Scene;
 use crate::sh::ShRgb9;
 use glam::{DVec3, Vec3};

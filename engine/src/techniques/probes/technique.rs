@@ -11,14 +11,16 @@ use super::set::{bounds, is_static, ProbeSet, ProbeSettings, StaticLighting, MOV
 use super::Walker;
 use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, Depth, GraphicsPipeline, MemoryLocation};
 use crate::error::{Error, Result};
+use crate::frame::scene_pass::{draw_lit_meshes, lighting_pipeline};
+use crate::frame::GpuScene;
+use crate::frame::{FrameInputs, FrameState};
 use crate::layouts::{bytes_of, spirv, ProbeLight};
 use crate::pass::Pass;
-use crate::renderer::GpuScene;
+use crate::prt::TransferSet;
 use crate::scene::Scene;
-use crate::techniques::prt::TransferSet;
 use crate::techniques::tamura::technique::{OcclusionSettings, PrtTechnique};
-use crate::techniques::unshadowed::{draw_meshes, scene_pipeline, Unshadowed};
-use crate::techniques::{FrameInputs, FrameState, Technique};
+use crate::techniques::unshadowed::Unshadowed;
+use crate::techniques::Technique;
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -70,7 +72,7 @@ impl ProbeTechnique {
         });
         Ok(ProbeTechnique {
             statics,
-            pipeline: scene_pipeline(ctx, "scene_probes", spirv::PROBE_SCENE_FRAG)?,
+            pipeline: lighting_pipeline(ctx, "scene_probes", spirv::PROBE_SCENE_FRAG)?,
             set: ProbeSet::capture(ctx, scene, gpu, settings)?,
             centre,
             walker: Walker::default(),
@@ -127,7 +129,7 @@ impl Technique for ProbeTechnique {
                 Statics::Sloan(prt) => prt.record_draws(ctx, cmd, uniforms, scene),
             }
             self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(&self.light)]);
-            draw_meshes(ctx, cmd, &self.pipeline, scene, |m| (!is_static(m.group)).then_some(m.albedo));
+            draw_lit_meshes(ctx, cmd, &self.pipeline, scene, |m| (!is_static(m.group)).then_some(m.albedo));
             ctx.end_rendering(cmd);
         }));
         passes

@@ -2,9 +2,9 @@
 //! hull faces, and each tetrahedron's precomputed inverse matrix for barycentric weights
 //! (Morishige 2014, step 4: the tetrahedra never change at run time).
 use super::delaunay::{opposite, tetrahedralize};
-use super::error::ProbeError;
 use super::extrapolate::{Hull, HullFace};
 use super::input::{distinct, Merged};
+use crate::error::ProbeError;
 use glam::{DMat3, DVec3};
 
 /// What lies across a face of a tetrahedron.

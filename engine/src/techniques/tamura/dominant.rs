@@ -150,8 +150,8 @@ pub fn split(map: &EnvMap, max: usize) -> Split {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frame::regions::tests::map_energy;
     use crate::scene::SunMap;
-    use crate::techniques::tamura::regions::tests::map_energy;
 
     /// A 2° sun over a dim sky: one light, at the sun, of the sun's size and energy; the sky
     /// stays in the residual, and the energies add up to the map's.

@@ -5,14 +5,13 @@
 //! percentage-closer tap). Shadows between groups take the occlusion layers' path, as the
 //! regions' do, with the light's own angular size for their penumbra.
 use super::dominant::DominantLight;
-use super::occlusion::GroupBounds;
-use super::self_shadow::rotation_of;
 use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, MemoryLocation, Sampler};
 use crate::error::{Error, Result};
+use crate::frame::bounds::{rotation_of, GroupBounds};
+use crate::frame::shadow_depth::ShadowMaps;
+use crate::frame::GpuScene;
 use crate::layouts::{self, bytes_of, constants, DominantLights, DominantMap};
 use crate::pass::Pass;
-use crate::renderer::GpuScene;
-use crate::techniques::shadow_depth::ShadowMaps;
 use glam::{Mat3, Mat4, Vec3};
 use std::sync::Arc;
 

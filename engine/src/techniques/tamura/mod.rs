@@ -4,7 +4,6 @@
 pub mod dominant;
 pub mod dominant_maps;
 pub mod occlusion;
-pub mod regions;
 pub mod self_shadow;
 pub mod technique;
 

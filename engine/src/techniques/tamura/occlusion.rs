@@ -21,89 +21,23 @@
 //!   the light than the receiver; occluders whose shadow cylinder misses the receiver's sphere.
 //!   A group alone runs no occlusion pass at all.
 use super::dominant::DominantLight;
-use super::regions::{Region, Regions};
-use super::self_shadow::rotation_of;
 use super::technique::{OcclusionSettings, Penumbra};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
     GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
 use crate::error::Result;
+use crate::frame::bounds::{rotation_of, GroupBounds};
+use crate::frame::gpu_scene::MESH_POSITIONS;
+use crate::frame::regions::{Region, Regions};
+use crate::frame::{GpuScene, DEPTH_FORMAT};
 use crate::layouts::{
     bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
 };
 use crate::pass::Pass;
-use crate::renderer::{GpuScene, DEPTH_FORMAT};
 use crate::sh;
-use crate::techniques::unshadowed::MESH_POSITIONS;
 use glam::{Mat3, Mat4, Vec3};
 use std::sync::Arc;
-
-/// A group's bounds in its object space: what culling needs to know of it.
-#[derive(Clone, Copy, Debug)]
-pub struct GroupBounds {
-    /// Bounding sphere.
-    pub centre: Vec3,
-    pub radius: f32,
-    /// Axis-aligned box.
-    pub min: Vec3,
-    pub max: Vec3,
-    /// The cone holding every vertex normal: unit axis and half-angle in radians (π or more:
-    /// normals face every way).
-    pub normal_axis: Vec3,
-    pub normal_spread: f32,
-}
-
-impl GroupBounds {
-    /// Whether no vertex of the group can receive light from object-space direction `w`.
-    pub fn faces_away_from(&self, w: Vec3) -> bool {
-        let angle = self.normal_axis.dot(w).clamp(-1.0, 1.0).acos();
-        angle >= std::f32::consts::FRAC_PI_2 + self.normal_spread
-    }
-
-    /// The world positions of the box's corners, with `transform` placing the group.
-    fn corners(&self, transform: &Mat4) -> [Vec3; 8] {
-        std::array::from_fn(|c| {
-            transform.transform_point3(Vec3::new(
-                if c & 1 == 0 { self.min.x } else { self.max.x },
-                if c & 2 == 0 { self.min.y } else { self.max.y },
-                if c & 4 == 0 { self.min.z } else { self.max.z },
-            ))
-        })
-    }
-
-    /// Whether this group (placed by `transform`) lies wholly on the far side of a world axis
-    /// plane from `receiver`, with the light `w` on the receiver's side: then no ray from the
-    /// receiver towards the light can meet it (a floor under anything lit from above). Such a
-    /// pair must not get a layer: where the receiver is absent from a mask texel the occluder
-    /// counts as in front of it, and the box filter would carry that into the receiver's
-    /// silhouette as seen from the light, a false shadow along its terminator.
-    pub fn behind_along_an_axis(
-        &self,
-        transform: &Mat4,
-        receiver: &GroupBounds,
-        placed: &Mat4,
-        w: Vec3,
-    ) -> bool {
-        let world = |b: &GroupBounds, t: &Mat4| {
-            b.corners(t)
-                .iter()
-                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(*c), hi.max(*c)))
-        };
-        let ((lo, hi), (r_lo, r_hi)) = (world(self, transform), world(receiver, placed));
-        // Touching counts as behind (contact; the masks' contact bias already ignores it).
-        let slack = 1e-4 * (r_hi - r_lo).max_element().max(1e-6);
-        (0..3).any(|k| (hi[k] <= r_lo[k] + slack && w[k] >= 0.0) || (lo[k] >= r_hi[k] - slack && w[k] <= 0.0))
-    }
-
-    /// The smallest and largest signed distance along `w` of the box's corners from `origin`.
-    pub fn extent_along(&self, transform: &Mat4, origin: Vec3, w: Vec3) -> (f32, f32) {
-        self.corners(transform)
-            .iter()
-            .map(|c| (*c - origin).dot(w))
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
-    }
-}
 
 struct Job {
     receiver: usize,
@@ -552,29 +486,4 @@ impl Occlusion {
             }),
         ]
     }
-}
-
-/// The object-space bounds of every group.
-pub fn group_bounds(scene: &crate::scene::Scene) -> Vec<GroupBounds> {
-    scene
-        .groups
-        .iter()
-        .map(|g| {
-            let points = || g.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from_array(*p)));
-            let normals = || g.meshes.iter().flat_map(|m| m.normals.iter().map(|n| Vec3::from_array(*n)));
-            let (min, max) =
-                points().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
-            let (min, max) = if min.x <= max.x { (min, max) } else { (Vec3::ZERO, Vec3::ZERO) };
-            let centre = 0.5 * (min + max);
-            let radius = points().map(|p| p.distance(centre)).fold(0.0, f32::max);
-            let sum: Vec3 = normals().sum();
-            let normal_axis = sum.try_normalize().unwrap_or(Vec3::Y);
-            let normal_spread = if sum.length_squared() > 0.0 {
-                normals().map(|n| normal_axis.dot(n).clamp(-1.0, 1.0).acos()).fold(0.0, f32::max)
-            } else {
-                std::f32::consts::PI
-            };
-            GroupBounds { centre, radius, min, max, normal_axis, normal_spread }
-        })
-        .collect()
 }

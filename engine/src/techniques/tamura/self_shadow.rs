@@ -6,11 +6,12 @@ use crate::backend::{
     ImageDesc, MemoryLocation, VertexAttribute, VertexBuffer,
 };
 use crate::error::{Error, Result};
+use crate::frame::bounds::rotation_of;
+use crate::frame::GpuScene;
 use crate::layouts::{bytes_of, constants, spirv, GroupLight, SelfShadowPush};
 use crate::pass::Pass;
-use crate::renderer::GpuScene;
+use crate::prt::TransferSet;
 use crate::sh::rotation;
-use crate::techniques::prt::TransferSet;
 use glam::{Mat3, Mat4};
 use std::sync::Arc;
 
@@ -35,17 +36,6 @@ pub const TRANSFER_STRIDE: u32 = 16 * TRANSFER_VEC4 as u32;
 /// and normal).
 pub fn transfer_vertex_buffer(first_location: u32) -> [VertexAttribute; TRANSFER_VEC4] {
     TRANSFER_ATTRIBUTES.map(|a| VertexAttribute { location: a.location + first_location, ..a })
-}
-
-/// The rotation part of a rigid transform with uniform scale.
-pub fn rotation_of(transform: &Mat4) -> Mat3 {
-    let m = Mat3::from_mat4(*transform);
-    Mat3::from_cols(m.x_axis.normalize(), m.y_axis.normalize(), m.z_axis.normalize())
-}
-
-/// Rotation of the environment about +Y by `angle` radians.
-pub fn env_rotation(angle: f32) -> Mat3 {
-    Mat3::from_rotation_y(angle)
 }
 
 pub struct SelfShadow {

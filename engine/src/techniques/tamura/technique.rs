@@ -2,21 +2,23 @@
 //! regions, the light other groups block (Tamura et al. eq. (15)).
 use super::dominant;
 use super::dominant_maps::{self, DominantMaps};
-use super::occlusion::{group_bounds, Occlusion, RegionSize};
-use super::regions::Regions;
-use super::self_shadow::{env_rotation, transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
+use super::occlusion::{Occlusion, RegionSize};
+use super::self_shadow::{transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline,
     Sampler, VertexBuffer,
 };
 use crate::error::{Error, Result};
+use crate::frame::bounds::{env_rotation, group_bounds};
+use crate::frame::gpu_scene::MESH_VERTICES;
+use crate::frame::regions::Regions;
+use crate::frame::{FrameInputs, FrameState};
+use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush, ShCoeffs};
 use crate::pass::Pass;
-use crate::renderer::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::prt::TransferSet;
 use crate::scene::Scene;
-use crate::techniques::prt::TransferSet;
-use crate::techniques::unshadowed::MESH_VERTICES;
-use crate::techniques::{FrameInputs, FrameState, Technique};
+use crate::techniques::Technique;
 use std::sync::Arc;
 
 /// How wide the penumbra of a shadow between groups is.

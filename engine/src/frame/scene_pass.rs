@@ -7,16 +7,16 @@
 //! EQUAL: their lighting looks up a shadow map per fragment, and with the scene drawn in any
 //! order a fragment hidden later would pay for it too (the `asm` scene's overdraw made its
 //! ASM lighting pass 2x as long on lavapipe; BENCHMARKS.md).
+use super::gpu_scene::MESH_VERTICES;
 use super::shadow_depth::depth_only_pipeline;
-use super::unshadowed::MESH_VERTICES;
 use super::FrameInputs;
 use crate::backend::{
     vk, Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
 };
 use crate::error::Result;
-use crate::layouts::{bytes_of, spirv, Pod};
+use crate::frame::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::layouts::{bytes_of, spirv, DrawPush, Pod};
 use crate::pass::Pass;
-use crate::renderer::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use glam::Mat4;
 use std::sync::Arc;
 
@@ -57,7 +57,7 @@ pub fn depth_prepass<'a, P: Pod>(
     Pass::new("depth_prepass", &["frame_uniforms"], &["depth"], move |cmd| {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear((&targets.depth).into())));
         pipeline.bind(cmd, &[Binding::Uniform(uniforms)]);
-        draw_meshes(ctx, cmd, scene, pipeline, &push);
+        draw_meshes(ctx, cmd, scene, pipeline, &|m, t| Some(push(m, t)));
         ctx.end_rendering(cmd);
     })
 }
@@ -108,22 +108,53 @@ pub fn scene_pass<'a, P: Pod>(
             if pipeline.depth() == DepthTest::Equal { Depth::Keep(depth) } else { Depth::Clear(depth) };
         ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some(depth));
         pipeline.bind(cmd, &bindings);
-        draw_meshes(ctx, cmd, scene, pipeline, &push);
+        draw_meshes(ctx, cmd, scene, pipeline, &|m, t| Some(push(m, t)));
         ctx.end_rendering(cmd);
     })
 }
 
-/// Draws every mesh of `scene` with the push constants `push(mesh, its model matrix)` gives.
-fn draw_meshes<P: Pod>(
+/// Draws the meshes of `scene` with the push constants `push(mesh, its model matrix)` gives
+/// (`None` leaves a mesh out).
+pub fn draw_meshes<P: Pod>(
     ctx: &Context,
     cmd: vk::CommandBuffer,
     scene: &GpuScene,
     pipeline: &GraphicsPipeline,
-    push: &impl Fn(&GpuMesh, &Mat4) -> P,
+    push: &impl Fn(&GpuMesh, &Mat4) -> Option<P>,
 ) {
     for mesh in &scene.meshes {
-        let p = push(mesh, &scene.transforms[mesh.group]);
-        pipeline.push(cmd, bytes_of(&p));
-        ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        if let Some(p) = push(mesh, &scene.transforms[mesh.group]) {
+            pipeline.push(cmd, bytes_of(&p));
+            ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+        }
     }
+}
+
+/// A pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
+/// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1) and a `DrawPush`.
+pub fn lighting_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> Result<GraphicsPipeline> {
+    let bindings = [BindingKind::UniformBuffer, BindingKind::UniformBuffer];
+    scene_pipeline(
+        ctx,
+        name,
+        (spirv::SCENE_VERT, fragment_spirv),
+        &bindings,
+        size_of::<DrawPush>(),
+        DepthTest::Less,
+    )
+}
+
+/// Draws, with a [`lighting_pipeline`] bound, the meshes of `scene` for which `albedo` gives an
+/// albedo (`None` leaves a mesh out), each with its group's transform.
+pub fn draw_lit_meshes(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    pipeline: &GraphicsPipeline,
+    scene: &GpuScene,
+    albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
+) {
+    draw_meshes(ctx, cmd, scene, pipeline, &|mesh, model| {
+        let albedo = albedo(mesh)?;
+        Some(DrawPush { model: model.to_cols_array_2d(), albedo: [albedo[0], albedo[1], albedo[2], 0.0] })
+    });
 }

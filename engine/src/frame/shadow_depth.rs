@@ -3,15 +3,15 @@
 //! view, and read back with nearest-texel lookups. Shared by the parallel-lights baseline
 //! (orthographic maps), the shadowmap technique (perspective maps of local lights) and adaptive
 //! shadow maps (its page pool: one tile per layer).
-use super::unshadowed::MESH_POSITIONS;
+use super::gpu_scene::MESH_POSITIONS;
 use crate::backend::{
     vk, Binding, BindingKind, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image,
     ImageDesc, Sampler, Target,
 };
 use crate::error::Result;
+use crate::frame::{GpuMesh, GpuScene, DEPTH_FORMAT};
 use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
 use crate::pass::Pass;
-use crate::renderer::{GpuMesh, GpuScene, DEPTH_FORMAT};
 use glam::Mat4;
 use std::sync::Arc;
 

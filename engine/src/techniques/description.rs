@@ -4,10 +4,10 @@
 use super::asm::AsmSettings;
 use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use super::probes::{ProbeSettings, StaticLighting};
-use super::prt::{PrtParams, TransferSet, Visibility};
 use super::tamura::occlusion::RegionSize;
 use super::tamura::technique::{OcclusionSettings, Penumbra};
 use crate::error::{Error, Result};
+use crate::prt::{PrtParams, TransferSet, Visibility};
 use crate::renderer::TechniqueChoice;
 use std::sync::Arc;
 

@@ -4,9 +4,9 @@ use super::environment::GpuEnvironment;
 use super::FrameInputs;
 use crate::backend::{vk, Binding, BindingKind, Buffer, Context, DepthTest, GraphicsDesc, GraphicsPipeline};
 use crate::error::Result;
+use crate::frame::COLOR_FORMAT;
 use crate::layouts::spirv;
 use crate::pass::Pass;
-use crate::renderer::COLOR_FORMAT;
 use std::sync::Arc;
 
 pub struct Background {

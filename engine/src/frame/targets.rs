@@ -1,0 +1,85 @@
+//! The frame's render targets: the colour and depth images every technique draws into, and the
+//! buffer the picture is read back through.
+use crate::backend::{vk, Buffer, BufferDesc, Context, Image, ImageDesc, MemoryLocation};
+use crate::error::{Error, Result};
+use crate::imageio::RgbaF32Image;
+use std::sync::Arc;
+
+/// Linear radiance, 32-bit float per channel: the picture is compared against the ray-traced
+/// reference pixel by pixel, so no precision is given away before the output file.
+pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// The largest image side Kage renders (lavapipe and current GPUs allow 16384; 8192 keeps the
+/// colour target and its readback within 2 GiB).
+pub const MAX_SIZE: u32 = 8192;
+
+pub struct Targets {
+    pub color: Image,
+    pub depth: Image,
+    readback: Buffer,
+}
+
+impl Targets {
+    pub fn new(ctx: &Arc<Context>, width: u32, height: u32) -> Result<Targets> {
+        if !(1..=MAX_SIZE).contains(&width) || !(1..=MAX_SIZE).contains(&height) {
+            return Err(Error::InvalidArgument(format!(
+                "image size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
+            )));
+        }
+        let color = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "color",
+                width,
+                height,
+                layers: 1,
+                array: false,
+                format: COLOR_FORMAT,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            },
+        )?;
+        let depth = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "depth",
+                width,
+                height,
+                layers: 1,
+                array: false,
+                format: DEPTH_FORMAT,
+                // Sampled: the ASM refinement analysis reads the visible surfaces back.
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            },
+        )?;
+        let readback = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "color.readback",
+                size: color.byte_size()?,
+                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )?;
+        Ok(Targets { color, depth, readback })
+    }
+
+    /// Records the copy of the colour target into the readback buffer.
+    pub fn record_readback(&self, cmd: vk::CommandBuffer) {
+        self.color.record_copy_to(cmd, &self.readback)
+    }
+
+    /// The last frame read back: linear radiance, row 0 at the top.
+    pub fn read(&self) -> Result<RgbaF32Image> {
+        let bytes = self.readback.read()?;
+        let pixels = bytes
+            .chunks_exact(16)
+            .map(|t| {
+                std::array::from_fn(|k| {
+                    f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])
+                })
+            })
+            .collect();
+        Ok(RgbaF32Image { width: self.color.width, height: self.color.height, pixels })
+    }
+}
