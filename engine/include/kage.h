@@ -90,7 +90,8 @@ typedef uint32_t kage_result;
 #endif // __cplusplus
 
 /**
- * The lighting techniques (the values of `kage_technique_desc.technique`).
+ * The lighting techniques by name. The values are the C ABI's `kage_technique` and never
+ * change; the command line spells them in kebab case.
  */
 enum kage_technique
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -102,49 +103,47 @@ enum kage_technique
    */
   KAGE_TECHNIQUE_UNSHADOWED = 0,
   /**
-   * Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs
-   * `kage_precompute`.
+   * Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs the PRT
+   * precomputation.
    */
   KAGE_TECHNIQUE_SLOAN_SELF = 1,
   /**
-   * Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from `regions`
-   * environment regions, the `dominant_lights` brightest small lights of the map (a sun,
-   * lamps) taken out and lit per pixel with soft shadows. Needs `kage_precompute`.
-   */
-  KAGE_TECHNIQUE_TAMURA = 2,
-  /**
-   * Baseline: `regions` environment regions as directional lights with binary shadow maps.
-   */
-  KAGE_TECHNIQUE_PARALLEL_LIGHTS = 3,
-  /**
-   * Morishige 2014: light probes (`probe_placement`), captured as SH when the renderer is
-   * created, light the scene's first group (the moving one); the other groups are lit as
-   * `probe_statics` says.
-   */
-  KAGE_TECHNIQUE_PROBES = 4,
-  /**
-   * The scene's point and spot lights with hard shadows from one conventional shadow map of
-   * `shadow_map_size`² texels per light (1 to 8 lights).
-   */
-  KAGE_TECHNIQUE_SHADOW_MAP = 5,
-  /**
-   * Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light:
-   * a quadtree of tiles in a page pool of `asm_budget_mb`, refined where the eye sees shadow
-   * edges coarser than its pixels, `asm_time_ms` of tile rendering per frame.
-   */
-  KAGE_TECHNIQUE_ASM = 6,
-  /**
-   * Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT with the whole
-   * scene's visibility at its pose when `kage_precompute` ran (shadows between groups baked
-   * into the vertices; they stay where they were when groups move). Needs `kage_precompute`.
+   * Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT whose visibility
+   * is the whole scene as it stood when precomputed (shadows between groups baked into the
+   * vertices; they stay where they were when groups move). Needs the PRT precomputation.
    */
   KAGE_TECHNIQUE_SLOAN_SCENE = 7,
   /**
-   * Tamura, Johan, Nishita as the paper has it: `regions` regions, the fixed penumbra from
-   * each region's solid angle, no dominant lights (`penumbra` and `dominant_lights` are not
-   * read). Needs `kage_precompute`.
+   * Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from q environment
+   * regions, the map's few brightest small lights (a sun, lamps) taken out and lit per pixel
+   * with soft shadows. Needs the PRT precomputation.
+   */
+  KAGE_TECHNIQUE_TAMURA = 2,
+  /**
+   * Tamura, Johan, Nishita as the paper has it: q regions, the fixed penumbra from each
+   * region's solid angle, no dominant lights. Needs the PRT precomputation.
    */
   KAGE_TECHNIQUE_TAMURA_PAPER = 8,
+  /**
+   * The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
+   */
+  KAGE_TECHNIQUE_PARALLEL_LIGHTS = 3,
+  /**
+   * The scene's point and spot lights (1 to 8), one conventional shadow map each (hard
+   * shadows).
+   */
+  KAGE_TECHNIQUE_SHADOW_MAP = 5,
+  /**
+   * Morishige 2014: light probes captured as SH when the renderer is made light the scene's
+   * first group (the moving one); the other groups are lit as the probe statics say.
+   */
+  KAGE_TECHNIQUE_PROBES = 4,
+  /**
+   * Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light: a
+   * quadtree of tiles in a page pool of a memory budget, refined where the eye sees shadow
+   * edges coarser than its pixels.
+   */
+  KAGE_TECHNIQUE_ASM = 6,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -155,7 +154,7 @@ typedef uint32_t kage_technique;
 #endif // __cplusplus
 
 /**
- * Width of Tamura's penumbrae (the values of `kage_technique_desc.penumbra`).
+ * How wide the penumbra of a shadow between groups is.
  */
 enum kage_penumbra
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -163,11 +162,14 @@ enum kage_penumbra
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
   /**
-   * The paper's: one filter width per group pair and region.
+   * The paper's: one box width per (receiver, occluder, region), s = sqrt(Ω_i)·R with R
+   * measured between the group centres (eqs. (12)–(13)).
    */
   KAGE_PENUMBRA_FIXED = 0,
   /**
-   * A width per pixel from its distance to the occluder.
+   * Beyond the paper: the same two 1D passes leave boxes of three widths, and each pixel
+   * takes a box as wide as sqrt(Ω_i) times its own distance to the occluder (interpolated
+   * between them), so shadows sharpen at contact and soften with distance.
    */
   KAGE_PENUMBRA_ADAPTIVE = 1,
 };
@@ -176,6 +178,111 @@ enum kage_penumbra
 typedef enum kage_penumbra kage_penumbra;
 #else
 typedef uint32_t kage_penumbra;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * Which light the cube maps hold (see the module documentation).
+ */
+enum kage_probe_light
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * The environment and the scene's lights where the probe sees them; static surfaces drawn
+   * black, so they only occlude: `kage reference --irradiance --bounces 0`.
+   */
+  KAGE_PROBE_LIGHT_SKY = 1,
+  /**
+   * The sky, plus the static surfaces with the radiance the ray caster computes for them
+   * ([`CaptureSettings::bounces`]).
+   */
+  KAGE_PROBE_LIGHT_SKY_AND_WALLS = 0,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_probe_light kage_probe_light;
+#else
+typedef uint32_t kage_probe_light;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * The shadow test of the lookup. The bias test is the default: at equal memory it holds twice
+ * the tiles, and over the `asm` walkthrough's close-ups it misclassified fewer pixels (IDs
+ * only won on the bunny, whose surfaces turn away from the light; BENCHMARKS.md).
+ */
+enum kage_asm_test
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * The paper's: a tile texel holding the receiver's own polygon is lit; otherwise the
+   * depth comparison with bias decides. Pages hold an ID per texel beside the depth.
+   */
+  KAGE_ASM_TEST_ID = 1,
+  /**
+   * The depth comparison with the shadowmap technique's slope-scaled bias alone.
+   */
+  KAGE_ASM_TEST_BIAS = 0,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_asm_test kage_asm_test;
+#else
+typedef uint32_t kage_asm_test;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * How the light between probes is found.
+ */
+enum kage_probe_interpolation
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
+   */
+  KAGE_PROBE_INTERPOLATION_TETRAHEDRAL = 0,
+  /**
+   * Trilinear weights of the grid cell holding the point: a [`ProbePlacement::Grid`] only.
+   */
+  KAGE_PROBE_INTERPOLATION_TRILINEAR = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_probe_interpolation kage_probe_interpolation;
+#else
+typedef uint32_t kage_probe_interpolation;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * How the static groups are lit in the frame the probes light the moving group in.
+ */
+enum kage_static_lighting
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * The environment's SH irradiance, unshadowed.
+   */
+  KAGE_STATIC_LIGHTING_UNSHADOWED = 0,
+  /**
+   * Sloan's PRT: self-shadowed by the static groups (needs the PRT precomputation).
+   */
+  KAGE_STATIC_LIGHTING_SLOAN = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_static_lighting kage_static_lighting;
+#else
+typedef uint32_t kage_static_lighting;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -205,19 +312,70 @@ typedef uint32_t kage_pixel_format;
 #endif // __cplusplus
 
 /**
- * What to precompute.
+ * Where the light probes go (the values of `kage_technique_desc.probe_placement`).
  */
-typedef struct PrtParams PrtParams;
+enum kage_probe_placement
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * `probe_grid` probes at the cell centres of that grid over the static groups' bounding box.
+   */
+  KAGE_PROBE_PLACEMENT_GRID = 0,
+  /**
+   * Candidates at the cell centres of a grid (`probe_candidates`; all 0: 8 along the box's
+   * longest side, proportionally fewer along the others) outside solids are captured, then
+   * those the others reproduce within `probe_tolerance` are dropped, the kept ones moved to
+   * nearby candidates while that lowers the error over all of them and their SH fitted to
+   * every capture; `kage_renderer_get_stats` reports how many remain.
+   */
+  KAGE_PROBE_PLACEMENT_AUTO = 1,
+  /**
+   * The `probe_position_count` world positions at `probe_positions`.
+   */
+  KAGE_PROBE_PLACEMENT_POSITIONS = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_probe_placement kage_probe_placement;
+#else
+typedef uint32_t kage_probe_placement;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
 
 /**
- * A rectangle of the light's view uv (u right, v down, the unit square the whole view).
+ * The window on each probe's SH against ringing (the values of `kage_technique_desc.probe_dering`).
  */
-typedef struct UvRect UvRect;
-
-/**
- * What a vertex's transfer is shadowed by.
- */
-typedef struct Visibility Visibility;
+enum kage_probe_dering
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * The SH as captured; the shading clamps negative irradiance at 0.
+   */
+  KAGE_PROBE_DERING_OFF = 0,
+  /**
+   * The gentlest window that keeps every probe's irradiance nonnegative.
+   */
+  KAGE_PROBE_DERING_NON_NEGATIVE = 1,
+  /**
+   * Hanning window of width `probe_dering_width` bands (Sloan 2008).
+   */
+  KAGE_PROBE_DERING_HANNING = 2,
+  /**
+   * Lanczos window of width `probe_dering_width` bands (Sloan 2008).
+   */
+  KAGE_PROBE_DERING_LANCZOS = 3,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_probe_dering kage_probe_dering;
+#else
+typedef uint32_t kage_probe_dering;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
 
 /**
  * A Vulkan device, queue and memory allocator that scenes are precomputed and rendered with.

@@ -11,53 +11,25 @@ use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::prt::TransferSet;
 use crate::scene::{Light, Scene};
-use crate::techniques::asm::technique::Asm;
-use crate::techniques::asm::{AsmSettings, AsmStats};
-use crate::techniques::parallel_lights::ParallelLights;
-use crate::techniques::probes::technique::ProbeTechnique;
-use crate::techniques::probes::ProbeSettings;
-use crate::techniques::shadow_map::ShadowMap;
-use crate::techniques::tamura::technique::OcclusionSettings;
-use crate::techniques::tamura::PrtTechnique;
-use crate::techniques::unshadowed::Unshadowed;
-use crate::techniques::Technique;
+use crate::techniques::description::TechniqueDesc;
+use crate::techniques::{Technique, TechniqueStats};
 use glam::Mat4;
 use std::sync::Arc;
-
-/// Which technique lights the scene.
-#[derive(Clone, Debug, Default)]
-pub enum TechniqueChoice {
-    /// SH irradiance, no shadows.
-    #[default]
-    Unshadowed,
-    /// PRT: with `occlusion.regions == 0` Sloan's self-shadowing alone, otherwise the
-    /// Tamura–Johan–Nishita technique with that many regions.
-    Prt { transfer: Arc<TransferSet>, occlusion: OcclusionSettings },
-    /// The paper's Fig. 3 baseline: `regions` environment regions (1 to 128) as directional
-    /// lights with binary shadow maps of `shadow_map_size`² texels.
-    ParallelLights { regions: usize, shadow_map_size: u32 },
-    /// Light probes captured when the renderer is built light the moving group; the static
-    /// groups are lit as `settings.statics` says: by `Unshadowed`, or by Sloan's PRT from
-    /// `transfer` (required then).
-    Probes { settings: ProbeSettings, transfer: Option<Arc<TransferSet>> },
-    /// The scene's point and spot lights with hard shadows from one conventional shadow map of
-    /// `size`² texels per light (the baseline of adaptive shadow maps).
-    ShadowMap { size: u32 },
-    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light.
-    Asm(AsmSettings),
-}
 
 /// What to render and how large.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
     pub width: u32,
     pub height: u32,
-    pub technique: TechniqueChoice,
+    pub technique: TechniqueDesc,
+    /// The PRT transfer the technique's [`TechniqueDesc::precomputation`] asks for (`None` when
+    /// it needs none).
+    pub transfer: Option<Arc<TransferSet>>,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { width: 512, height: 512, technique: TechniqueChoice::Unshadowed }
+        RenderOptions { width: 512, height: 512, technique: TechniqueDesc::Unshadowed, transfer: None }
     }
 }
 
@@ -82,22 +54,8 @@ impl Renderer {
         scene.validate()?;
         let targets = Targets::new(ctx, options.width, options.height)?;
         let gpu = GpuScene::new(ctx, scene)?;
-        let technique: Box<dyn Technique> = match &options.technique {
-            TechniqueChoice::Unshadowed => Box::new(Unshadowed::new(ctx)?),
-            TechniqueChoice::Prt { transfer, occlusion } => {
-                Box::new(PrtTechnique::new(ctx, scene, &gpu, transfer, *occlusion)?)
-            }
-            TechniqueChoice::ParallelLights { regions, shadow_map_size } => {
-                Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
-            }
-            TechniqueChoice::Probes { settings, transfer } => {
-                Box::new(ProbeTechnique::new(ctx, scene, &gpu, settings, transfer.as_deref())?)
-            }
-            TechniqueChoice::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
-            TechniqueChoice::Asm(settings) => {
-                Box::new(Asm::new(ctx, scene, &gpu, *settings, (options.width, options.height))?)
-            }
-        };
+        let size = (options.width, options.height);
+        let technique = options.technique.build(ctx, scene, &gpu, options.transfer.as_ref(), size)?;
         Ok(Renderer {
             ctx: ctx.clone(),
             scene: gpu,
@@ -221,28 +179,9 @@ impl Renderer {
         Ok(timings)
     }
 
-    /// Occlusion layers the last frame wanted but had no room for (see
-    /// `OcclusionSettings::max_layers`): the least energetic regions' shadows between groups
-    /// were left out.
-    pub fn dropped_layers(&self) -> usize {
-        self.technique.dropped_layers()
-    }
-
-    /// Bytes the technique keeps for the local lights' shadows (see
-    /// `Technique::shadow_memory_bytes`); `None` when it has no shadow storage.
-    pub fn shadow_memory_bytes(&self) -> Option<u64> {
-        self.technique.shadow_memory_bytes()
-    }
-
-    /// The adaptive shadow map's hierarchy after the last frame (`None` unless the technique
-    /// is `Asm`): bytes against the budget, resident tiles, deepest level, tiles rendered.
-    pub fn asm_stats(&self) -> Option<AsmStats> {
-        self.technique.asm_stats()
-    }
-
-    /// The light probes placed and kept (`None` unless the technique is `Probes`).
-    pub fn probe_counts(&self) -> Option<crate::techniques::probes::ProbeCounts> {
-        self.technique.probe_counts()
+    /// What the technique reports of the last frame besides the pass timings.
+    pub fn stats(&self) -> TechniqueStats {
+        self.technique.stats()
     }
 
     /// The last rendered frame: linear radiance, row 0 at the top.

@@ -1,16 +1,17 @@
-//! Adaptive shadow maps (`TechniqueChoice::Asm`) in the built-in `asm` scene, against the
+//! Adaptive shadow maps (`TechniqueDesc::Asm`) in the built-in `asm` scene, against the
 //! ray-traced local-light reference: the budget holds, refinement converges and beats a
 //! conventional map of the same memory, and moving the light or a group invalidates what it
 //! must and no more.
 use glam::{Mat4, Vec3};
 use kage::imageio::RgbaF32Image;
 use kage::reference::{shadow_mismatch, LightMode, ReferenceOptions, ReferenceRenderer, SHADOW_THRESHOLD};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{Light, Scene};
 use kage::techniques::asm::pool::{DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
 use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::tile::TileKey;
 use kage::techniques::asm::AsmSettings;
+use kage::techniques::description::TechniqueDesc;
 use kage_tests::Validated;
 
 const SIZE: u32 = 96;
@@ -28,8 +29,9 @@ fn settings(budget_bytes: u64, test: AsmTest) -> AsmSettings {
     AsmSettings { budget_mb: budget_bytes as f64 / MB as f64, time_ms: 1000.0, test }
 }
 
-fn renderer(ctx: &Validated, scene: &Scene, technique: TechniqueChoice) -> Renderer {
-    Renderer::new(ctx, scene, &RenderOptions { width: SIZE, height: SIZE, technique }).unwrap()
+fn renderer(ctx: &Validated, scene: &Scene, technique: TechniqueDesc) -> Renderer {
+    Renderer::new(ctx, scene, &RenderOptions { width: SIZE, height: SIZE, technique, transfer: None })
+        .unwrap()
 }
 
 fn reference(ctx: &Validated, scene: &Scene) -> RgbaF32Image {
@@ -61,14 +63,14 @@ fn refinement_converges_within_the_budget_and_beats_a_map_of_equal_memory() {
     let truth = reference(&ctx, &scene);
 
     let budget = 4 * MB;
-    let mut asm = renderer(&ctx, &scene, TechniqueChoice::Asm(settings(budget, AsmTest::Bias)));
+    let mut asm = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(budget, AsmTest::Bias)));
     let mut errors = Vec::new();
     for _ in 0..12 {
         errors.extend(mismatches(&mut asm, &truth, 1));
-        let stats = asm.asm_stats().unwrap();
+        let stats = asm.stats().asm.unwrap();
         assert!(stats.bytes_used <= budget, "{} bytes in a {budget}-byte pool", stats.bytes_used);
     }
-    let stats = asm.asm_stats().unwrap();
+    let stats = asm.stats().asm.unwrap();
     let differing: Vec<usize> = errors.iter().map(|m| m.differing).collect();
     eprintln!("asm 4 MiB: {differing:?}, deepest level {}", stats.deepest_level);
     // The first frame refines from the root down at most KAGE_ASM_CHAIN_LEVELS levels; the
@@ -77,7 +79,7 @@ fn refinement_converges_within_the_budget_and_beats_a_map_of_equal_memory() {
     assert!(2 * last <= differing[0], "no convergence: {differing:?}");
     assert!(stats.deepest_level >= 4, "deepest level {}", stats.deepest_level);
 
-    let mut map = renderer(&ctx, &scene, TechniqueChoice::ShadowMap { size: 1024 });
+    let mut map = renderer(&ctx, &scene, TechniqueDesc::ShadowMap { size: 1024 });
     let conventional = mismatches(&mut map, &truth, 1)[0].differing;
     eprintln!("shadowmap 1024² (4 MiB): {conventional}");
     assert!(last < conventional, "asm {last} against the conventional map's {conventional}");
@@ -87,11 +89,11 @@ fn refinement_converges_within_the_budget_and_beats_a_map_of_equal_memory() {
     // texels, so they are no more than the root tile alone (the least budget) gives.
     let least = AsmTest::Bias.least_budget_bytes();
     let tiny = least + 6 * DEPTH_PAGE_BYTES;
-    let mut small = renderer(&ctx, &scene, TechniqueChoice::Asm(settings(tiny, AsmTest::Bias)));
+    let mut small = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(tiny, AsmTest::Bias)));
     let small_errors = mismatches(&mut small, &truth, 8);
-    let stats = small.asm_stats().unwrap();
+    let stats = small.stats().asm.unwrap();
     assert!(stats.bytes_used <= tiny && stats.resident_tiles <= 3, "{stats:?}");
-    let root_alone = TechniqueChoice::Asm(settings(least, AsmTest::Bias));
+    let root_alone = TechniqueDesc::Asm(settings(least, AsmTest::Bias));
     let root = mismatches(&mut renderer(&ctx, &scene, root_alone), &truth, 2)[1].lit_in_render_only;
     let leaks = small_errors.last().unwrap().lit_in_render_only;
     eprintln!("4 pages: leaks {leaks} against the root's {root}");
@@ -107,14 +109,14 @@ fn refinement_converges_within_the_budget_and_beats_a_map_of_equal_memory() {
 fn the_light_moving_invalidates_all_tiles_and_a_group_only_those_it_touches() {
     let ctx = Validated::new();
     let scene = close_up(1);
-    let mut r = renderer(&ctx, &scene, TechniqueChoice::Asm(settings(8 * MB, AsmTest::Bias)));
+    let mut r = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(8 * MB, AsmTest::Bias)));
     for _ in 0..20 {
         r.render().unwrap();
-        if r.asm_stats().unwrap().rendered.is_empty() {
+        if r.stats().asm.unwrap().rendered.is_empty() {
             break;
         }
     }
-    let converged = r.asm_stats().unwrap();
+    let converged = r.stats().asm.unwrap();
     assert!(converged.rendered.is_empty() && converged.resident_tiles > 8, "{converged:?}");
 
     let nudge = |r: &mut Renderer, name: &str| {
@@ -122,7 +124,7 @@ fn the_light_moving_invalidates_all_tiles_and_a_group_only_those_it_touches() {
         let moved = Mat4::from_translation(Vec3::new(0.01, 0.0, 0.0)) * scene.groups[g].transform.matrix();
         r.set_group_transform(g, moved).unwrap();
         r.render().unwrap();
-        r.asm_stats().unwrap()
+        r.stats().asm.unwrap()
     };
     let bunny = nudge(&mut r, "bunny");
     eprintln!("bunny moved: {} of {} tiles rendered again", bunny.refreshed.len(), bunny.resident_tiles);
@@ -145,7 +147,7 @@ fn the_light_moving_invalidates_all_tiles_and_a_group_only_those_it_touches() {
     r.render().unwrap();
     // Every tile dropped: the frame renders the root again and refines from it (at most
     // KAGE_ASM_CHAIN_LEVELS levels in one frame); nothing from the old light stays resident.
-    let stats = r.asm_stats().unwrap();
+    let stats = r.stats().asm.unwrap();
     assert_eq!(stats.refreshed, vec![TileKey::ROOT], "{stats:?}");
     assert_eq!(1 + stats.rendered.len(), stats.resident_tiles, "{stats:?}");
     assert!(stats.deepest_level <= kage::layouts::constants::ASM_CHAIN_LEVELS, "{stats:?}");
@@ -162,9 +164,9 @@ fn the_id_test_counts_its_ids_in_the_budget_and_matches_the_reference() {
     let truth = reference(&ctx, &scene);
     let budget = 2 * MB;
     for test in [AsmTest::Id, AsmTest::Bias] {
-        let mut r = renderer(&ctx, &scene, TechniqueChoice::Asm(settings(budget, test)));
+        let mut r = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(budget, test)));
         let errors = mismatches(&mut r, &truth, 8);
-        let stats = r.asm_stats().unwrap();
+        let stats = r.stats().asm.unwrap();
         let page = if test == AsmTest::Id { ID_PAGE_BYTES } else { DEPTH_PAGE_BYTES };
         assert!(
             stats.bytes_used <= budget && stats.resident_tiles as u64 <= budget / (3 * page),
@@ -215,7 +217,7 @@ fn grazing_light_with_the_id_and_the_bias_test() {
     let truth = reference(&ctx, &scene);
     let mut leaks = Vec::new();
     for test in [AsmTest::Bias, AsmTest::Id] {
-        let mut r = renderer(&ctx, &scene, TechniqueChoice::Asm(settings(4 * MB, test)));
+        let mut r = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(4 * MB, test)));
         let last = *mismatches(&mut r, &truth, 10).last().unwrap();
         let acne = last.differing - last.lit_in_render_only;
         eprintln!("{test:?}: {} differing: {acne} acne, {} leaks", last.differing, last.lit_in_render_only);
@@ -246,7 +248,7 @@ fn a_fast_camera_turn_keeps_the_churn_per_frame_within_the_time_budget() {
     let ctx = Validated::new();
     let scene = close_up(1);
     let (budget, time_ms) = (MB, 2.0);
-    let technique = TechniqueChoice::Asm(AsmSettings { time_ms, ..settings(budget, AsmTest::Bias) });
+    let technique = TechniqueDesc::Asm(AsmSettings { time_ms, ..settings(budget, AsmTest::Bias) });
     let mut r = renderer(&ctx, &scene, technique);
     for _ in 0..10 {
         r.render().unwrap();
@@ -257,7 +259,7 @@ fn a_fast_camera_turn_keeps_the_churn_per_frame_within_the_time_budget() {
     let (mut differing, mut rendered) = (Vec::new(), Vec::new());
     for frame in 0..10 {
         differing.extend(mismatches(&mut r, &truth, 1).iter().map(|m| m.differing));
-        let stats = r.asm_stats().unwrap();
+        let stats = r.stats().asm.unwrap();
         assert!(stats.bytes_used <= budget, "{stats:?}");
         let most = 1 + (time_ms / stats.cost.1).floor() as usize;
         assert!(
@@ -292,12 +294,12 @@ fn the_light_inside_the_view() {
     scene.camera.fov_y_deg = 100.0;
     let truth = reference(&ctx, &scene);
     let budget = MB;
-    let mut asm = renderer(&ctx, &scene, TechniqueChoice::Asm(settings(budget, AsmTest::Bias)));
+    let mut asm = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(budget, AsmTest::Bias)));
     let errors = mismatches(&mut asm, &truth, 10);
-    assert!(asm.asm_stats().unwrap().bytes_used <= budget);
+    assert!(asm.stats().asm.unwrap().bytes_used <= budget);
     let image = asm.image().unwrap();
     assert!(image.pixels.iter().flatten().all(|v| v.is_finite()), "non-finite pixels");
-    let mut map = renderer(&ctx, &scene, TechniqueChoice::ShadowMap { size: 512 });
+    let mut map = renderer(&ctx, &scene, TechniqueDesc::ShadowMap { size: 512 });
     let conventional = mismatches(&mut map, &truth, 1)[0].differing;
     let last = errors.last().unwrap().differing;
     eprintln!(

@@ -1,4 +1,4 @@
-//! The failure-mode suite across the engine (issue 8): each case feeds the engine something
+//! The failure-mode suite across the engine: each case feeds the engine something
 //! hostile and asserts its documented behaviour, either a clear error naming what is wrong or a
 //! finite picture, never a panic, a hang, a validation message or a silently wrong picture.
 //!
@@ -17,10 +17,11 @@ use kage::imageio::RgbaF32Image;
 use kage::layouts::{constants, CastRay};
 use kage::prt::{transfer, PrtParams};
 use kage::raycast::{closest_hit_brute_force, GpuBvh, GpuRays, Query, RayCaster, SceneBvh};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::envmap::MAX_RADIANCE;
 use kage::scene::{shapes, Camera, EnvMap, Group, Light, Mesh, Scene, Transform};
 use kage::techniques::asm::AsmSettings;
+use kage::techniques::description::TechniqueDesc;
 use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSettings};
 use kage::techniques::tamura::technique::OcclusionSettings;
 use kage::Error;
@@ -105,7 +106,9 @@ fn degenerate_mesh() -> Mesh {
 }
 
 /// Every technique at its cheapest settings; the PRT transfer is computed for `scene`.
-fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, TechniqueChoice)> {
+/// Every technique at its cheapest settings, with the PRT transfer computed for `scene` where it
+/// needs one; the callers set the image size.
+fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, RenderOptions)> {
     let transfer = Arc::new(
         transfer::precompute(
             ctx,
@@ -115,39 +118,34 @@ fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, Technique
         )
         .unwrap(),
     );
-    let prt = |regions| TechniqueChoice::Prt {
-        transfer: transfer.clone(),
-        occlusion: OcclusionSettings { regions, mask_size: 16, ..Default::default() },
-    };
-    vec![
-        ("unshadowed", TechniqueChoice::Unshadowed),
-        ("sloan", prt(0)),
-        ("tamura", prt(4)),
-        ("parallel-lights", TechniqueChoice::ParallelLights { regions: 4, shadow_map_size: 16 }),
-        ("shadowmap", TechniqueChoice::ShadowMap { size: 16 }),
+    let prt = transfer.params;
+    let occlusion = OcclusionSettings { regions: 4, mask_size: 16, ..Default::default() };
+    let with_transfer =
+        [("sloan", TechniqueDesc::SloanSelf { prt }), ("tamura", TechniqueDesc::Tamura { prt, occlusion })];
+    let without = [
+        ("unshadowed", TechniqueDesc::Unshadowed),
+        ("parallel-lights", TechniqueDesc::ParallelLights { regions: 4, shadow_map_size: 16 }),
+        ("shadowmap", TechniqueDesc::ShadowMap { size: 16 }),
         (
             "probes",
-            TechniqueChoice::Probes {
-                settings: ProbeSettings {
+            TechniqueDesc::Probes {
+                probes: ProbeSettings {
                     placement: ProbePlacement::Grid([2, 2, 2]),
                     capture: CaptureSettings { cube_size: 8, samples: 16, ..Default::default() },
                     ..Default::default()
                 },
-                transfer: None,
+                prt,
             },
         ),
-        ("asm", TechniqueChoice::Asm(AsmSettings { budget_mb: 1.0, ..AsmSettings::default() })),
-    ]
+        ("asm", TechniqueDesc::Asm(AsmSettings { budget_mb: 1.0, ..AsmSettings::default() })),
+    ];
+    let options = |technique, transfer| RenderOptions { width: 0, height: 0, technique, transfer };
+    let with_transfer = with_transfer.into_iter().map(|(n, t)| (n, options(t, Some(transfer.clone()))));
+    without.into_iter().map(|(n, t)| (n, options(t, None))).chain(with_transfer).collect()
 }
 
-fn render(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    technique: TechniqueChoice,
-    width: u32,
-    height: u32,
-) -> RgbaF32Image {
-    let mut renderer = Renderer::new(ctx, scene, &RenderOptions { width, height, technique }).unwrap();
+fn render(ctx: &Arc<Context>, scene: &Scene, options: RenderOptions) -> RgbaF32Image {
+    let mut renderer = Renderer::new(ctx, scene, &options).unwrap();
     renderer.render().unwrap();
     renderer.image().unwrap()
 }
@@ -163,8 +161,9 @@ fn assert_finite(image: &RgbaF32Image, what: &str) {
 
 /// Renders `scene` with every technique at `size`² and checks that each picture is finite.
 fn every_technique_renders(ctx: &Arc<Context>, scene: &Scene, size: u32) {
-    for (name, technique) in techniques(ctx, scene) {
-        assert_finite(&render(ctx, scene, technique, size, size), &format!("{} with {name}", scene.name));
+    for (name, options) in techniques(ctx, scene) {
+        let options = RenderOptions { width: size, height: size, ..options };
+        assert_finite(&render(ctx, scene, options), &format!("{} with {name}", scene.name));
     }
 }
 
@@ -232,13 +231,13 @@ fn env_maps_with_nan_infinite_or_huge_texels_are_rejected_naming_the_texel() {
     // region split used to loop forever looking for a texel for each region).
     scene.environment = EnvMap::from_pixels(4, 2, vec![[1.0; 3]; 8]).unwrap();
     let tamura = techniques(&ctx, &scene).into_iter().find(|(name, _)| *name == "tamura").unwrap().1;
-    let TechniqueChoice::Prt { transfer, .. } = tamura else { unreachable!() };
     let occlusion = OcclusionSettings { regions: 9, mask_size: 16, ..Default::default() };
+    let prt = tamura.transfer.as_ref().unwrap().params;
     for technique in [
-        TechniqueChoice::Prt { transfer, occlusion },
-        TechniqueChoice::ParallelLights { regions: 9, shadow_map_size: 16 },
+        TechniqueDesc::Tamura { prt, occlusion },
+        TechniqueDesc::ParallelLights { regions: 9, shadow_map_size: 16 },
     ] {
-        let options = RenderOptions { width: 8, height: 8, technique };
+        let options = RenderOptions { width: 8, height: 8, technique, ..tamura.clone() };
         assert_error_says(Renderer::new(&ctx, &scene, &options), &["q = 9", "4x2", "8"]);
     }
 }
@@ -326,8 +325,8 @@ fn meshes_without_triangles_are_errors_and_empty_groups_draw_nothing() {
     let nothing = Group { name: "nothing".into(), meshes: vec![], transform: Transform::default() };
     for scene in [scene(vec![]), scene(vec![nothing.clone()]), scene(vec![nothing, room()])] {
         let groups = scene.groups.len();
-        for (name, technique) in techniques(&ctx, &scene) {
-            let made = Renderer::new(&ctx, &scene, &RenderOptions { width: 8, height: 8, technique });
+        for (name, options) in techniques(&ctx, &scene) {
+            let made = Renderer::new(&ctx, &scene, &RenderOptions { width: 8, height: 8, ..options });
             if name == "probes" && !scene.groups.iter().skip(1).any(|g| !g.meshes.is_empty()) {
                 assert_error_says(made, &["no static group"]);
                 continue;
@@ -372,24 +371,24 @@ fn two_hundred_groups_report_dropped_layers_and_render() {
     // Ball i is group i, or i + 1 past the room.
     let ball_groups = (0..200).filter(|g| *g != 1);
 
-    for (name, technique) in techniques(&ctx, &scene) {
+    for (name, options) in techniques(&ctx, &scene) {
         let start = std::time::Instant::now();
         let mut renderer =
-            Renderer::new(&ctx, &scene, &RenderOptions { width: 16, height: 16, technique }).unwrap();
+            Renderer::new(&ctx, &scene, &RenderOptions { width: 16, height: 16, ..options }).unwrap();
         let timings = renderer.render().unwrap();
         assert!(
             !timings.is_empty()
                 && timings.iter().all(|t| t.gpu_ms.is_none_or(|ms| ms.is_finite() && ms >= 0.0))
         );
         assert_finite(&renderer.image().unwrap(), &format!("200 groups with {name}"));
-        let dropped = renderer.dropped_layers();
+        let dropped = renderer.stats().dropped_layers;
         if name == "tamura" {
             assert!(dropped > 0, "the crowd fits {} layers?", constants::MAX_OCCLUSION_LAYERS);
             for (i, g) in ball_groups.clone().enumerate() {
                 renderer.set_group_transform(g, Mat4::from_translation(spread(i))).unwrap();
             }
             renderer.render().unwrap();
-            let spread_dropped = renderer.dropped_layers();
+            let spread_dropped = renderer.stats().dropped_layers;
             println!(
                 "200 groups, tamura: {dropped} layers dropped in a cluster, {spread_dropped} spread out"
             );
@@ -423,14 +422,19 @@ fn one_pixel_and_the_largest_sizes_render_and_beyond_is_an_error() {
     let scene = scene(vec![group("object", vec![degenerate_mesh()], Vec3::ZERO), room()]);
     every_technique_renders(&ctx, &scene, 1);
     for (width, height) in [(MAX_SIZE, 1), (1, MAX_SIZE)] {
-        let image = render(&ctx, &scene, TechniqueChoice::Unshadowed, width, height);
+        let image = render(&ctx, &scene, RenderOptions { width, height, ..Default::default() });
         assert_eq!(image.pixels.len(), MAX_SIZE as usize);
         assert_finite(&image, &format!("{width}x{height}"));
     }
-    let largest = RenderOptions { width: MAX_SIZE, height: MAX_SIZE, technique: TechniqueChoice::Unshadowed };
+    let largest = RenderOptions {
+        width: MAX_SIZE,
+        height: MAX_SIZE,
+        technique: TechniqueDesc::Unshadowed,
+        transfer: None,
+    };
     drop(Renderer::new(&ctx, &scene, &largest).unwrap());
     for (width, height) in [(MAX_SIZE + 1, 1), (1, MAX_SIZE + 1), (0, 16)] {
-        let options = RenderOptions { width, height, technique: TechniqueChoice::Unshadowed };
+        let options = RenderOptions { width, height, technique: TechniqueDesc::Unshadowed, transfer: None };
         assert_error_says(
             Renderer::new(&ctx, &scene, &options),
             &[&format!("{width}x{height}"), "1 to 8192"],
@@ -447,7 +451,8 @@ fn the_largest_image_renders() {
     let ctx = Validated::new();
     let scene = scene(vec![group("object", vec![degenerate_mesh()], Vec3::ZERO), room()]);
     let start = std::time::Instant::now();
-    let image = render(&ctx, &scene, TechniqueChoice::Unshadowed, MAX_SIZE, MAX_SIZE);
+    let image =
+        render(&ctx, &scene, RenderOptions { width: MAX_SIZE, height: MAX_SIZE, ..Default::default() });
     println!("8192² unshadowed frame and readback: {:.1} s", start.elapsed().as_secs_f64());
     assert_finite(&image, "8192²");
 }
@@ -495,8 +500,12 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
         .unwrap(),
     );
     let occlusion = OcclusionSettings { regions: 64, mask_size: 2048, ..Default::default() };
-    let technique = TechniqueChoice::Prt { transfer, occlusion };
-    match Renderer::new(&ctx, &scene, &RenderOptions { width: 16, height: 16, technique }) {
+    let technique = TechniqueDesc::Tamura { prt: transfer.params, occlusion };
+    match Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions { width: 16, height: 16, technique, transfer: Some(transfer) },
+    ) {
         Err(e) => {
             assert!(is_out_of_memory(&e), "{e}");
             assert!(e.to_string().contains("occlusion.mask"), "{e}");
@@ -566,10 +575,11 @@ fn memory_stays_flat(frames: usize) {
     let ctx = Validated::new();
     let scene = scene(vec![group("object", vec![degenerate_mesh()], Vec3::ZERO), room()]);
     for (name, technique) in
-        [("unshadowed", TechniqueChoice::Unshadowed), ("shadowmap", TechniqueChoice::ShadowMap { size: 16 })]
+        [("unshadowed", TechniqueDesc::Unshadowed), ("shadowmap", TechniqueDesc::ShadowMap { size: 16 })]
     {
         let mut renderer =
-            Renderer::new(&ctx, &scene, &RenderOptions { width: 16, height: 16, technique }).unwrap();
+            Renderer::new(&ctx, &scene, &RenderOptions { width: 16, height: 16, technique, transfer: None })
+                .unwrap();
         let mut frame = |i: usize| {
             let turn = Quat::from_rotation_y(i as f32 * 0.01);
             renderer.set_group_transform(0, Mat4::from_rotation_translation(turn, Vec3::ZERO)).unwrap();
@@ -821,7 +831,9 @@ fn c_abi_catches_bad_values_and_calls_after_free() {
 /// counted back by `kage_renderer_get_stats`; bad probe values are errors naming the field.
 #[test]
 fn c_abi_places_probes_and_reports_them() {
-    use capi::technique::{kage_probe_dering, kage_probe_interpolation, kage_probe_placement};
+    use capi::technique::{kage_probe_dering, kage_probe_placement};
+    use kage::techniques::description::TechniqueKind;
+    use kage::techniques::probes::{CapturedLight, ProbeInterpolation, StaticLighting};
     let _shared = alongside_others();
     let c = CHost::new();
     // Around the triangles (the scene's static group is the upper one): a tetrahedralization
@@ -833,8 +845,8 @@ fn c_abi_places_probes_and_reports_them() {
         probe_positions: positions.as_ptr(),
         probe_position_count: 5,
         probe_cube_size: 8,
-        probe_light: capi::technique::kage_probe_light::Sky as u32,
-        ..c.technique(capi::technique::kage_technique::Probes as u32)
+        probe_light: CapturedLight::Sky as u32,
+        ..c.technique(TechniqueKind::Probes as u32)
     };
     let create = |technique| {
         let desc = capi::renderer::kage_renderer_desc { width: 8, height: 8, technique };
@@ -855,7 +867,7 @@ fn c_abi_places_probes_and_reports_them() {
     assert_eq!((stats.probes, stats.probe_candidates, stats.probes_inside_geometry), (5, 5, 0));
 
     let hanning = kage_probe_dering::Hanning as u32;
-    let trilinear = kage_probe_interpolation::Trilinear as u32;
+    let trilinear = ProbeInterpolation::Trilinear as u32;
     for (technique, expected, named) in [
         (
             capi::technique::kage_technique_desc { probe_placement: 3, ..probes },
@@ -892,10 +904,7 @@ fn c_abi_places_probes_and_reports_them() {
             "probe_statics",
         ),
         (
-            capi::technique::kage_technique_desc {
-                probe_statics: capi::technique::kage_static_lighting::Sloan as u32,
-                ..probes
-            },
+            capi::technique::kage_technique_desc { probe_statics: StaticLighting::Sloan as u32, ..probes },
             kage_result::InvalidValue,
             "precompute it first",
         ),

@@ -2,16 +2,19 @@
 //! binary shadow maps.
 use glam::Vec3;
 use kage::frame::regions::Regions;
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, Camera, EnvMap, Scene};
+use kage::techniques::description::TechniqueDesc;
 use kage_tests::{single_mesh_scene, Validated};
 
-fn parallel(regions: usize) -> TechniqueChoice {
-    TechniqueChoice::ParallelLights { regions, shadow_map_size: 512 }
+fn parallel(regions: usize) -> TechniqueDesc {
+    TechniqueDesc::ParallelLights { regions, shadow_map_size: 512 }
 }
 
-fn render(ctx: &Validated, scene: &Scene, size: u32, technique: TechniqueChoice) -> Vec<[f32; 4]> {
-    let mut r = Renderer::new(ctx, scene, &RenderOptions { width: size, height: size, technique }).unwrap();
+fn render(ctx: &Validated, scene: &Scene, size: u32, technique: TechniqueDesc) -> Vec<[f32; 4]> {
+    let mut r =
+        Renderer::new(ctx, scene, &RenderOptions { width: size, height: size, technique, transfer: None })
+            .unwrap();
     r.render().unwrap();
     r.image().unwrap().pixels
 }
@@ -103,15 +106,18 @@ fn the_teapot_shadows_the_floor() {
 fn region_count_and_map_size_are_checked() {
     let ctx = Validated::new();
     let scene = Scene::builtin("teapot").unwrap();
-    let attempt =
-        |technique| match Renderer::new(&ctx, &scene, &RenderOptions { width: 16, height: 16, technique }) {
-            Ok(_) => panic!("accepted"),
-            Err(e) => e.to_string(),
-        };
+    let attempt = |technique| match Renderer::new(
+        &ctx,
+        &scene,
+        &RenderOptions { width: 16, height: 16, technique, transfer: None },
+    ) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    };
     for q in [0, 129] {
         let message = attempt(parallel(q));
         assert!(message.contains("1 to 128"), "q = {q}: {message}");
     }
-    let message = attempt(TechniqueChoice::ParallelLights { regions: 8, shadow_map_size: 4 });
+    let message = attempt(TechniqueDesc::ParallelLights { regions: 8, shadow_map_size: 4 });
     assert!(message.contains("shadow map size"), "{message}");
 }

@@ -2,9 +2,10 @@
 //! coefficients' irradiance negative (clamped in the shading, or removed by a deringing
 //! window).
 use glam::{DVec3, Vec3};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, Camera, EnvMap, Group, Scene, Transform};
 use kage::sh::ShRgb9;
+use kage::techniques::description::TechniqueDesc;
 use kage::techniques::probes::{CaptureSettings, CapturedLight, Dering, ProbePlacement, ProbeSettings};
 use kage_tests::Validated;
 use std::sync::Arc;
@@ -73,7 +74,8 @@ fn a_tiny_sun_rings_negative_the_shading_clamps_it_and_deringing_removes_it() {
     let options = |dering| RenderOptions {
         width: 32,
         height: 32,
-        technique: TechniqueChoice::Probes { settings: probes(dering), transfer: None },
+        technique: TechniqueDesc::Probes { probes: probes(dering), prt: kage::prt::PrtParams::DEFAULT },
+        transfer: None,
     };
     let mut renderer = Renderer::new(&ctx, &scene, &options(Dering::Off)).unwrap();
     renderer.render().unwrap();
@@ -149,7 +151,8 @@ fn a_probe_inside_a_wall_is_detected_and_left_out() {
     let options = RenderOptions {
         width: 24,
         height: 24,
-        technique: TechniqueChoice::Probes { settings, transfer: None },
+        technique: TechniqueDesc::Probes { probes: settings, prt: kage::prt::PrtParams::DEFAULT },
+        transfer: None,
     };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     renderer.render().unwrap();

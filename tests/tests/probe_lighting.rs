@@ -4,8 +4,9 @@ use glam::{Mat4, Vec3};
 use kage::frame::GpuScene;
 use kage::reference::irradiance::Point;
 use kage::reference::{surface_radiance, IrradianceReference};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{Light, Scene};
+use kage::techniques::description::TechniqueDesc;
 use kage::techniques::probes::{
     is_static, CaptureSettings, CapturedLight, ProbeCapture, ProbePlacement, ProbeSet, ProbeSettings, Walker,
     MOVING_GROUP, RADIANCE_SEED,
@@ -33,7 +34,8 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
     let options = RenderOptions {
         width: 48,
         height: 48,
-        technique: TechniqueChoice::Probes { settings: probes, transfer: None },
+        technique: TechniqueDesc::Probes { probes, prt: kage::prt::PrtParams::DEFAULT },
+        transfer: None,
     };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     // Two frames, the first with the bunny near the green wall: the second frame's walk starts
@@ -60,28 +62,27 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
 fn static_groups_keep_their_own_prt_lighting_beside_the_probe_lit_bunny() {
     use kage::prt::{transfer, PrtParams};
     use kage::techniques::probes::StaticLighting;
-    use kage::techniques::tamura::technique::OcclusionSettings;
     use std::sync::Arc;
     let ctx = Validated::new();
     let scene = Scene::builtin("probe-room").unwrap();
-    let params = PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT };
+    let params = PrtParams { bands: 3, rays: 16, ..kage::prt::PrtParams::DEFAULT };
     let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| {}).unwrap());
     let probes = ProbeSettings {
         placement: ProbePlacement::Grid([2, 2, 2]),
         capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
         ..Default::default()
     };
-    let render = |technique| {
-        let options = RenderOptions { width: 48, height: 48, technique };
+    let render = |technique, transfer| {
+        let options = RenderOptions { width: 48, height: 48, technique, transfer };
         let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
         renderer.render().unwrap();
         renderer.image().unwrap().pixels
     };
     let sloan_statics = ProbeSettings { statics: StaticLighting::Sloan, ..probes.clone() };
-    let combined = render(TechniqueChoice::Probes { settings: sloan_statics, transfer: Some(prt.clone()) });
-    let sloan = OcclusionSettings { regions: 0, ..OcclusionSettings::default() };
-    let pure_sloan = render(TechniqueChoice::Prt { transfer: prt, occlusion: sloan });
-    let unshadowed_statics = render(TechniqueChoice::Probes { settings: probes, transfer: None });
+    let params = prt.params;
+    let combined = render(TechniqueDesc::Probes { probes: sloan_statics, prt: params }, Some(prt.clone()));
+    let pure_sloan = render(TechniqueDesc::SloanSelf { prt: params }, Some(prt));
+    let unshadowed_statics = render(TechniqueDesc::Probes { probes, prt: params }, None);
     let (mut as_sloan, mut as_probes) = (0, 0);
     for (i, p) in combined.iter().enumerate() {
         let (s, u) = (*p == pure_sloan[i], *p == unshadowed_statics[i]);

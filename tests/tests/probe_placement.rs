@@ -2,8 +2,9 @@
 //! captures (8² faces) in the built-in scenes.
 use glam::Vec3;
 use kage::frame::GpuScene;
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
+use kage::techniques::description::TechniqueDesc;
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings, Solids,
 };
@@ -69,7 +70,8 @@ fn trilinear_interpolation_needs_a_grid_and_lights_the_bunny() {
     let options = RenderOptions {
         width: 24,
         height: 24,
-        technique: TechniqueChoice::Probes { settings: probes, transfer: None },
+        technique: TechniqueDesc::Probes { probes, prt: kage::prt::PrtParams::DEFAULT },
+        transfer: None,
     };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     renderer.render().unwrap();

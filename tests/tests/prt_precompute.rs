@@ -1,4 +1,4 @@
-//! PRT precomputation (issue 3): the GPU transfer against closed forms, under rotation, and the
+//! PRT precomputation: the GPU transfer against closed forms, under rotation, and the
 //! cache's detection of every kind of stale file.
 use glam::{DVec3, Quat, Vec3};
 use kage::prt::cache::{self, CacheKey, Stale};

@@ -2,8 +2,9 @@
 //! ray-traced local-light reference, pixel by pixel.
 use glam::Vec3;
 use kage::reference::{shadow_mismatch, LightMode, ReferenceOptions, ReferenceRenderer, SHADOW_THRESHOLD};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, Camera, EnvMap, Group, Light, Scene, Transform};
+use kage::techniques::description::TechniqueDesc;
 use kage_tests::Validated;
 
 const SIZE: u32 = 128;
@@ -42,8 +43,10 @@ fn box_over_floor_lit_from(light: Vec3) -> Scene {
     }
 }
 
-fn render(ctx: &Validated, scene: &Scene, technique: TechniqueChoice) -> kage::imageio::RgbaF32Image {
-    let mut r = Renderer::new(ctx, scene, &RenderOptions { width: SIZE, height: SIZE, technique }).unwrap();
+fn render(ctx: &Validated, scene: &Scene, technique: TechniqueDesc) -> kage::imageio::RgbaF32Image {
+    let mut r =
+        Renderer::new(ctx, scene, &RenderOptions { width: SIZE, height: SIZE, technique, transfer: None })
+            .unwrap();
     r.render().unwrap();
     r.image().unwrap()
 }
@@ -112,7 +115,7 @@ fn shadows_match_the_reference_within_the_texel_bound() {
     assert!(boundary > 100, "the scene should show a shadow edge: {boundary} boundary pixels");
     let mut previous = None;
     for map_size in [32, 512] {
-        let image = render(&ctx, &scene, TechniqueChoice::ShadowMap { size: map_size });
+        let image = render(&ctx, &scene, TechniqueDesc::ShadowMap { size: map_size });
         let m = shadow_mismatch(&image, &truth, SHADOW_THRESHOLD).unwrap();
         let bound = texel_bound(&scene, map_size, boundary);
         eprintln!("map {map_size}: {} pixels misclassified ({:.5}), bound {bound}", m.differing, m.fraction);
@@ -123,7 +126,7 @@ fn shadows_match_the_reference_within_the_texel_bound() {
         previous = Some(m.differing);
     }
     // Lit pixels get the reference's radiance: the same falloff and BRDF.
-    let image = render(&ctx, &scene, TechniqueChoice::ShadowMap { size: 512 });
+    let image = render(&ctx, &scene, TechniqueDesc::ShadowMap { size: 512 });
     for (a, b) in image.pixels.iter().zip(&truth.pixels) {
         if a[1] > 0.0 && b[1] > 0.0 {
             assert!((a[1] - b[1]).abs() <= 1e-3 * b[1].max(1e-3), "{a:?} against {b:?}");
@@ -144,7 +147,12 @@ fn a_moved_light_re_renders_its_shadow() {
     let mut renderer = Renderer::new(
         &ctx,
         &before,
-        &RenderOptions { width: SIZE, height: SIZE, technique: TechniqueChoice::ShadowMap { size: 512 } },
+        &RenderOptions {
+            width: SIZE,
+            height: SIZE,
+            technique: TechniqueDesc::ShadowMap { size: 512 },
+            transfer: None,
+        },
     )
     .unwrap();
     renderer.render().unwrap();
@@ -163,14 +171,14 @@ fn a_moved_light_re_renders_its_shadow() {
     );
     assert!(m.differing <= bound, "{} pixels misclassified, bound {bound}", m.differing);
     assert!(stale.differing > bound, "the light should have moved the shadow: {}", stale.differing);
-    let fresh = render(&ctx, &after, TechniqueChoice::ShadowMap { size: 512 });
+    let fresh = render(&ctx, &after, TechniqueDesc::ShadowMap { size: 512 });
     assert_eq!(shadow_mismatch(&image, &fresh, SHADOW_THRESHOLD).unwrap().differing, 0);
 
     // One D32 map of 512² texels for the one light; a technique without shadow maps has none.
-    assert_eq!(renderer.shadow_memory_bytes(), Some(512 * 512 * 4));
+    assert_eq!(renderer.stats().shadow_memory_bytes, Some(512 * 512 * 4));
     let unshadowed =
         Renderer::new(&ctx, &after, &RenderOptions { width: 16, height: 16, ..Default::default() });
-    assert_eq!(unshadowed.unwrap().shadow_memory_bytes(), None);
+    assert_eq!(unshadowed.unwrap().stats().shadow_memory_bytes, None);
 
     let err = renderer.set_light(1, spot_at(moved)).unwrap_err().to_string();
     assert!(err.contains("light 1 does not exist (the scene has 1)"), "{err}");
@@ -182,7 +190,12 @@ fn a_moved_light_re_renders_its_shadow() {
 fn needs_local_lights_and_a_map_size_in_range() {
     let ctx = Validated::new();
     let attempt = |scene: &Scene, size| {
-        let options = RenderOptions { width: 16, height: 16, technique: TechniqueChoice::ShadowMap { size } };
+        let options = RenderOptions {
+            width: 16,
+            height: 16,
+            technique: TechniqueDesc::ShadowMap { size },
+            transfer: None,
+        };
         match Renderer::new(&ctx, scene, &options) {
             Ok(_) => panic!("accepted"),
             Err(e) => e.to_string(),
@@ -203,8 +216,12 @@ fn needs_local_lights_and_a_map_size_in_range() {
 fn the_asm_walkthrough_renders_cleanly() {
     let ctx = Validated::new();
     let scene = Scene::builtin("asm").unwrap();
-    let options =
-        RenderOptions { width: 48, height: 48, technique: TechniqueChoice::ShadowMap { size: 1024 } };
+    let options = RenderOptions {
+        width: 48,
+        height: 48,
+        technique: TechniqueDesc::ShadowMap { size: 1024 },
+        transfer: None,
+    };
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     for t in [0.0, 0.2] {
         renderer.set_camera(kage::scene::animation::camera_at(&scene.walkthrough, t).unwrap()).unwrap();
@@ -229,11 +246,11 @@ fn the_depth_prepass_leaves_no_pixel_unshaded() {
         let image = render(&ctx, &scene, technique);
         image.pixels.iter().map(|p| p[..3] != [2.0; 3]).collect::<Vec<bool>>()
     };
-    let expected = covered(TechniqueChoice::Unshadowed);
+    let expected = covered(TechniqueDesc::Unshadowed);
     let count = expected.iter().filter(|&&c| c).count();
     assert!(count > expected.len() / 4, "the scene covers {count} pixels");
     let asm = kage::techniques::asm::AsmSettings { budget_mb: 1.0, ..Default::default() };
-    for technique in [TechniqueChoice::ShadowMap { size: 512 }, TechniqueChoice::Asm(asm)] {
+    for technique in [TechniqueDesc::ShadowMap { size: 512 }, TechniqueDesc::Asm(asm)] {
         let name = format!("{technique:?}");
         let got = covered(technique);
         let holes = expected.iter().zip(&got).filter(|(e, g)| **e && !**g).count();

@@ -7,9 +7,10 @@ use kage::frame::GpuScene;
 use kage::layouts::{bytes_of, bytes_of_slice, spirv, BlurPush, OcclusionLayer};
 use kage::pass::{FrameExecutor, Pass};
 use kage::prt::TransferSet;
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::animation::pose;
 use kage::scene::Scene;
+use kage::techniques::description::TechniqueDesc;
 use kage::techniques::tamura::occlusion::{Occlusion, RegionSize};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use kage_tests::Validated;
@@ -19,11 +20,17 @@ fn transfer_of(ctx: &Validated, scene: &Scene) -> Arc<TransferSet> {
     kage_tests::shadow_test_transfer(ctx, scene)
 }
 
-fn prt(transfer: &Arc<TransferSet>, regions: usize) -> TechniqueChoice {
-    TechniqueChoice::Prt {
-        transfer: transfer.clone(),
-        occlusion: OcclusionSettings { regions, ..Default::default() },
-    }
+/// Tamura's technique at q = `regions` with `transfer`, `size`² pixels.
+fn tamura(transfer: &Arc<TransferSet>, regions: usize, size: u32) -> RenderOptions {
+    let occlusion = OcclusionSettings { regions, ..Default::default() };
+    let technique = TechniqueDesc::Tamura { prt: transfer.params, occlusion };
+    RenderOptions { width: size, height: size, technique, transfer: Some(transfer.clone()) }
+}
+
+/// Sloan's technique with `transfer`, `size`² pixels.
+fn sloan(transfer: &Arc<TransferSet>, size: u32) -> RenderOptions {
+    let technique = TechniqueDesc::SloanSelf { prt: transfer.params };
+    RenderOptions { width: size, height: size, technique, transfer: Some(transfer.clone()) }
 }
 
 /// Runs the two 1D passes of the occlusion filter over one `size`² layer of (coverage,
@@ -144,14 +151,15 @@ fn a_group_alone_runs_no_occlusion_pass() {
     let mut scene = Scene::builtin("teapot").unwrap();
     scene.groups.truncate(1);
     let transfer = transfer_of(&ctx, &scene);
-    let mut tamura =
-        Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 32) })
-            .unwrap();
+    // Without dominant lights and with the cosine from the vertices, as Sloan's.
+    let mut options = tamura(&transfer, 32, 48);
+    if let TechniqueDesc::Tamura { occlusion, .. } = &mut options.technique {
+        (occlusion.dominant_lights, occlusion.pixel_cosine) = (0, false);
+    }
+    let mut tamura = Renderer::new(&ctx, &scene, &options).unwrap();
     let names: Vec<&str> = tamura.render().unwrap().iter().map(|t| t.name).collect();
     assert!(!names.iter().any(|n| n.contains("mask") || n.contains("blur")), "{names:?}");
-    let mut sloan =
-        Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 0) })
-            .unwrap();
+    let mut sloan = Renderer::new(&ctx, &scene, &sloan(&transfer, 48)).unwrap();
     sloan.render().unwrap();
     assert!(tamura.image().unwrap().pixels == sloan.image().unwrap().pixels);
 }
@@ -171,11 +179,9 @@ fn layers_beyond_the_budget_are_dropped_and_counted() {
         scene.groups.push(copy);
     }
     let transfer = transfer_of(&ctx, &scene);
-    let mut renderer =
-        Renderer::new(&ctx, &scene, &RenderOptions { width: 48, height: 48, technique: prt(&transfer, 32) })
-            .unwrap();
+    let mut renderer = Renderer::new(&ctx, &scene, &tamura(&transfer, 32, 48)).unwrap();
     renderer.render().unwrap();
-    let dropped = renderer.dropped_layers();
+    let dropped = renderer.stats().dropped_layers;
     println!("{dropped} layers dropped");
     assert!(dropped > 0, "five teapots at q = 32 should exceed the layer budget");
     let image = renderer.image().unwrap();
@@ -197,7 +203,10 @@ fn the_teapot_casts_a_contact_shadow_on_the_floor() {
     let transfer = transfer_of(&ctx, &scene);
     let size = 96;
     let render = |regions| {
-        let options = RenderOptions { width: size, height: size, technique: prt(&transfer, regions) };
+        let options = match regions {
+            0 => sloan(&transfer, size),
+            _ => tamura(&transfer, regions, size),
+        };
         let mut r = Renderer::new(&ctx, &scene, &options).unwrap();
         r.render().unwrap();
         r.image().unwrap()

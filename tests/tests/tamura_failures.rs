@@ -1,5 +1,4 @@
-//! Where the Tamura–Johan–Nishita method is known to fail (issue 4, "Where the method is known to
-//! fail"): one test per failure mode, each checking documented, physical behaviour against the
+//! Where the Tamura–Johan–Nishita method is known to fail: one test per failure mode, each checking documented, physical behaviour against the
 //! Monte Carlo reference or an analytic expectation. The sixth mode, a group alone, is tested in
 //! tests/tamura.rs (`a_group_alone_runs_no_occlusion_pass`).
 //!
@@ -13,9 +12,10 @@ use kage::prt::TransferSet;
 use kage::raycast::closest_hit_brute_force;
 use kage::reference::irradiance::Point;
 use kage::reference::{compare, IrradianceReference, LightMode, ReferenceOptions, ReferenceRenderer};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::animation::pose;
 use kage::scene::{shapes, EnvMap, Group, Scene, Transform};
+use kage::techniques::description::TechniqueDesc;
 use kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use kage::techniques::tamura::technique::OcclusionSettings;
 use kage_tests::Validated;
@@ -39,12 +39,16 @@ fn render_with(
     size: u32,
     setup: impl FnOnce(&mut Renderer),
 ) -> RgbaF32Image {
-    let technique = TechniqueChoice::Prt {
-        transfer: transfer.clone(),
-        occlusion: OcclusionSettings { regions, ..Default::default() },
+    // q = 0: Sloan's technique, the same PRT without shadows between groups.
+    let technique = match regions {
+        0 => TechniqueDesc::SloanSelf { prt: transfer.params },
+        _ => TechniqueDesc::Tamura {
+            prt: transfer.params,
+            occlusion: OcclusionSettings { regions, ..Default::default() },
+        },
     };
-    let mut renderer =
-        Renderer::new(ctx, scene, &RenderOptions { width: size, height: size, technique }).unwrap();
+    let options = RenderOptions { width: size, height: size, technique, transfer: Some(transfer.clone()) };
+    let mut renderer = Renderer::new(ctx, scene, &options).unwrap();
     setup(&mut renderer);
     renderer.render().unwrap();
     let image = renderer.image().unwrap();
@@ -289,9 +293,10 @@ fn a_tiny_bright_sun_holds_against_parallel_lights() {
     let tamura = render(&ctx, &scene, &t, REGIONS, size);
     let sloan = render(&ctx, &scene, &t, 0, size);
     let technique =
-        TechniqueChoice::ParallelLights { regions: REGIONS, shadow_map_size: DEFAULT_SHADOW_MAP_SIZE };
+        TechniqueDesc::ParallelLights { regions: REGIONS, shadow_map_size: DEFAULT_SHADOW_MAP_SIZE };
     let mut renderer =
-        Renderer::new(&ctx, &scene, &RenderOptions { width: size, height: size, technique }).unwrap();
+        Renderer::new(&ctx, &scene, &RenderOptions { width: size, height: size, technique, transfer: None })
+            .unwrap();
     renderer.render().unwrap();
     let parallel = renderer.image().unwrap();
     let (reference, noise) = reference(&ctx, &scene, size, 4096);

@@ -11,11 +11,11 @@ use glam::Vec4Swizzles;
 use kage::imageio::RgbaF32Image;
 use kage::raycast::closest_hit_brute_force;
 use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
 use kage::sh::{equirect_direction, equirect_texel_solid_angle};
-use kage::techniques::description::{TechniqueKind, TechniqueSettings};
+use kage::techniques::description::{TechniqueDesc, TechniqueKind};
 use kage_tests::Validated;
 use std::path::Path;
 use std::sync::Arc;
@@ -53,15 +53,17 @@ fn floor_irradiance(map: &EnvMap, above: f32) -> (f64, f64) {
 
 /// Tamura's default on the teapot scene, its transfer precomputed once (it depends on neither
 /// the map nor the pose); few rays, since these tests look at shadows between groups.
-struct Tamura(TechniqueChoice);
+struct Tamura(RenderOptions);
 
 impl Tamura {
     fn new(ctx: &Arc<kage::backend::Context>) -> Tamura {
         let scene = Scene::builtin("teapot").unwrap();
         let transfer = kage_tests::shadow_test_transfer(ctx, &scene);
-        let settings =
-            TechniqueSettings { kind: TechniqueKind::Tamura, prt: transfer.params, ..Default::default() };
-        Tamura(settings.choice(Some(transfer)).unwrap())
+        let TechniqueDesc::Tamura { occlusion, .. } = TechniqueDesc::new(TechniqueKind::Tamura) else {
+            unreachable!("a Tamura desc")
+        };
+        let technique = TechniqueDesc::Tamura { prt: transfer.params, occlusion };
+        Tamura(RenderOptions { width: SIZE, height: SIZE, technique, transfer: Some(transfer) })
     }
 }
 
@@ -134,7 +136,7 @@ impl Case {
         reference.run_batch(SPP).unwrap();
         let reference = reference.statistics().unwrap().mean.iter().map(|p| luminance(*p)).collect();
 
-        let options = RenderOptions { width: SIZE, height: SIZE, technique: tamura.0.clone() };
+        let options = tamura.0.clone();
         let mut renderer = Renderer::new(ctx, &scene, &options).unwrap();
         renderer.render().unwrap();
         let image: RgbaF32Image = renderer.image().unwrap();

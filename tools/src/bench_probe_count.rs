@@ -1,7 +1,6 @@
 //! `kage bench probe-count`: the error of probe-interpolated irradiance against the ray-cast
 //! ground truth, as the probe count grows, for a regular grid with trilinear interpolation and
-//! for automatic placement with tetrahedral interpolation (Morishige 2014; issue 6, "Error
-//! against probe count").
+//! for automatic placement with tetrahedral interpolation (Morishige 2014).
 //!
 //! Test points: random points in the moving group's bounding box at random times of its
 //! scripted motion (`--animate`), those inside a solid dropped, each with random normals.
@@ -77,8 +76,8 @@ pub struct ProbeCountArgs {
     /// The light the probes capture: `sky` is what the reference integrates today (the
     /// environment with visibility, no bounce); rerun with the reference's transport when it
     /// changes.
-    #[arg(long, value_enum, default_value_t = crate::render::ProbeLightName::Sky)]
-    probe_light: crate::render::ProbeLightName,
+    #[arg(long, value_enum, default_value_t = kage::techniques::probes::CapturedLight::Sky)]
+    probe_light: kage::techniques::probes::CapturedLight,
     /// The relative error a method must reach; default: each grid level's own error.
     #[arg(long)]
     target: Option<f64>,
@@ -165,11 +164,7 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         points: args.points,
         normals: args.normals,
         spp: args.spp,
-        capture: CaptureSettings {
-            cube_size: args.cube_size,
-            light: args.probe_light.captured(),
-            ..Default::default()
-        },
+        capture: CaptureSettings { cube_size: args.cube_size, light: args.probe_light, ..Default::default() },
         cache: Some(&args.cache),
     };
     println!(

@@ -17,24 +17,14 @@ pub struct PrecomputeArgs {
     prt: PrtArgs,
     /// Whose shadows the transfer holds: `group` (each group's own: sloan-self, tamura) or
     /// `scene` (the whole scene at rest: sloan-scene).
-    #[arg(long, value_enum, default_value_t = VisibilityName::Group)]
-    visibility: VisibilityName,
+    #[arg(long, value_enum, default_value_t = Visibility::Group)]
+    visibility: Visibility,
     #[command(flatten)]
     gpu: GpuArgs,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-enum VisibilityName {
-    Group,
-    Scene,
-}
-
 pub fn run(args: &PrecomputeArgs) -> Result<()> {
-    let visibility = match args.visibility {
-        VisibilityName::Group => Visibility::Group,
-        VisibilityName::Scene => Visibility::Scene,
-    };
-    let params = PrtParams { visibility, ..args.prt.params()? };
+    let params = PrtParams { visibility: args.visibility, ..args.prt.params()? };
     let scene = Scene::from_arg(&args.scene)?;
     println!(
         "scene {}: {} groups, {} meshes, {} vertices; {} SH bands ({} coefficients per vertex), \

@@ -39,8 +39,8 @@ pub struct PlaceArgs {
     #[arg(long, default_value_t = 32)]
     probe_cube_size: u32,
     /// What the probes capture besides the sky they see.
-    #[arg(long, value_enum, default_value_t = crate::render::ProbeLightName::SkyAndWalls)]
-    probe_light: crate::render::ProbeLightName,
+    #[arg(long, value_enum, default_value_t = kage::techniques::probes::CapturedLight::SkyAndWalls)]
+    probe_light: kage::techniques::probes::CapturedLight,
     /// Where to write {"positions": [[x,y,z], ...]}.
     #[arg(long)]
     out: PathBuf,
@@ -100,7 +100,7 @@ fn place(args: &PlaceArgs) -> Result<()> {
         placement,
         capture: CaptureSettings {
             cube_size: args.probe_cube_size,
-            light: args.probe_light.captured(),
+            light: args.probe_light,
             ..Default::default()
         },
         ..Default::default()

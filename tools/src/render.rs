@@ -9,7 +9,7 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::AsmSettings;
-use kage::techniques::description::{TechniqueKind, TechniqueSettings};
+use kage::techniques::description::{TechniqueDesc, TechniqueKind};
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
     DEFAULT_TOLERANCE,
@@ -18,90 +18,17 @@ use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The lighting techniques `kage render` offers (one per [`TechniqueKind`]).
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TechniqueName {
-    /// SH irradiance, no shadows.
-    Unshadowed,
-    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only.
-    SloanSelf,
-    /// Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT whose
-    /// visibility is the whole scene at rest (shadows between groups baked into the vertices).
-    SloanScene,
-    /// Tamura, Johan, Nishita: PRT plus per-pixel shadows between groups from q regions, the
-    /// map's few brightest small lights (sun, lamps) lit per pixel with soft shadows.
-    Tamura,
-    /// Tamura, Johan, Nishita as the paper has it: q regions, the fixed penumbra from each
-    /// region's solid angle, no dominant lights.
-    TamuraPaper,
-    /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
-    ParallelLights,
-    /// The scene's point and spot lights, one conventional shadow map each (hard shadows).
-    Shadowmap,
-    /// Morishige 2014: light probes captured as SH light the moving group (the first).
-    Probes,
-    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light.
-    Asm,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ProbeLightName {
-    /// The sky where the probe sees it, and the static groups as the ray caster lights them
-    /// (environment and local lights with shadows, --probe-bounces).
-    SkyAndWalls,
-    /// The sky where the probe sees it; the static groups only occlude.
-    Sky,
-}
-
-impl ProbeLightName {
-    pub fn captured(self) -> CapturedLight {
-        match self {
-            ProbeLightName::SkyAndWalls => CapturedLight::SkyAndWalls,
-            ProbeLightName::Sky => CapturedLight::Sky,
-        }
-    }
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ProbeInterpolationName {
-    /// Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
-    Tetrahedral,
-    /// Trilinear weights of the grid cell holding the point (a `grid:` placement only).
-    Trilinear,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StaticLightingName {
-    /// The environment's SH irradiance, unshadowed.
-    Unshadowed,
-    /// Sloan's PRT, self-shadowed among the static groups (precomputed and cached as for
-    /// `--technique sloan`).
-    Sloan,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AsmTestName {
-    Id,
-    Bias,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PenumbraName {
-    Fixed,
-    Adaptive,
-}
-
 #[derive(Args)]
 pub struct RenderArgs {
-    #[arg(long, value_enum, default_value_t = TechniqueName::Unshadowed)]
-    technique: TechniqueName,
+    #[arg(long, value_enum, default_value_t = TechniqueKind::Unshadowed)]
+    technique: TechniqueKind,
     /// Environment regions q of the Tamura technique (1 to 64) or of parallel-lights (1 to 128).
     #[arg(long, default_value_t = OcclusionSettings::default().regions)]
     regions: usize,
     /// Penumbra of the Tamura shadows: `fixed` (the paper's box width per group pair) or
     /// `adaptive` (a width per pixel from its distance to the occluder).
-    #[arg(long, value_enum, default_value_t = PenumbraName::Fixed)]
-    penumbra: PenumbraName,
+    #[arg(long, value_enum, default_value_t = Penumbra::Fixed)]
+    penumbra: Penumbra,
     /// Side of a Tamura occlusion mask layer, texels.
     #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
     mask_size: u32,
@@ -124,8 +51,8 @@ pub struct RenderArgs {
     asm_time_ms: f64,
     /// Adaptive shadow maps: the shadow test, `id` (the paper's polygon IDs, depth with bias
     /// as fallback; pages take twice the bytes) or `bias` (depth with slope-scaled bias).
-    #[arg(long, value_enum, default_value_t = AsmTestName::Bias)]
-    asm_test: AsmTestName,
+    #[arg(long, value_enum, default_value_t = AsmTest::Bias)]
+    asm_test: AsmTest,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`), a file
     /// {"positions": [[x,y,z], ...]}, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
@@ -134,17 +61,17 @@ pub struct RenderArgs {
     #[arg(long, default_value = "grid:3,2,3")]
     probes: String,
     /// How the light between probes is found: `trilinear` needs a `grid:` placement.
-    #[arg(long, value_enum, default_value_t = ProbeInterpolationName::Tetrahedral)]
-    probe_interpolation: ProbeInterpolationName,
+    #[arg(long, value_enum, default_value_t = ProbeInterpolation::Tetrahedral)]
+    probe_interpolation: ProbeInterpolation,
     /// How the probes technique lights the static groups beside the probe-lit moving group.
-    #[arg(long, value_enum, default_value_t = StaticLightingName::Unshadowed)]
-    probe_statics: StaticLightingName,
+    #[arg(long, value_enum, default_value_t = StaticLighting::Unshadowed)]
+    probe_statics: StaticLighting,
     /// Texels per side of a probe's cube-map face, 8 to 256.
     #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_CUBE_SIZE)]
     probe_cube_size: u32,
     /// What the probes capture besides the sky they see.
-    #[arg(long, value_enum, default_value_t = ProbeLightName::SkyAndWalls)]
-    probe_light: ProbeLightName,
+    #[arg(long, value_enum, default_value_t = CapturedLight::SkyAndWalls)]
+    probe_light: CapturedLight,
     /// Reflections of the walls' light the probes capture: 1 (walls lit directly) or 2 (and
     /// by each other once).
     #[arg(long, default_value_t = kage::reference::MAX_BOUNCES)]
@@ -195,6 +122,55 @@ struct TimingsFile {
     frame_median_ms: f64,
 }
 
+/// The command line's technique options as the engine's description (each technique reads its
+/// own options; the others are ignored).
+fn technique(args: &RenderArgs, scene: &Scene) -> Result<TechniqueDesc> {
+    let prt = args.prt.params()?;
+    let regions = args.regions;
+    let desc = match args.technique {
+        TechniqueKind::Unshadowed => TechniqueDesc::Unshadowed,
+        TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt },
+        TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt },
+        TechniqueKind::Tamura => TechniqueDesc::Tamura {
+            prt,
+            occlusion: OcclusionSettings {
+                regions,
+                mask_size: args.mask_size,
+                penumbra: args.penumbra,
+                dominant_lights: args.dominant_lights,
+                light_map_size: args.light_map_size,
+                ..OcclusionSettings::default()
+            },
+        },
+        TechniqueKind::TamuraPaper => TechniqueDesc::TamuraPaper { prt, regions, mask_size: args.mask_size },
+        TechniqueKind::ParallelLights => {
+            TechniqueDesc::ParallelLights { regions, shadow_map_size: args.shadow_map_size }
+        }
+        TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: args.shadow_map_size },
+        TechniqueKind::Probes => TechniqueDesc::Probes {
+            probes: ProbeSettings {
+                placement: probe_placement(&args.probes, scene)?,
+                capture: CaptureSettings {
+                    cube_size: args.probe_cube_size,
+                    light: args.probe_light,
+                    bounces: args.probe_bounces,
+                    samples: args.probe_samples,
+                    dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
+                },
+                interpolation: args.probe_interpolation,
+                statics: args.probe_statics,
+            },
+            prt,
+        },
+        TechniqueKind::Asm => TechniqueDesc::Asm(AsmSettings {
+            budget_mb: args.asm_budget_mb,
+            time_ms: args.asm_time_ms,
+            test: args.asm_test,
+        }),
+    };
+    Ok(desc.validated()?)
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     if args.frames == 0 {
         anyhow::bail!("--frames must be at least 1");
@@ -209,57 +185,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let scene = args.scene.load()?;
     let ctx = args.gpu.context()?;
-    let settings = TechniqueSettings {
-        kind: match args.technique {
-            TechniqueName::Unshadowed => TechniqueKind::Unshadowed,
-            TechniqueName::SloanSelf => TechniqueKind::SloanSelf,
-            TechniqueName::SloanScene => TechniqueKind::SloanScene,
-            TechniqueName::Tamura => TechniqueKind::Tamura,
-            TechniqueName::TamuraPaper => TechniqueKind::TamuraPaper,
-            TechniqueName::ParallelLights => TechniqueKind::ParallelLights,
-            TechniqueName::Probes => TechniqueKind::Probes,
-            TechniqueName::Shadowmap => TechniqueKind::ShadowMap,
-            TechniqueName::Asm => TechniqueKind::Asm,
-        },
-        prt: args.prt.params()?,
-        regions: args.regions,
-        mask_size: args.mask_size,
-        dominant_lights: args.dominant_lights,
-        light_map_size: args.light_map_size,
-        penumbra: match args.penumbra {
-            PenumbraName::Fixed => Penumbra::Fixed,
-            PenumbraName::Adaptive => Penumbra::Adaptive,
-        },
-        shadow_map_size: args.shadow_map_size,
-        probes: ProbeSettings {
-            placement: probe_placement(&args.probes, &scene)?,
-            capture: CaptureSettings {
-                cube_size: args.probe_cube_size,
-                light: args.probe_light.captured(),
-                bounces: args.probe_bounces,
-                samples: args.probe_samples,
-                dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
-            },
-            interpolation: match args.probe_interpolation {
-                ProbeInterpolationName::Tetrahedral => ProbeInterpolation::Tetrahedral,
-                ProbeInterpolationName::Trilinear => ProbeInterpolation::Trilinear,
-            },
-            statics: match args.probe_statics {
-                StaticLightingName::Unshadowed => StaticLighting::Unshadowed,
-                StaticLightingName::Sloan => StaticLighting::Sloan,
-            },
-        },
-        asm: AsmSettings {
-            budget_mb: args.asm_budget_mb,
-            time_ms: args.asm_time_ms,
-            test: match args.asm_test {
-                AsmTestName::Id => AsmTest::Id,
-                AsmTestName::Bias => AsmTest::Bias,
-            },
-        },
-    }
-    .validated()?;
-    let transfer = match settings.precomputation() {
+    let technique = technique(args, &scene)?;
+    let transfer = match technique.precomputation() {
         None => None,
         Some(params) => {
             let (transfer, origin) = args.prt.obtain(&ctx, &scene, params)?;
@@ -272,12 +199,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             Some(std::sync::Arc::new(transfer))
         }
     };
-    let technique = settings.choice(transfer)?;
     let setup = Instant::now();
-    let mut renderer =
-        Renderer::new(&ctx, &scene, &RenderOptions { width: args.width, height: args.height, technique })
-            .context("setting up the renderer")?;
-    if let Some(counts) = renderer.probe_counts() {
+    let options = RenderOptions { width: args.width, height: args.height, technique, transfer };
+    let mut renderer = Renderer::new(&ctx, &scene, &options).context("setting up the renderer")?;
+    if let Some(counts) = renderer.stats().probes {
         let seconds = setup.elapsed().as_secs_f64();
         let left_out = match counts.inside_geometry {
             0 => String::new(),
@@ -308,7 +233,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             renderer.set_group_transform(0, animation::pose(group, t).matrix())?;
         }
         table.add_frame(&renderer.render()?);
-        dropped = dropped.max(renderer.dropped_layers());
+        dropped = dropped.max(renderer.stats().dropped_layers);
         bar.inc(1);
         if start.elapsed().as_secs_f32() < 1.0 {
             bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -317,7 +242,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     bar.finish_and_clear();
-    if let Some(stats) = renderer.asm_stats() {
+    if let Some(stats) = renderer.stats().asm {
         println!(
             "asm: {} tiles resident, {:.2} of {:.2} MB, deepest level {}, {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",
             stats.resident_tiles,

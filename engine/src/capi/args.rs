@@ -87,15 +87,9 @@ pub(crate) unsafe fn text<'a>(ptr: *const c_char, name: &str) -> Result<&'a str,
     c.to_str().map_err(|_| Failure::invalid(format!("{name} is not UTF-8")))
 }
 
-/// An enumeration passed as `uint32_t`.
-pub(crate) fn enumeration<T>(value: u32, name: &str, known: &[(u32, T)]) -> Result<T, Failure>
-where
-    T: Copy,
-{
-    known
-        .iter()
-        .find(|(v, _)| *v == value)
-        .map(|(_, t)| *t)
+/// An enumeration passed as `uint32_t`, read by the enum's `from_repr`.
+pub(crate) fn enumeration<T>(value: u32, name: &str, from_repr: fn(u32) -> Option<T>) -> Result<T, Failure> {
+    from_repr(value)
         .ok_or_else(|| Failure::invalid(format!("{name} {value} is not one of the values kage.h defines")))
 }
 

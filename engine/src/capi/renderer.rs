@@ -29,7 +29,7 @@ pub struct kage_renderer_desc {
 
 /// Pixel formats of `kage_renderer_read_pixels`.
 #[repr(u32)]
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, strum::FromRepr)]
 pub enum kage_pixel_format {
     /// 4 bytes per pixel: radiance × exposure, tonemapped (ACES fit), sRGB-encoded; alpha 255.
     Rgba8Srgb = 0,
@@ -75,8 +75,13 @@ pub unsafe extern "C" fn kage_renderer_create(
             (handles::get(context, "context")?, handles::get(scene, "scene")?, args::value(desc, "desc")?)
         };
         // SAFETY: the caller promises a valid desc, its probe positions included.
-        let technique = unsafe { desc.technique.settings() }?.choice(scene.transfer.clone())?;
-        let options = RenderOptions { width: desc.width, height: desc.height, technique };
+        let technique = unsafe { desc.technique.desc() }?;
+        let options = RenderOptions {
+            width: desc.width,
+            height: desc.height,
+            technique,
+            transfer: scene.transfer.clone(),
+        };
         let made = Renderer::new(&context.ctx, &scene.scene, &options);
         kage_context::check_validation(&context.ctx)?;
         let made = kage_renderer { renderer: made?, ctx: context.ctx.clone(), timings: None };
@@ -191,10 +196,11 @@ pub unsafe extern "C" fn kage_renderer_get_stats(
         // SAFETY: the host does not destroy the handle during the call; stats NULL or writable.
         let (r, stats) = unsafe { (handles::get(renderer, "renderer")?, args::out(stats, "stats")?) };
         let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
-        let probes = r.renderer.probe_counts();
+        let technique = r.renderer.stats();
+        let probes = technique.probes;
         *stats = kage_renderer_stats {
             gpu_bytes: r.ctx.allocated_bytes(),
-            dropped_layers: count(r.renderer.dropped_layers()),
+            dropped_layers: count(technique.dropped_layers),
             probes: probes.map_or(0, |p| count(p.kept)),
             probe_candidates: probes.map_or(0, |p| count(p.candidates)),
             probes_inside_geometry: probes.map_or(0, |p| count(p.inside_geometry)),
@@ -240,14 +246,7 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
     boundary(|| {
         // SAFETY: the host does not destroy the handle during the call.
         let r = unsafe { handles::get(renderer, "renderer") }?;
-        let format = args::enumeration(
-            format,
-            "format",
-            &[
-                (kage_pixel_format::Rgba8Srgb as u32, kage_pixel_format::Rgba8Srgb),
-                (kage_pixel_format::Rgba32fLinear as u32, kage_pixel_format::Rgba32fLinear),
-            ],
-        )?;
+        let format = args::enumeration(format, "format", kage_pixel_format::from_repr)?;
         if pixels.is_null() {
             return Err(Failure::new(kage_result::NullArgument, "pixels is NULL"));
         }

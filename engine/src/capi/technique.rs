@@ -7,85 +7,19 @@ use super::scene::kage_scene;
 use crate::prt::{transfer, PrtParams};
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
-use crate::techniques::description::{TechniqueKind, TechniqueSettings};
+use crate::techniques::description::{TechniqueDesc, TechniqueKind};
+use crate::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use crate::techniques::probes::{
     CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
     StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
-use crate::techniques::tamura::technique::Penumbra;
+use crate::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use glam::DVec3;
 use std::sync::Arc;
 
-/// The lighting techniques (the values of `kage_technique_desc.technique`).
-#[repr(u32)]
-#[derive(Clone, Copy)]
-pub enum kage_technique {
-    /// SH irradiance, no shadows.
-    Unshadowed = 0,
-    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs
-    /// `kage_precompute`.
-    SloanSelf = 1,
-    /// Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from `regions`
-    /// environment regions, the `dominant_lights` brightest small lights of the map (a sun,
-    /// lamps) taken out and lit per pixel with soft shadows. Needs `kage_precompute`.
-    Tamura = 2,
-    /// Baseline: `regions` environment regions as directional lights with binary shadow maps.
-    ParallelLights = 3,
-    /// Morishige 2014: light probes (`probe_placement`), captured as SH when the renderer is
-    /// created, light the scene's first group (the moving one); the other groups are lit as
-    /// `probe_statics` says.
-    Probes = 4,
-    /// The scene's point and spot lights with hard shadows from one conventional shadow map of
-    /// `shadow_map_size`² texels per light (1 to 8 lights).
-    ShadowMap = 5,
-    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light:
-    /// a quadtree of tiles in a page pool of `asm_budget_mb`, refined where the eye sees shadow
-    /// edges coarser than its pixels, `asm_time_ms` of tile rendering per frame.
-    Asm = 6,
-    /// Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT with the whole
-    /// scene's visibility at its pose when `kage_precompute` ran (shadows between groups baked
-    /// into the vertices; they stay where they were when groups move). Needs `kage_precompute`.
-    SloanScene = 7,
-    /// Tamura, Johan, Nishita as the paper has it: `regions` regions, the fixed penumbra from
-    /// each region's solid angle, no dominant lights (`penumbra` and `dominant_lights` are not
-    /// read). Needs `kage_precompute`.
-    TamuraPaper = 8,
-}
-
-/// What the light probes capture (the values of `kage_technique_desc.probe_light`).
-#[repr(u32)]
-#[derive(Clone, Copy)]
-pub enum kage_probe_light {
-    /// The environment where the probe sees it, plus the static groups as Kage's ray caster
-    /// lights them (environment and local lights with shadows, one bounce between them).
-    SkyAndWalls = 0,
-    /// The environment where the probe sees it; the static groups only occlude it.
-    Sky = 1,
-}
-
-/// The shadow test of adaptive shadow maps (the values of `kage_technique_desc.asm_test`).
-#[repr(u32)]
-#[derive(Clone, Copy)]
-pub enum kage_asm_test {
-    /// The depth comparison with a slope-scaled bias.
-    Bias = 0,
-    /// The paper's polygon-ID comparison, depth with bias as fallback.
-    Id = 1,
-}
-
-/// Width of Tamura's penumbrae (the values of `kage_technique_desc.penumbra`).
-#[repr(u32)]
-#[derive(Clone, Copy)]
-pub enum kage_penumbra {
-    /// The paper's: one filter width per group pair and region.
-    Fixed = 0,
-    /// A width per pixel from its distance to the occluder.
-    Adaptive = 1,
-}
-
 /// Where the light probes go (the values of `kage_technique_desc.probe_placement`).
 #[repr(u32)]
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, strum::FromRepr)]
 pub enum kage_probe_placement {
     /// `probe_grid` probes at the cell centres of that grid over the static groups' bounding box.
     Grid = 0,
@@ -99,19 +33,9 @@ pub enum kage_probe_placement {
     Positions = 2,
 }
 
-/// How the light between probes is found (the values of `kage_technique_desc.probe_interpolation`).
-#[repr(u32)]
-#[derive(Clone, Copy)]
-pub enum kage_probe_interpolation {
-    /// Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
-    Tetrahedral = 0,
-    /// Trilinear weights of the grid cell holding the point: `KAGE_PROBE_PLACEMENT_GRID` only.
-    Trilinear = 1,
-}
-
 /// The window on each probe's SH against ringing (the values of `kage_technique_desc.probe_dering`).
 #[repr(u32)]
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, strum::FromRepr)]
 pub enum kage_probe_dering {
     /// The SH as captured; the shading clamps negative irradiance at 0.
     Off = 0,
@@ -121,17 +45,6 @@ pub enum kage_probe_dering {
     Hanning = 2,
     /// Lanczos window of width `probe_dering_width` bands (Sloan 2008).
     Lanczos = 3,
-}
-
-/// How the probes technique lights the static groups (the values of
-/// `kage_technique_desc.probe_statics`).
-#[repr(u32)]
-#[derive(Clone, Copy)]
-pub enum kage_static_lighting {
-    /// The environment's SH irradiance, unshadowed.
-    Unshadowed = 0,
-    /// Sloan's PRT, self-shadowed among the static groups.
-    Sloan = 1,
 }
 
 /// A technique and all its parameters; each technique reads the fields it uses and ignores the
@@ -204,55 +117,58 @@ pub struct kage_technique_desc {
 }
 
 impl kage_technique_desc {
+    /// The technique this desc names, with the fields it reads (the others are ignored),
+    /// checked.
+    ///
     /// # Safety
     /// With `KAGE_PROBE_PLACEMENT_POSITIONS`, `probe_positions` must be NULL or readable for
     /// `probe_position_count` × 3 floats.
-    pub(crate) unsafe fn settings(&self) -> Result<TechniqueSettings, Failure> {
-        use kage_technique as T;
-        let kind = args::enumeration(
-            self.technique,
-            "technique",
-            &[
-                (T::Unshadowed as u32, TechniqueKind::Unshadowed),
-                (T::SloanSelf as u32, TechniqueKind::SloanSelf),
-                (T::SloanScene as u32, TechniqueKind::SloanScene),
-                (T::Tamura as u32, TechniqueKind::Tamura),
-                (T::TamuraPaper as u32, TechniqueKind::TamuraPaper),
-                (T::ParallelLights as u32, TechniqueKind::ParallelLights),
-                (T::ShadowMap as u32, TechniqueKind::ShadowMap),
-                (T::Probes as u32, TechniqueKind::Probes),
-                (T::Asm as u32, TechniqueKind::Asm),
-            ],
-        )?;
-        let probe_light = args::enumeration(
-            self.probe_light,
-            "probe_light",
-            &[
-                (kage_probe_light::SkyAndWalls as u32, CapturedLight::SkyAndWalls),
-                (kage_probe_light::Sky as u32, CapturedLight::Sky),
-            ],
-        )?;
-        let asm_test = args::enumeration(
-            self.asm_test,
-            "asm_test",
-            &[(kage_asm_test::Bias as u32, AsmTest::Bias), (kage_asm_test::Id as u32, AsmTest::Id)],
-        )?;
-        let penumbra = args::enumeration(
-            self.penumbra,
-            "penumbra",
-            &[
-                (kage_penumbra::Fixed as u32, Penumbra::Fixed),
-                (kage_penumbra::Adaptive as u32, Penumbra::Adaptive),
-            ],
-        )?;
+    pub(crate) unsafe fn desc(&self) -> Result<TechniqueDesc, Failure> {
+        let kind = args::enumeration(self.technique, "technique", TechniqueKind::from_repr)?;
+        let prt = PrtParams { bands: self.sh_bands, rays: self.prt_rays, ..PrtParams::DEFAULT };
+        let regions = self.regions as usize;
+        let desc = match kind {
+            TechniqueKind::Unshadowed => TechniqueDesc::Unshadowed,
+            TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt },
+            TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt },
+            TechniqueKind::Tamura => TechniqueDesc::Tamura {
+                prt,
+                occlusion: OcclusionSettings {
+                    regions,
+                    mask_size: self.mask_size,
+                    penumbra: args::enumeration(self.penumbra, "penumbra", Penumbra::from_repr)?,
+                    dominant_lights: self.dominant_lights as usize,
+                    light_map_size: self.light_map_size,
+                    ..OcclusionSettings::default()
+                },
+            },
+            TechniqueKind::TamuraPaper => {
+                TechniqueDesc::TamuraPaper { prt, regions, mask_size: self.mask_size }
+            }
+            TechniqueKind::ParallelLights => {
+                TechniqueDesc::ParallelLights { regions, shadow_map_size: self.shadow_map_size }
+            }
+            TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: self.shadow_map_size },
+            // SAFETY: the caller's promise about the probe positions.
+            TechniqueKind::Probes => TechniqueDesc::Probes { probes: unsafe { self.probes() }?, prt },
+            TechniqueKind::Asm => TechniqueDesc::Asm(AsmSettings {
+                budget_mb: self.asm_budget_mb,
+                time_ms: self.asm_time_ms,
+                test: args::enumeration(self.asm_test, "asm_test", AsmTest::from_repr)?,
+            }),
+        };
+        Ok(desc.validated()?)
+    }
+
+    /// The probe fields.
+    ///
+    /// # Safety
+    /// As [`Self::desc`].
+    unsafe fn probes(&self) -> Result<ProbeSettings, Failure> {
         let placement = match args::enumeration(
             self.probe_placement,
             "probe_placement",
-            &[
-                (kage_probe_placement::Grid as u32, kage_probe_placement::Grid),
-                (kage_probe_placement::Auto as u32, kage_probe_placement::Auto),
-                (kage_probe_placement::Positions as u32, kage_probe_placement::Positions),
-            ],
+            kage_probe_placement::from_repr,
         )? {
             kage_probe_placement::Grid => ProbePlacement::Grid(self.probe_grid),
             kage_probe_placement::Auto => ProbePlacement::Auto {
@@ -266,56 +182,30 @@ impl kage_technique_desc {
                 ProbePlacement::Positions(points.iter().map(|&p| DVec3::from(p.map(f64::from))).collect())
             }
         };
-        let interpolation = args::enumeration(
-            self.probe_interpolation,
-            "probe_interpolation",
-            &[
-                (kage_probe_interpolation::Tetrahedral as u32, ProbeInterpolation::Tetrahedral),
-                (kage_probe_interpolation::Trilinear as u32, ProbeInterpolation::Trilinear),
-            ],
-        )?;
         let width = self.probe_dering_width;
-        let dering = args::enumeration(
-            self.probe_dering,
-            "probe_dering",
-            &[
-                (kage_probe_dering::Off as u32, Dering::Off),
-                (kage_probe_dering::NonNegative as u32, Dering::NonNegative),
-                (kage_probe_dering::Hanning as u32, Dering::Hanning(width)),
-                (kage_probe_dering::Lanczos as u32, Dering::Lanczos(width)),
-            ],
-        )?;
-        Ok(TechniqueSettings {
-            kind,
-            prt: PrtParams { bands: self.sh_bands, rays: self.prt_rays, ..PrtParams::DEFAULT },
-            regions: self.regions as usize,
-            mask_size: self.mask_size,
-            penumbra,
-            dominant_lights: self.dominant_lights as usize,
-            light_map_size: self.light_map_size,
-            shadow_map_size: self.shadow_map_size,
-            probes: ProbeSettings {
-                placement,
-                capture: CaptureSettings {
-                    cube_size: self.probe_cube_size,
-                    light: probe_light,
-                    bounces: self.probe_bounces,
-                    samples: self.probe_samples,
-                    dering,
-                },
-                interpolation,
-                statics: args::enumeration(
-                    self.probe_statics,
-                    "probe_statics",
-                    &[
-                        (kage_static_lighting::Unshadowed as u32, StaticLighting::Unshadowed),
-                        (kage_static_lighting::Sloan as u32, StaticLighting::Sloan),
-                    ],
-                )?,
+        let dering = match args::enumeration(self.probe_dering, "probe_dering", kage_probe_dering::from_repr)?
+        {
+            kage_probe_dering::Off => Dering::Off,
+            kage_probe_dering::NonNegative => Dering::NonNegative,
+            kage_probe_dering::Hanning => Dering::Hanning(width),
+            kage_probe_dering::Lanczos => Dering::Lanczos(width),
+        };
+        Ok(ProbeSettings {
+            placement,
+            capture: CaptureSettings {
+                cube_size: self.probe_cube_size,
+                light: args::enumeration(self.probe_light, "probe_light", CapturedLight::from_repr)?,
+                bounces: self.probe_bounces,
+                samples: self.probe_samples,
+                dering,
             },
-            asm: AsmSettings { budget_mb: self.asm_budget_mb, time_ms: self.asm_time_ms, test: asm_test },
-        }
-        .validated()?)
+            interpolation: args::enumeration(
+                self.probe_interpolation,
+                "probe_interpolation",
+                ProbeInterpolation::from_repr,
+            )?,
+            statics: args::enumeration(self.probe_statics, "probe_statics", StaticLighting::from_repr)?,
+        })
     }
 }
 
@@ -331,41 +221,39 @@ pub unsafe extern "C" fn kage_technique_desc_default(
     boundary(|| {
         // SAFETY: the caller promises NULL or writable.
         let desc = unsafe { args::out(desc, "desc") }?;
-        let d = TechniqueSettings::default();
+        let (prt, occlusion) = (PrtParams::DEFAULT, OcclusionSettings::default());
+        let (probes, asm) = (ProbeSettings::default(), AsmSettings::default());
         let filled = kage_technique_desc {
             technique,
-            sh_bands: d.prt.bands,
-            prt_rays: d.prt.rays,
-            regions: d.regions as u32,
-            mask_size: d.mask_size,
-            penumbra: kage_penumbra::Fixed as u32,
-            shadow_map_size: d.shadow_map_size,
+            sh_bands: prt.bands,
+            prt_rays: prt.rays,
+            regions: occlusion.regions as u32,
+            mask_size: occlusion.mask_size,
+            penumbra: occlusion.penumbra as u32,
+            shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
             probe_grid: DEFAULT_GRID,
-            probe_cube_size: d.probes.capture.cube_size,
-            probe_light: kage_probe_light::SkyAndWalls as u32,
-            asm_budget_mb: d.asm.budget_mb,
-            asm_time_ms: d.asm.time_ms,
-            asm_test: match d.asm.test {
-                AsmTest::Bias => kage_asm_test::Bias as u32,
-                AsmTest::Id => kage_asm_test::Id as u32,
-            },
+            probe_cube_size: probes.capture.cube_size,
+            probe_light: probes.capture.light as u32,
+            asm_budget_mb: asm.budget_mb,
+            asm_time_ms: asm.time_ms,
+            asm_test: asm.test as u32,
             probe_placement: kage_probe_placement::Grid as u32,
             probe_candidates: [0; 3],
             probe_tolerance: DEFAULT_TOLERANCE,
             probe_positions: std::ptr::null(),
             probe_position_count: 0,
-            probe_interpolation: kage_probe_interpolation::Tetrahedral as u32,
-            probe_bounces: d.probes.capture.bounces,
-            probe_samples: d.probes.capture.samples,
+            probe_interpolation: probes.interpolation as u32,
+            probe_bounces: probes.capture.bounces,
+            probe_samples: probes.capture.samples,
             probe_dering: kage_probe_dering::Off as u32,
             probe_dering_width: 0.0,
-            probe_statics: kage_static_lighting::Unshadowed as u32,
-            dominant_lights: d.dominant_lights as u32,
-            light_map_size: d.light_map_size,
+            probe_statics: probes.statics as u32,
+            dominant_lights: occlusion.dominant_lights as u32,
+            light_map_size: occlusion.light_map_size,
         };
         // An unknown technique is reported here already, not at the first use.
         // SAFETY: the default places no probes at positions.
-        unsafe { filled.settings() }?;
+        unsafe { filled.desc() }?;
         *desc = filled;
         Ok(())
     })
@@ -393,8 +281,8 @@ pub unsafe extern "C" fn kage_precompute(
         let (context, scene) =
             unsafe { (handles::get(context, "context")?, handles::get_mut(scene, "scene")?) };
         // SAFETY: the caller promises NULL or a valid desc (its probe positions included).
-        let settings = unsafe { args::value(technique, "technique")?.settings() }?;
-        if let Some(params) = settings.precomputation() {
+        let desc = unsafe { args::value(technique, "technique")?.desc() }?;
+        if let Some(params) = desc.precomputation() {
             let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut |_, _| {});
             kage_context::check_validation(&context.ctx)?;
             scene.transfer = Some(Arc::new(set?));

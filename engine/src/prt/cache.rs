@@ -144,11 +144,9 @@ impl CacheKey {
     }
 }
 
+/// The file's code of a visibility: its stable value.
 fn visibility_code(visibility: Visibility) -> u32 {
-    match visibility {
-        Visibility::Group => 0,
-        Visibility::Scene => 1,
-    }
+    visibility as u32
 }
 
 fn visibility_name(code: u32) -> &'static str {

@@ -30,16 +30,18 @@ pub const MAX_BANDS: u32 = crate::sh::MAX_BANDS as u32;
 pub const MAX_RAYS: u32 = 1 << 20;
 
 /// What a vertex's transfer is shadowed by.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Visibility {
     /// Its own group only: the transfer holds whatever pose the groups take (Sloan's PRT as
     /// the Tamura technique uses it).
     #[default]
-    Group,
+    Group = 0,
     /// The whole scene at its rest pose (the groups' transforms in the scene): Sloan's PRT as
     /// the paper compares against, the shadows between groups baked into the receivers'
     /// vertices, and wrong once a group moves.
-    Scene,
+    Scene = 1,
 }
 
 /// What to precompute.

@@ -1,7 +1,7 @@
 //! The reference renderer: progressive Monte Carlo direct lighting of the scene, a batch of
 //! samples per pixel per submission (shaders-glsl/reference_render.comp).
 //!
-//! Same camera and pixel grid as [`crate::renderer::Renderer`]: the camera's view and
+//! Same camera and pixel grid as the renderer: the camera's view and
 //! projection matrices and one primary ray through each pixel centre ((i + ½) / width, row 0 at
 //! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
 use super::lighting::{ReferenceLighting, IMPORTS};

@@ -1,284 +1,340 @@
-//! A technique named with all its parameters: what the command line's options and the C ABI's
-//! `kage_technique_desc` both turn into, checked in one place, and turned into the renderer's
-//! [`TechniqueChoice`] once the precomputation it needs is done.
+//! A technique named with its parameters: the one description the command line and the C ABI
+//! both convert into, checked in one place ([`TechniqueDesc::validated`]) before any GPU work,
+//! and built into the running technique by [`TechniqueDesc::build`].
+//!
+//! Adding a technique: its folder or file under `techniques/`, a [`TechniqueKind`] value, a
+//! [`TechniqueDesc`] variant (the compiler then asks for its arms here), and one conversion each
+//! in the command line (`tools/src/render.rs`) and the C ABI (`capi/technique.rs`).
+use super::asm::technique::Asm;
 use super::asm::AsmSettings;
-use super::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
+use super::parallel_lights::{ParallelLights, DEFAULT_SHADOW_MAP_SIZE};
+use super::probes::technique::ProbeTechnique;
 use super::probes::{ProbeSettings, StaticLighting};
-use super::tamura::occlusion::RegionSize;
-use super::tamura::technique::{OcclusionSettings, Penumbra};
+use super::shadow_map::ShadowMap;
+use super::tamura::technique::{OcclusionSettings, PrtTechnique};
+use super::unshadowed::Unshadowed;
+use super::{sloan, Technique};
+use crate::backend::Context;
 use crate::error::{Error, Result};
+use crate::frame::GpuScene;
 use crate::prt::{PrtParams, TransferSet, Visibility};
-use crate::renderer::TechniqueChoice;
+use crate::scene::Scene;
 use std::sync::Arc;
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// The lighting techniques by name. The values are the C ABI's `kage_technique` and never
+/// change; the command line spells them in kebab case.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum TechniqueKind {
     /// SH irradiance, no shadows.
     #[default]
-    Unshadowed,
-    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only.
-    SloanSelf,
+    Unshadowed = 0,
+    /// Sloan et al. 2002: per-vertex PRT, self-shadowing within each group only. Needs the PRT
+    /// precomputation.
+    SloanSelf = 1,
     /// Sloan et al. 2002 as the Tamura paper compares against: per-vertex PRT whose visibility
-    /// is the whole scene at its rest pose (shadows between groups baked into the vertices).
-    SloanScene,
-    /// Tamura, Johan, Nishita, with dominant lights lit per pixel (Kage's default): PRT plus
-    /// per-pixel shadows between groups, q regions.
-    Tamura,
-    /// Tamura, Johan, Nishita as the paper has it: q regions, the fixed penumbra of eq. (13)
-    /// from each region's solid angle, no dominant lights.
-    TamuraPaper,
-    /// The paper's Fig. 3 baseline: q regions as directional lights with binary shadow maps.
-    ParallelLights,
-    /// Morishige 2014: light probes captured as SH light the moving group (group 0).
-    Probes,
-    /// The scene's point and spot lights with hard shadows from one conventional shadow map
-    /// per light.
-    ShadowMap,
-    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light.
-    Asm,
+    /// is the whole scene as it stood when precomputed (shadows between groups baked into the
+    /// vertices; they stay where they were when groups move). Needs the PRT precomputation.
+    SloanScene = 7,
+    /// Tamura, Johan, Nishita: PRT plus soft shadows between moving groups from q environment
+    /// regions, the map's few brightest small lights (a sun, lamps) taken out and lit per pixel
+    /// with soft shadows. Needs the PRT precomputation.
+    Tamura = 2,
+    /// Tamura, Johan, Nishita as the paper has it: q regions, the fixed penumbra from each
+    /// region's solid angle, no dominant lights. Needs the PRT precomputation.
+    TamuraPaper = 8,
+    /// The paper's Fig. 3 baseline: the q regions as directional lights with binary shadow maps.
+    ParallelLights = 3,
+    /// The scene's point and spot lights (1 to 8), one conventional shadow map each (hard
+    /// shadows).
+    #[cfg_attr(feature = "clap", value(name = "shadowmap"))]
+    ShadowMap = 5,
+    /// Morishige 2014: light probes captured as SH when the renderer is made light the scene's
+    /// first group (the moving one); the other groups are lit as the probe statics say.
+    Probes = 4,
+    /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light: a
+    /// quadtree of tiles in a page pool of a memory budget, refined where the eye sees shadow
+    /// edges coarser than its pixels.
+    Asm = 6,
 }
 
-/// Every parameter of every technique; each technique reads the ones it uses.
+/// A technique and its parameters.
 #[derive(Clone, Debug)]
-pub struct TechniqueSettings {
-    pub kind: TechniqueKind,
-    /// The PRT precomputation of Sloan and Tamura (SH bands, rays per vertex).
-    pub prt: PrtParams,
-    /// q: environment regions of Tamura (1 to 64) and parallel-lights (1 to 128).
-    pub regions: usize,
-    /// Side of a Tamura occlusion mask layer, texels.
-    pub mask_size: u32,
-    pub penumbra: Penumbra,
-    /// Most dominant lights Tamura lights per pixel (0 to 8; they count among the q regions).
-    pub dominant_lights: usize,
-    /// Side of a group's depth map along a dominant light, texels.
-    pub light_map_size: u32,
-    /// Side of a shadow map (parallel-lights, shadowmap), texels.
-    pub shadow_map_size: u32,
-    /// Placement and capture of the light probes.
-    pub probes: ProbeSettings,
-    /// Adaptive shadow maps: memory and time budgets.
-    pub asm: AsmSettings,
+pub enum TechniqueDesc {
+    Unshadowed,
+    SloanSelf {
+        prt: PrtParams,
+    },
+    SloanScene {
+        prt: PrtParams,
+    },
+    Tamura {
+        prt: PrtParams,
+        occlusion: OcclusionSettings,
+    },
+    /// q = `regions` regions on masks of `mask_size`² texels; everything else as published.
+    TamuraPaper {
+        prt: PrtParams,
+        regions: usize,
+        mask_size: u32,
+    },
+    /// `regions` (1 to 128) directional lights with shadow maps of `shadow_map_size`² texels.
+    ParallelLights {
+        regions: usize,
+        shadow_map_size: u32,
+    },
+    /// One shadow map of `size`² texels per local light.
+    ShadowMap {
+        size: u32,
+    },
+    /// `prt` is read when the static groups are lit by Sloan's PRT.
+    Probes {
+        probes: ProbeSettings,
+        prt: PrtParams,
+    },
+    Asm(AsmSettings),
 }
 
-impl Default for TechniqueSettings {
+impl Default for TechniqueDesc {
     fn default() -> Self {
-        let occlusion = OcclusionSettings::default();
-        TechniqueSettings {
-            kind: TechniqueKind::default(),
-            prt: PrtParams::DEFAULT,
-            regions: occlusion.regions,
-            mask_size: occlusion.mask_size,
-            penumbra: occlusion.penumbra,
-            dominant_lights: occlusion.dominant_lights,
-            light_map_size: occlusion.light_map_size,
-            shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
-            probes: ProbeSettings::default(),
-            asm: AsmSettings::default(),
-        }
+        TechniqueDesc::new(TechniqueKind::default())
     }
 }
 
-impl TechniqueSettings {
+impl TechniqueDesc {
+    /// `kind` with every parameter at its default.
+    pub fn new(kind: TechniqueKind) -> TechniqueDesc {
+        let prt = PrtParams::DEFAULT;
+        let occlusion = OcclusionSettings::default();
+        match kind {
+            TechniqueKind::Unshadowed => TechniqueDesc::Unshadowed,
+            TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt },
+            TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt },
+            TechniqueKind::Tamura => TechniqueDesc::Tamura { prt, occlusion },
+            TechniqueKind::TamuraPaper => {
+                TechniqueDesc::TamuraPaper { prt, regions: occlusion.regions, mask_size: occlusion.mask_size }
+            }
+            TechniqueKind::ParallelLights => TechniqueDesc::ParallelLights {
+                regions: occlusion.regions,
+                shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
+            },
+            TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: DEFAULT_SHADOW_MAP_SIZE },
+            TechniqueKind::Probes => TechniqueDesc::Probes { probes: ProbeSettings::default(), prt },
+            TechniqueKind::Asm => TechniqueDesc::Asm(AsmSettings::default()),
+        }
+    }
+
+    pub fn kind(&self) -> TechniqueKind {
+        match self {
+            TechniqueDesc::Unshadowed => TechniqueKind::Unshadowed,
+            TechniqueDesc::SloanSelf { .. } => TechniqueKind::SloanSelf,
+            TechniqueDesc::SloanScene { .. } => TechniqueKind::SloanScene,
+            TechniqueDesc::Tamura { .. } => TechniqueKind::Tamura,
+            TechniqueDesc::TamuraPaper { .. } => TechniqueKind::TamuraPaper,
+            TechniqueDesc::ParallelLights { .. } => TechniqueKind::ParallelLights,
+            TechniqueDesc::ShadowMap { .. } => TechniqueKind::ShadowMap,
+            TechniqueDesc::Probes { .. } => TechniqueKind::Probes,
+            TechniqueDesc::Asm(_) => TechniqueKind::Asm,
+        }
+    }
+
     /// The PRT precomputation the technique needs before its first frame, if any.
     pub fn precomputation(&self) -> Option<PrtParams> {
-        let sloan_statics =
-            self.kind == TechniqueKind::Probes && self.probes.statics == StaticLighting::Sloan;
-        let own_group = matches!(
-            self.kind,
-            TechniqueKind::SloanSelf | TechniqueKind::Tamura | TechniqueKind::TamuraPaper
-        );
-        match self.kind {
-            TechniqueKind::SloanScene => Some(PrtParams { visibility: Visibility::Scene, ..self.prt }),
-            _ if own_group || sloan_statics => Some(PrtParams { visibility: Visibility::Group, ..self.prt }),
+        let group = |prt: &PrtParams| Some(PrtParams { visibility: Visibility::Group, ..*prt });
+        match self {
+            TechniqueDesc::SloanSelf { prt }
+            | TechniqueDesc::Tamura { prt, .. }
+            | TechniqueDesc::TamuraPaper { prt, .. } => group(prt),
+            TechniqueDesc::SloanScene { prt } => Some(PrtParams { visibility: Visibility::Scene, ..*prt }),
+            TechniqueDesc::Probes { probes, prt } if probes.statics == StaticLighting::Sloan => group(prt),
             _ => None,
         }
     }
 
-    /// Checks what can be checked before any GPU work (the techniques check the rest when
-    /// they are built), so that a bad parameter fails before a long precomputation.
-    pub fn validated(mut self) -> Result<TechniqueSettings> {
-        if self.precomputation().is_some() {
-            self.prt.validated()?;
+    /// Checks every parameter that can be checked before GPU work, so that a bad one fails
+    /// before a long precomputation.
+    pub fn validated(mut self) -> Result<TechniqueDesc> {
+        if let Some(prt) = self.precomputation() {
+            prt.validated()?;
         }
-        if self.kind == TechniqueKind::Probes {
-            self.probes = self.probes.validated()?;
-        }
-        if self.kind == TechniqueKind::Asm {
-            self.asm = self.asm.validated()?;
-        }
-        // Zero regions would quietly be Sloan's technique (see `TechniqueChoice::Prt`).
-        let tamura = matches!(self.kind, TechniqueKind::Tamura | TechniqueKind::TamuraPaper);
-        if tamura && self.regions == 0 {
-            return Err(Error::InvalidArgument("regions must be at least 1 for the Tamura technique".into()));
-        }
-        if self.kind == TechniqueKind::Tamura {
-            let max = crate::layouts::constants::MAX_DOMINANT_LIGHTS as usize;
-            if self.dominant_lights > max {
-                return Err(Error::InvalidArgument(format!(
-                    "dominant lights: {} is more than the {max} Tamura lights per pixel",
-                    self.dominant_lights
-                )));
+        // Zero regions would quietly be Sloan's technique.
+        let at_least_one_region = |regions: usize| match regions {
+            0 => Err(Error::InvalidArgument("regions must be at least 1 for the Tamura technique".into())),
+            _ => Ok(()),
+        };
+        match &mut self {
+            TechniqueDesc::Tamura { occlusion, .. } => {
+                at_least_one_region(occlusion.regions)?;
+                *occlusion = occlusion.validated()?;
             }
-            let sizes = super::tamura::dominant_maps::MAP_SIZES;
-            if !sizes.contains(&self.light_map_size) {
-                return Err(Error::InvalidArgument(format!(
-                    "light map size {} must be {} to {} texels",
-                    self.light_map_size,
-                    sizes.start(),
-                    sizes.end()
-                )));
+            TechniqueDesc::TamuraPaper { regions, mask_size, .. } => {
+                at_least_one_region(*regions)?;
+                OcclusionSettings::paper(*regions, *mask_size).validated()?;
             }
+            TechniqueDesc::Probes { probes, .. } => *probes = probes.clone().validated()?,
+            TechniqueDesc::Asm(asm) => *asm = asm.validated()?,
+            // Parallel lights and shadow maps check their sizes when built, before GPU work.
+            TechniqueDesc::Unshadowed
+            | TechniqueDesc::SloanSelf { .. }
+            | TechniqueDesc::SloanScene { .. }
+            | TechniqueDesc::ParallelLights { .. }
+            | TechniqueDesc::ShadowMap { .. } => {}
         }
         Ok(self)
     }
 
-    /// What the renderer runs. `transfer` is the result of [`Self::precomputation`] (ignored
-    /// by techniques that need none); it must have been computed with `self.prt`'s bands.
-    pub fn choice(&self, transfer: Option<Arc<TransferSet>>) -> Result<TechniqueChoice> {
-        let settings = self.clone().validated()?;
-        let transfer = || match &transfer {
+    /// `transfer` if it is what [`Self::precomputation`] asks for; `None` when the technique
+    /// needs none.
+    fn transfer<'t>(&self, transfer: Option<&'t Arc<TransferSet>>) -> Result<Option<&'t TransferSet>> {
+        let Some(wanted) = self.precomputation() else { return Ok(None) };
+        let kind = self.kind();
+        match transfer {
             None => Err(Error::InvalidArgument(format!(
-                "the {:?} technique needs the PRT transfer: precompute it first",
-                settings.kind
+                "the {kind:?} technique needs the PRT transfer: precompute it first"
             ))),
-            Some(transfer) if transfer.params.bands != settings.prt.bands => {
-                Err(Error::InvalidArgument(format!(
-                    "the transfer was precomputed with {} SH bands, the technique asks for {}",
-                    transfer.params.bands, settings.prt.bands
-                )))
-            }
-            Some(transfer)
-                if Some(transfer.params.visibility) != settings.precomputation().map(|p| p.visibility) =>
-            {
-                Err(Error::InvalidArgument(format!(
-                    "the transfer was precomputed with {:?} visibility, the {:?} technique needs {:?}",
-                    transfer.params.visibility,
-                    settings.kind,
-                    settings.precomputation().map(|p| p.visibility)
-                )))
-            }
-            Some(transfer) => Ok(transfer.clone()),
-        };
-        let prt = |occlusion| Ok(TechniqueChoice::Prt { transfer: transfer()?, occlusion });
-        let occlusion = OcclusionSettings {
-            regions: settings.regions,
-            mask_size: settings.mask_size,
-            penumbra: settings.penumbra,
-            size: RegionSize::Energy,
-            dominant_lights: settings.dominant_lights,
-            light_map_size: settings.light_map_size,
-            ..OcclusionSettings::default()
-        };
-        let sloan = OcclusionSettings { regions: 0, dominant_lights: 0, pixel_cosine: false, ..occlusion };
-        match settings.kind {
-            TechniqueKind::Unshadowed => Ok(TechniqueChoice::Unshadowed),
-            TechniqueKind::SloanSelf | TechniqueKind::SloanScene => prt(sloan),
-            TechniqueKind::Tamura => prt(occlusion),
-            TechniqueKind::TamuraPaper => prt(OcclusionSettings {
-                penumbra: Penumbra::Fixed,
-                size: RegionSize::Geometric,
-                dominant_lights: 0,
-                pixel_cosine: false,
-                ..occlusion
-            }),
-            TechniqueKind::ParallelLights => Ok(TechniqueChoice::ParallelLights {
-                regions: settings.regions,
-                shadow_map_size: settings.shadow_map_size,
-            }),
-            TechniqueKind::Probes => Ok(TechniqueChoice::Probes {
-                transfer: match settings.probes.statics {
-                    StaticLighting::Unshadowed => None,
-                    StaticLighting::Sloan => Some(transfer()?),
-                },
-                settings: settings.probes.clone(),
-            }),
-            TechniqueKind::ShadowMap => Ok(TechniqueChoice::ShadowMap { size: settings.shadow_map_size }),
-            TechniqueKind::Asm => Ok(TechniqueChoice::Asm(settings.asm)),
+            Some(t) if t.params.bands != wanted.bands => Err(Error::InvalidArgument(format!(
+                "the transfer was precomputed with {} SH bands, the technique asks for {}",
+                t.params.bands, wanted.bands
+            ))),
+            Some(t) if t.params.visibility != wanted.visibility => Err(Error::InvalidArgument(format!(
+                "the transfer was precomputed with {:?} visibility, the {kind:?} technique needs {:?}",
+                t.params.visibility, wanted.visibility
+            ))),
+            Some(t) => Ok(Some(t.as_ref())),
         }
+    }
+
+    /// Builds the technique for `scene` (on the GPU as `gpu`) and images of `size`, after
+    /// [`Self::validated`]; `transfer` is the result of [`Self::precomputation`].
+    pub fn build(
+        &self,
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        gpu: &GpuScene,
+        transfer: Option<&Arc<TransferSet>>,
+        size: (u32, u32),
+    ) -> Result<Box<dyn Technique>> {
+        let desc = self.clone().validated()?;
+        let transfer = desc.transfer(transfer)?;
+        let prt = || transfer.ok_or_else(|| Error::Internal("a PRT technique without its transfer".into()));
+        Ok(match &desc {
+            TechniqueDesc::Unshadowed => Box::new(Unshadowed::new(ctx)?),
+            TechniqueDesc::SloanSelf { .. } | TechniqueDesc::SloanScene { .. } => {
+                Box::new(sloan::new(ctx, scene, gpu, prt()?)?)
+            }
+            TechniqueDesc::Tamura { occlusion, .. } => {
+                Box::new(PrtTechnique::new(ctx, scene, gpu, prt()?, *occlusion)?)
+            }
+            TechniqueDesc::TamuraPaper { regions, mask_size, .. } => Box::new(PrtTechnique::new(
+                ctx,
+                scene,
+                gpu,
+                prt()?,
+                OcclusionSettings::paper(*regions, *mask_size),
+            )?),
+            TechniqueDesc::ParallelLights { regions, shadow_map_size } => {
+                Box::new(ParallelLights::new(ctx, scene, *regions, *shadow_map_size)?)
+            }
+            TechniqueDesc::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
+            TechniqueDesc::Probes { probes, .. } => {
+                Box::new(ProbeTechnique::new(ctx, scene, gpu, probes, transfer)?)
+            }
+            TechniqueDesc::Asm(settings) => Box::new(Asm::new(ctx, scene, gpu, *settings, size)?),
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::techniques::probes::ProbePlacement;
 
-    fn transfer(bands: u32) -> Option<Arc<TransferSet>> {
-        Some(Arc::new(TransferSet {
-            params: PrtParams { bands, rays: 1, ..PrtParams::DEFAULT },
-            seconds: 0.0,
-            meshes: vec![],
-        }))
+    fn transfer(bands: u32, visibility: Visibility) -> Option<Arc<TransferSet>> {
+        let params = PrtParams { bands, rays: 1, visibility };
+        Some(Arc::new(TransferSet { params, seconds: 0.0, meshes: vec![] }))
     }
 
-    fn error(settings: TechniqueSettings, transfer: Option<Arc<TransferSet>>) -> String {
-        settings.choice(transfer).unwrap_err().to_string()
+    fn invalid(desc: TechniqueDesc) -> String {
+        desc.validated().unwrap_err().to_string()
+    }
+
+    /// Every kind's defaults name that kind, and its value is the one kage.h gives it.
+    #[test]
+    fn each_kind_has_its_desc_and_its_value() {
+        for value in 0..=8 {
+            let kind = TechniqueKind::from_repr(value).unwrap();
+            assert_eq!(kind as u32, value);
+            let desc = TechniqueDesc::new(kind);
+            assert_eq!(desc.kind(), kind);
+            desc.validated().unwrap();
+        }
+        assert_eq!(TechniqueKind::from_repr(9), None);
     }
 
     #[test]
-    fn each_kind_becomes_its_choice() {
-        let of = |kind| TechniqueSettings { kind, regions: 4, ..Default::default() };
-        assert!(matches!(of(TechniqueKind::Unshadowed).choice(None), Ok(TechniqueChoice::Unshadowed)));
-        let sloan = of(TechniqueKind::SloanSelf).choice(transfer(3)).unwrap();
-        assert!(matches!(sloan, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 0));
-        let tamura = of(TechniqueKind::Tamura).choice(transfer(3)).unwrap();
-        assert!(matches!(tamura, TechniqueChoice::Prt { occlusion, .. } if occlusion.regions == 4));
-        let lights = of(TechniqueKind::ParallelLights).choice(None).unwrap();
-        assert!(matches!(lights, TechniqueChoice::ParallelLights { regions: 4, .. }));
-        let map = TechniqueSettings { shadow_map_size: 2048, ..of(TechniqueKind::ShadowMap) };
-        assert!(matches!(map.choice(None), Ok(TechniqueChoice::ShadowMap { size: 2048 })));
-        assert_eq!(of(TechniqueKind::ParallelLights).precomputation(), None);
-        assert_eq!(of(TechniqueKind::Tamura).precomputation(), Some(PrtParams::DEFAULT));
-        assert!(matches!(
-            of(TechniqueKind::Probes).choice(None),
-            Ok(TechniqueChoice::Probes { transfer: None, .. })
-        ));
-        let asm = TechniqueSettings {
-            asm: AsmSettings { budget_mb: 4.0, time_ms: 2.0, ..AsmSettings::default() },
-            ..of(TechniqueKind::Asm)
+    fn the_precomputation_follows_the_technique() {
+        let group = Some(PrtParams::DEFAULT);
+        let scene = Some(PrtParams { visibility: Visibility::Scene, ..PrtParams::DEFAULT });
+        for (kind, wanted) in [
+            (TechniqueKind::Unshadowed, None),
+            (TechniqueKind::SloanSelf, group),
+            (TechniqueKind::SloanScene, scene),
+            (TechniqueKind::Tamura, group),
+            (TechniqueKind::TamuraPaper, group),
+            (TechniqueKind::ParallelLights, None),
+            (TechniqueKind::ShadowMap, None),
+            (TechniqueKind::Probes, None),
+            (TechniqueKind::Asm, None),
+        ] {
+            assert_eq!(TechniqueDesc::new(kind).precomputation(), wanted, "{kind:?}");
+        }
+        // Static groups lit by Sloan's PRT: the probes technique needs the transfer too.
+        let mut probes = ProbeSettings::default();
+        probes.statics = StaticLighting::Sloan;
+        let sloan_statics = TechniqueDesc::Probes { probes, prt: PrtParams::DEFAULT };
+        assert_eq!(sloan_statics.precomputation(), group);
+        assert!(sloan_statics.transfer(None).unwrap_err().to_string().contains("precompute it first"));
+    }
+
+    #[test]
+    fn a_missing_or_mismatched_transfer_is_an_error() {
+        let tamura = TechniqueDesc::new(TechniqueKind::Tamura);
+        let error = |t: Option<Arc<TransferSet>>| tamura.transfer(t.as_ref()).unwrap_err().to_string();
+        assert!(error(None).contains("precompute it first"));
+        assert!(error(transfer(4, Visibility::Group)).contains("4 SH bands"));
+        assert!(error(transfer(3, Visibility::Scene)).contains("Scene visibility"));
+        assert!(tamura.transfer(transfer(3, Visibility::Group).as_ref()).unwrap().is_some());
+        let scene = TechniqueDesc::new(TechniqueKind::SloanScene);
+        let group = transfer(3, Visibility::Group);
+        assert!(scene.transfer(group.as_ref()).unwrap_err().to_string().contains("Group visibility"));
+        assert!(TechniqueDesc::Unshadowed.transfer(None).unwrap().is_none());
+    }
+
+    #[test]
+    fn bad_parameters_are_errors_naming_them() {
+        let tamura = |change: fn(&mut OcclusionSettings)| {
+            let mut occlusion = OcclusionSettings::default();
+            change(&mut occlusion);
+            TechniqueDesc::Tamura { prt: PrtParams::DEFAULT, occlusion }
         };
-        assert!(
-            matches!(asm.choice(None), Ok(TechniqueChoice::Asm(s)) if s.budget_mb == 4.0 && s.time_ms == 2.0)
-        );
-        assert_eq!(of(TechniqueKind::Probes).precomputation(), None);
-        // Static groups by Sloan's PRT: the probes technique needs the transfer too.
-        let mut sloan_statics = of(TechniqueKind::Probes);
-        sloan_statics.probes.statics = StaticLighting::Sloan;
-        assert_eq!(sloan_statics.precomputation(), Some(PrtParams::DEFAULT));
-        assert!(matches!(
-            sloan_statics.choice(transfer(3)),
-            Ok(TechniqueChoice::Probes { transfer: Some(_), .. })
-        ));
-        assert!(error(sloan_statics, None).contains("precompute it first"));
-    }
-
-    #[test]
-    fn missing_or_mismatched_precomputation_and_bad_parameters_are_errors() {
-        let tamura = TechniqueSettings { kind: TechniqueKind::Tamura, ..Default::default() };
-        assert!(error(tamura.clone(), None).contains("precompute it first"));
-        assert!(error(tamura.clone(), transfer(4)).contains("4 SH bands"));
-        assert!(error(TechniqueSettings { regions: 0, ..tamura.clone() }, transfer(3)).contains("at least 1"));
-        let dominant = TechniqueSettings { dominant_lights: 9, ..tamura.clone() };
-        assert!(error(dominant, transfer(3)).contains("dominant lights: 9"));
-        let light_map = TechniqueSettings { light_map_size: 8, ..tamura.clone() };
-        assert!(error(light_map, transfer(3)).contains("light map size 8"));
-        let paper = TechniqueSettings { kind: TechniqueKind::TamuraPaper, regions: 0, ..tamura.clone() };
-        assert!(error(paper, transfer(3)).contains("at least 1"));
-        // Sloan's whole-scene variant needs a transfer with the whole scene's visibility.
-        let scene = TechniqueSettings { kind: TechniqueKind::SloanScene, ..tamura.clone() };
-        assert!(error(scene, transfer(3)).contains("Group visibility"));
-        let bands = PrtParams { bands: 9, ..PrtParams::DEFAULT };
-        assert!(error(TechniqueSettings { prt: bands, ..tamura }, transfer(9)).contains("9 SH bands"));
-        let mut probes = TechniqueSettings { kind: TechniqueKind::Probes, ..Default::default() };
-        probes.probes.placement = crate::techniques::probes::ProbePlacement::Grid([2, 1, 2]);
-        assert!(error(probes.clone(), None).contains("probe grid [2, 1, 2]"));
-        probes.probes = ProbeSettings::default();
-        probes.probes.capture.cube_size = 512;
-        assert!(error(probes, None).contains("cube map size 512"));
-        let mut asm = TechniqueSettings { kind: TechniqueKind::Asm, ..Default::default() };
-        asm.asm.budget_mb = 0.01;
-        assert!(error(asm.clone(), None).contains("holds no tile"));
-        asm.asm = AsmSettings { time_ms: 0.0, ..AsmSettings::default() };
-        assert!(error(asm, None).contains("time budget"));
+        assert!(invalid(tamura(|o| o.regions = 0)).contains("at least 1"));
+        assert!(invalid(tamura(|o| o.dominant_lights = 9)).contains("dominant lights: 9"));
+        assert!(invalid(tamura(|o| o.light_map_size = 8)).contains("light map size 8"));
+        assert!(invalid(tamura(|o| o.mask_size = 4)).contains("mask size 4"));
+        let paper = TechniqueDesc::TamuraPaper { prt: PrtParams::DEFAULT, regions: 0, mask_size: 128 };
+        assert!(invalid(paper).contains("at least 1"));
+        let bands = TechniqueDesc::SloanSelf { prt: PrtParams { bands: 9, ..PrtParams::DEFAULT } };
+        assert!(invalid(bands).contains("9 SH bands"));
+        let mut probes = ProbeSettings { placement: ProbePlacement::Grid([2, 1, 2]), ..Default::default() };
+        let desc = |probes| TechniqueDesc::Probes { probes, prt: PrtParams::DEFAULT };
+        assert!(invalid(desc(probes.clone())).contains("probe grid [2, 1, 2]"));
+        probes = ProbeSettings::default();
+        probes.capture.cube_size = 512;
+        assert!(invalid(desc(probes)).contains("cube map size 512"));
+        let asm =
+            |budget_mb, time_ms| TechniqueDesc::Asm(AsmSettings { budget_mb, time_ms, ..Default::default() });
+        assert!(invalid(asm(0.01, 8.0)).contains("holds no tile"));
+        assert!(invalid(asm(16.0, 0.0)).contains("time budget"));
     }
 }

@@ -5,6 +5,7 @@ pub mod description;
 pub mod parallel_lights;
 pub mod probes;
 pub mod shadow_map;
+pub mod sloan;
 pub mod tamura;
 pub mod unshadowed;
 
@@ -36,22 +37,24 @@ pub trait Technique {
     /// The GPU times of the frame's own passes, after it completed (the adaptive shadow map
     /// scales its tile cost model by them).
     fn timed(&mut self, _timings: &[PassTiming]) {}
-    /// Occlusion layers the last frame wanted but had no room for (their light was left
-    /// unshadowed): 0 for techniques without a layer budget.
-    fn dropped_layers(&self) -> usize {
-        0
+    /// What the technique reports of its last frame besides the pass timings.
+    fn stats(&self) -> TechniqueStats {
+        TechniqueStats::default()
     }
+}
+
+/// What a technique reports of its last frame besides the pass timings; what it does not have
+/// stays at the default (0, `None`). The renderer, the command line and the C ABI pass it on.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TechniqueStats {
+    /// Tamura: occlusion layers the last frame wanted but had no room for (their light was
+    /// left unshadowed: see `OcclusionSettings::max_layers`).
+    pub dropped_layers: usize,
     /// Bytes of the shadow storage of the scene's local lights (maps, tile pools), what the
-    /// memory comparisons of shadow-map techniques count; `None` for techniques without one.
-    fn shadow_memory_bytes(&self) -> Option<u64> {
-        None
-    }
-    /// The adaptive shadow map's hierarchy after the last update; `None` for other techniques.
-    fn asm_stats(&self) -> Option<asm::AsmStats> {
-        None
-    }
-    /// The light probes placed and kept; `None` for techniques without probes.
-    fn probe_counts(&self) -> Option<probes::ProbeCounts> {
-        None
-    }
+    /// memory comparisons of shadow-map techniques count.
+    pub shadow_memory_bytes: Option<u64>,
+    /// The adaptive shadow map's hierarchy after the last update.
+    pub asm: Option<asm::AsmStats>,
+    /// The light probes placed and kept.
+    pub probes: Option<probes::ProbeCounts>,
 }

@@ -1,6 +1,5 @@
 //! The conventional shadow map for the scene's point and spot lights (the baseline of Adaptive
-//! Shadow Maps, ../shared/papers/README.md section 2): one perspective depth map per light, hard
-//! shadows, lit exactly as `kage reference --light local` (shaders-glsl/include/local_light.glsl)
+//! Shadow Maps): one perspective depth map per light, hard shadows, lit exactly as `kage reference --light local` (shaders-glsl/include/local_light.glsl)
 //! so that the two compare pixel by pixel.
 //!
 //! Each light's map is a perspective view from the light:
@@ -16,7 +15,7 @@
 //! slope-scaled bias in texels of the receiver's depth: a surface at angle θ to the light spans
 //! a depth of tan θ per unit of width inside a texel, so the bias grows with tan θ (capped:
 //! grazing surfaces would otherwise detach their shadows entirely).
-use super::Technique;
+use super::{Technique, TechniqueStats};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
@@ -176,8 +175,8 @@ impl Technique for ShadowMap {
         vec![shadow_maps, prepass, scene_pass]
     }
 
-    fn shadow_memory_bytes(&self) -> Option<u64> {
+    fn stats(&self) -> TechniqueStats {
         // D32 has a texel size, so this never fails.
-        self.shadow_maps.byte_size().ok()
+        TechniqueStats { shadow_memory_bytes: self.shadow_maps.byte_size().ok(), ..Default::default() }
     }
 }

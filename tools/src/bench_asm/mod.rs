@@ -1,5 +1,5 @@
 //! `kage bench asm`: shadow-map techniques for local lights side by side over a scene's camera
-//! walkthrough (issue 5's measurements): per frame, the fraction of pixels shadowed differently
+//! walkthrough: per frame, the fraction of pixels shadowed differently
 //! from the ray-traced reference, the GPU time of every pass, and, where the camera moves
 //! slowly, the pixels whose shadow flips when the reference's does not; per configuration, the
 //! shadow memory, and the frames the error takes to stop falling once the camera rests.
@@ -23,7 +23,7 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
 use kage::techniques::asm::technique::AsmTest;
 use kage::techniques::asm::AsmSettings;
-use kage::techniques::description::{TechniqueKind, TechniqueSettings};
+use kage::techniques::description::TechniqueDesc;
 use report::{FrameRow, Series};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -83,7 +83,7 @@ struct ConfigKind {
     parameter: &'static str,
     /// The chart's series, naming what the values count.
     series: &'static str,
-    settings: fn(&str) -> Result<TechniqueSettings>,
+    settings: fn(&str) -> Result<TechniqueDesc>,
 }
 
 const KINDS: &[ConfigKind] = &[
@@ -107,23 +107,22 @@ const KINDS: &[ConfigKind] = &[
     },
 ];
 
-fn shadowmap(value: &str) -> Result<TechniqueSettings> {
+fn shadowmap(value: &str) -> Result<TechniqueDesc> {
     let size = value.parse().with_context(|| format!("{value:?} is not a whole number of texels"))?;
-    Ok(TechniqueSettings { kind: TechniqueKind::ShadowMap, shadow_map_size: size, ..Default::default() })
+    Ok(TechniqueDesc::ShadowMap { size })
 }
 
-fn asm_with(value: &str, test: AsmTest) -> Result<TechniqueSettings> {
+fn asm_with(value: &str, test: AsmTest) -> Result<TechniqueDesc> {
     let budget_mb = value.parse().with_context(|| format!("{value:?} is not a number of MB"))?;
-    let asm = AsmSettings { budget_mb, test, ..AsmSettings::default() };
-    Ok(TechniqueSettings { kind: TechniqueKind::Asm, asm, ..Default::default() })
+    Ok(TechniqueDesc::Asm(AsmSettings { budget_mb, test, ..AsmSettings::default() }))
 }
 
-fn asm(value: &str) -> Result<TechniqueSettings> {
+fn asm(value: &str) -> Result<TechniqueDesc> {
     asm_with(value, AsmTest::Bias)
 }
 
 /// ASM with the paper's polygon-ID test (its pages twice the bytes).
-fn asm_id(value: &str) -> Result<TechniqueSettings> {
+fn asm_id(value: &str) -> Result<TechniqueDesc> {
     asm_with(value, AsmTest::Id)
 }
 
@@ -135,7 +134,7 @@ pub struct Config {
     pub parameter: &'static str,
     pub series: &'static str,
     pub value: String,
-    settings: TechniqueSettings,
+    settings: TechniqueDesc,
 }
 
 fn parse_config(arg: &str) -> Result<Config> {
@@ -246,7 +245,8 @@ pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
         bail!("{} has no GPU timestamps, so frame times cannot be measured", ctx.info().name);
     }
     let options = |config: &Config| -> Result<RenderOptions> {
-        Ok(RenderOptions { width: args.size, height: args.size, technique: config.settings.choice(None)? })
+        let technique = config.settings.clone().validated()?;
+        Ok(RenderOptions { width: args.size, height: args.size, technique, transfer: None })
     };
     let mut renderers = configs
         .iter()
@@ -277,7 +277,7 @@ pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
         references.loaded,
         cache.map_or_else(|| "nowhere (no cache folder)".to_string(), |d| d.display().to_string()),
     );
-    let memory: Vec<Option<u64>> = renderers.iter().map(Renderer::shadow_memory_bytes).collect();
+    let memory: Vec<Option<u64>> = renderers.iter().map(|r| r.stats().shadow_memory_bytes).collect();
     let summaries: Vec<report::Summary> =
         series.iter().zip(&memory).map(|(s, &bytes)| s.summary(bytes, args.converge_tolerance)).collect();
     let title = format!("{}: {} frames at {}², {device}", scene.name, plan.len(), args.size);
@@ -359,8 +359,8 @@ mod tests {
     #[test]
     fn configurations_parse_or_say_what_is_known() {
         let c = parse_config("shadowmap:2048").unwrap();
-        assert_eq!((c.kind, c.value.as_str(), c.settings.shadow_map_size), ("shadowmap", "2048", 2048));
-        assert_eq!(c.settings.kind, TechniqueKind::ShadowMap);
+        assert_eq!((c.kind, c.value.as_str()), ("shadowmap", "2048"));
+        assert!(matches!(c.settings, TechniqueDesc::ShadowMap { size: 2048 }));
         for (bad, expected) in [
             ("shadowmap", "expected KIND:VALUE, one of shadowmap:VALUE"),
             ("cube:4", "no technique \"cube\""),

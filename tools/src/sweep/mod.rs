@@ -17,10 +17,11 @@ use kage::backend::Context;
 use kage::pass::TimingTable;
 use kage::prt::{PrtParams, TransferSet};
 use kage::reference::compare;
-use kage::renderer::{RenderOptions, Renderer, TechniqueChoice};
+use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
-use kage::techniques::description::{TechniqueKind, TechniqueSettings};
+use kage::techniques::description::{TechniqueDesc, TechniqueKind};
+use kage::techniques::tamura::technique::OcclusionSettings;
 use pick::Point;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -153,19 +154,34 @@ impl Setting {
     }
 
     /// The technique and its parameters, as `kage render` and the C ABI take them.
-    fn technique(self) -> TechniqueSettings {
-        let defaults = TechniqueSettings::default();
-        let (kind, prt, regions) = match self {
-            Setting::Unshadowed => (TechniqueKind::Unshadowed, defaults.prt, defaults.regions),
-            Setting::SloanSelf { bands } => {
-                (TechniqueKind::SloanSelf, PrtParams { bands, ..defaults.prt }, 0)
+    fn technique(self) -> TechniqueDesc {
+        let of = TechniqueDesc::new;
+        match (self, of(self.kind())) {
+            (Setting::SloanSelf { bands }, TechniqueDesc::SloanSelf { prt }) => {
+                TechniqueDesc::SloanSelf { prt: PrtParams { bands, ..prt } }
             }
-            Setting::SloanScene => (TechniqueKind::SloanScene, defaults.prt, 0),
-            Setting::TamuraPaper { regions } => (TechniqueKind::TamuraPaper, defaults.prt, regions),
-            Setting::Tamura { regions } => (TechniqueKind::Tamura, defaults.prt, regions),
-            Setting::ParallelLights { regions } => (TechniqueKind::ParallelLights, defaults.prt, regions),
-        };
-        TechniqueSettings { kind, prt, regions, ..defaults }
+            (Setting::TamuraPaper { regions }, TechniqueDesc::TamuraPaper { prt, mask_size, .. }) => {
+                TechniqueDesc::TamuraPaper { prt, regions, mask_size }
+            }
+            (Setting::Tamura { regions }, TechniqueDesc::Tamura { prt, occlusion }) => {
+                TechniqueDesc::Tamura { prt, occlusion: OcclusionSettings { regions, ..occlusion } }
+            }
+            (Setting::ParallelLights { regions }, TechniqueDesc::ParallelLights { shadow_map_size, .. }) => {
+                TechniqueDesc::ParallelLights { regions, shadow_map_size }
+            }
+            (_, desc) => desc,
+        }
+    }
+
+    fn kind(self) -> TechniqueKind {
+        match self {
+            Setting::Unshadowed => TechniqueKind::Unshadowed,
+            Setting::SloanSelf { .. } => TechniqueKind::SloanSelf,
+            Setting::SloanScene => TechniqueKind::SloanScene,
+            Setting::TamuraPaper { .. } => TechniqueKind::TamuraPaper,
+            Setting::Tamura { .. } => TechniqueKind::Tamura,
+            Setting::ParallelLights { .. } => TechniqueKind::ParallelLights,
+        }
     }
 
     /// The PRT transfer it needs, if any.
@@ -349,7 +365,8 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
                 &RenderOptions {
                     width: args.size,
                     height: args.size,
-                    technique: setting.technique().choice(transfer.clone())?,
+                    technique: setting.technique(),
+                    transfer: transfer.clone(),
                 },
             )
             .with_context(|| format!("setting up {}", setting.name()))?;
@@ -363,8 +380,13 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             }
             drop(renderer);
             let frame_ms = if args.frames > 0 {
-                let choice = setting.technique().choice(transfer.clone())?;
-                let ms = frame_time(&ctx, &lit, choice, args.time_size, args.frames)?;
+                let options = RenderOptions {
+                    width: args.time_size,
+                    height: args.time_size,
+                    technique: setting.technique(),
+                    transfer: transfer.clone(),
+                };
+                let ms = frame_time(&ctx, &lit, &options, args.frames)?;
                 bar.inc(1);
                 Some(ms)
             } else {
@@ -502,15 +524,8 @@ fn posed(scene: &Scene, t: f32) -> Scene {
 }
 
 /// Median GPU milliseconds per frame over `frames` frames of the scripted motion.
-fn frame_time(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    choice: TechniqueChoice,
-    size: u32,
-    frames: u32,
-) -> Result<f64> {
-    let mut renderer =
-        Renderer::new(ctx, scene, &RenderOptions { width: size, height: size, technique: choice })?;
+fn frame_time(ctx: &Arc<Context>, scene: &Scene, options: &RenderOptions, frames: u32) -> Result<f64> {
+    let mut renderer = Renderer::new(ctx, scene, options)?;
     // One untimed frame: pipelines are compiled on first use on CPU drivers.
     renderer.render()?;
     let mut table = TimingTable::default();

@@ -8,13 +8,13 @@
 //! count), so the chart's x axis counts probes and `--pick` takes `--max-probes`.
 use super::{write_outputs, SweepArgs, Terms};
 use crate::bench_probe_count::{measure, Params, TestRegion, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
-use crate::render::ProbeLightName;
 use crate::sweep::chart::Axes;
 use crate::sweep::pick::Point;
 use anyhow::{bail, Context as _, Result};
 use kage::scene::Scene;
 use kage::sh::ShRgb9;
 use kage::techniques::probes::CaptureSettings;
+use kage::techniques::probes::CapturedLight;
 use std::fmt::Write as _;
 
 /// Tolerances over the whole box, where the kept set grows from 4 probes to 57 between
@@ -49,11 +49,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         points: POINTS,
         normals: NORMALS,
         spp,
-        capture: CaptureSettings {
-            cube_size: CUBE_SIZE,
-            light: ProbeLightName::Sky.captured(),
-            ..Default::default()
-        },
+        capture: CaptureSettings { cube_size: CUBE_SIZE, light: CapturedLight::Sky, ..Default::default() },
         cache: Some(&cache),
     };
     let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {}", scene.name))?;

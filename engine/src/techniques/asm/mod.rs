@@ -1,5 +1,4 @@
-//! Adaptive Shadow Maps (Fernando, Fernandez, Bala, Greenberg 2001; ../shared/papers/README.md
-//! section 2).
+//! Adaptive Shadow Maps (Fernando, Fernandez, Bala, Greenberg 2001).
 //!
 //! - [`technique`]: the technique: the eye view's analysis, then in the same frame tile
 //!   rendering and lookup; invalidation.

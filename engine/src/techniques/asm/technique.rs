@@ -45,7 +45,7 @@ use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::clusters::Cluster;
 use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
-use crate::techniques::Technique;
+use crate::techniques::{Technique, TechniqueStats};
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -56,14 +56,16 @@ pub const MB: u64 = 1 << 20;
 /// The shadow test of the lookup. The bias test is the default: at equal memory it holds twice
 /// the tiles, and over the `asm` walkthrough's close-ups it misclassified fewer pixels (IDs
 /// only won on the bunny, whose surfaces turn away from the light; BENCHMARKS.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum AsmTest {
     /// The paper's: a tile texel holding the receiver's own polygon is lit; otherwise the
     /// depth comparison with bias decides. Pages hold an ID per texel beside the depth.
-    Id,
+    Id = 1,
     /// The depth comparison with the shadowmap technique's slope-scaled bias alone.
     #[default]
-    Bias,
+    Bias = 0,
 }
 
 impl AsmTest {
@@ -465,11 +467,6 @@ impl Asm {
             bias: DEPTH_BIAS,
         }
     }
-
-    /// The hierarchy's state for measurements.
-    pub fn stats(&self) -> AsmStats {
-        self.stats.clone()
-    }
 }
 
 /// The index runs a render of `key` draws: the clusters (per mesh: its group, its clusters)
@@ -694,13 +691,13 @@ impl Technique for Asm {
         }
     }
 
-    fn asm_stats(&self) -> Option<AsmStats> {
-        Some(self.stats())
-    }
-
-    /// The whole atlas and the scratch, allocated up front (within the budget), whatever
-    /// is resident.
-    fn shadow_memory_bytes(&self) -> Option<u64> {
-        Some(self.pages.bytes(self.settings.test.page_bytes()))
+    /// Shadow memory: the whole atlas and the scratch, allocated up front (within the
+    /// budget), whatever is resident.
+    fn stats(&self) -> TechniqueStats {
+        TechniqueStats {
+            shadow_memory_bytes: Some(self.pages.bytes(self.settings.test.page_bytes())),
+            asm: Some(self.stats.clone()),
+            ..Default::default()
+        }
     }
 }

@@ -67,15 +67,17 @@ const CUBE_FACES: [(Vec3, Vec3); 6] = [
 ];
 
 /// Which light the cube maps hold (see the module documentation).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum CapturedLight {
     /// The environment and the scene's lights where the probe sees them; static surfaces drawn
     /// black, so they only occlude: `kage reference --irradiance --bounces 0`.
-    Sky,
+    Sky = 1,
     /// The sky, plus the static surfaces with the radiance the ray caster computes for them
     /// ([`CaptureSettings::bounces`]).
     #[default]
-    SkyAndWalls,
+    SkyAndWalls = 0,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,4 +1,4 @@
-//! Light probes (Morishige 2014; ../shared/papers/README.md, section 3).
+//! Light probes (Morishige 2014).
 //!
 //! Capture ([`ProbeCapture`]): a cube map of the scene at each probe projected to SH on the GPU;
 //! [`ProbeSet`]: placement, capture and interpolation; [`technique`]: the moving group lit by

@@ -52,13 +52,15 @@ pub const AUTO_CANDIDATES: u32 = 8;
 pub const DEFAULT_TOLERANCE: f32 = 0.05;
 
 /// How the light between probes is found.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ProbeInterpolation {
     /// Barycentric weights of the Delaunay tetrahedron holding the point (Morishige 2014).
     #[default]
-    Tetrahedral,
+    Tetrahedral = 0,
     /// Trilinear weights of the grid cell holding the point: a [`ProbePlacement::Grid`] only.
-    Trilinear,
+    Trilinear = 1,
 }
 
 /// A small grid for a room: 18 probes, two layers.
@@ -71,13 +73,15 @@ impl Default for ProbePlacement {
 }
 
 /// How the static groups are lit in the frame the probes light the moving group in.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum StaticLighting {
     /// The environment's SH irradiance, unshadowed.
     #[default]
-    Unshadowed,
+    Unshadowed = 0,
     /// Sloan's PRT: self-shadowed by the static groups (needs the PRT precomputation).
-    Sloan,
+    Sloan = 1,
 }
 
 /// The probes' placement and capture, and the static groups' lighting beside them.

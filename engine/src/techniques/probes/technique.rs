@@ -18,9 +18,10 @@ use crate::layouts::{bytes_of, spirv, ProbeLight};
 use crate::pass::Pass;
 use crate::prt::TransferSet;
 use crate::scene::Scene;
-use crate::techniques::tamura::technique::{OcclusionSettings, PrtTechnique};
+use crate::techniques::sloan;
+use crate::techniques::tamura::technique::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
-use crate::techniques::Technique;
+use crate::techniques::{Technique, TechniqueStats};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -56,8 +57,7 @@ impl ProbeTechnique {
         let statics = match (settings.statics, transfer) {
             (StaticLighting::Unshadowed, _) => Statics::Unshadowed(Unshadowed::new(ctx)?),
             (StaticLighting::Sloan, Some(transfer)) => {
-                let sloan = OcclusionSettings { regions: 0, ..OcclusionSettings::default() };
-                let prt = PrtTechnique::new(ctx, scene, gpu, transfer, sloan)?.for_groups(is_static);
+                let prt = sloan::new(ctx, scene, gpu, transfer)?.for_groups(is_static);
                 Statics::Sloan(Box::new(prt))
             }
             (StaticLighting::Sloan, None) => {
@@ -135,7 +135,7 @@ impl Technique for ProbeTechnique {
         passes
     }
 
-    fn probe_counts(&self) -> Option<super::ProbeCounts> {
-        Some(self.set.counts())
+    fn stats(&self) -> TechniqueStats {
+        TechniqueStats { probes: Some(self.set.counts()), ..Default::default() }
     }
 }

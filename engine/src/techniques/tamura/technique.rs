@@ -3,7 +3,6 @@
 use super::dominant;
 use super::dominant_maps::{self, DominantMaps};
 use super::occlusion::{Occlusion, RegionSize};
-use super::self_shadow::{transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline,
     Sampler, VertexBuffer,
@@ -18,20 +17,23 @@ use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush, ShCoeffs};
 use crate::pass::Pass;
 use crate::prt::TransferSet;
 use crate::scene::Scene;
-use crate::techniques::Technique;
+use crate::techniques::sloan::self_shadow::{transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
+use crate::techniques::{Technique, TechniqueStats};
 use std::sync::Arc;
 
 /// How wide the penumbra of a shadow between groups is.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Penumbra {
     /// The paper's: one box width per (receiver, occluder, region), s = sqrt(Ω_i)·R with R
     /// measured between the group centres (eqs. (12)–(13)).
     #[default]
-    Fixed,
+    Fixed = 0,
     /// Beyond the paper: the same two 1D passes leave boxes of three widths, and each pixel
     /// takes a box as wide as sqrt(Ω_i) times its own distance to the occluder (interpolated
     /// between them), so shadows sharpen at contact and soften with distance.
-    Adaptive,
+    Adaptive = 1,
 }
 
 /// Settings of the occlusion between groups.
@@ -71,6 +73,62 @@ impl Default for OcclusionSettings {
     }
 }
 
+impl OcclusionSettings {
+    /// The technique as published: q = `regions` regions on masks of `mask_size`² texels, one
+    /// box width per group pair from each region's solid angle, no dominant lights, the cosine
+    /// per vertex.
+    pub fn paper(regions: usize, mask_size: u32) -> OcclusionSettings {
+        OcclusionSettings {
+            regions,
+            mask_size,
+            penumbra: Penumbra::Fixed,
+            size: RegionSize::Geometric,
+            dominant_lights: 0,
+            pixel_cosine: false,
+            ..OcclusionSettings::default()
+        }
+    }
+
+    /// Checks every setting (0 regions is Sloan's PRT: see [`crate::techniques::sloan`]).
+    pub fn validated(self) -> Result<OcclusionSettings> {
+        let invalid = |message: String| Err(Error::InvalidArgument(message));
+        if self.regions > constants::MAX_REGIONS as usize {
+            return invalid(format!(
+                "{} regions: the Tamura technique interpolates at most {} per vertex",
+                self.regions,
+                constants::MAX_REGIONS
+            ));
+        }
+        if self.max_layers > constants::MAX_OCCLUSION_LAYERS {
+            return invalid(format!(
+                "{} occlusion layers: at most {} fit the uniform buffer",
+                self.max_layers,
+                constants::MAX_OCCLUSION_LAYERS
+            ));
+        }
+        if !(8..=2048).contains(&self.mask_size) {
+            return invalid(format!("mask size {} must be 8 to 2048 texels", self.mask_size));
+        }
+        let max = constants::MAX_DOMINANT_LIGHTS as usize;
+        if self.dominant_lights > max {
+            return invalid(format!(
+                "dominant lights: {} is more than the {max} Tamura lights per pixel",
+                self.dominant_lights
+            ));
+        }
+        let sizes = dominant_maps::MAP_SIZES;
+        if !sizes.contains(&self.light_map_size) {
+            return invalid(format!(
+                "light map size {} must be {} to {} texels",
+                self.light_map_size,
+                sizes.start(),
+                sizes.end()
+            ));
+        }
+        Ok(self)
+    }
+}
+
 pub struct PrtTechnique {
     /// The groups it lights (all, unless another technique lights some: see `for_groups`).
     drawn: fn(usize) -> bool,
@@ -91,33 +149,7 @@ impl PrtTechnique {
         transfer: &TransferSet,
         settings: OcclusionSettings,
     ) -> Result<PrtTechnique> {
-        if settings.regions > constants::MAX_REGIONS as usize {
-            return Err(Error::InvalidArgument(format!(
-                "{} regions: the Tamura technique interpolates at most {} per vertex",
-                settings.regions,
-                constants::MAX_REGIONS
-            )));
-        }
-        if settings.max_layers > constants::MAX_OCCLUSION_LAYERS {
-            return Err(Error::InvalidArgument(format!(
-                "{} occlusion layers: at most {} fit the uniform buffer",
-                settings.max_layers,
-                constants::MAX_OCCLUSION_LAYERS
-            )));
-        }
-        if !(8..=2048).contains(&settings.mask_size) {
-            return Err(Error::InvalidArgument(format!(
-                "mask size {} must be 8 to 2048 texels",
-                settings.mask_size
-            )));
-        }
-        if settings.dominant_lights > constants::MAX_DOMINANT_LIGHTS as usize {
-            return Err(Error::InvalidArgument(format!(
-                "{} dominant lights: the Tamura technique lights at most {} per pixel",
-                settings.dominant_lights,
-                constants::MAX_DOMINANT_LIGHTS
-            )));
-        }
+        let settings = settings.validated()?;
         let bands = transfer.params.bands as usize;
         // Without regions (Sloan's PRT) the whole map is the self-shadowed light.
         let max_lights = if settings.regions == 0 { 0 } else { settings.dominant_lights };
@@ -193,8 +225,11 @@ impl PrtTechnique {
 }
 
 impl Technique for PrtTechnique {
-    fn dropped_layers(&self) -> usize {
-        self.occlusion.dropped + self.dominant.dropped
+    fn stats(&self) -> TechniqueStats {
+        TechniqueStats {
+            dropped_layers: self.occlusion.dropped + self.dominant.dropped,
+            ..Default::default()
+        }
     }
 
     fn update(&mut self, state: &FrameState) -> Result<()> {
