@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what Kage needs on a Debian/Ubuntu machine and prepares the static glslang/shaderc
-# archive that engine/build.rs links (see vendor-notes.md, "Building shaders"). Idempotent.
+# archive that the engine links (see vendor-notes.md, "Building shaders"). Idempotent.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 

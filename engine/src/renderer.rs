@@ -5,10 +5,10 @@ use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
 use crate::frame::sh_projection::ShProjection;
-use crate::frame::{FrameInputs, FrameState, GpuScene, Targets};
+use crate::frame::{FrameInputs, FrameState, GpuScene, Targets, COLOR, ENVIRONMENT, ENV_SH, FRAME_UNIFORMS};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
-use crate::pass::{FrameExecutor, Pass, PassTiming};
+use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
 use crate::prt::TransferSet;
 use crate::scene::{Light, Scene};
 use crate::techniques::description::TechniqueDesc;
@@ -148,7 +148,7 @@ impl Renderer {
             scene: &self.scene,
             targets: &self.targets,
         };
-        let mut imports = vec!["frame_uniforms", "environment"];
+        let mut imports = vec![FRAME_UNIFORMS, ENVIRONMENT];
         imports.extend_from_slice(self.technique.persistent());
         let analysis = self.technique.analysis_passes(&inputs);
         let mut timings = Vec::new();
@@ -156,8 +156,7 @@ impl Renderer {
             drop(analysis);
         } else {
             // What the analysis wrote stays for the frame (the ASM depth prepass).
-            let written: Vec<&'static str> =
-                analysis.iter().flat_map(|p| p.outputs.iter().copied()).collect();
+            let written: Vec<Resource> = analysis.iter().flat_map(|p| p.outputs.iter().copied()).collect();
             timings = self.executor.run(&imports, analysis)?;
             imports.extend(written);
             self.technique.analysed()?;
@@ -166,12 +165,12 @@ impl Renderer {
         if self.env_dirty {
             passes.extend(self.env_sh.passes(&self.env.image, &self.env.sampler));
         } else {
-            imports.push("env_sh");
+            imports.push(ENV_SH);
         }
         passes.push(self.background.pass(&inputs));
         passes.extend(self.technique.passes(&inputs));
         let targets = &self.targets;
-        passes.push(Pass::new("readback", &["color"], &[], move |cmd| targets.record_readback(cmd)));
+        passes.push(Pass::new("readback", &[COLOR], &[], move |cmd| targets.record_readback(cmd)));
         let frame = self.executor.run(&imports, passes)?;
         self.technique.timed(&frame);
         timings.extend(frame);

@@ -4,6 +4,7 @@ use kage::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, ContextDesc, MemoryLocation,
 };
 use kage::layouts::{bytes_of, bytes_of_slice, constants, spirv, ShCoeffs, ShProjectPush};
+use kage::pass::Resource;
 use kage::pass::{FrameExecutor, Pass};
 use kage_tests::Validated;
 
@@ -71,8 +72,8 @@ fn compute_shader_result_is_exact() {
     let mut executor = FrameExecutor::new(&ctx, "exact").unwrap();
     let timings = executor
         .run(
-            &["partials"],
-            vec![Pass::new("reduce", &["partials"], &["sum"], |cmd| {
+            &[Resource("partials")],
+            vec![Pass::new("reduce", &[Resource("partials")], &[Resource("sum")], |cmd| {
                 pipeline.dispatch(
                     cmd,
                     &[Binding::Storage(&input), Binding::Storage(&output)],
@@ -107,8 +108,8 @@ fn frame_with_unordered_passes_is_rejected() {
         .run(
             &[],
             vec![
-                Pass::new("consumer", &["thing"], &[], |_| {}),
-                Pass::new("producer", &[], &["thing"], |_| {}),
+                Pass::new("consumer", &[Resource("thing")], &[], |_| {}),
+                Pass::new("producer", &[], &[Resource("thing")], |_| {}),
             ],
         )
         .unwrap_err();

@@ -566,10 +566,11 @@ fn rss_bytes() -> u64 {
 /// Renders `frames` animated frames at 16² with the unshadowed and the shadowmap technique and
 /// checks that memory stays flat: device memory (`Context::allocated_bytes`) exactly, resident
 /// host memory within `RSS_SLACK` after a warm-up of 1,000 frames (allocator pools and the
-/// validation layer's first-use tables settle there). A leak of one 16² readback per frame
-/// (4 KiB) would add 16 MiB in 4,000 frames.
+/// validation layer's first-use tables settle there; after it, the suite measured up to 3 MiB
+/// of drift over 3,000 frames while other test binaries ran). A leak of one 16² readback per
+/// frame (4 KiB) would add 12 MiB in 3,000 frames, three times the slack.
 fn memory_stays_flat(frames: usize) {
-    const RSS_SLACK: u64 = 2 << 20;
+    const RSS_SLACK: u64 = 4 << 20;
     const WARM_UP: usize = 1000;
     let _alone = ALONE.write().unwrap_or_else(|e| e.into_inner());
     let ctx = Validated::new();

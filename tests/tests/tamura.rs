@@ -5,6 +5,7 @@ use kage::frame::bounds::group_bounds;
 use kage::frame::regions::Regions;
 use kage::frame::GpuScene;
 use kage::layouts::{bytes_of, bytes_of_slice, spirv, BlurPush, OcclusionLayer};
+use kage::pass::Resource;
 use kage::pass::{FrameExecutor, Pass};
 use kage::prt::TransferSet;
 use kage::renderer::{RenderOptions, Renderer};
@@ -82,8 +83,8 @@ fn filter_layer(
     };
     let mut executor = FrameExecutor::new(ctx, "filter").unwrap();
     let passes = vec![
-        Pass::new("horizontal", &[], &["half"], |cmd| filter(cmd, 0, &mask, &temp)),
-        Pass::new("vertical", &["half"], &[], |cmd| filter(cmd, 1, &temp, &filtered)),
+        Pass::new("horizontal", &[], &[Resource("half")], |cmd| filter(cmd, 0, &mask, &temp)),
+        Pass::new("vertical", &[Resource("half")], &[], |cmd| filter(cmd, 1, &temp, &filtered)),
     ];
     executor.run(&[], passes).unwrap();
     let floats: Vec<f32> = filtered

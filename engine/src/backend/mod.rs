@@ -9,6 +9,7 @@ mod descriptor;
 mod device;
 mod image;
 mod pipeline;
+mod reflect;
 mod rendering;
 mod timestamps;
 mod validation;

@@ -1,7 +1,7 @@
 //! Compute and graphics pipelines. Each owns its set layout (push descriptors, set 0) and
 //! pipeline layout, and records its own binds so passes stay short.
 use super::descriptor::{push_descriptors, set_layout_bindings};
-use super::{Binding, BindingKind, Context};
+use super::{reflect, Binding, BindingKind, Context};
 use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
@@ -57,11 +57,16 @@ struct Module<'a> {
 }
 
 impl<'a> Module<'a> {
-    fn new(ctx: &'a Context, name: &str, spirv: &[u8]) -> Result<Module<'a>> {
+    /// The module of `spirv`, after checking that the pipeline's `bindings` declare every
+    /// descriptor the shader uses with its kind.
+    fn new(ctx: &'a Context, name: &str, spirv: &[u8], bindings: &[BindingKind]) -> Result<Module<'a>> {
         let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
             .map_err(|e| Error::Internal(format!("SPIR-V of {name}: {e}")))?;
+        reflect::descriptor_bindings(&words)
+            .and_then(|used| reflect::check(name, bindings, &used))
+            .map_err(|e| Error::Internal(format!("shader {name}: {e}")))?;
         let info = vk::ShaderModuleCreateInfo::default().code(&words);
-        // SAFETY: the words are SPIR-V compiled by build.rs.
+        // SAFETY: the words are SPIR-V compiled by the build script.
         let raw = unsafe { ctx.device.create_shader_module(&info, None) }
             .map_err(Error::vk("vkCreateShaderModule"))?;
         ctx.set_name(raw, name);
@@ -98,7 +103,7 @@ impl ComputePipeline {
         bindings: &[BindingKind],
         push_size: u32,
     ) -> Result<ComputePipeline> {
-        let module = Module::new(ctx, &format!("{name}.comp"), spirv)?;
+        let module = Module::new(ctx, &format!("{name}.comp"), spirv, bindings)?;
         let layout = create_layout(ctx, name, bindings, push_size)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -207,8 +212,8 @@ pub struct GraphicsPipeline {
 
 impl GraphicsPipeline {
     pub fn new(ctx: &Arc<Context>, desc: &GraphicsDesc) -> Result<GraphicsPipeline> {
-        let vs = Module::new(ctx, &format!("{}.vert", desc.name), desc.vertex_spirv)?;
-        let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv)?;
+        let vs = Module::new(ctx, &format!("{}.vert", desc.name), desc.vertex_spirv, desc.bindings)?;
+        let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv, desc.bindings)?;
         let layout = create_layout(ctx, desc.name, desc.bindings, desc.push_size)?;
         let entries: Vec<vk::SpecializationMapEntry> = (0..desc.constants.len() as u32)
             .map(|id| vk::SpecializationMapEntry { constant_id: id, offset: 4 * id, size: 4 })

@@ -1,7 +1,7 @@
 //! The environment seen directly, behind everything: one full-screen triangle that clears the
 //! colour target and looks up the map along each pixel's view ray.
 use super::environment::GpuEnvironment;
-use super::FrameInputs;
+use super::{FrameInputs, COLOR, ENVIRONMENT, FRAME_UNIFORMS};
 use crate::backend::{vk, Binding, BindingKind, Buffer, Context, DepthTest, GraphicsDesc, GraphicsPipeline};
 use crate::error::Result;
 use crate::frame::COLOR_FORMAT;
@@ -38,7 +38,7 @@ impl Background {
     pub fn pass<'a>(&'a self, inputs: &FrameInputs<'a>) -> Pass<'a> {
         let (ctx, uniforms, env, color) =
             (inputs.ctx, inputs.uniforms, inputs.environment, &inputs.targets.color);
-        Pass::new("background", &["frame_uniforms", "environment"], &["color"], move |cmd| {
+        Pass::new("background", &[FRAME_UNIFORMS, ENVIRONMENT], &[COLOR], move |cmd| {
             ctx.begin_rendering(cmd, Some(color.into()), Some([0.0; 4]), None);
             self.draw(ctx, cmd, uniforms, env);
             ctx.end_rendering(cmd);

@@ -9,21 +9,22 @@
 //! ASM lighting pass 2x as long on lavapipe; BENCHMARKS.md).
 use super::gpu_scene::MESH_VERTICES;
 use super::shadow_depth::depth_only_pipeline;
-use super::FrameInputs;
+use super::shadow_depth::SHADOW_MAPS;
+use super::{FrameInputs, COLOR, DEPTH, FRAME_UNIFORMS};
 use crate::backend::{
     vk, Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
 };
 use crate::error::Result;
 use crate::frame::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::{bytes_of, spirv, DrawPush, Pod};
-use crate::pass::Pass;
+use crate::pass::{Pass, Resource};
 use glam::Mat4;
 use std::sync::Arc;
 
 /// What a shadow-map technique's scene pass reads.
-pub const SCENE_READS: [&str; 3] = ["frame_uniforms", "shadow_maps", "color"];
+pub const SCENE_READS: [Resource; 3] = [FRAME_UNIFORMS, SHADOW_MAPS, COLOR];
 /// What a shadow-map technique's scene pass after a depth prepass reads.
-pub const PREPASS_SCENE_READS: [&str; 4] = ["frame_uniforms", "shadow_maps", "color", "depth"];
+pub const PREPASS_SCENE_READS: [Resource; 4] = [FRAME_UNIFORMS, SHADOW_MAPS, COLOR, DEPTH];
 
 /// A scene pipeline named `name` from its two shaders, resources and push-constant size, drawing
 /// the meshes' positions and normals with the depth test `depth` (`Equal` after
@@ -54,7 +55,7 @@ pub fn depth_prepass<'a, P: Pod>(
     push: impl Fn(&GpuMesh, &Mat4) -> P + 'a,
 ) -> Pass<'a> {
     let (ctx, scene, targets, uniforms) = (frame.ctx, frame.scene, frame.targets, frame.uniforms);
-    Pass::new("depth_prepass", &["frame_uniforms"], &["depth"], move |cmd| {
+    Pass::new("depth_prepass", &[FRAME_UNIFORMS], &[DEPTH], move |cmd| {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear((&targets.depth).into())));
         pipeline.bind(cmd, &[Binding::Uniform(uniforms)]);
         draw_meshes(ctx, cmd, scene, pipeline, &|m, t| Some(push(m, t)));
@@ -96,13 +97,13 @@ pub fn scene_pipeline_with(
 /// `Equal`, else into a cleared depth target.
 pub fn scene_pass<'a, P: Pod>(
     frame: &FrameInputs<'a>,
-    reads: &'a [&'static str],
+    reads: &'a [Resource],
     pipeline: &'a GraphicsPipeline,
     bindings: Vec<Binding<'a>>,
     push: impl Fn(&GpuMesh, &Mat4) -> P + 'a,
 ) -> Pass<'a> {
     let (ctx, scene, targets) = (frame.ctx, frame.scene, frame.targets);
-    Pass::new("scene", reads, &["color", "depth"], move |cmd| {
+    Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
         let depth = (&targets.depth).into();
         let depth =
             if pipeline.depth() == DepthTest::Equal { Depth::Keep(depth) } else { Depth::Clear(depth) };

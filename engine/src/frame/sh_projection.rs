@@ -9,7 +9,7 @@ use crate::backend::{
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, constants, spirv, ShCoeffs, ShProjectPush};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, Resource};
 use crate::scene::EnvMap;
 use crate::sh::ShRgb9;
 use std::sync::Arc;
@@ -44,16 +44,16 @@ impl Mapping {
 #[derive(Clone, Copy, Debug)]
 pub struct ProjectionNames {
     /// The image projected (a pass input).
-    pub source: &'static str,
+    pub source: Resource,
     /// The partial sums (between the two passes).
-    pub partials: &'static str,
+    pub partials: Resource,
     /// The result (the second pass's output) and its buffer's debug name.
-    pub result: &'static str,
+    pub result: Resource,
 }
 
 /// The environment's projection as the renderer runs it.
 pub const ENVIRONMENT: ProjectionNames =
-    ProjectionNames { source: "environment", partials: "sh_partials", result: "env_sh" };
+    ProjectionNames { source: super::ENVIRONMENT, partials: Resource("sh_partials"), result: super::ENV_SH };
 
 pub struct ShProjection {
     project: ComputePipeline,
@@ -90,7 +90,7 @@ impl ShProjection {
             partials: Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: names.partials,
+                    name: names.partials.0,
                     size: groups as u64 * size_of::<ShCoeffs>() as u64,
                     usage: storage,
                     location: MemoryLocation::GpuOnly,
@@ -99,7 +99,7 @@ impl ShProjection {
             coefficients: Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: names.result,
+                    name: names.result.0,
                     size: size_of::<ShCoeffs>() as u64,
                     // Read per fragment as uniforms: far cheaper than a storage buffer on CPU drivers.
                     usage: storage

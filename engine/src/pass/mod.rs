@@ -25,19 +25,25 @@ use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
 
+/// A resource passes read and write (a GPU buffer or image), named once as a constant beside
+/// what makes it (`frame::COLOR`, `techniques::tamura::occlusion::OCCLUSION`), so that a
+/// misspelt resource is a compile error; the executor checks a frame's order by them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resource(pub &'static str);
+
 /// One pass of a frame.
 pub struct Pass<'a> {
     pub name: &'static str,
-    pub inputs: &'a [&'static str],
-    pub outputs: &'a [&'static str],
+    pub inputs: &'a [Resource],
+    pub outputs: &'a [Resource],
     record: Box<dyn FnOnce(vk::CommandBuffer) + 'a>,
 }
 
 impl<'a> Pass<'a> {
     pub fn new(
         name: &'static str,
-        inputs: &'a [&'static str],
-        outputs: &'a [&'static str],
+        inputs: &'a [Resource],
+        outputs: &'a [Resource],
         record: impl FnOnce(vk::CommandBuffer) + 'a,
     ) -> Pass<'a> {
         Pass { name, inputs, outputs, record: Box::new(record) }
@@ -97,7 +103,7 @@ impl FrameExecutor {
     }
 
     /// Runs `passes` in order as one submission and returns each pass's GPU time.
-    pub fn run(&mut self, imports: &[&'static str], passes: Vec<Pass<'_>>) -> Result<Vec<PassTiming>> {
+    pub fn run(&mut self, imports: &[Resource], passes: Vec<Pass<'_>>) -> Result<Vec<PassTiming>> {
         check_data_flow(imports, &passes)?;
         let count = 2 * passes.len() as u32;
         let period_ns = self.ctx.info().timestamp_period_ns;
@@ -163,13 +169,13 @@ impl Drop for FrameExecutor {
     }
 }
 
-fn check_data_flow(imports: &[&'static str], passes: &[Pass<'_>]) -> Result<()> {
-    let mut available: Vec<&str> = imports.to_vec();
+fn check_data_flow(imports: &[Resource], passes: &[Pass<'_>]) -> Result<()> {
+    let mut available: Vec<Resource> = imports.to_vec();
     for pass in passes {
         if let Some(missing) = pass.inputs.iter().find(|i| !available.contains(i)) {
             return Err(Error::Internal(format!(
-                "pass {} reads {missing}, which no earlier pass writes and the frame does not import",
-                pass.name
+                "pass {} reads {}, which no earlier pass writes and the frame does not import",
+                pass.name, missing.0
             )));
         }
         available.extend_from_slice(pass.outputs);

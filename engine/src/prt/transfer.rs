@@ -11,7 +11,8 @@ use crate::backend::MemoryLocation;
 use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, PrtTransferPush, PrtVertex};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::raycast::BVH;
 use crate::raycast::{GpuBvh, SceneBvh};
 use crate::scene::Scene;
 
@@ -113,7 +114,7 @@ fn run_jobs(
     let mut done = 0;
     progress(done, total);
     for batch in submissions(&mesh_layout(scene), params) {
-        let pass = Pass::new("prt_transfer", &["bvh"], &["prt_transfer"], |cmd| {
+        let pass = Pass::new("prt_transfer", &[BVH], &[Resource("prt_transfer")], |cmd| {
             for first_ray in (0..params.rays).step_by(RAYS_PER_DISPATCH as usize) {
                 // Each dispatch adds to the sums the previous one wrote.
                 if first_ray > 0 {
@@ -130,7 +131,7 @@ fn run_jobs(
                 }
             }
         });
-        executor.run(&["bvh"], vec![pass])?;
+        executor.run(&[BVH], vec![pass])?;
         done += batch.iter().map(|p| p.range[1] as usize).sum::<usize>();
         progress(done, total);
     }

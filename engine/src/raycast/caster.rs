@@ -6,7 +6,10 @@ use crate::backend::{
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, CastPush, CastRay, CastResult};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, Resource};
+
+/// The hits of a batch of rays.
+pub const RESULTS: Resource = Resource("raycast.results");
 use std::sync::Arc;
 
 /// What to ask of each ray.
@@ -46,7 +49,7 @@ impl GpuRays {
             results: Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: "raycast.results",
+                    name: RESULTS.0,
                     size: rays.len() as u64 * size_of::<CastResult>() as u64,
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
                     location: MemoryLocation::GpuOnly,
@@ -116,7 +119,7 @@ impl RayCaster {
         let pipeline = &self.pipeline;
         let timings = self.executor.run(
             &[],
-            vec![Pass::new("raycast", &[], &["raycast.results"], move |cmd| {
+            vec![Pass::new("raycast", &[], &[RESULTS], move |cmd| {
                 let mut bindings: Vec<Binding> = bvh.bindings().into();
                 bindings.extend([Binding::Storage(&rays.rays), Binding::Storage(&rays.results)]);
                 for first in (0..rays.count).step_by(per_dispatch as usize) {

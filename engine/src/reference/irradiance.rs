@@ -20,7 +20,7 @@ use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{vk, BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, IrradiancePoint, IrradiancePush};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, Resource};
 use crate::scene::Scene;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
@@ -285,7 +285,7 @@ impl IrradianceReference {
             };
             let bindings =
                 lighting.bindings(&[accum, points, &lighting.lights, radiance, &lighting.triangle_vertices]);
-            Pass::new("reference_irradiance", &IMPORTS, &["irradiance_accum"], move |cmd| {
+            Pass::new("reference_irradiance", &IMPORTS, &[Resource("irradiance_accum")], move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
             })
         });

@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::frame::MAX_SIZE;
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, constants, spirv, ReferenceLight, ReferencePush};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, Resource};
 use crate::scene::{Camera, Light, Scene};
 use std::sync::Arc;
 
@@ -91,7 +91,7 @@ impl ReferenceRenderer {
             let push =
                 ReferencePush { inv_view_proj, camera_pos, frame: [width, height, first, count], params };
             let bindings = lighting.bindings(&[accum, lights]);
-            Pass::new("reference_render", &IMPORTS, &["reference_accum"], move |cmd| {
+            Pass::new("reference_render", &IMPORTS, &[Resource("reference_accum")], move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
             })
         });

@@ -290,8 +290,7 @@ mod tests {
             assert_eq!(TechniqueDesc::new(kind).precomputation(), wanted, "{kind:?}");
         }
         // Static groups lit by Sloan's PRT: the probes technique needs the transfer too.
-        let mut probes = ProbeSettings::default();
-        probes.statics = StaticLighting::Sloan;
+        let probes = ProbeSettings { statics: StaticLighting::Sloan, ..Default::default() };
         let sloan_statics = TechniqueDesc::Probes { probes, prt: PrtParams::DEFAULT };
         assert_eq!(sloan_statics.precomputation(), group);
         assert!(sloan_statics.transfer(None).unwrap_err().to_string().contains("precompute it first"));

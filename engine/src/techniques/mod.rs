@@ -11,7 +11,7 @@ pub mod unshadowed;
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, FrameState};
-use crate::pass::{Pass, PassTiming};
+use crate::pass::{Pass, PassTiming, Resource};
 
 /// A lighting technique: host-side updates, then the passes that draw the scene over the
 /// background (the colour target is cleared and holds the environment when they start).
@@ -19,7 +19,7 @@ pub trait Technique {
     fn update(&mut self, state: &FrameState) -> Result<()>;
     /// Resources the technique keeps from frame to frame, which its passes may read without a
     /// pass of the same frame writing them.
-    fn persistent(&self) -> &'static [&'static str] {
+    fn persistent(&self) -> &'static [Resource] {
         &[]
     }
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>>;

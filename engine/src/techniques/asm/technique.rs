@@ -38,10 +38,12 @@ use crate::frame::bounds::{group_bounds, GroupBounds};
 use crate::frame::scene_pass::{
     depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
 };
+use crate::frame::shadow_depth::SHADOW_MAPS;
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuMesh, GpuScene};
+use crate::frame::{DEPTH, FRAME_UNIFORMS};
 use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, LocalDrawPush, ShadowLight};
-use crate::pass::{FrameExecutor, Pass, PassTiming};
+use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
 use crate::scene::clusters::Cluster;
 use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
@@ -362,7 +364,7 @@ impl Asm {
             let passes = renders
                 .iter()
                 .map(|t| {
-                    Pass::new("asm_calibration", &[], &["asm_calibration"], move |cmd| {
+                    Pass::new("asm_calibration", &[], &[Resource("asm_calibration")], move |cmd| {
                         self.pages.record(ctx, cmd, gpu, std::slice::from_ref(t))
                     })
                 })
@@ -574,7 +576,7 @@ impl Technique for Asm {
 
     fn analysis_passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene, targets, uniforms) = (inputs.ctx, inputs.scene, inputs.targets, inputs.uniforms);
-        let refresh = Pass::new("asm_refresh", &[], &["shadow_maps"], move |cmd| {
+        let refresh = Pass::new("asm_refresh", &[], &[SHADOW_MAPS], move |cmd| {
             self.pages.record(ctx, cmd, scene, &self.refresh);
         });
         // The eye view the analysis reads is the lighting pass' depth prepass.
@@ -582,8 +584,8 @@ impl Technique for Asm {
         let (width, height) = (targets.depth.width, targets.depth.height);
         let analysis = Pass::new(
             "asm_analysis",
-            &["frame_uniforms", "shadow_maps", "depth"],
-            &["asm_requests"],
+            &[FRAME_UNIFORMS, SHADOW_MAPS, DEPTH],
+            &[Resource("asm_requests")],
             move |cmd| {
                 self.requests.record_zero(cmd);
                 ctx.full_barrier(cmd);
@@ -662,7 +664,7 @@ impl Technique for Asm {
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene) = (inputs.ctx, inputs.scene);
-        let tiles = Pass::new("asm_tiles", &[], &["shadow_maps"], move |cmd| {
+        let tiles = Pass::new("asm_tiles", &[], &[SHADOW_MAPS], move |cmd| {
             self.pages.record(ctx, cmd, scene, &self.render);
         });
         let mut bindings = vec![

@@ -33,10 +33,18 @@ use crate::frame::environment::GpuEnvironment;
 use crate::frame::gpu_scene::MESH_POSITIONS;
 use crate::frame::scene_pass::scene_pipeline_with;
 use crate::frame::sh_projection::{Mapping, ProjectionNames, ShProjection};
+use crate::frame::ENVIRONMENT;
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::ReferenceLight;
 use crate::layouts::{bytes_of, spirv, DrawPush, FrameUniforms};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{FrameExecutor, Pass, Resource};
+
+/// The cube faces' view matrices.
+const FACES: Resource = Resource("probe_faces");
+/// The static surfaces' radiance per vertex.
+const RADIANCE: Resource = Resource("probe_radiance");
+/// The captured cube map.
+const CUBE: Resource = Resource("probe_cube");
 use crate::raycast::SceneBvh;
 use crate::reference::{irradiance::check_bounces, surface_radiance};
 use crate::scene::{Camera, Scene};
@@ -162,10 +170,10 @@ const RADIANCE_VERTICES: VertexBuffer<'static> =
     VertexBuffer { stride: 16, attributes: &RADIANCE_ATTRIBUTES };
 
 const PROBE_CUBE: ProjectionNames =
-    ProjectionNames { source: "probe_cube", partials: "probe_sh_partials", result: "probe_sh" };
+    ProjectionNames { source: CUBE, partials: Resource("probe_sh_partials"), result: Resource("probe_sh") };
 /// What every capture reads without writing it: the faces' cameras, the environment and the
 /// walls' radiance.
-const IMPORTS: [&str; 3] = ["probe_faces", "environment", "probe_radiance"];
+const IMPORTS: [Resource; 3] = [FACES, ENVIRONMENT, RADIANCE];
 
 /// Captures probes of one scene, one after another, reusing its cube map and pipelines.
 pub struct ProbeCapture {
@@ -218,7 +226,7 @@ impl ProbeCapture {
             ctx: ctx.clone(),
             settings,
             cube: image(
-                PROBE_CUBE.source,
+                PROBE_CUBE.source.0,
                 COLOR_FORMAT,
                 vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
             )?,
@@ -277,7 +285,7 @@ impl ProbeCapture {
         let (background, surfaces, env, radiance) =
             (&self.background, &self.surfaces, &self.env, &self.radiance);
         let mut passes = vec![
-            Pass::new("probe_background", &["probe_faces", "environment"], &["probe_cube"], move |cmd| {
+            Pass::new("probe_background", &[FACES, ENVIRONMENT], &[CUBE], move |cmd| {
                 ctx.begin_rendering(cmd, Some(cube.into()), Some([0.0; 4]), None);
                 for (f, uniforms) in faces.iter().enumerate() {
                     ctx.set_viewport(cmd, face_area(f as u32));
@@ -287,8 +295,8 @@ impl ProbeCapture {
             }),
             Pass::new(
                 "probe_surfaces",
-                &["probe_faces", "probe_radiance", "probe_cube"],
-                &["probe_cube", "probe_depth"],
+                &[FACES, RADIANCE, CUBE],
+                &[CUBE, Resource("probe_depth")],
                 move |cmd| {
                     ctx.begin_rendering(cmd, Some(cube.into()), None, Some(Depth::Clear(depth.into())));
                     for (f, uniforms) in faces.iter().enumerate() {

@@ -14,11 +14,13 @@ use crate::error::{Error, Result};
 use crate::frame::scene_pass::{draw_lit_meshes, lighting_pipeline};
 use crate::frame::GpuScene;
 use crate::frame::{FrameInputs, FrameState};
+use crate::frame::{COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
 use crate::layouts::{bytes_of, spirv, ProbeLight};
-use crate::pass::Pass;
+use crate::pass::{Pass, Resource};
 use crate::prt::TransferSet;
 use crate::scene::Scene;
 use crate::techniques::sloan;
+use crate::techniques::sloan::self_shadow::SELF_SHADOW;
 use crate::techniques::tamura::technique::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
 use crate::techniques::{Technique, TechniqueStats};
@@ -102,7 +104,7 @@ impl Technique for ProbeTechnique {
         self.light.write(0, bytes_of(&ProbeLight { red, green, blue }))
     }
 
-    fn persistent(&self) -> &'static [&'static str] {
+    fn persistent(&self) -> &'static [Resource] {
         match &self.statics {
             Statics::Unshadowed(_) => &[],
             Statics::Sloan(prt) => prt.persistent(),
@@ -112,11 +114,11 @@ impl Technique for ProbeTechnique {
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, env_sh, scene, targets) =
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
-        let (mut passes, reads): (Vec<Pass>, &'static [&'static str]) = match &self.statics {
-            Statics::Unshadowed(_) => (Vec::new(), &["frame_uniforms", "env_sh", "color"]),
-            Statics::Sloan(prt) => (prt.prepasses(ctx, scene), &["frame_uniforms", "self_shadow", "color"]),
+        let (mut passes, reads): (Vec<Pass>, &'static [Resource]) = match &self.statics {
+            Statics::Unshadowed(_) => (Vec::new(), &[FRAME_UNIFORMS, ENV_SH, COLOR]),
+            Statics::Sloan(prt) => (prt.prepasses(ctx, scene), &[FRAME_UNIFORMS, SELF_SHADOW, COLOR]),
         };
-        passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
+        passes.push(Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
             ctx.begin_rendering(
                 cmd,
                 Some((&targets.color).into()),

@@ -34,7 +34,14 @@ use crate::frame::{GpuScene, DEPTH_FORMAT};
 use crate::layouts::{
     bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
 };
-use crate::pass::Pass;
+use crate::pass::{Pass, Resource};
+
+/// The occluder masks before filtering.
+pub const MASKS: Resource = Resource("occlusion_masks");
+/// The masks after the horizontal filter pass.
+pub const HALF_FILTERED: Resource = Resource("occlusion_half");
+/// The filtered masks V_o the scene pass reads.
+pub const OCCLUSION: Resource = Resource("occlusion");
 use crate::sh;
 use glam::{Mat3, Mat4, Vec3};
 use std::sync::Arc;
@@ -468,7 +475,7 @@ impl Occlusion {
             }
         };
         vec![
-            Pass::new("occluder_masks", &[], &["occlusion_masks"], move |cmd| {
+            Pass::new("occluder_masks", &[], &[MASKS], move |cmd| {
                 for (l, (layer, &receiver)) in self.in_use.iter().zip(&self.receivers).enumerate() {
                     let target = Target { image: &self.mask, layer: l as u32 };
                     let depth = Depth::Clear(Target { image: &self.mask_depth, layer: l as u32 });
@@ -478,10 +485,10 @@ impl Occlusion {
                     ctx.end_rendering(cmd);
                 }
             }),
-            Pass::new("blur_horizontal", &["occlusion_masks"], &["occlusion_half"], move |cmd| {
+            Pass::new("blur_horizontal", &[MASKS], &[HALF_FILTERED], move |cmd| {
                 blur(cmd, true, &self.mask, &self.temp)
             }),
-            Pass::new("blur_vertical", &["occlusion_half"], &["occlusion"], move |cmd| {
+            Pass::new("blur_vertical", &[HALF_FILTERED], &[OCCLUSION], move |cmd| {
                 blur(cmd, false, &self.temp, &self.filtered)
             }),
         ]

@@ -1,7 +1,9 @@
 //! The PRT scene technique: self-shadowed radiance per vertex (Sloan et al.), minus, with
 //! regions, the light other groups block (Tamura et al. eq. (15)).
 use super::dominant;
+use super::dominant_maps::DOMINANT_MAPS;
 use super::dominant_maps::{self, DominantMaps};
+use super::occlusion::OCCLUSION;
 use super::occlusion::{Occlusion, RegionSize};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline,
@@ -13,10 +15,12 @@ use crate::frame::gpu_scene::MESH_VERTICES;
 use crate::frame::regions::Regions;
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::frame::{COLOR, DEPTH, FRAME_UNIFORMS};
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush, ShCoeffs};
-use crate::pass::Pass;
+use crate::pass::{Pass, Resource};
 use crate::prt::TransferSet;
 use crate::scene::Scene;
+use crate::techniques::sloan::self_shadow::SELF_SHADOW;
 use crate::techniques::sloan::self_shadow::{transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::techniques::{Technique, TechniqueStats};
 use std::sync::Arc;
@@ -239,20 +243,20 @@ impl Technique for PrtTechnique {
         self.occlusion.update(state.transforms, env)
     }
 
-    fn persistent(&self) -> &'static [&'static str] {
-        &["self_shadow", "dominant_maps"]
+    fn persistent(&self) -> &'static [Resource] {
+        &[SELF_SHADOW, DOMINANT_MAPS]
     }
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
         let mut passes = self.prepasses(ctx, scene);
-        // What the scene pass reads: the frame's layers, where there are any.
-        let reads: &'static [&'static str] = if passes.iter().any(|p| p.name == "blur_vertical") {
-            &["frame_uniforms", "self_shadow", "occlusion", "dominant_maps", "color"]
+        // What the scene pass reads: the filtered layers where an earlier pass wrote them.
+        let reads: &'static [Resource] = if passes.iter().any(|p| p.outputs.contains(&OCCLUSION)) {
+            &[FRAME_UNIFORMS, SELF_SHADOW, OCCLUSION, DOMINANT_MAPS, COLOR]
         } else {
-            &["frame_uniforms", "self_shadow", "dominant_maps", "color"]
+            &[FRAME_UNIFORMS, SELF_SHADOW, DOMINANT_MAPS, COLOR]
         };
-        passes.push(Pass::new("scene", reads, &["color", "depth"], move |cmd| {
+        passes.push(Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
             ctx.begin_rendering(
                 cmd,
                 Some((&targets.color).into()),

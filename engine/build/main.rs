@@ -1,0 +1,97 @@
+//! Build-time code generation for everything GLSL and Rust share (see src/layouts.rs):
+//!
+//! - every top-level `.comp`/`.vert`/`.frag` in `shaders-glsl/` becomes `$OUT_DIR/<name>.spv`,
+//!   listed as byte constants in `$OUT_DIR/shaders.rs`;
+//! - `shaders-glsl/include/constants.glsl` (`#define KAGE_NAME value`) becomes
+//!   `$OUT_DIR/constants.rs`;
+//! - the `struct`s of `shaders-glsl/include/layouts.glsl` become `#[repr(C)]` Rust structs with
+//!   std430 offsets in `$OUT_DIR/layouts.rs`, with compile-time size and offset assertions.
+//!
+//! Linking shaderc: `.cargo/config.toml` points `SHADERC_LIB_DIR` at `.deps/shaderc`, where
+//! scripts/deps.sh merges Debian's static glslang/SPIRV-Tools/shaderc archives into one
+//! `libshaderc_combined.a` (libstdc++ comes through shaderc-sys's `link-cplusplus` dependency).
+//! If that archive is missing, shaderc-sys only prints a warning and falls back to building
+//! glslang from source (about ten minutes on two cores). This script cannot stop that: build
+//! dependencies are built before it runs. It does check for the archive afterwards so that the
+//! cause is at least named; run scripts/deps.sh (then `cargo clean -p shaderc-sys`) to fix it.
+
+mod constants;
+mod layouts;
+mod shaders;
+
+use constants::generate_constants;
+use layouts::generate_layouts;
+use shaders::compile_shaders;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+fn main() {
+    let manifest_dir = PathBuf::from(env("CARGO_MANIFEST_DIR"));
+    let out_dir = PathBuf::from(env("OUT_DIR"));
+    // Canonical, so that error messages name `/…/shaders-glsl/x.comp` without `engine/..`.
+    let shader_dir = fs::canonicalize(manifest_dir.join("../shaders-glsl"))
+        .unwrap_or_else(|e| panic!("cannot find shaders-glsl/ next to engine/: {e}"));
+    let include_dir = shader_dir.join("include");
+
+    check_shaderc_archive(&manifest_dir);
+
+    println!("cargo:rerun-if-changed={}", shader_dir.display());
+    println!("cargo:rerun-if-changed={}", include_dir.display());
+    let top_level = list_files(&shader_dir);
+    for file in top_level.iter().chain(&list_files(&include_dir)) {
+        println!("cargo:rerun-if-changed={}", file.display());
+    }
+
+    let result = generate_constants(&include_dir.join("constants.glsl"))
+        .and_then(|(constants, rust)| {
+            write(&out_dir.join("constants.rs"), &rust);
+            generate_layouts(&include_dir.join("layouts.glsl"), &constants)
+        })
+        .map(|rust| write(&out_dir.join("layouts.rs"), &rust))
+        .and_then(|()| compile_shaders(&top_level, &include_dir, &out_dir))
+        .map(|rust| write(&out_dir.join("shaders.rs"), &rust));
+    if let Err(message) = result {
+        // A plain message and exit code read better in cargo's output than a panic's backtrace.
+        eprintln!("error: {message}");
+        std::process::exit(1);
+    }
+}
+
+fn env(name: &str) -> String {
+    std::env::var(name).unwrap_or_else(|_| panic!("cargo did not set {name}"))
+}
+
+fn write(path: &Path, text: impl AsRef<[u8]>) {
+    fs::write(path, text).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
+}
+
+fn check_shaderc_archive(manifest_dir: &Path) {
+    println!("cargo:rerun-if-env-changed=SHADERC_LIB_DIR");
+    let dir = std::env::var_os("SHADERC_LIB_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| manifest_dir.join("../.deps/shaderc"));
+    if !dir.join("libshaderc_combined.a").is_file() {
+        println!(
+            "cargo:warning={}/libshaderc_combined.a is missing, so shaderc-sys built glslang from \
+             source; run scripts/deps.sh, then `cargo clean -p shaderc-sys`",
+            dir.display()
+        );
+    }
+}
+
+/// Plain files directly in `dir`, sorted so that generated code is deterministic.
+fn list_files(dir: &Path) -> Vec<PathBuf> {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut files: Vec<PathBuf> = entries
+        .map(|e| e.unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display())).path())
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    files
+}
+
+pub fn read(path: &Path) -> Result<String, String> {
+    fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+}

@@ -1,0 +1,140 @@
+//! The descriptor bindings a SPIR-V module uses, read from its instructions, so that every
+//! pipeline's declared bindings are checked against its shaders when the pipeline is made: a
+//! wrong binding list fails there, naming the shader and the binding, not as a validation
+//! message at draw time. Only what Kage's shaders use is read: set 0, uniform and storage
+//! buffers, combined image samplers and storage images.
+use super::descriptor::BindingKind;
+use std::collections::HashMap;
+
+const OP_TYPE_IMAGE: u32 = 25;
+const OP_TYPE_SAMPLED_IMAGE: u32 = 27;
+const OP_TYPE_ARRAY: u32 = 28;
+const OP_TYPE_RUNTIME_ARRAY: u32 = 29;
+const OP_TYPE_POINTER: u32 = 32;
+const OP_VARIABLE: u32 = 59;
+const OP_DECORATE: u32 = 71;
+const DECORATION_BLOCK: u32 = 2;
+const DECORATION_BUFFER_BLOCK: u32 = 3;
+const DECORATION_BINDING: u32 = 33;
+const DECORATION_DESCRIPTOR_SET: u32 = 34;
+const STORAGE_UNIFORM_CONSTANT: u32 = 0;
+const STORAGE_UNIFORM: u32 = 2;
+const STORAGE_STORAGE_BUFFER: u32 = 12;
+/// `OpTypeImage`'s "sampled" operand for an image used without a sampler (a storage image).
+const IMAGE_STORAGE: u32 = 2;
+
+/// The (binding, kind) of every descriptor of set 0 the module uses, by binding; `Err` names an
+/// instruction this reader does not know how to classify.
+pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<(u32, BindingKind)>, String> {
+    let mut decorations: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
+    let mut types: HashMap<u32, (u32, Vec<u32>)> = HashMap::new();
+    let mut variables = Vec::new();
+    let mut at = 5; // past the header
+    while at < words.len() {
+        let (count, opcode) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+        if count == 0 || at + count > words.len() {
+            return Err(format!("malformed instruction at word {at}"));
+        }
+        let operands = &words[at + 1..at + count];
+        match opcode {
+            OP_DECORATE if operands.len() >= 2 => {
+                let value = operands.get(2).copied().unwrap_or(0);
+                decorations.entry(operands[0]).or_default().push((operands[1], value));
+            }
+            OP_VARIABLE if operands.len() >= 3 => variables.push((operands[1], operands[0], operands[2])),
+            OP_TYPE_IMAGE
+            | OP_TYPE_SAMPLED_IMAGE
+            | OP_TYPE_ARRAY
+            | OP_TYPE_RUNTIME_ARRAY
+            | OP_TYPE_POINTER
+                if !operands.is_empty() =>
+            {
+                types.insert(operands[0], (opcode, operands[1..].to_vec()));
+            }
+            _ => {}
+        }
+        at += count;
+    }
+    let decoration = |id: u32, which: u32| {
+        decorations.get(&id).and_then(|d| d.iter().find(|(k, _)| *k == which)).map(|(_, v)| *v)
+    };
+    let has = |id: u32, which: u32| decoration(id, which).is_some();
+    let mut found = Vec::new();
+    for (id, pointer, storage) in variables {
+        let Some(binding) = decoration(id, DECORATION_BINDING) else { continue };
+        if decoration(id, DECORATION_DESCRIPTOR_SET).unwrap_or(0) != 0 {
+            continue;
+        }
+        // The pointee, through descriptor arrays to their element.
+        let mut pointee = types.get(&pointer).and_then(|(_, ops)| ops.get(1).copied()).unwrap_or(0);
+        while let Some((OP_TYPE_ARRAY | OP_TYPE_RUNTIME_ARRAY, ops)) = types.get(&pointee) {
+            pointee = ops[0];
+        }
+        let kind = match (storage, types.get(&pointee)) {
+            (STORAGE_STORAGE_BUFFER, _) => BindingKind::StorageBuffer,
+            (STORAGE_UNIFORM, _) if has(pointee, DECORATION_BUFFER_BLOCK) => BindingKind::StorageBuffer,
+            (STORAGE_UNIFORM, _) if has(pointee, DECORATION_BLOCK) => BindingKind::UniformBuffer,
+            (STORAGE_UNIFORM_CONSTANT, Some((OP_TYPE_SAMPLED_IMAGE, _))) => BindingKind::SampledImage,
+            (STORAGE_UNIFORM_CONSTANT, Some((OP_TYPE_IMAGE, ops))) if ops.get(5) == Some(&IMAGE_STORAGE) => {
+                BindingKind::StorageImage
+            }
+            _ => return Err(format!("binding {binding}: a descriptor of a kind Kage does not use")),
+        };
+        found.push((binding, kind));
+    }
+    found.sort_by_key(|(b, _)| *b);
+    Ok(found)
+}
+
+/// Checks that every binding `used` by the shader `shader` is declared in `declared` (the
+/// pipeline's list, in binding order) with the same kind.
+pub fn check(shader: &str, declared: &[BindingKind], used: &[(u32, BindingKind)]) -> Result<(), String> {
+    for &(binding, kind) in used {
+        match declared.get(binding as usize) {
+            Some(&d) if d == kind => {}
+            Some(d) => {
+                return Err(format!(
+                    "{shader} uses binding {binding} as {kind:?}, the pipeline declares it as {d:?}"
+                ))
+            }
+            None => {
+                return Err(format!(
+                    "{shader} uses binding {binding} ({kind:?}), the pipeline declares {} bindings",
+                    declared.len()
+                ))
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layouts::spirv;
+    use BindingKind::{SampledImage, StorageBuffer, StorageImage, UniformBuffer};
+
+    fn used(spirv: &[u8]) -> Vec<(u32, BindingKind)> {
+        descriptor_bindings(&ash::util::read_spv(&mut std::io::Cursor::new(spirv)).unwrap()).unwrap()
+    }
+
+    /// Each kind, read from Kage's own shaders (their GLSL declares these bindings).
+    #[test]
+    fn the_shaders_bindings_are_read_with_their_kinds() {
+        assert_eq!(used(spirv::BACKGROUND_FRAG), [(0, UniformBuffer), (1, SampledImage)]);
+        assert_eq!(
+            used(spirv::OCCLUSION_BLUR_COMP),
+            [(0, StorageBuffer), (1, SampledImage), (2, StorageImage)]
+        );
+    }
+
+    #[test]
+    fn a_wrong_or_short_list_is_an_error_naming_the_binding() {
+        let background = used(spirv::BACKGROUND_FRAG);
+        assert!(check("background.frag", &[UniformBuffer, SampledImage], &background).is_ok());
+        let wrong = check("background.frag", &[UniformBuffer, StorageBuffer], &background).unwrap_err();
+        assert!(wrong.contains("binding 1 as SampledImage") && wrong.contains("StorageBuffer"), "{wrong}");
+        let short = check("background.frag", &[UniformBuffer], &background).unwrap_err();
+        assert!(short.contains("binding 1") && short.contains("declares 1 bindings"), "{short}");
+    }
+}
