@@ -101,7 +101,7 @@ static kage_transform box_at(float x) {
 
 /* The test scene, built from arrays in the host's memory: a grey floor (group 0) and a red box
  * (group 1) standing on it, under a sky brighter above than below. */
-static kage_scene *make_scene(void) {
+kage_scene *make_scene(void) {
   build_floor();
   build_box();
   build_environment();

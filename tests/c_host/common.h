@@ -14,6 +14,10 @@ void expect_result(const char *what, kage_result got, kage_result want, const ch
 #define REQUIRE(condition) require((condition), #condition, __FILE__, __LINE__)
 void require(int condition, const char *what, const char *file, int line);
 
+/* The test scene, built from arrays: a grey floor (group 0) and a red box (group 1) standing
+ * on it, under a sky brighter above than below. */
+kage_scene *make_scene(void);
+
 /* Prints the context's device; builds the scene; precomputes for `technique` (a kage_technique,
  * with parameters small enough for a CPU driver); renders `frames` frames of `size`² pixels,
  * moving the box from left to right, and checks every frame: pixels finite and not all equal,

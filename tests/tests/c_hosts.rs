@@ -31,6 +31,9 @@ struct Hosts {
     arrays: PathBuf,
     /// Creates its own Vulkan device and hands it to Kage; linked with libkage.so.
     vulkan: PathBuf,
+    /// Calls Kage from several threads at once and uses destroyed handles; linked with
+    /// libkage.a.
+    threads: PathBuf,
 }
 
 fn hosts() -> &'static Hosts {
@@ -55,14 +58,18 @@ fn hosts() -> &'static Hosts {
         let cdylib_dir = library("libkage.so").parent().expect("folder").display().to_string();
         let rpath = format!("-Wl,-rpath,{cdylib_dir}");
         let common = src.join("common.c").display().to_string();
-        Hosts {
-            // After the archive, the system libraries Rust's standard library needs (what
-            // `rustc --print native-static-libs` lists for linux-gnu).
-            arrays: compile(
-                "arrays",
+        // After the archive, the system libraries Rust's standard library needs (what
+        // `rustc --print native-static-libs` lists for linux-gnu).
+        let with_staticlib = |name| {
+            compile(
+                name,
                 &[&common, &staticlib, "-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"],
-            ),
+            )
+        };
+        Hosts {
+            arrays: with_staticlib("arrays"),
             vulkan: compile("vulkan", &[&common, &format!("-L{cdylib_dir}"), "-lkage", &rpath, "-lvulkan"]),
+            threads: with_staticlib("threads"),
         }
     })
 }
@@ -86,6 +93,16 @@ fn c_hosts_run_with_validation() {
     let out =
         succeeded("vulkan host", Command::new(&hosts.vulkan).args(["10", "64", "1", "1"]).output().unwrap());
     assert!(out.contains("frame 9:") && out.ends_with("ok\n"), "{out}");
+}
+
+/// Threads and stale handles (tests/c_host/threads.c): one renderer called from four threads,
+/// a renderer per thread on one context, a destroy racing a render, destroyed handles reused:
+/// every call OK, BUSY or INVALID_HANDLE as the case is, validation on, no crash.
+#[test]
+fn c_host_threads_and_stale_handles() {
+    let out = succeeded("threads host", Command::new(&hosts().threads).output().unwrap());
+    println!("{out}");
+    assert!(out.contains("stale handles: refused") && out.ends_with("ok\n"), "{out}");
 }
 
 /// Memcheck: no invalid read or write, no definite leak. Lavapipe compiles every shader with

@@ -8,45 +8,53 @@ use ash::vk;
 /// rendering, precomputation) are split into submissions well below this on lavapipe.
 const FENCE_TIMEOUT_NS: u64 = 600_000_000_000;
 
-/// A command buffer with its fence, reused frame after frame.
+/// A command buffer with its fence, reused frame after frame. Each has its own command pool:
+/// a pool is externally synchronized, so recorders of one context (renderers driven from
+/// different threads) may then record at the same time.
 pub struct CommandRecorder {
+    pool: vk::CommandPool,
     pub(crate) cmd: vk::CommandBuffer,
     fence: vk::Fence,
 }
 
 impl Context {
     pub(crate) fn create_recorder(&self, name: &str) -> Result<CommandRecorder> {
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(self.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: valid device and create info.
+        let pool = unsafe { self.device.create_command_pool(&pool_info, None) }
+            .map_err(Error::vk("vkCreateCommandPool"))?;
         let info = vk::CommandBufferAllocateInfo::default()
-            .command_pool(*self.command_pool.lock().unwrap_or_else(|e| e.into_inner()))
+            .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
-        // SAFETY: the pool is locked for the allocation (pools are externally synchronized).
-        let cmd = {
-            let _pool = self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
-            unsafe { self.device.allocate_command_buffers(&info) }
-                .map_err(Error::vk("vkAllocateCommandBuffers"))?[0]
-        };
-        // SAFETY: valid device, default create info.
-        let fence = match unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) } {
-            Ok(f) => f,
+        // SAFETY: the pool is this recorder's own.
+        let made = unsafe { self.device.allocate_command_buffers(&info) }
+            .map_err(Error::vk("vkAllocateCommandBuffers"))
+            .and_then(|cmds| {
+                // SAFETY: valid device, default create info.
+                let fence = unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) }
+                    .map_err(Error::vk("vkCreateFence"))?;
+                Ok((cmds[0], fence))
+            });
+        let (cmd, fence) = match made {
+            Ok(made) => made,
             Err(e) => {
-                self.free_command_buffer(cmd);
-                return Err(Error::vk("vkCreateFence")(e));
+                // SAFETY: nothing from the pool was submitted; destroying it frees its buffers.
+                unsafe { self.device.destroy_command_pool(pool, None) };
+                return Err(e);
             }
         };
+        self.set_name(pool, &format!("{name}.pool"));
         self.set_name(cmd, name);
         self.set_name(fence, &format!("{name}.fence"));
-        Ok(CommandRecorder { cmd, fence })
-    }
-
-    fn free_command_buffer(&self, cmd: vk::CommandBuffer) {
-        let pool = self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
-        // SAFETY: the buffer came from this pool and is not pending (callers wait first).
-        unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
+        Ok(CommandRecorder { pool, cmd, fence })
     }
 
     pub(crate) fn destroy_recorder(&self, recorder: &CommandRecorder) {
-        self.free_command_buffer(recorder.cmd);
+        // SAFETY: the buffer is not pending (callers wait first); destroying the pool frees it.
+        unsafe { self.device.destroy_command_pool(recorder.pool, None) };
         // SAFETY: the fence is not in use once the last submission was waited for.
         unsafe { self.device.destroy_fence(recorder.fence, None) };
     }

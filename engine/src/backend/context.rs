@@ -69,7 +69,8 @@ pub struct Context {
     pub(crate) dynamic_rendering: ash::khr::dynamic_rendering::Device,
     pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
     queue: Mutex<vk::Queue>,
-    pub(crate) command_pool: Mutex<vk::CommandPool>,
+    /// The queue's family, for each recorder's command pool.
+    pub(crate) queue_family: u32,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     info: DeviceInfo,
     /// False for a host's device ([`Context::adopt`]): then the host destroys device and instance.
@@ -275,13 +276,6 @@ impl Context {
         })
         .map_err(|e| Error::Allocation { name: "allocator".into(), message: e.to_string() })?;
 
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        // SAFETY: valid device and create info.
-        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }
-            .map_err(Error::vk("vkCreateCommandPool"))?;
-
         let ctx = Context {
             debug: parts.debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
             dynamic_rendering: ash::khr::dynamic_rendering::Device::new(&instance, &device),
@@ -294,12 +288,11 @@ impl Context {
             physical,
             device,
             queue: Mutex::new(queue),
-            command_pool: Mutex::new(command_pool),
+            queue_family,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             info: parts.info,
             owns_device: parts.owns_device,
         };
-        ctx.set_name(command_pool, "kage.command_pool");
         ctx.set_name(queue, "kage.queue");
         Ok(Arc::new(ctx))
     }
@@ -364,8 +357,6 @@ impl Drop for Context {
         // device would also wait for (and race with) the host's own queues.
         unsafe {
             let _ = self.device.queue_wait_idle(*self.queue.get_mut().unwrap_or_else(|e| e.into_inner()));
-            self.device
-                .destroy_command_pool(*self.command_pool.get_mut().unwrap_or_else(|e| e.into_inner()), None);
         }
         // The allocator frees its memory blocks through the device: drop it before the device.
         // SAFETY: dropped exactly once, here.

@@ -140,11 +140,8 @@ pub unsafe extern "C" fn kage_context_create_from_vulkan(
 /// Destroys a context handle. Renderers made with it keep the device alive until they are
 /// destroyed too (they hold their own reference); scenes do not depend on it. NULL is allowed
 /// and does nothing. The handle must not be used afterwards.
-///
-/// # Safety
-/// `context` must not be in use by another thread.
 #[no_mangle]
-pub unsafe extern "C" fn kage_context_destroy(context: *mut kage_context) -> kage_result {
+pub extern "C" fn kage_context_destroy(context: *mut kage_context) -> kage_result {
     boundary(|| handles::destroy(context, "context"))
 }
 
@@ -162,8 +159,7 @@ pub unsafe extern "C" fn kage_context_device_name(
     length: *mut usize,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: the host does not destroy the handle during the call (threading rules).
-        let context = unsafe { handles::get(context, "context") }?;
+        let context = handles::get(context, "context")?;
         // SAFETY: the caller's promises about buffer and length.
         unsafe { args::copy_text(&context.ctx.info().name, buffer, capacity, length, "buffer") }
     })

@@ -5,14 +5,17 @@
 //! - It returns a [`kage_result`]; on failure [`kage_last_error_message`] says why.
 //! - It runs behind a panic boundary (`result::boundary`): a panic becomes
 //!   `KAGE_RESULT_PANIC`, never an unwind into C.
-//! - Handles are opaque and checked against the set of live handles (`handles.rs`) before use:
-//!   NULL is `KAGE_RESULT_NULL_ARGUMENT`; a destroyed, foreign or wrong-kind handle is
-//!   `KAGE_RESULT_INVALID_HANDLE`, not undefined behaviour.
+//! - Handles are opaque values (a slot and its generation, not addresses) checked against the
+//!   table of live handles (`handles.rs`) before use: NULL is `KAGE_RESULT_NULL_ARGUMENT`; a
+//!   destroyed, foreign or wrong-kind handle is `KAGE_RESULT_INVALID_HANDLE`, for good, even
+//!   after later objects are made.
 //! - Enumerations arrive as `uint32_t`, so that an out-of-range value from C is
 //!   `KAGE_RESULT_INVALID_VALUE` rather than an invalid Rust enum.
 //!
-//! Threading: a handle may move between threads, but calls on one handle, or on handles made
-//! from one context, must not overlap. The last error message is per thread.
+//! Threading: any function may be called from any thread. A call on a handle that a call on
+//! another thread is using returns `KAGE_RESULT_BUSY` and does nothing; calls on different
+//! handles run at the same time (a context's queue is locked inside, each renderer records its
+//! own command buffers). The last error message is per thread.
 #![allow(non_camel_case_types)]
 
 mod args;

@@ -58,7 +58,7 @@ pub struct kage_pass_timing {
 /// owns and frees with `kage_renderer_destroy`; on failure it is set to NULL.
 ///
 /// # Safety
-/// `context` and `scene` must be NULL or handles not in use by another thread; `desc` NULL or
+/// `desc` NULL or
 /// valid; `renderer` NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_create(
@@ -70,10 +70,9 @@ pub unsafe extern "C" fn kage_renderer_create(
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
         let out = unsafe { args::handle_out(renderer, "renderer") }?;
-        // SAFETY: the host does not destroy the handles during the call; desc is NULL or valid.
-        let (context, scene, desc) = unsafe {
-            (handles::get(context, "context")?, handles::get(scene, "scene")?, args::value(desc, "desc")?)
-        };
+        let (context, scene) = (handles::get(context, "context")?, handles::get(scene, "scene")?);
+        // SAFETY: the caller promises NULL or a valid desc.
+        let desc = unsafe { args::value(desc, "desc") }?;
         // SAFETY: the caller promises a valid desc, its probe positions included.
         let technique = unsafe { desc.technique.desc() }?;
         let options = RenderOptions {
@@ -93,17 +92,13 @@ pub unsafe extern "C" fn kage_renderer_create(
 /// Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The
 /// handle must not be used afterwards (also when this fails with `KAGE_RESULT_VALIDATION`,
 /// which reports what the layer said while its objects were destroyed).
-///
-/// # Safety
-/// `renderer` must not be in use by another thread.
 #[no_mangle]
-pub unsafe extern "C" fn kage_renderer_destroy(renderer: *mut kage_renderer) -> kage_result {
+pub extern "C" fn kage_renderer_destroy(renderer: *mut kage_renderer) -> kage_result {
     boundary(|| {
         if renderer.is_null() {
             return Ok(());
         }
-        // SAFETY: the host does not use the handle elsewhere during the call.
-        let ctx = unsafe { handles::get(renderer, "renderer") }?.ctx.clone();
+        let ctx = handles::get(renderer, "renderer")?.ctx.clone();
         handles::destroy(renderer, "renderer")?;
         kage_context::check_validation(&ctx)
     })
@@ -113,7 +108,7 @@ pub unsafe extern "C" fn kage_renderer_destroy(renderer: *mut kage_renderer) -> 
 /// is only read during the call.
 ///
 /// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread; `transform` NULL or valid.
+/// `transform` NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_set_group_transform(
     renderer: *mut kage_renderer,
@@ -121,9 +116,9 @@ pub unsafe extern "C" fn kage_renderer_set_group_transform(
     transform: *const kage_transform,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: exclusive use of a live handle (threading rules); transform NULL or valid.
-        let (r, transform) =
-            unsafe { (handles::get_mut(renderer, "renderer")?, args::value(transform, "transform")?) };
+        let mut r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or a valid transform.
+        let transform = unsafe { args::value(transform, "transform") }?;
         let transform = transform.validated().map_err(|e| Failure::invalid(format!("group {group}: {e}")))?;
         Ok(r.renderer.set_group_transform(group as usize, transform.matrix())?)
     })
@@ -133,16 +128,16 @@ pub unsafe extern "C" fn kage_renderer_set_group_transform(
 /// only read during the call.
 ///
 /// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread; `camera` NULL or valid.
+/// `camera` NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_set_camera(
     renderer: *mut kage_renderer,
     camera: *const kage_camera_desc,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: exclusive use of a live handle (threading rules); camera NULL or valid.
-        let (r, camera) =
-            unsafe { (handles::get_mut(renderer, "renderer")?, args::value(camera, "camera")?) };
+        let mut r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or a valid camera.
+        let camera = unsafe { args::value(camera, "camera") }?;
         Ok(r.renderer.set_camera(camera.camera()?)?)
     })
 }
@@ -150,17 +145,10 @@ pub unsafe extern "C" fn kage_renderer_set_camera(
 /// Turns the environment about +Y (counter-clockwise seen from above) by `radians` (finite) for
 /// the next frames, as `kage render --env-rotation` does. Techniques that capture the
 /// environment once (the light probes) keep their captured light.
-///
-/// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread.
 #[no_mangle]
-pub unsafe extern "C" fn kage_renderer_set_env_rotation(
-    renderer: *mut kage_renderer,
-    radians: f32,
-) -> kage_result {
+pub extern "C" fn kage_renderer_set_env_rotation(renderer: *mut kage_renderer, radians: f32) -> kage_result {
     boundary(|| {
-        // SAFETY: exclusive use of a live handle (threading rules).
-        let r = unsafe { handles::get_mut(renderer, "renderer") }?;
+        let mut r = handles::get(renderer, "renderer")?;
         Ok(r.renderer.set_env_rotation(radians)?)
     })
 }
@@ -186,15 +174,16 @@ pub struct kage_renderer_stats {
 /// Writes the renderer's statistics to `*stats`.
 ///
 /// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread; `stats` NULL or writable.
+/// `stats` NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_get_stats(
     renderer: *const kage_renderer,
     stats: *mut kage_renderer_stats,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: the host does not destroy the handle during the call; stats NULL or writable.
-        let (r, stats) = unsafe { (handles::get(renderer, "renderer")?, args::out(stats, "stats")?) };
+        let r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or writable.
+        let stats = unsafe { args::out(stats, "stats") }?;
         let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
         let technique = r.renderer.stats();
         let probes = technique.probes;
@@ -211,14 +200,10 @@ pub unsafe extern "C" fn kage_renderer_get_stats(
 
 /// Renders one frame and waits for it; then `kage_renderer_read_pixels` and
 /// `kage_renderer_timings` give its picture and pass timings.
-///
-/// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread.
 #[no_mangle]
-pub unsafe extern "C" fn kage_renderer_render(renderer: *mut kage_renderer) -> kage_result {
+pub extern "C" fn kage_renderer_render(renderer: *mut kage_renderer) -> kage_result {
     boundary(|| {
-        // SAFETY: exclusive use of a live handle (threading rules).
-        let r = unsafe { handles::get_mut(renderer, "renderer") }?;
+        let mut r = handles::get(renderer, "renderer")?;
         let timings = r.renderer.render();
         kage_context::check_validation(&r.ctx)?;
         r.timings = Some(timings?);
@@ -233,7 +218,7 @@ pub unsafe extern "C" fn kage_renderer_render(renderer: *mut kage_renderer) -> k
 /// it. Before the first `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
 ///
 /// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread; `pixels` NULL or `size`
+/// `pixels` NULL or `size`
 /// writable bytes.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_read_pixels(
@@ -244,8 +229,7 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
     size: usize,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: the host does not destroy the handle during the call.
-        let r = unsafe { handles::get(renderer, "renderer") }?;
+        let r = handles::get(renderer, "renderer")?;
         let format = args::enumeration(format, "format", kage_pixel_format::from_repr)?;
         if pixels.is_null() {
             return Err(Failure::new(kage_result::NullArgument, "pixels is NULL"));
@@ -293,7 +277,7 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
 /// the count is 0.
 ///
 /// # Safety
-/// `renderer` must be NULL or a handle not in use by another thread; `timings` NULL or
+/// `timings` NULL or
 /// `capacity` writable elements; `count` NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn kage_renderer_timings(
@@ -303,8 +287,9 @@ pub unsafe extern "C" fn kage_renderer_timings(
     count: *mut usize,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: the host does not destroy the handle during the call; count NULL or writable.
-        let (r, count) = unsafe { (handles::get(renderer, "renderer")?, args::out(count, "count")?) };
+        let r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or writable.
+        let count = unsafe { args::out(count, "count") }?;
         let frame = r.timings.as_deref().unwrap_or_default();
         *count = frame.len();
         if capacity > 0 && timings.is_null() {

@@ -41,6 +41,9 @@ pub enum kage_result {
     /// Kage found an internal error (a bug) without panicking, such as a pass reading what no
     /// earlier pass wrote; the message names it.
     Internal = 13,
+    /// The handle is in use by a call on another thread (calls on one handle must not overlap);
+    /// nothing was done.
+    Busy = 14,
 }
 
 /// A failure on its way to the host: the code and the message for `kage_last_error_message`.

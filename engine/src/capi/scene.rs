@@ -225,11 +225,8 @@ fn invalid(error: SceneError) -> Failure {
 
 /// Destroys a scene handle. Renderers made from it keep what they need and stay usable. NULL is
 /// allowed and does nothing. The handle must not be used afterwards.
-///
-/// # Safety
-/// `scene` must not be in use by another thread.
 #[no_mangle]
-pub unsafe extern "C" fn kage_scene_destroy(scene: *mut kage_scene) -> kage_result {
+pub extern "C" fn kage_scene_destroy(scene: *mut kage_scene) -> kage_result {
     boundary(|| handles::destroy(scene, "scene"))
 }
 
@@ -241,8 +238,7 @@ pub unsafe extern "C" fn kage_scene_destroy(scene: *mut kage_scene) -> kage_resu
 #[no_mangle]
 pub unsafe extern "C" fn kage_scene_group_count(scene: *const kage_scene, count: *mut u32) -> kage_result {
     boundary(|| {
-        // SAFETY: the host does not destroy the handle during the call (threading rules).
-        let scene = unsafe { handles::get(scene, "scene") }?;
+        let scene = handles::get(scene, "scene")?;
         // SAFETY: the caller promises NULL or writable.
         *unsafe { args::out(count, "count") }? = scene.scene.groups.len() as u32;
         Ok(())

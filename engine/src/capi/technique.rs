@@ -268,7 +268,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
 /// The scene keeps no reference to the context.
 ///
 /// # Safety
-/// `context` and `scene` must be NULL or handles not in use by another thread; `technique` NULL
+/// `technique` NULL
 /// or a valid desc.
 #[no_mangle]
 pub unsafe extern "C" fn kage_precompute(
@@ -277,9 +277,7 @@ pub unsafe extern "C" fn kage_precompute(
     technique: *const kage_technique_desc,
 ) -> kage_result {
     boundary(|| {
-        // SAFETY: the host does not destroy or share the handles during the call.
-        let (context, scene) =
-            unsafe { (handles::get(context, "context")?, handles::get_mut(scene, "scene")?) };
+        let (context, mut scene) = (handles::get(context, "context")?, handles::get(scene, "scene")?);
         // SAFETY: the caller promises NULL or a valid desc (its probe positions included).
         let desc = unsafe { args::value(technique, "technique")?.desc() }?;
         if let Some(params) = desc.precomputation() {
