@@ -1,7 +1,7 @@
 //! Files that lie or are not files: an image header claiming billions of pixels, a FIFO or
-//! `/dev/zero` given as a scene, mesh, map or image. Each is an error
-//! naming the path and what is wrong, returned at once: no abort, no hang, no unbounded read.
-//! No GPU needed.
+//! `/dev/zero` given as a scene, mesh, map or image. Each is an error naming the path and what
+//! is wrong, returned at once: no abort, no hang, no unbounded read. And a scene file with a
+//! byte order mark reads. No GPU needed.
 use std::ffi::{c_char, CString};
 use std::path::{Path, PathBuf};
 use std::ptr::null_mut;
@@ -166,4 +166,17 @@ fn devices_and_fifos_are_refused_without_reading() {
     let (result, message) = promptly("kage_scene_load", move || scene_load(&fifo_json));
     assert_eq!(result, kage_result::File, "{message}");
     assert_says(&message, &["fifo.json", pipe]);
+}
+
+/// Editors on Windows start UTF-8 files with a byte order mark; JSON forbids it, Kage skips it.
+#[test]
+fn a_scene_file_starting_with_a_byte_order_mark_loads() {
+    let dir = scratch_dir("hostile-bom");
+    let plain = scene_file(&dir, "plain.json", None, None);
+    let mut bytes = b"\xEF\xBB\xBF".to_vec();
+    bytes.extend(std::fs::read(&plain).unwrap());
+    let bom = dir.join("bom.json");
+    std::fs::write(&bom, bytes).unwrap();
+    let scene = Scene::load(&bom).unwrap();
+    assert_eq!(scene.groups, Scene::load(&plain).unwrap().groups);
 }
