@@ -1,7 +1,7 @@
 //! Files that lie or are not files: an image header claiming billions of pixels, a FIFO or
-//! `/dev/zero` given as a scene, mesh, map or image. Each is an error naming the path and what
-//! is wrong, returned at once: no abort, no hang, no unbounded read. And a scene file with a
-//! byte order mark reads. No GPU needed.
+//! `/dev/zero` given as a scene, mesh, map or image, a folder given as a scene. Each is an error
+//! naming the path and what is wrong, returned at once: no abort, no hang, no unbounded read.
+//! And a scene file with a byte order mark reads. No GPU needed.
 use std::ffi::{c_char, CString};
 use std::path::{Path, PathBuf};
 use std::ptr::null_mut;
@@ -166,6 +166,25 @@ fn devices_and_fifos_are_refused_without_reading() {
     let (result, message) = promptly("kage_scene_load", move || scene_load(&fifo_json));
     assert_eq!(result, kage_result::File, "{message}");
     assert_says(&message, &["fifo.json", pipe]);
+}
+
+/// An existing path that is no scene file, given as the scene (`--scene`, `kage_scene_load`):
+/// a folder without a scene file, `/dev/zero`. Each is the path's fault (`KAGE_RESULT_FILE`),
+/// named, not an unknown built-in name.
+#[test]
+fn existing_paths_that_are_no_scene_file_are_file_errors_naming_them() {
+    let dir = scratch_dir("hostile-folder");
+    for (path, problem) in [
+        (dir.display().to_string(), "a folder without scene.json"),
+        ("/dev/zero".to_string(), "a character device, not a regular file"),
+    ] {
+        let message = Scene::from_arg(&path).unwrap_err().to_string();
+        assert_says(&message, &[&path, problem]);
+        let arg = path.clone();
+        let (result, message) = promptly("kage_scene_load", move || scene_load(&arg));
+        assert_eq!(result, kage_result::File, "{message}");
+        assert_says(&message, &[&path, problem]);
+    }
 }
 
 /// Editors on Windows start UTF-8 files with a byte order mark; JSON forbids it, Kage skips it.
