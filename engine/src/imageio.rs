@@ -1,7 +1,13 @@
 //! Rendered images to and from disk. The format follows the file name: `.png` is for looking
 //! at (tonemapped, sRGB, 8-bit), `.exr` is for measuring (linear radiance, 32-bit float, so that
 //! tests can compare renders without a tonemapper in the way).
+use std::io::{BufReader, Seek};
 use std::path::{Path, PathBuf};
+
+use exr::prelude::{ReadChannels, ReadLayers};
+
+use crate::files::{self, ReadError};
+use crate::image_size::{Declared, SizeError};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ImageIoError {
@@ -25,6 +31,10 @@ pub enum ImageIoError {
     Png { path: PathBuf, error: image::ImageError },
     #[error("{}: OpenEXR failed: {error}", path.display())]
     Exr { path: PathBuf, error: exr::error::Error },
+    #[error("{}: {error}", path.display())]
+    Read { path: PathBuf, error: ReadError },
+    #[error("{}: {error}", path.display())]
+    DeclaredSize { path: PathBuf, error: SizeError },
 }
 
 /// Linear RGBA radiance, row-major, row 0 at the top.
@@ -124,17 +134,33 @@ fn write_exr(path: &Path, image: &RgbaF32Image) -> Result<(), ImageIoError> {
 }
 
 /// Reads the first RGB or RGBA layer of an OpenEXR file, half or float, as linear f32 (alpha 1
-/// where the file has none). NaN or infinite pixels are an error, as they are on writing.
+/// where the file has none). NaN or infinite pixels are an error, as they are on writing. The
+/// file must be a regular file within [`files::IMAGE`], and the size its header declares within
+/// what [`Declared::check`] allows, before any pixel is allocated.
 pub fn read_exr(path: impl AsRef<Path>) -> Result<RgbaF32Image, ImageIoError> {
     let path = path.as_ref();
-    let image = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |size, _| (size.width(), vec![[0.0f32, 0.0, 0.0, 1.0]; size.area()]),
-        |(width, pixels): &mut (usize, Vec<[f32; 4]>), pos, (r, g, b, a): (f32, f32, f32, f32)| {
-            pixels[pos.y() * *width + pos.x()] = [r, g, b, a];
-        },
-    )
-    .map_err(|error| ImageIoError::Exr { path: path.to_owned(), error })?;
+    let exr_error = |error| ImageIoError::Exr { path: path.to_owned(), error };
+    let (file, bytes) = files::open(path, files::IMAGE)
+        .map_err(|error| ImageIoError::Read { path: path.to_owned(), error })?;
+    let mut reader = BufReader::new(file);
+    Declared::exr(&mut reader)
+        .map_err(exr_error)?
+        .check(bytes)
+        .map_err(|error| ImageIoError::DeclaredSize { path: path.to_owned(), error })?;
+    reader.rewind().map_err(|e| exr_error(e.into()))?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |size, _| (size.width(), vec![[0.0f32, 0.0, 0.0, 1.0]; size.area()]),
+            |(width, pixels): &mut (usize, Vec<[f32; 4]>), pos, (r, g, b, a): (f32, f32, f32, f32)| {
+                pixels[pos.y() * *width + pos.x()] = [r, g, b, a];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(reader)
+        .map_err(exr_error)?;
     let size = image.layer_data.size;
     let pixels = image.layer_data.channel_data.pixels.1;
     // OpenEXR keeps its data window in i32s, so both sides fit a u32.

@@ -13,7 +13,8 @@
 //! - [`renderer`]: the frame loop; then [`capi`] (and the command line, outside this crate).
 //!
 //! Beside the layers, imported by any of them: [`scene`] (what a scene holds and its file
-//! format), [`sh`], [`layouts`] (the GPU/host structs), [`error`], [`imageio`].
+//! format), [`sh`], [`layouts`] (the GPU/host structs), [`error`], [`imageio`], [`files`]
+//! (opening what a user names) and [`image_size`] (image headers checked before decoding).
 //!
 //! Conventions: right-handed, +Y up; equirectangular maps map direction (x, y, z) to
 //! u = atan2(x, -z) / 2π wrapped into [0, 1), v = acos(y) / π, row 0 at the top (+Y).
@@ -22,7 +23,9 @@
 pub mod backend;
 pub mod capi;
 pub mod error;
+pub mod files;
 pub mod frame;
+pub mod image_size;
 pub mod imageio;
 pub mod layouts;
 pub mod pass;

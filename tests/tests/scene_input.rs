@@ -271,11 +271,14 @@ fn built_in_scenes_are_listed_and_unknown_names_rejected() {
     assert_eq!(BUILTIN[0], "teapot");
     let message = Scene::from_arg("no-such-scene").unwrap_err().to_string();
     assert!(BUILTIN.iter().all(|name| message.contains(name)), "{message}");
-    // A folder without a scene file is no scene file: the answer lists the built-ins, never
-    // "is a directory".
+    // A folder without a scene file is the folder's fault: the answer names it and lists the
+    // built-ins, never "is a directory".
     let empty = temp_dir("no-scene-file");
-    let message = Scene::from_arg(empty.to_str().unwrap()).unwrap_err().to_string();
+    let error = Scene::from_arg(empty.to_str().unwrap()).unwrap_err();
+    assert_eq!(error.file(), Some(empty.as_path()));
+    let message = error.to_string();
     assert!(BUILTIN.iter().all(|name| message.contains(name)), "{message}");
+    assert!(!message.contains("directory"), "{message}");
     let hires = Scene::builtin("teapot-hires-floor").unwrap();
     let floor = hires.groups.iter().find(|g| g.name == "floor").unwrap();
     assert_eq!(floor.meshes[0].vertex_count(), 111 * 111);

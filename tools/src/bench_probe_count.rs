@@ -20,6 +20,7 @@ use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use glam::{DVec3, Vec3};
 use kage::backend::Context;
+use kage::files;
 use kage::frame::GpuScene;
 use kage::reference::irradiance::{IrradianceFile, Point};
 use kage::reference::IrradianceReference;
@@ -507,8 +508,8 @@ fn reference(
         let region = format!("{:?}", params.test_region).to_lowercase();
         dir.join(format!("{}-{region}-{}-{}spp.json", scene.name, points.len(), params.spp))
     });
-    let cached = path.as_ref().and_then(|p| std::fs::read_to_string(p).ok()).and_then(|text| {
-        serde_json::from_str::<Cached>(&text).ok().filter(|c| c.scene == scene.name && c.points == points)
+    let cached = path.as_ref().and_then(|p| files::read(p, files::JSON).ok()).and_then(|bytes| {
+        serde_json::from_slice::<Cached>(&bytes).ok().filter(|c| c.scene == scene.name && c.points == points)
     });
     let start = Instant::now();
     let file = match cached {

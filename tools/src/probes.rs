@@ -3,6 +3,7 @@
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
 use glam::DVec3;
+use kage::files;
 use kage::frame::GpuScene;
 use kage::scene::Scene;
 use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker};
@@ -122,8 +123,8 @@ fn place(args: &PlaceArgs) -> Result<()> {
 
 /// The positions of a probe file.
 pub fn read_positions(path: &Path) -> Result<Vec<DVec3>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let file: ProbeFile = serde_json::from_str(&text)
+    let bytes = files::read(path, files::JSON).with_context(|| format!("reading {}", path.display()))?;
+    let file: ProbeFile = serde_json::from_slice(&bytes)
         .with_context(|| format!("{}: not a probe file {{\"positions\": [[x,y,z], ...]}}", path.display()))?;
     Ok(file.positions.into_iter().map(DVec3::from_array).collect())
 }

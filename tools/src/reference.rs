@@ -5,6 +5,7 @@ use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use kage::files;
 use kage::reference::{
     IrradianceFile, IrradianceReference, LightMode, PointsFile, ReferenceOptions, ReferenceRenderer,
     Statistics,
@@ -181,8 +182,9 @@ fn run_image(
 }
 
 fn read_points(path: &Path) -> Result<PointsFile> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    PointsFile::parse(&text).with_context(|| format!("in {}", path.display()))
+    let bytes = files::read(path, files::JSON).with_context(|| format!("reading {}", path.display()))?;
+    let text = std::str::from_utf8(&bytes).with_context(|| format!("in {}", path.display()))?;
+    PointsFile::parse(text).with_context(|| format!("in {}", path.display()))
 }
 
 fn run_irradiance(

@@ -13,6 +13,8 @@ pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// The largest image side Kage renders (lavapipe and current GPUs allow 16384; 8192 keeps the
 /// colour target and its readback within 2 GiB).
 pub const MAX_SIZE: u32 = 8192;
+// Any render Kage writes, `kage compare` and `imageio::read_exr` read back.
+const _: () = assert!(MAX_SIZE as u64 * MAX_SIZE as u64 <= crate::image_size::MAX_IMAGE_PIXELS);
 
 pub struct Targets {
     pub color: Image,

@@ -30,6 +30,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
+use crate::files::{self, ReadError};
 use crate::scene::Scene;
 
 pub const MAGIC: [u8; 8] = *b"KAGEPRT\0";
@@ -125,6 +126,12 @@ impl CacheKey {
         CacheKey { params, geometry, layout: mesh_layout(scene) }
     }
 
+    /// The length of the file this key describes: the header, the mesh table, the coefficients.
+    fn file_bytes(&self) -> usize {
+        let vertices: usize = self.layout.iter().map(|m| m.2).sum();
+        HEADER_BYTES + MESH_ENTRY_BYTES * self.layout.len() + 4 * self.params.coeffs() * vertices
+    }
+
     /// `<scene name>-<16 hex digits>.kageprt`: the digits hash the geometry, the parameters and
     /// the format version, so scenes that share a name and runs with other parameters each keep
     /// their own file.
@@ -192,10 +199,16 @@ pub fn geometry_hash(scene: &Scene) -> u128 {
 }
 
 /// Reads the cache file at `path` if it matches `key` in every respect; otherwise says why not.
+/// Reads no more than the key's file length (and only a regular file, see [`files`]).
 pub fn load(path: &Path, key: &CacheKey) -> Result<TransferSet, Stale> {
-    let bytes = match std::fs::read(path) {
+    let expected = key.file_bytes();
+    let limit = files::Limit { kind: "this PRT cache", bytes: expected as u64 };
+    let bytes = match files::read(path, limit) {
         Ok(bytes) => bytes,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(Stale::Missing),
+        Err(ReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => return Err(Stale::Missing),
+        Err(ReadError::TooLarge { bytes, .. }) => {
+            return Err(Stale::TrailingBytes { bytes: bytes as usize, expected })
+        }
         Err(e) => return Err(Stale::Unreadable(e.to_string())),
     };
     parse(&bytes, key)
@@ -250,7 +263,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
     }
     let coeffs = key.params.coeffs();
     let data_start = HEADER_BYTES + MESH_ENTRY_BYTES * key.layout.len();
-    let expected = data_start + 4 * coeffs * scene_vertices;
+    let expected = key.file_bytes();
     if bytes.len() < expected {
         return Err(truncated(expected));
     }

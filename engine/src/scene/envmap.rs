@@ -13,6 +13,8 @@ use exr::prelude::{self as exrp, ReadChannels, ReadLayers, WritableImage};
 use glam::{Vec2, Vec3};
 
 use super::SceneError;
+use crate::files;
+use crate::image_size::{Declared, SizeError};
 
 #[derive(Debug, Clone)]
 pub struct EnvMap {
@@ -72,7 +74,7 @@ impl EnvMap {
     }
 
     /// Reads `.exr` (RGB or RGBA, any sample type and compression `exr` supports) or Radiance
-    /// `.hdr`, chosen by extension.
+    /// `.hdr`, chosen by extension, from a regular file within [`files::IMAGE`].
     pub fn load(path: &Path) -> Result<EnvMap, SceneError> {
         let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let decode = match extension.as_deref() {
@@ -85,13 +87,14 @@ impl EnvMap {
                 ))
             }
         };
-        let bytes =
-            std::fs::read(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
+        let bytes = files::read(path, files::IMAGE).map_err(|e| SceneError::in_file(path, e.to_string()))?;
         decode(&bytes).map_err(|e| SceneError::in_file(path, e.problem()))
     }
 
-    /// Decodes an OpenEXR file held in memory (its first layer with R, G and B channels).
+    /// Decodes an OpenEXR file held in memory (its first layer with R, G and B channels); the
+    /// size its header declares is checked ([`Declared::check`]) before a pixel is allocated.
     pub fn from_exr_bytes(bytes: &[u8]) -> Result<EnvMap, SceneError> {
+        Declared::exr(Cursor::new(bytes)).map_err(not_exr)?.check(bytes.len() as u64).map_err(size_error)?;
         let image = exrp::read()
             .no_deep_data()
             .largest_resolution_level()
@@ -104,16 +107,18 @@ impl EnvMap {
             .first_valid_layer()
             .all_attributes()
             .from_buffered(Cursor::new(bytes))
-            .map_err(|e| SceneError::invalid(format!("not a readable OpenEXR RGB image: {e}")))?;
+            .map_err(not_exr)?;
         let layer = image.layer_data;
         let (width, height) = (layer.size.width(), layer.size.height());
         EnvMap::from_pixels(dimension(width)?, dimension(height)?, layer.channel_data.pixels.1)
     }
 
-    /// Decodes a Radiance RGBE (.hdr) file held in memory.
+    /// Decodes a Radiance RGBE (.hdr) file held in memory, its declared size checked as
+    /// [`EnvMap::from_exr_bytes`] does.
     pub fn from_hdr_bytes(bytes: &[u8]) -> Result<EnvMap, SceneError> {
+        Declared::hdr(bytes).map_err(not_hdr)?.check(bytes.len() as u64).map_err(size_error)?;
         let image = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr)
-            .map_err(|e| SceneError::invalid(format!("not a readable Radiance HDR image: {e}")))?
+            .map_err(not_hdr)?
             .into_rgb32f();
         let (width, height) = image.dimensions();
         let pixels = image.pixels().map(|p| p.0).collect();
@@ -195,6 +200,18 @@ fn check_radiance(width: u32, pixels: &[[f32; 3]]) -> Result<(), SceneError> {
         "is NaN or infinite; radiance must be finite".into()
     };
     Err(SceneError::invalid(format!("environment map pixel ({x}, {y}) {problem}: {p:?}")))
+}
+
+fn not_exr(error: exr::error::Error) -> SceneError {
+    SceneError::invalid(format!("not a readable OpenEXR RGB image: {error}"))
+}
+
+fn not_hdr(error: image::ImageError) -> SceneError {
+    SceneError::invalid(format!("not a readable Radiance HDR image: {error}"))
+}
+
+fn size_error(error: SizeError) -> SceneError {
+    SceneError::invalid(error.to_string())
 }
 
 fn dimension(size: usize) -> Result<u32, SceneError> {

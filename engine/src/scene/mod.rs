@@ -84,13 +84,28 @@ impl Scene {
     }
 
     /// What a `--scene` argument means: an existing file or a name ending in `.json` is a scene
-    /// file, a folder holding [`SCENE_FILE`] (as [`Scene::export`] writes it) that file, anything
-    /// else a built-in name (so a folder named like a built-in scene does not hide it).
+    /// file, a folder holding [`SCENE_FILE`] (as [`Scene::export`] writes it) that file, then a
+    /// built-in name is that scene (so a folder named like a built-in scene does not hide it),
+    /// and any other existing path is a file that cannot be read (a folder without
+    /// [`SCENE_FILE`], a device, a FIFO): an error naming it, not "no built-in scene".
     pub fn from_arg(arg: &str) -> Result<Scene, SceneError> {
         let path = Path::new(arg);
         if path.join(SCENE_FILE).is_file() {
             Scene::load(&path.join(SCENE_FILE))
         } else if path.is_file() || arg.ends_with(".json") {
+            Scene::load(path)
+        } else if BUILTIN.contains(&arg) {
+            Scene::builtin(arg)
+        } else if path.is_dir() {
+            Err(SceneError::in_file(
+                path,
+                format!(
+                    "a folder without {SCENE_FILE}; a scene is a scene file, a folder holding one, \
+                     or a built-in name: {}",
+                    BUILTIN.join(", ")
+                ),
+            ))
+        } else if path.symlink_metadata().is_ok() {
             Scene::load(path)
         } else {
             Scene::builtin(arg)

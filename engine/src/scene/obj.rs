@@ -5,6 +5,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 use super::{Mesh, SceneError};
+use crate::files;
 
 /// Parses OBJ text held in memory. Errors name no file; the caller attributes them.
 pub fn parse_obj(bytes: &[u8], name: &str, albedo: [f32; 3]) -> Result<Mesh, SceneError> {
@@ -31,9 +32,9 @@ pub fn parse_obj(bytes: &[u8], name: &str, albedo: [f32; 3]) -> Result<Mesh, Sce
     Mesh::new(name, positions, normals, indices, albedo)
 }
 
-/// Reads an OBJ file; every error names `path`.
+/// Reads an OBJ file (a regular file within [`files::OBJ`]); every error names `path`.
 pub fn load_obj(path: &Path, albedo: [f32; 3]) -> Result<Mesh, SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::in_file(path, format!("cannot read: {e}")))?;
+    let bytes = files::read(path, files::OBJ).map_err(|e| SceneError::in_file(path, e.to_string()))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     parse_obj(&bytes, &name, albedo).map_err(|e| SceneError::in_file(path, e.problem()))
 }

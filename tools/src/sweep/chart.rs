@@ -3,6 +3,7 @@
 //! front drawn through the settings nothing beats.
 use super::pick::{pareto_front, Point};
 use anyhow::{anyhow, Context as _, Result};
+use kage::files;
 use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 use std::path::Path;
@@ -11,6 +12,8 @@ use std::sync::OnceLock;
 /// The chart's text face: DejaVu Sans from Debian's fonts-dejavu-core, or `$KAGE_CHART_FONT`.
 const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 const SIZE: (u32, u32) = (960, 640);
+/// DejaVu Sans is 0.7 MiB; the largest fonts (CJK collections) some 30.
+const FONT: files::Limit = files::Limit { kind: "a font", bytes: 64 << 20 };
 
 /// Registers the font once per process (plotters keeps fonts for the program's life).
 fn font() -> Result<()> {
@@ -18,7 +21,7 @@ fn font() -> Result<()> {
     REGISTERED
         .get_or_init(|| {
             let path = std::env::var("KAGE_CHART_FONT").unwrap_or_else(|_| DEFAULT_FONT.to_string());
-            let bytes = std::fs::read(&path).map_err(|e| {
+            let bytes = files::read(Path::new(&path), FONT).map_err(|e| {
                 format!("reading the chart font {path}: {e} (install fonts-dejavu-core, as scripts/deps.sh does, or set KAGE_CHART_FONT to a .ttf file)")
             })?;
             plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(bytes.into_boxed_slice()))

@@ -3,6 +3,7 @@
 //! same scene, pose, map and size reuses it.
 use anyhow::{Context as _, Result};
 use kage::backend::Context;
+use kage::files;
 use kage::imageio::{self, RgbaF32Image};
 use kage::prt::cache;
 use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
@@ -94,10 +95,13 @@ pub fn reference(
     Ok(Reference { image, noise, spp })
 }
 
+/// The note beside a cached reference: two numbers.
+const NOTE: files::Limit = files::Limit { kind: "a reference's note", bytes: 1024 };
+
 /// A cached reference, or `None` when either file is missing or unreadable (then it is redone).
 fn load(exr: &Path, meta: &Path) -> Option<Reference> {
-    let text = std::fs::read_to_string(meta).ok()?;
-    let mut fields = text.split_whitespace();
+    let bytes = files::read(meta, NOTE).ok()?;
+    let mut fields = std::str::from_utf8(&bytes).ok()?.split_whitespace();
     let spp = fields.next()?.parse().ok()?;
     let noise = fields.next()?.parse().ok()?;
     let image = imageio::read_exr(exr).ok()?;

@@ -1,0 +1,201 @@
+//! Files that lie or are not files: an image header claiming billions of pixels, a FIFO or
+//! `/dev/zero` given as a scene, mesh, map or image, a folder given as a scene. Each is an error
+//! naming the path and what is wrong, returned at once: no abort, no hang, no unbounded read.
+//! And a scene file with a byte order mark reads. No GPU needed.
+use std::ffi::{c_char, CString};
+use std::path::{Path, PathBuf};
+use std::ptr::null_mut;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage};
+use kage::capi::{self, kage_result};
+use kage::imageio;
+use kage::scene::{EnvMap, Scene};
+use kage_tests::scratch_dir;
+
+/// A valid 2 × 1 OpenEXR file whose header then claims `width` × `height` pixels: its
+/// `dataWindow` attribute (box2i: xMin, yMin, xMax, yMax) and `chunkCount` (one block per row,
+/// uncompressed) patched to agree, the pixels left as they were.
+fn exr_declaring(path: &Path, width: i32, height: i32) {
+    let channels = SpecificChannels::rgb(|_: Vec2<usize>| (1.0f32, 1.0f32, 1.0f32));
+    let layer = Layer::new((2, 1), LayerAttributes::default(), Encoding::UNCOMPRESSED, channels);
+    let mut bytes = Vec::new();
+    Image::from_layer(layer).write().to_buffered(std::io::Cursor::new(&mut bytes)).unwrap();
+    let mut patch = |attribute: &[u8], values: &[i32]| {
+        let at = bytes.windows(attribute.len()).position(|w| w == attribute).unwrap() + attribute.len();
+        assert_eq!(bytes[at..at + 4], (4 * values.len() as i32).to_le_bytes(), "the attribute's size");
+        for (i, value) in values.iter().enumerate() {
+            bytes[at + 4 + 4 * i..at + 8 + 4 * i].copy_from_slice(&value.to_le_bytes());
+        }
+    };
+    patch(b"dataWindow\0box2i\0", &[0, 0, width - 1, height - 1]);
+    patch(b"chunkCount\0int\0", &[height]);
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// A Radiance HDR header claiming `width` × `height` pixels, followed by one pixel.
+fn hdr_declaring(path: &Path, width: u32, height: u32) {
+    let mut bytes = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n").into_bytes();
+    bytes.extend([128, 128, 128, 129]);
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn fifo(path: &Path) {
+    let made = std::process::Command::new("mkfifo").arg(path).status().unwrap();
+    assert!(made.success(), "mkfifo {}", path.display());
+}
+
+/// A scene file with a sphere (or the mesh `obj`) under the map `image` (or a constant sky).
+fn scene_file(dir: &Path, name: &str, obj: Option<&Path>, image: Option<&Path>) -> PathBuf {
+    let mesh = match obj {
+        Some(obj) => format!(r#"{{"obj": {:?}, "albedo": [0.5, 0.5, 0.5]}}"#, obj.to_str().unwrap()),
+        None => r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#.into(),
+    };
+    let environment = match image {
+        Some(image) => format!(r#"{{"image": {:?}}}"#, image.to_str().unwrap()),
+        None => r#"{"constant": [1, 1, 1]}"#.into(),
+    };
+    let json = format!(
+        r#"{{"camera": {{"position": [0, 2, 6], "target": [0, 0.5, 0], "fov_y_deg": 40}},
+            "environment": {environment}, "groups": [{{"name": "g", "meshes": [{mesh}]}}]}}"#
+    );
+    let path = dir.join(name);
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+/// Runs `f` on its own thread and fails the test if it takes more than 10 seconds (a FIFO
+/// opened for reading waits for a writer forever).
+fn promptly<T: Send + 'static>(what: &str, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (send, receive) = mpsc::channel();
+    std::thread::spawn(move || send.send(f()));
+    receive.recv_timeout(Duration::from_secs(10)).unwrap_or_else(|_| panic!("{what} hangs"))
+}
+
+#[track_caller]
+fn assert_says(message: &str, parts: &[&str]) {
+    for part in parts {
+        assert!(message.contains(part), "{message:?} does not say {part:?}");
+    }
+}
+
+/// `kage_scene_load(path)`: its result and the thread's error message.
+fn scene_load(path: &str) -> (kage_result, String) {
+    let path = CString::new(path).unwrap();
+    let mut scene = null_mut();
+    // SAFETY: a NUL-terminated string and a local out pointer.
+    let result = unsafe { capi::scene::kage_scene_load(path.as_ptr(), &mut scene) };
+    assert!(scene.is_null() || result == kage_result::Ok);
+    let mut buffer = [0 as c_char; 1024];
+    let mut length = 0;
+    // SAFETY: a local buffer of the stated size.
+    unsafe { capi::kage_last_error_message(buffer.as_mut_ptr(), buffer.len(), &mut length) };
+    let bytes: Vec<u8> = buffer[..length.min(buffer.len() - 1)].iter().map(|c| *c as u8).collect();
+    (result, String::from_utf8_lossy(&bytes).into_owned())
+}
+
+/// A 65536 × 32768 header in a file of a few hundred bytes: before the check, reading it
+/// allocated 24 GiB for the pixels and aborted. Every reader refuses it naming the file, the
+/// declared size and the limit; a header within the limit that the file cannot hold is refused
+/// as truncated.
+#[test]
+fn image_headers_declaring_huge_sizes_are_refused_before_allocating() {
+    let dir = scratch_dir("hostile-huge");
+    let huge = dir.join("huge.exr");
+    exr_declaring(&huge, 65536, 32768);
+    let name = huge.display().to_string();
+    let limit = "16384x8192";
+    assert_says(&imageio::read_exr(&huge).unwrap_err().to_string(), &[&name, "65536x32768", limit]);
+    assert_says(&EnvMap::load(&huge).unwrap_err().to_string(), &[&name, "65536x32768", limit]);
+    let scene = scene_file(&dir, "huge-map.json", None, Some(&huge));
+    assert_says(&Scene::load(&scene).unwrap_err().to_string(), &["huge-map.json", &name, "65536x32768"]);
+    let (result, message) = scene_load(scene.to_str().unwrap());
+    assert_eq!(result, kage_result::File, "{message}");
+    assert_says(&message, &[&name, "65536x32768", limit]);
+
+    let lying = dir.join("lying.exr");
+    exr_declaring(&lying, 8192, 4096);
+    for message in
+        [imageio::read_exr(&lying).unwrap_err().to_string(), EnvMap::load(&lying).unwrap_err().to_string()]
+    {
+        assert_says(&message, &["lying.exr", "8192x4096", "truncated"]);
+    }
+
+    let hdr = dir.join("huge.hdr");
+    hdr_declaring(&hdr, 65536, 32768);
+    assert_says(&EnvMap::load(&hdr).unwrap_err().to_string(), &["huge.hdr", "65536x32768", limit]);
+    let hdr = dir.join("lying.hdr");
+    hdr_declaring(&hdr, 8192, 4096);
+    assert_says(&EnvMap::load(&hdr).unwrap_err().to_string(), &["lying.hdr", "8192x4096", "truncated"]);
+}
+
+/// `/dev/zero` (endless) and a FIFO (no writer: opening it waits forever) as the scene, an OBJ,
+/// the environment map and an image to compare: each refused at once, naming the path and
+/// saying it is not a regular file.
+#[test]
+fn devices_and_fifos_are_refused_without_reading() {
+    let dir = scratch_dir("hostile-special");
+    let zero_exr = dir.join("zero.exr");
+    std::os::unix::fs::symlink("/dev/zero", &zero_exr).unwrap();
+    let fifo_exr = dir.join("fifo.exr");
+    fifo(&fifo_exr);
+    let fifo_obj = dir.join("fifo.obj");
+    fifo(&fifo_obj);
+    let fifo_json = dir.join("fifo.json");
+    fifo(&fifo_json);
+    let device = "a character device, not a regular file";
+    let pipe = "a FIFO, not a regular file";
+
+    let cases: Vec<(PathBuf, PathBuf, &str)> = vec![
+        (scene_file(&dir, "zero-obj.json", Some(Path::new("/dev/zero")), None), "/dev/zero".into(), device),
+        (scene_file(&dir, "fifo-obj.json", Some(&fifo_obj), None), fifo_obj.clone(), pipe),
+        (scene_file(&dir, "zero-map.json", None, Some(&zero_exr)), zero_exr.clone(), device),
+        (scene_file(&dir, "fifo-map.json", None, Some(&fifo_exr)), fifo_exr.clone(), pipe),
+    ];
+    for (scene, blamed, kind) in cases {
+        let message = promptly("loading a scene", move || Scene::load(&scene).unwrap_err().to_string());
+        assert_says(&message, &[&blamed.display().to_string(), kind]);
+    }
+    for (image, kind) in [(zero_exr, device), (fifo_exr, pipe)] {
+        let name = image.display().to_string();
+        let message = promptly("reading an EXR", move || imageio::read_exr(&image).unwrap_err().to_string());
+        assert_says(&message, &[&name, kind]);
+    }
+    let fifo_json = fifo_json.display().to_string();
+    let (result, message) = promptly("kage_scene_load", move || scene_load(&fifo_json));
+    assert_eq!(result, kage_result::File, "{message}");
+    assert_says(&message, &["fifo.json", pipe]);
+}
+
+/// An existing path that is no scene file, given as the scene (`--scene`, `kage_scene_load`):
+/// a folder without a scene file, `/dev/zero`. Each is the path's fault (`KAGE_RESULT_FILE`),
+/// named, not an unknown built-in name.
+#[test]
+fn existing_paths_that_are_no_scene_file_are_file_errors_naming_them() {
+    let dir = scratch_dir("hostile-folder");
+    for (path, problem) in [
+        (dir.display().to_string(), "a folder without scene.json"),
+        ("/dev/zero".to_string(), "a character device, not a regular file"),
+    ] {
+        let message = Scene::from_arg(&path).unwrap_err().to_string();
+        assert_says(&message, &[&path, problem]);
+        let arg = path.clone();
+        let (result, message) = promptly("kage_scene_load", move || scene_load(&arg));
+        assert_eq!(result, kage_result::File, "{message}");
+        assert_says(&message, &[&path, problem]);
+    }
+}
+
+/// Editors on Windows start UTF-8 files with a byte order mark; JSON forbids it, Kage skips it.
+#[test]
+fn a_scene_file_starting_with_a_byte_order_mark_loads() {
+    let dir = scratch_dir("hostile-bom");
+    let plain = scene_file(&dir, "plain.json", None, None);
+    let mut bytes = b"\xEF\xBB\xBF".to_vec();
+    bytes.extend(std::fs::read(&plain).unwrap());
+    let bom = dir.join("bom.json");
+    std::fs::write(&bom, bytes).unwrap();
+    let scene = Scene::load(&bom).unwrap();
+    assert_eq!(scene.groups, Scene::load(&plain).unwrap().groups);
+}
