@@ -25,6 +25,9 @@ use shaders::compile_shaders;
 use std::fs;
 use std::path::{Path, PathBuf};
 
+/// The C ABI version (see `kage_abi` in src/capi/mod.rs).
+const C_ABI_VERSION: u32 = 1;
+
 fn main() {
     let manifest_dir = PathBuf::from(env("CARGO_MANIFEST_DIR"));
     let out_dir = PathBuf::from(env("OUT_DIR"));
@@ -34,6 +37,10 @@ fn main() {
     let include_dir = shader_dir.join("include");
 
     check_shaderc_archive(&manifest_dir);
+    // The C ABI's version in libkage.so's SONAME, so that the dynamic loader refuses to pair a
+    // host with a library of another ABI (the same number as `kage_abi::Version` in
+    // src/capi/mod.rs; the C host tests check that they agree).
+    println!("cargo:rustc-cdylib-link-arg=-Wl,-soname,libkage.so.{C_ABI_VERSION}");
 
     println!("cargo:rerun-if-changed={}", shader_dir.display());
     println!("cargo:rerun-if-changed={}", include_dir.display());

@@ -3,7 +3,12 @@
  * Handles are opaque values, not addresses; each has a create/destroy pair, and a destroyed handle
  * stays invalid (KAGE_RESULT_INVALID_HANDLE) for good. Threading: any function may be called
  * from any thread; a call on a handle that another thread's call is using returns
- * KAGE_RESULT_BUSY and does nothing; calls on different handles may run at the same time. */
+ * KAGE_RESULT_BUSY and does nothing; calls on different handles may run at the same time.
+ * Compatibility: KAGE_ABI_VERSION rises with every incompatible change to this header, and
+ * libkage.so carries it in its SONAME (libkage.so.1); check kage_abi_version() against it at
+ * start-up. Every desc struct starts with its size (set it to sizeof the struct): a host
+ * compiled against another version of this header gets KAGE_RESULT_INVALID_VALUE, never a
+ * misread struct. Bad input of any kind gives an error code, never a crash. */
 
 #ifndef KAGE_H
 #define KAGE_H
@@ -385,6 +390,28 @@ typedef uint32_t kage_probe_dering;
 #endif // __cplusplus
 
 /**
+ * The version of the C ABI kage.h declares. It rises with every incompatible change (a struct
+ * field added, removed or moved, a function's parameters, an enumeration's values), and
+ * libkage.so carries it in its SONAME (`libkage.so.1`). A host checks at start-up that
+ * `kage_abi_version()` equals the `KAGE_ABI_VERSION` it was compiled with; beyond that, every
+ * desc struct carries its `size`, which each call checks.
+ */
+enum kage_abi
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  KAGE_ABI_VERSION = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_abi kage_abi;
+#else
+typedef uint32_t kage_abi;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * A Vulkan device, queue and memory allocator that scenes are precomputed and rendered with.
  */
 typedef struct kage_context kage_context;
@@ -404,6 +431,11 @@ typedef struct kage_scene kage_scene;
  */
 typedef struct {
   /**
+   * `sizeof(kage_context_desc)` as the host's kage.h declares it: checked, so that a host built
+   * against another version of the header gets an error instead of a misread struct.
+   */
+  uint32_t size;
+  /**
    * Use the first Vulkan device whose name contains this (case-insensitive), e.g.
    * "llvmpipe". NULL: the `KAGE_DEVICE` environment variable, else a discrete GPU, else any.
    */
@@ -420,6 +452,11 @@ typedef struct {
  * pointer (dispatchable Vulkan handles are pointers), so that kage.h needs no Vulkan header.
  */
 typedef struct {
+  /**
+   * `sizeof(kage_vulkan_handles)` as the host's kage.h declares it: checked, so that a host built
+   * against another version of the header gets an error instead of a misread struct.
+   */
+  uint32_t size;
   /**
    * The VkInstance, created with apiVersion 1.2 or later.
    */
@@ -456,6 +493,11 @@ typedef struct {
  * recompile.
  */
 typedef struct {
+  /**
+   * `sizeof(kage_technique_desc)` as the host's kage.h declares it: checked, so that a host built
+   * against another version of the header gets an error instead of a misread struct.
+   */
+  uint32_t size;
   /**
    * A `kage_technique` value.
    */
@@ -574,6 +616,11 @@ typedef struct {
  * What `kage_renderer_create` builds.
  */
 typedef struct {
+  /**
+   * `sizeof(kage_renderer_desc)` as the host's kage.h declares it: checked, so that a host built
+   * against another version of the header gets an error instead of a misread struct.
+   */
+  uint32_t size;
   /**
    * Image size in pixels, 1 to 8192 each.
    */
@@ -707,6 +754,11 @@ typedef struct {
  * A whole scene from the host's memory, no files involved.
  */
 typedef struct {
+  /**
+   * `sizeof(kage_scene_desc)` as the host's kage.h declares it: checked, so that a host built
+   * against another version of the header gets an error instead of a misread struct.
+   */
+  uint32_t size;
   const kage_group_desc *groups;
   uint32_t group_count;
   kage_environment_desc environment;
@@ -716,6 +768,17 @@ typedef struct {
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+/**
+ * The C ABI version of this library: `KAGE_ABI_VERSION` of the kage.h it was built with.
+ */
+uint32_t kage_abi_version(void);
+
+/**
+ * This library's version, e.g. "0.1.0": a NUL-terminated string that lives as long as the
+ * library.
+ */
+const char *kage_version(void);
 
 /**
  * Creates a context with its own Vulkan instance and device.

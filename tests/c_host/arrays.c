@@ -28,7 +28,7 @@ static kage_scene_desc triangle(void) {
   kage_mesh_desc mesh = {tri_positions, NULL, 3, tri_indices, 3, {0.5f, 0.5f, 0.5f}};
   kage_group_desc group = {NULL, {{0, 0, 0}, {0, 0, 0, 1}, 1.0f}, &tri_mesh, 1};
   tri_mesh = mesh, tri_group = group;
-  kage_scene_desc desc = {&tri_group, 1, {tri_sky, 2, 1}, {{0, 1, 2}, {0, 0, 0}, {0, 1, 0}, 60.0f}};
+  kage_scene_desc desc = {sizeof(kage_scene_desc), &tri_group, 1, {tri_sky, 2, 1}, {{0, 1, 2}, {0, 0, 0}, {0, 1, 0}, 60.0f}};
   return desc;
 }
 
@@ -40,15 +40,23 @@ static void check_bad_arguments(kage_context *context) {
   kage_scene *no_scene = (kage_scene *)1;
   kage_renderer *no_renderer = (kage_renderer *)1;
 
+  /* The ABI version, and a desc from a host compiled against another kage.h: an error, not a
+   * misread struct. */
+  REQUIRE(kage_abi_version() == KAGE_ABI_VERSION);
+  REQUIRE(kage_version() != NULL && strlen(kage_version()) > 0);
+
   /* Contexts. */
-  kage_context_desc context_desc = {NULL, false};
+  kage_context_desc context_desc = {sizeof(kage_context_desc), NULL, false};
+  context_desc.size = sizeof(kage_context_desc) - 8;
   kage_context *made = no_context;
+  EXPECT(kage_context_create(&context_desc, &made), KAGE_RESULT_INVALID_VALUE);
+  context_desc.size = sizeof(kage_context_desc);
   EXPECT(kage_context_create(NULL, &made), KAGE_RESULT_NULL_ARGUMENT);
   REQUIRE(made == NULL); /* out-handles are NULL after a failure */
   EXPECT(kage_context_create(&context_desc, NULL), KAGE_RESULT_NULL_ARGUMENT);
   context_desc.device_name = "no such device anywhere";
   EXPECT(kage_context_create(&context_desc, &made), KAGE_RESULT_NO_DEVICE);
-  kage_vulkan_handles handles = {NULL, NULL, NULL, 0, NULL, false};
+  kage_vulkan_handles handles = {sizeof(kage_vulkan_handles), NULL, NULL, NULL, 0, NULL, false};
   EXPECT(kage_context_create_from_vulkan(NULL, &made), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_context_create_from_vulkan(&handles, NULL), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_context_create_from_vulkan(&handles, &made), KAGE_RESULT_NULL_ARGUMENT);
@@ -135,11 +143,17 @@ static void check_bad_arguments(kage_context *context) {
 
   /* Renderers. */
   kage_renderer *renderer = NULL;
-  kage_renderer_desc renderer_desc = {8, 8, technique};
+  kage_renderer_desc renderer_desc = {sizeof(kage_renderer_desc), 8, 8, technique};
   EXPECT(kage_renderer_create(NULL, scene, &renderer_desc, &renderer), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_create(context, NULL, &renderer_desc, &renderer), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_create(context, scene, NULL, &renderer), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_create(context, scene, &renderer_desc, NULL), KAGE_RESULT_NULL_ARGUMENT);
+  renderer_desc.size -= 8; /* an older host's shorter struct */
+  EXPECT(kage_renderer_create(context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_VALUE);
+  renderer_desc.size += 8;
+  renderer_desc.technique.size += 8;
+  EXPECT(kage_renderer_create(context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_VALUE);
+  renderer_desc.technique.size -= 8;
   EXPECT(kage_renderer_create(no_context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_HANDLE);
   /* Tamura before its precomputation. */
   EXPECT(kage_renderer_create(context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_VALUE);
@@ -235,7 +249,7 @@ int main(int argc, char **argv) {
     return 2;
   }
   unsigned frames = (unsigned)atoi(argv[1]), size = (unsigned)atoi(argv[2]);
-  kage_context_desc context_desc = {NULL, atoi(argv[3]) != 0};
+  kage_context_desc context_desc = {sizeof(kage_context_desc), NULL, atoi(argv[3]) != 0};
   kage_context *context = NULL;
   CHECK(kage_context_create(&context_desc, &context));
   check_bad_arguments(context);

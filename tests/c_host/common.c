@@ -114,7 +114,7 @@ kage_scene *make_scene(void) {
       {"box", box_at(-1.0f), &box_mesh, 1},
   };
   kage_scene_desc desc = {
-      groups, 2, {environment, ENV_WIDTH, ENV_HEIGHT}, {{0.0f, 3.0f, 4.0f}, {0.0f, 0.3f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f}};
+      sizeof(kage_scene_desc), groups, 2, {environment, ENV_WIDTH, ENV_HEIGHT}, {{0.0f, 3.0f, 4.0f}, {0.0f, 0.3f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f}};
   kage_scene *scene = NULL;
   CHECK(kage_scene_create(&desc, &scene));
   return scene;
@@ -139,7 +139,7 @@ static int has_pass(const kage_pass_timing *timings, size_t count, const char *n
 
 static void run_frames(kage_context *context, kage_scene *scene, const kage_technique_desc *technique,
                        unsigned frames, unsigned size) {
-  kage_renderer_desc desc = {size, size, *technique};
+  kage_renderer_desc desc = {sizeof(kage_renderer_desc), size, size, *technique};
   kage_renderer *renderer = NULL;
   CHECK(kage_renderer_create(context, scene, &desc, &renderer));
   uint8_t *rgba8 = malloc((size_t)size * size * 4);

@@ -15,7 +15,7 @@ static kage_context *context;
 static kage_scene *scene;
 
 static kage_renderer *new_renderer(void) {
-  kage_renderer_desc desc = {SIZE, SIZE, {0}};
+  kage_renderer_desc desc = {sizeof(kage_renderer_desc), SIZE, SIZE, {0}};
   CHECK(kage_technique_desc_default(KAGE_TECHNIQUE_UNSHADOWED, &desc.technique));
   kage_renderer *renderer = NULL;
   kage_result result;
@@ -143,7 +143,7 @@ static void stale_handles(void) {
   CHECK(kage_renderer_render(s));
   CHECK(kage_renderer_destroy(s));
 
-  kage_context_desc desc = {NULL, 1};
+  kage_context_desc desc = {sizeof(kage_context_desc), NULL, 1};
   kage_context *c = NULL;
   CHECK(kage_context_create(&desc, &c));
   CHECK(kage_context_destroy(c));
@@ -154,7 +154,7 @@ static void stale_handles(void) {
 }
 
 int main(void) {
-  kage_context_desc desc = {NULL, 1};
+  kage_context_desc desc = {sizeof(kage_context_desc), NULL, 1};
   CHECK(kage_context_create(&desc, &context));
   scene = make_scene();
   one_renderer_from_four_threads();

@@ -117,7 +117,7 @@ int main(int argc, char **argv) {
   VkDevice bare = make_device(physical, family, 0);
   VkQueue bare_queue;
   vkGetDeviceQueue(bare, family, 0, &bare_queue);
-  kage_vulkan_handles handles = {instance, physical, bare, family, bare_queue, validation};
+  kage_vulkan_handles handles = {sizeof(kage_vulkan_handles), instance, physical, bare, family, bare_queue, validation};
   kage_context *context = NULL;
   EXPECT(kage_context_create_from_vulkan(&handles, &context), KAGE_RESULT_UNSUPPORTED);
   char message[512];

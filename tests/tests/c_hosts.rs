@@ -55,8 +55,14 @@ fn hosts() -> &'static Hosts {
             out
         };
         let staticlib = library("libkage.a").display().to_string();
-        let cdylib_dir = library("libkage.so").parent().expect("folder").display().to_string();
-        let rpath = format!("-Wl,-rpath,{cdylib_dir}");
+        // The cdylib's SONAME names the ABI version (libkage.so.1), which the host then needs
+        // at run time: a link by that name beside the hosts, as an install would make it.
+        let cdylib = library("libkage.so");
+        let soname = dir.join(soname());
+        let _ = std::fs::remove_file(&soname);
+        std::os::unix::fs::symlink(&cdylib, &soname).expect("the SONAME link beside the hosts");
+        let cdylib_dir = cdylib.parent().expect("folder").display().to_string();
+        let rpath = format!("-Wl,-rpath,{}", dir.display());
         let common = src.join("common.c").display().to_string();
         // After the archive, the system libraries Rust's standard library needs (what
         // `rustc --print native-static-libs` lists for linux-gnu).
@@ -72,6 +78,20 @@ fn hosts() -> &'static Hosts {
             threads: with_staticlib("threads"),
         }
     })
+}
+
+/// The SONAME libkage.so must carry: the ABI version the library reports.
+fn soname() -> String {
+    format!("libkage.so.{}", kage::capi::kage_abi_version())
+}
+
+/// The library's SONAME is its ABI version, so that the loader refuses a library of another.
+#[test]
+fn the_shared_library_is_named_for_its_abi_version() {
+    let output =
+        Command::new("readelf").arg("-d").arg(library("libkage.so")).output().expect("readelf (binutils)");
+    let dynamic = succeeded("readelf -d libkage.so", output);
+    assert!(dynamic.contains(&format!("Library soname: [{}]", soname())), "{dynamic}");
 }
 
 #[track_caller]

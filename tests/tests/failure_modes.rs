@@ -521,7 +521,12 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
     technique.mask_size = 2048;
     // SAFETY: live handles and a valid desc.
     assert_eq!(unsafe { capi::technique::kage_precompute(c.context, c.scene, &technique) }, kage_result::Ok);
-    let desc = capi::renderer::kage_renderer_desc { width: 16, height: 16, technique };
+    let desc = capi::renderer::kage_renderer_desc {
+        size: size_of::<capi::renderer::kage_renderer_desc>() as u32,
+        width: 16,
+        height: 16,
+        technique,
+    };
     let mut renderer = null_mut();
     // SAFETY: as above; `renderer` is writable.
     let code = unsafe { capi::renderer::kage_renderer_create(c.context, c.scene, &desc, &mut renderer) };
@@ -529,8 +534,7 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
         assert_eq!(code, kage_result::OutOfMemory, "{}", last_error());
         assert!(last_error().contains("occlusion.mask"), "{}", last_error());
     }
-    // SAFETY: NULL or a live renderer.
-    unsafe { capi::renderer::kage_renderer_destroy(renderer) };
+    capi::renderer::kage_renderer_destroy(renderer);
 }
 
 /// Device loss and running out of memory have their own errors, and their own C result codes
@@ -648,6 +652,7 @@ fn scene_desc(
         group.meshes = mesh;
     }
     capi::scene::kage_scene_desc {
+        size: size_of::<capi::scene::kage_scene_desc>() as u32,
         groups: groups.as_ptr(),
         group_count: 2,
         environment: capi::scene::kage_environment_desc { pixels: sky.as_ptr(), width: SKY.0, height: SKY.1 },
@@ -697,7 +702,11 @@ fn create_scene(sky: &[f32]) -> (kage_result, *mut capi::scene::kage_scene) {
 
 impl CHost {
     fn new() -> CHost {
-        let desc = capi::context::kage_context_desc { device_name: null(), validation: true };
+        let desc = capi::context::kage_context_desc {
+            size: size_of::<capi::context::kage_context_desc>() as u32,
+            device_name: null(),
+            validation: true,
+        };
         let mut context = null_mut();
         // SAFETY: a valid desc and a writable out-handle.
         assert_eq!(unsafe { capi::context::kage_context_create(&desc, &mut context) }, kage_result::Ok);
@@ -724,11 +733,9 @@ impl CHost {
 
 impl Drop for CHost {
     fn drop(&mut self) {
-        // SAFETY: handles this host made (destroying an already destroyed one is caught).
-        unsafe {
-            capi::scene::kage_scene_destroy(self.scene);
-            capi::context::kage_context_destroy(self.context);
-        }
+        // Handles this host made (destroying an already destroyed one is caught).
+        capi::scene::kage_scene_destroy(self.scene);
+        capi::context::kage_context_destroy(self.context);
     }
 }
 
@@ -773,12 +780,22 @@ fn c_abi_catches_bad_values_and_calls_after_free() {
     ] {
         let technique =
             capi::technique::kage_technique_desc { probe_light, shadow_map_size, technique, ..unshadowed };
-        let desc = capi::renderer::kage_renderer_desc { width, height, technique };
+        let desc = capi::renderer::kage_renderer_desc {
+            size: size_of::<capi::renderer::kage_renderer_desc>() as u32,
+            width,
+            height,
+            technique,
+        };
         assert_eq!(create(&desc, c.context).0, kage_result::InvalidValue);
         assert!(last_error().contains(named), "{} does not name {named}", last_error());
     }
 
-    let desc = capi::renderer::kage_renderer_desc { width: 4, height: 4, technique: unshadowed };
+    let desc = capi::renderer::kage_renderer_desc {
+        size: size_of::<capi::renderer::kage_renderer_desc>() as u32,
+        width: 4,
+        height: 4,
+        technique: unshadowed,
+    };
     let (code, renderer) = create(&desc, c.context);
     assert_eq!(code, kage_result::Ok, "{}", last_error());
     let mut pixels = [0u8; 4 * 4 * 16];
@@ -850,7 +867,12 @@ fn c_abi_places_probes_and_reports_them() {
         ..c.technique(TechniqueKind::Probes as u32)
     };
     let create = |technique| {
-        let desc = capi::renderer::kage_renderer_desc { width: 8, height: 8, technique };
+        let desc = capi::renderer::kage_renderer_desc {
+            size: size_of::<capi::renderer::kage_renderer_desc>() as u32,
+            width: 8,
+            height: 8,
+            technique,
+        };
         let mut renderer = null_mut();
         // SAFETY: live handles, a desc whose positions hold the count it states, a writable out.
         let code = unsafe { capi::renderer::kage_renderer_create(c.context, c.scene, &desc, &mut renderer) };

@@ -29,6 +29,11 @@ pub struct CompareArgs {
 }
 
 pub fn run(args: &CompareArgs) -> Result<()> {
+    for (path, flag) in [(&args.diff, "--diff"), (&args.mismatch_image, "--mismatch-image")] {
+        if let Some(path) = path {
+            crate::outputs::check(path, flag, &["png"])?;
+        }
+    }
     let a = kage::imageio::read_exr(&args.a)?;
     let b = kage::imageio::read_exr(&args.b)?;
     let m = compare(&a, &b)

@@ -6,6 +6,7 @@ mod bench_probes;
 mod compare;
 mod env_cmd;
 mod info;
+mod outputs;
 mod precompute;
 mod probe_image;
 mod probes;

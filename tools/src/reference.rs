@@ -114,10 +114,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
             bail!("--time-budget must be a positive number of seconds, got {budget}");
         }
     }
-    let json_out = args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    if args.irradiance.is_some() && !json_out {
-        bail!("--out {}: irradiance results are written as .json", args.out.display());
-    }
+    // Irradiance results are written as .json, images as .png or .exr.
+    let extensions: &[&str] = if args.irradiance.is_some() { &["json"] } else { &["png", "exr"] };
+    crate::outputs::check(&args.out, "--out", extensions)?;
     // Bad input files fail before the GPU is set up.
     let points = args.irradiance.as_deref().map(read_points).transpose()?;
     let scene = args.scene.load()?;

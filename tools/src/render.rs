@@ -178,6 +178,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !(args.exposure.is_finite() && args.exposure > 0.0) {
         anyhow::bail!("--exposure must be a positive number");
     }
+    crate::outputs::check(&args.out, "--out", &["png", "exr"])?;
+    if let Some(timings) = &args.timings {
+        crate::outputs::check(timings, "--timings", &["json"])?;
+    }
     if args.animate && args.scene.keyframe.is_some() {
         anyhow::bail!(
             "--animate plays the walkthrough and --keyframe holds one of its cameras: give one of them"

@@ -169,7 +169,15 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let dir = scratch_dir("cli-bad");
     let bad_scene = dir.join("bad.json");
     std::fs::write(&bad_scene, r#"{"camera": {"position": [0,0,1], "target": [0,0,0], "fov_y_deg": 40}, "environment": {"constant": [1,1,1]}, "groups": [], "colour": 1}"#).unwrap();
-    let cases: [(&[&str], &str); 15] = [
+    let points = dir.join("points.json");
+    std::fs::write(&points, r#"{"points": [{"position": [0, 0.5, 0], "normal": [0, 1, 0]}]}"#).unwrap();
+    let (points, out_json) = (points.to_str().unwrap(), dir.join("e.json"));
+    let no_samples = ["--bounces", "1", "--bounce-samples", "0", "--out", out_json.to_str().unwrap()];
+    let cases: [(&[&str], &str); 18] = [
+        // Outputs are checked before the work that would fill them.
+        (&["compare", "a.exr", "b.exr", "--diff", "d.jpg"], "--diff d.jpg: the file must end in .png"),
+        (&["reference", "--out", "/no/such/folder/r.exr"], "the folder /no/such/folder does not exist"),
+        (&[&["reference", "--irradiance", points][..], &no_samples[..]].concat(), "0 samples per vertex"),
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", "asm", "--keyframe", "5"], "scene asm has 5 walkthrough keyframes"),
         (&["reference", "--keyframe", "1", "--out", "x.exr"], "scene teapot has 0 walkthrough keyframes"),
@@ -190,6 +198,25 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["bench", "probe-count", "--scenes", "probe-room", "--candidates", "1"], "grid level 1"),
     ];
     assert_clear_errors(&cases);
+}
+
+/// `kage scene export` writes its own files, never through a symbolic link to one elsewhere.
+#[cfg(unix)]
+#[test]
+fn scene_export_does_not_write_through_a_symbolic_link() {
+    let dir = scratch_dir("cli-export-link");
+    let elsewhere = dir.join("elsewhere.txt");
+    std::fs::write(&elsewhere, "keep").unwrap();
+    let out = dir.join("export");
+    std::fs::create_dir_all(&out).unwrap();
+    let link = out.join("scene.json");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(&elsewhere, &link).unwrap();
+    let run = kage(&["scene", "export", "--scene", "teapot", "--out", out.to_str().unwrap()]);
+    let all = text(&run);
+    assert_eq!(run.status.code(), Some(1), "{all}");
+    assert!(all.contains("scene.json") && all.contains("symbolic link"), "{all}");
+    assert_eq!(std::fs::read_to_string(&elsewhere).unwrap(), "keep");
 }
 
 #[test]

@@ -16,6 +16,35 @@ pub(crate) unsafe fn value<'a, T>(ptr: *const T, name: &str) -> Result<&'a T, Fa
     unsafe { ptr.as_ref() }.ok_or_else(|| null(name))
 }
 
+/// A desc struct the host filled, whose first field is its `size` (see [`check_size`]).
+///
+/// # Safety
+/// `ptr` must be NULL or valid for reads of the host's version of `T`, whose first field is
+/// its size as a `u32`.
+pub(crate) unsafe fn sized<'a, T>(ptr: *const T, name: &str) -> Result<&'a T, Failure> {
+    if ptr.is_null() {
+        return Err(null(name));
+    }
+    // SAFETY: every version of the struct starts with its u32 size, so this reads within it.
+    check_size::<T>(unsafe { ptr.cast::<u32>().read_unaligned() }, name)?;
+    // SAFETY: the host's struct has this library's size, so it is this library's `T`.
+    Ok(unsafe { &*ptr })
+}
+
+/// Checks the `size` field of a desc struct against this library's `sizeof(T)`.
+pub(crate) fn check_size<T>(size: u32, name: &str) -> Result<(), Failure> {
+    let own = size_of::<T>();
+    if size as usize != own {
+        let kind = std::any::type_name::<T>().rsplit("::").next().unwrap_or("desc");
+        return Err(Failure::invalid(format!(
+            "{name}.size is {size}, but this library's {kind} is {own} bytes: the host was compiled \
+             against another version of kage.h (this library has ABI version {})",
+            super::kage_abi::Version as u32
+        )));
+    }
+    Ok(())
+}
+
 /// Where to write a result.
 ///
 /// # Safety

@@ -29,6 +29,9 @@ impl kage_context {
 /// How `kage_context_create` makes its device.
 #[repr(C)]
 pub struct kage_context_desc {
+    /// `sizeof(kage_context_desc)` as the host's kage.h declares it: checked, so that a host built
+    /// against another version of the header gets an error instead of a misread struct.
+    pub size: u32,
     /// Use the first Vulkan device whose name contains this (case-insensitive), e.g.
     /// "llvmpipe". NULL: the `KAGE_DEVICE` environment variable, else a discrete GPU, else any.
     pub device_name: *const c_char,
@@ -54,7 +57,7 @@ pub unsafe extern "C" fn kage_context_create(
         // SAFETY: the caller promises NULL or a writable pointer.
         let context = unsafe { args::handle_out(context, "context") }?;
         // SAFETY: the caller promises NULL or a valid desc.
-        let desc = unsafe { args::value(desc, "desc") }?;
+        let desc = unsafe { args::sized(desc, "desc") }?;
         let device = match desc.device_name.is_null() {
             true => None,
             // SAFETY: the caller promises a NUL-terminated string.
@@ -71,6 +74,9 @@ pub unsafe extern "C" fn kage_context_create(
 /// pointer (dispatchable Vulkan handles are pointers), so that kage.h needs no Vulkan header.
 #[repr(C)]
 pub struct kage_vulkan_handles {
+    /// `sizeof(kage_vulkan_handles)` as the host's kage.h declares it: checked, so that a host built
+    /// against another version of the header gets an error instead of a misread struct.
+    pub size: u32,
     /// The VkInstance, created with apiVersion 1.2 or later.
     pub instance: *mut c_void,
     /// The VkPhysicalDevice the device was created on.
@@ -111,7 +117,7 @@ pub unsafe extern "C" fn kage_context_create_from_vulkan(
         // SAFETY: the caller promises NULL or a writable pointer.
         let context = unsafe { args::handle_out(context, "context") }?;
         // SAFETY: the caller promises NULL or a valid struct.
-        let host = unsafe { args::value(handles, "handles") }?;
+        let host = unsafe { args::sized(handles, "handles") }?;
         for (name, handle) in [
             ("handles->instance", host.instance),
             ("handles->physical_device", host.physical_device),

@@ -18,6 +18,29 @@
 //! own command buffers). The last error message is per thread.
 #![allow(non_camel_case_types)]
 
+/// The version of the C ABI kage.h declares. It rises with every incompatible change (a struct
+/// field added, removed or moved, a function's parameters, an enumeration's values), and
+/// libkage.so carries it in its SONAME (`libkage.so.1`). A host checks at start-up that
+/// `kage_abi_version()` equals the `KAGE_ABI_VERSION` it was compiled with; beyond that, every
+/// desc struct carries its `size`, which each call checks.
+#[repr(u32)]
+pub enum kage_abi {
+    Version = 1,
+}
+
+/// The C ABI version of this library: `KAGE_ABI_VERSION` of the kage.h it was built with.
+#[no_mangle]
+pub extern "C" fn kage_abi_version() -> u32 {
+    kage_abi::Version as u32
+}
+
+/// This library's version, e.g. "0.1.0": a NUL-terminated string that lives as long as the
+/// library.
+#[no_mangle]
+pub extern "C" fn kage_version() -> *const std::ffi::c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
 mod args;
 pub mod context;
 mod handles;

@@ -21,6 +21,9 @@ pub struct kage_renderer {
 /// What `kage_renderer_create` builds.
 #[repr(C)]
 pub struct kage_renderer_desc {
+    /// `sizeof(kage_renderer_desc)` as the host's kage.h declares it: checked, so that a host built
+    /// against another version of the header gets an error instead of a misread struct.
+    pub size: u32,
     /// Image size in pixels, 1 to 8192 each.
     pub width: u32,
     pub height: u32,
@@ -72,7 +75,7 @@ pub unsafe extern "C" fn kage_renderer_create(
         let out = unsafe { args::handle_out(renderer, "renderer") }?;
         let (context, scene) = (handles::get(context, "context")?, handles::get(scene, "scene")?);
         // SAFETY: the caller promises NULL or a valid desc.
-        let desc = unsafe { args::value(desc, "desc") }?;
+        let desc = unsafe { args::sized(desc, "desc") }?;
         // SAFETY: the caller promises a valid desc, its probe positions included.
         let technique = unsafe { desc.technique.desc() }?;
         let options = RenderOptions {

@@ -91,6 +91,9 @@ impl kage_camera_desc {
 /// A whole scene from the host's memory, no files involved.
 #[repr(C)]
 pub struct kage_scene_desc {
+    /// `sizeof(kage_scene_desc)` as the host's kage.h declares it: checked, so that a host built
+    /// against another version of the header gets an error instead of a misread struct.
+    pub size: u32,
     pub groups: *const kage_group_desc,
     pub group_count: u32,
     pub environment: kage_environment_desc,
@@ -142,7 +145,7 @@ pub unsafe extern "C" fn kage_scene_create(
         // SAFETY: the caller promises NULL or a writable pointer.
         let out = unsafe { args::handle_out(scene, "scene") }?;
         // SAFETY: the caller promises NULL or a valid desc with arrays as stated.
-        let scene = unsafe { scene_from_desc(args::value(desc, "desc")?) }?;
+        let scene = unsafe { scene_from_desc(args::sized(desc, "desc")?) }?;
         *out = handles::register(kage_scene { scene, transfer: None });
         Ok(())
     })

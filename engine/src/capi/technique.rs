@@ -54,6 +54,9 @@ pub enum kage_probe_dering {
 #[repr(C)]
 #[derive(Clone, Copy)]
 pub struct kage_technique_desc {
+    /// `sizeof(kage_technique_desc)` as the host's kage.h declares it: checked, so that a host built
+    /// against another version of the header gets an error instead of a misread struct.
+    pub size: u32,
     /// A `kage_technique` value.
     pub technique: u32,
     /// SH bands of the PRT transfer (Sloan, Tamura), 2 to 5; default 3.
@@ -124,6 +127,8 @@ impl kage_technique_desc {
     /// With `KAGE_PROBE_PLACEMENT_POSITIONS`, `probe_positions` must be NULL or readable for
     /// `probe_position_count` × 3 floats.
     pub(crate) unsafe fn desc(&self) -> Result<TechniqueDesc, Failure> {
+        // Checked here too for the desc inside a `kage_renderer_desc`.
+        args::check_size::<kage_technique_desc>(self.size, "technique")?;
         let kind = args::enumeration(self.technique, "technique", TechniqueKind::from_repr)?;
         let prt = PrtParams { bands: self.sh_bands, rays: self.prt_rays, ..PrtParams::DEFAULT };
         let regions = self.regions as usize;
@@ -224,6 +229,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
         let (prt, occlusion) = (PrtParams::DEFAULT, OcclusionSettings::default());
         let (probes, asm) = (ProbeSettings::default(), AsmSettings::default());
         let filled = kage_technique_desc {
+            size: size_of::<kage_technique_desc>() as u32,
             technique,
             sh_bands: prt.bands,
             prt_rays: prt.rays,
@@ -279,7 +285,7 @@ pub unsafe extern "C" fn kage_precompute(
     boundary(|| {
         let (context, mut scene) = (handles::get(context, "context")?, handles::get(scene, "scene")?);
         // SAFETY: the caller promises NULL or a valid desc (its probe positions included).
-        let desc = unsafe { args::value(technique, "technique")?.desc() }?;
+        let desc = unsafe { args::sized(technique, "technique")?.desc() }?;
         if let Some(params) = desc.precomputation() {
             let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut |_, _| {});
             kage_context::check_validation(&context.ctx)?;

@@ -121,6 +121,11 @@ pub fn surface_radiance(
     seed: u32,
 ) -> Result<Option<Vec<[f32; 4]>>> {
     check_bounces(bounces)?;
+    if bounces > 0 && samples == 0 {
+        return Err(Error::InvalidArgument(format!(
+            "{bounces} bounces with 0 samples per vertex: the surfaces' radiance needs at least 1"
+        )));
+    }
     let points = vertex_points(scene);
     if points.is_empty() {
         return Ok((bounces > 0).then(Vec::new));

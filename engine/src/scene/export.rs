@@ -1,7 +1,7 @@
 //! Writing a scene as a self-contained folder that [`Scene::load`] reads back identically:
 //! `scene.json`, one OBJ per mesh and the environment as 32-bit float EXR.
 use std::collections::HashSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::file::{
     CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, PointDesc, ProbeDesc, SceneFile, SpotDesc,
@@ -11,10 +11,22 @@ use super::{obj, Camera, Light, Scene, SceneError};
 pub const SCENE_FILE: &str = "scene.json";
 pub const ENVIRONMENT_FILE: &str = "environment.exr";
 
+/// `dir/name`, unless a symbolic link is there: the export writes its own files, never through
+/// a link to a file elsewhere.
+fn output(dir: &Path, name: &str) -> Result<PathBuf, SceneError> {
+    let path = dir.join(name);
+    match std::fs::symlink_metadata(&path) {
+        Ok(meta) if meta.file_type().is_symlink() => {
+            Err(SceneError::in_file(&path, "is a symbolic link: the export does not write through it"))
+        }
+        _ => Ok(path),
+    }
+}
+
 pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
     std::fs::create_dir_all(dir)
         .map_err(|e| SceneError::in_file(dir, format!("cannot create folder: {e}")))?;
-    scene.environment.write_exr(&dir.join(ENVIRONMENT_FILE))?;
+    scene.environment.write_exr(&output(dir, ENVIRONMENT_FILE)?)?;
 
     let mut used_files = HashSet::new();
     let mut groups = Vec::with_capacity(scene.groups.len());
@@ -22,7 +34,7 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
         let mut meshes = Vec::with_capacity(group.meshes.len());
         for mesh in &group.meshes {
             let file = unique_file_name(&mesh.name, &mut used_files);
-            obj::write_obj(mesh, &dir.join(&file))?;
+            obj::write_obj(mesh, &output(dir, &file)?)?;
             meshes.push(MeshDesc {
                 name: Some(mesh.name.clone()),
                 obj: Some(file),
@@ -62,7 +74,7 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
             .map(|p| ProbeDesc { position: p.position.to_array(), role: p.role })
             .collect(),
     };
-    let path = dir.join(SCENE_FILE);
+    let path = output(dir, SCENE_FILE)?;
     let json = serde_json::to_string_pretty(&file)
         .map_err(|e| SceneError::in_file(&path, format!("cannot encode scene: {e}")))?;
     std::fs::write(&path, json + "\n").map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))

@@ -334,6 +334,7 @@ mod tests {
         let asm =
             |budget_mb, time_ms| TechniqueDesc::Asm(AsmSettings { budget_mb, time_ms, ..Default::default() });
         assert!(invalid(asm(0.01, 8.0)).contains("holds no tile"));
+        assert!(invalid(asm(f64::INFINITY, 8.0)).contains("finite number of MB"));
         assert!(invalid(asm(16.0, 0.0)).contains("time budget"));
     }
 }

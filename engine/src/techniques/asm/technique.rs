@@ -107,7 +107,13 @@ impl AsmSettings {
     pub fn validated(self) -> Result<AsmSettings> {
         let bytes = self.budget_mb * MB as f64;
         let least = self.test.least_budget_bytes();
-        if !(bytes >= least as f64 && bytes.is_finite()) {
+        if !bytes.is_finite() {
+            return Err(Error::InvalidArgument(format!(
+                "an ASM budget of {} MB: the budget must be a finite number of MB",
+                self.budget_mb
+            )));
+        }
+        if bytes < least as f64 {
             return Err(Error::InvalidArgument(format!(
                 "an ASM budget of {} MB holds no tile: the root tile and the scratch take {} KiB",
                 self.budget_mb,
