@@ -108,4 +108,9 @@ pub enum ProbeError {
     FitDiverged { probes: usize },
     #[error("{total} probes given: at most {max} are supported")]
     TooMany { total: usize, max: usize },
+    #[error(
+        "the Delaunay tetrahedralization of {points} probes needs more than {max} tetrahedra: probes \
+         on a few lines or curves (two skew lines) make quadratically many; spread them in 3D"
+    )]
+    TooManyTetrahedra { points: usize, max: usize },
 }

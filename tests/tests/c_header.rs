@@ -37,3 +37,28 @@ fn header_compiles_as_cpp() {
         .expect("c++ (Debian: g++)");
     assert!(output.status.success(), "kage.h as C++:\n{}", String::from_utf8_lossy(&output.stderr));
 }
+
+/// A host uses every enumeration value and every struct field by name (tests/c_host/names.c):
+/// it compiles as strict C11 and as C++17.
+#[test]
+fn every_name_compiles_in_c_and_cpp() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let include = repo.join("engine/include");
+    let source = repo.join("tests/c_host/names.c");
+    for (compiler, standard) in [("cc", "-std=c11"), ("c++", "-std=c++17")] {
+        let mut command = std::process::Command::new(compiler);
+        command
+            .args([standard, "-fsyntax-only", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+            .arg("-I")
+            .arg(&include);
+        if compiler == "c++" {
+            command.args(["-x", "c++"]);
+        }
+        let output = command.arg(&source).output().expect("cc and c++ (Debian: gcc, g++)");
+        assert!(
+            output.status.success(),
+            "names.c with {compiler} {standard}:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+}

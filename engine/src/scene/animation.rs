@@ -5,7 +5,7 @@
 //!   hopping ([`pose`]). At t = 0 and t = 0.5 it rests in its scene pose (for the teapot:
 //!   standing on the floor, the contact case of the soft-shadow method); in between it rises by
 //!   up to 40% of its height.
-use super::{Camera, Group, Transform};
+use super::{Camera, Group, SceneError, Transform};
 use glam::{Quat, Vec3};
 use std::f32::consts::TAU;
 
@@ -55,6 +55,38 @@ pub fn camera_at(keys: &[Camera], t: f32) -> Option<Camera> {
     })
 }
 
+/// Checks every camera the walkthrough passes through, not only its keyframes: between two
+/// valid keyframes the position can run through the target, or the view line up with up. Each
+/// step is checked at the position's closest approach to the target and at 64 points.
+pub fn check_walkthrough(keys: &[Camera]) -> Result<(), SceneError> {
+    let n = keys.len();
+    for k in 0..n {
+        let (a, b) = (&keys[k], &keys[(k + 1) % n]);
+        let (from, to) = (a.position - a.target, b.position - b.target);
+        let step = to - from;
+        let closest = match step.length_squared() {
+            0.0 => 0.0,
+            l => (-from.dot(step) / l).clamp(0.0, 1.0),
+        };
+        let shares = (0..=64).map(|i| i as f32 / 64.0).chain([closest]);
+        for s in shares {
+            // The time at which `camera_at`'s easing has gone the share `s` of this step.
+            let x = (k as f32 + inverse_smoothstep(s)) / n as f32;
+            if let Some(camera) = camera_at(keys, x) {
+                camera.validated().map_err(|e| {
+                    e.within(&format!("the walkthrough between cameras {k} and {}", (k + 1) % n))
+                })?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The f in [0, 1] at which smoothstep reaches `s`.
+fn inverse_smoothstep(s: f32) -> f32 {
+    0.5 - ((1.0 - 2.0 * s).asin() / 3.0).sin()
+}
+
 fn motion(base: &Transform, height: f32, t: f32) -> Transform {
     let t = t.rem_euclid(1.0);
     let phase = TAU * t;
@@ -66,6 +98,23 @@ fn motion(base: &Transform, height: f32, t: f32) -> Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two valid keyframes on opposite sides of the target: half-way the camera stands on it.
+    #[test]
+    fn a_walkthrough_through_its_target_is_refused_naming_the_step() {
+        let at = |z: f32| Camera {
+            position: Vec3::new(0.0, 1.0, z),
+            target: Vec3::Y,
+            up: Vec3::Y,
+            fov_y_deg: 45.0,
+        };
+        let keys = [at(2.0), at(-2.0)];
+        keys.iter().for_each(|k| assert!(k.validated().is_ok()));
+        let error = check_walkthrough(&keys).unwrap_err().to_string();
+        assert!(error.contains("between cameras 0 and 1") && error.contains("same point"), "{error}");
+        let around = [at(2.0), Camera { position: Vec3::new(2.0, 1.0, 0.0), ..at(0.0) }];
+        check_walkthrough(&around).unwrap();
+    }
 
     #[test]
     fn the_walkthrough_rests_at_each_keyframe_and_wraps() {

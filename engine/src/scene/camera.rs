@@ -53,14 +53,20 @@ impl Camera {
                 return Err(SceneError::invalid(format!("camera {name} {v} is not finite")));
             }
         }
-        let forward = self.target - self.position;
-        if forward.length_squared() == 0.0 {
-            return Err(SceneError::invalid("camera position and target are the same point"));
-        }
-        if self.up.length_squared() == 0.0 {
+        // Directions scaled by their largest component before normalizing: far-away points
+        // (1e30) would overflow a squared length, and tiny vectors underflow one.
+        let direction =
+            |v: Vec3| (v.abs().max_element() > 0.0).then(|| (v / v.abs().max_element()).normalize());
+        let Some(forward) = direction(self.target - self.position).filter(|f| f.is_finite()) else {
+            return Err(SceneError::invalid(format!(
+                "camera position {} and target {} are the same point, or too far apart for f32",
+                self.position, self.target
+            )));
+        };
+        let Some(up) = direction(self.up) else {
             return Err(SceneError::invalid("camera up vector has zero length"));
-        }
-        if forward.normalize().cross(self.up.normalize()).length_squared() < 1e-12 {
+        };
+        if forward.cross(up).length_squared() < 1e-12 {
             return Err(SceneError::invalid("camera up vector is parallel to the viewing direction"));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
@@ -79,6 +85,16 @@ mod tests {
 
     fn camera() -> Camera {
         Camera { position: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 }
+    }
+
+    /// A camera far away or with a tiny up vector is still a camera, not "up is parallel".
+    #[test]
+    fn far_cameras_and_tiny_up_vectors_are_valid() {
+        let far = Camera { position: Vec3::new(0.0, 0.0, 1e30), ..camera() };
+        far.validated().unwrap();
+        Camera { up: Vec3::new(0.0, 1e-30, 0.0), ..camera() }.validated().unwrap();
+        let parallel = Camera { up: Vec3::Z, ..far }.validated().unwrap_err().to_string();
+        assert!(parallel.contains("parallel"), "{parallel}");
     }
 
     #[test]

@@ -32,7 +32,8 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .iter()
         .enumerate()
         .map(|(at, c)| camera_of(c).map_err(|e| e.within(&format!("walkthrough camera {at}"))))
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<Vec<_>, _>>()?;
+    super::animation::check_walkthrough(&walkthrough)?;
     let environment = environment(&file.environment, folder)?;
     if file.groups.is_empty() {
         return Err(SceneError::invalid("it has no groups"));

@@ -16,6 +16,7 @@
 //! Scenes come from JSON files ([`file`] documents the schema), from the built-in set
 //! ([`BUILTIN`]), or from code. Every loading error is a [`SceneError`] naming the file and the
 //! problem.
+use glam::Vec3;
 use std::path::Path;
 
 pub mod animation;
@@ -48,6 +49,12 @@ pub use mesh::Mesh;
 pub use obj::{load_obj, parse_obj, write_obj};
 pub use probe::{ProbeRole, SceneProbe};
 pub use sun_map::SunMap;
+
+/// How far from the origin, in world units along any axis, a scene's geometry may reach. The
+/// shadow maps of the local-light and parallel-light techniques fit the whole scene, and with
+/// f32 depth a scene spanning far more than this (one small sphere at 1e20) shadows everything;
+/// at 1e6 a 4096² map's texel is still finer than the scene's extent over 1e3.
+pub const MAX_EXTENT: f32 = 1e6;
 pub use transform::Transform;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -130,12 +137,25 @@ impl Scene {
             group.transform.validated().map_err(|e| e.within(&place))?;
             for (m, mesh) in group.meshes.iter().enumerate() {
                 mesh.validate().map_err(|e| e.within(&format!("{place}: mesh {m}")))?;
+                let farthest =
+                    mesh.positions.iter().map(|p| Vec3::from(*p).abs().max_element()).fold(0.0, f32::max);
+                let reach =
+                    group.transform.translation.abs().max_element() + group.transform.scale * farthest;
+                if reach > MAX_EXTENT {
+                    return Err(SceneError::invalid(format!(
+                        "{place}: mesh {m} reaches {reach:e} from the origin; scenes must lie within \
+                         {MAX_EXTENT:e} of it (the shadow maps fit the whole scene, and f32 depth loses \
+                         every shadow beyond that)"
+                    )));
+                }
             }
         }
         for (l, light) in self.lights.iter().enumerate() {
             light.validated().map_err(|e| e.within(&format!("scene \"{}\": light {l}", self.name)))?;
         }
         self.camera.validated().map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
+        animation::check_walkthrough(&self.walkthrough)
+            .map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         Ok(())
     }
 
@@ -149,5 +169,21 @@ impl Scene {
 
     pub fn vertex_count(&self) -> usize {
         self.meshes().map(|(_, m)| m.vertex_count()).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A finite but far-away group is refused with the group, the distance and the limit, not
+    /// drawn with every surface shadowed.
+    #[test]
+    fn geometry_beyond_the_extent_is_refused() {
+        let mut scene = Scene::builtin("teapot").unwrap();
+        scene.validate().unwrap();
+        scene.groups[0].transform.translation.x = 1e20;
+        let error = scene.validate().unwrap_err().to_string();
+        assert!(error.contains("group 0") && error.contains("1e20") && error.contains("1e6"), "{error}");
     }
 }

@@ -1,5 +1,5 @@
 //! Rigid placement of a group: uniform scale, then rotation, then translation.
-use glam::{EulerRot, Mat4, Quat, Vec3};
+use glam::{EulerRot, Mat4, Quat, Vec3, Vec4};
 
 use super::SceneError;
 
@@ -42,12 +42,17 @@ impl Transform {
                 self.scale
             )));
         }
-        if !self.rotation.is_finite() || self.rotation.length_squared() == 0.0 {
+        // Any nonzero finite quaternion names a rotation. Unit ones are left untouched, so that a
+        // written and re-read scene is bit-identical; others are divided by their largest
+        // component before normalizing, so that a long one (1e20 along an axis, whose squared
+        // length overflows) or a tiny one (whose squared length underflows) keeps its rotation.
+        let q = Vec4::from(self.rotation);
+        let largest = q.abs().max_element();
+        if !q.is_finite() || largest == 0.0 {
             return Err(SceneError::invalid(format!("rotation {} is not a rotation", self.rotation)));
         }
-        // Leave unit quaternions untouched so that a written and re-read scene is bit-identical.
         if !self.rotation.is_normalized() {
-            self.rotation = self.rotation.normalize();
+            self.rotation = Quat::from_vec4((q / largest).normalize());
         }
         Ok(self)
     }
@@ -56,6 +61,21 @@ impl Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One rule for every quaternion: a nonzero finite one is its rotation, however long.
+    #[test]
+    fn long_and_tiny_quaternions_keep_their_rotation() {
+        let with = |rotation: Quat| Transform { rotation, ..Transform::default() }.validated();
+        for length in [1e20f32, 1e-30, 3.0] {
+            let turned = with(Quat::from_xyzw(length, 0.0, 0.0, 0.0)).unwrap().rotation;
+            assert_eq!(turned.to_array(), [1.0, 0.0, 0.0, 0.0], "x = {length}");
+        }
+        let half = with(Quat::from_xyzw(0.0, 1e20, 0.0, 1e20)).unwrap().rotation;
+        assert!(half.abs_diff_eq(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2), 1e-6), "{half}");
+        let zero = with(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)).unwrap_err().to_string();
+        assert!(zero.contains("is not a rotation"), "{zero}");
+        assert!(with(Quat::from_xyzw(f32::INFINITY, 0.0, 0.0, 1.0)).is_err());
+    }
 
     #[test]
     fn euler_applies_x_then_y_then_z() {

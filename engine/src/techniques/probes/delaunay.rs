@@ -44,13 +44,27 @@ pub struct Tet {
     pub n: [Option<u32>; 4],
 }
 
+/// The most tetrahedra (and ghost cells) a tetrahedralization may hold: points in general
+/// position make about 6.5 per point, so this allows some 600,000 well-spread probes, while
+/// points on two skew lines, which make quadratically many, stop here at about 150 MB instead of
+/// growing without bound.
+pub const MAX_TETRAHEDRA: usize = 1 << 22;
+
 /// The Delaunay tetrahedralization of distinct `points` (at least 4), vertices indexing `points`.
 pub fn tetrahedralize(points: &[DVec3]) -> Result<Vec<Tet>, ProbeError> {
+    tetrahedralize_within(points, MAX_TETRAHEDRA)
+}
+
+/// [`tetrahedralize`] with at most `max` cells.
+fn tetrahedralize_within(points: &[DVec3], max: usize) -> Result<Vec<Tet>, ProbeError> {
     let first = first_tetrahedron(points)?;
     let mut builder = Builder::new(points, first);
     for p in insertion_order(points) {
         if !first.contains(&p) {
             builder.insert(p);
+            if builder.cells.len() - builder.free.len() > max {
+                return Err(ProbeError::TooManyTetrahedra { points: points.len(), max });
+            }
         }
     }
     Ok(builder.finite_tets())
@@ -286,5 +300,25 @@ impl<'a> Builder<'a> {
             }
         }
         tets
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points on two skew lines make quadratically many tetrahedra (n² for n points on each):
+    /// past the bound the construction stops with an error naming it, instead of growing.
+    #[test]
+    fn quadratically_many_tetrahedra_stop_at_the_bound() {
+        let line = |n: usize, f: fn(f64) -> DVec3| (0..n).map(move |i| f(i as f64 / n as f64));
+        let skew: Vec<DVec3> = line(40, |t| DVec3::new(t, 0.0, 0.0))
+            .chain(line(40, |t| DVec3::new(0.5, 1.0, t - 0.5)))
+            .collect();
+        let all = tetrahedralize_within(&skew, usize::MAX).unwrap().len();
+        assert!(all > 40 * 30, "{all} tetrahedra: not quadratic, the test proves nothing");
+        let error = tetrahedralize_within(&skew, all / 2).unwrap_err();
+        assert!(matches!(error, ProbeError::TooManyTetrahedra { points: 80, .. }), "{error}");
+        assert!(error.to_string().contains("spread them in 3D"), "{error}");
     }
 }
