@@ -80,6 +80,11 @@ static void check_bad_arguments(kage_context *context) {
   CHECK(kage_last_error_message(text, sizeof text, NULL));
   REQUIRE(strstr(text, "/nonexistent/scene.json") != NULL);
   EXPECT(kage_scene_load("no-such-builtin", &scene), KAGE_RESULT_INVALID_VALUE);
+  /* Existing paths that are no scene file: a folder, a device. */
+  EXPECT(kage_scene_load("/tmp", &scene), KAGE_RESULT_FILE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "/tmp") != NULL);
+  EXPECT(kage_scene_load("/dev/zero", &scene), KAGE_RESULT_FILE);
   EXPECT(kage_scene_create(NULL, &scene), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_scene_destroy(NULL), KAGE_RESULT_OK);
   EXPECT(kage_scene_group_count(NULL, NULL), KAGE_RESULT_NULL_ARGUMENT);
@@ -212,6 +217,20 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_renderer_render(NULL), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_render((kage_renderer *)scene), KAGE_RESULT_INVALID_HANDLE);
   CHECK(kage_renderer_render(renderer));
+  /* A quaternion of any length is its rotation: 1e20 along X draws what 1 along X draws. */
+  {
+    static uint8_t unit[8 * 8 * 4], long_one[8 * 8 * 4];
+    kage_transform turned = {{0, 0, 0}, {1, 0, 0, 0}, 1.0f};
+    CHECK(kage_renderer_set_group_transform(renderer, 0, &turned));
+    CHECK(kage_renderer_render(renderer));
+    CHECK(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA8_SRGB, 1.0f, unit, sizeof unit));
+    turned.rotation[0] = 1e20f;
+    CHECK(kage_renderer_set_group_transform(renderer, 0, &turned));
+    CHECK(kage_renderer_render(renderer));
+    CHECK(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA8_SRGB, 1.0f, long_one, sizeof long_one));
+    REQUIRE(memcmp(unit, long_one, sizeof unit) == 0);
+    CHECK(kage_renderer_set_group_transform(renderer, 0, &transform));
+  }
   EXPECT(kage_renderer_read_pixels(NULL, KAGE_PIXEL_FORMAT_RGBA8_SRGB, 1.0f, pixels, sizeof pixels),
          KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA8_SRGB, 1.0f, NULL, sizeof pixels),
