@@ -10,7 +10,7 @@ use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
 use crate::prt::TransferSet;
-use crate::scene::{Light, Scene};
+use crate::scene::{check_extent, Light, Scene};
 use crate::techniques::description::TechniqueDesc;
 use crate::techniques::{Technique, TechniqueStats};
 use glam::Mat4;
@@ -47,6 +47,8 @@ pub struct Renderer {
     frame_uniforms: Buffer,
     targets: Targets,
     executor: FrameExecutor,
+    /// Each group's [`crate::scene::Group::object_reach`], for `set_group_transform`.
+    reach: Vec<f32>,
 }
 
 impl Renderer {
@@ -57,6 +59,7 @@ impl Renderer {
         let size = (options.width, options.height);
         let technique = options.technique.build(ctx, scene, &gpu, options.transfer.as_ref(), size)?;
         Ok(Renderer {
+            reach: scene.groups.iter().map(|g| g.object_reach()).collect(),
             ctx: ctx.clone(),
             scene: gpu,
             camera: scene.camera,
@@ -117,6 +120,9 @@ impl Renderer {
         let slot = self.scene.transforms.get_mut(group).ok_or_else(|| {
             Error::InvalidArgument(format!("group {group} does not exist (the scene has {count})"))
         })?;
+        let scale = transform.x_axis.truncate().length();
+        check_extent(transform.w_axis.truncate(), scale, self.reach[group])
+            .map_err(|e| e.within(&format!("group {group}")))?;
         *slot = transform;
         Ok(())
     }

@@ -179,6 +179,10 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_renderer_set_group_transform(renderer, 1, &transform), KAGE_RESULT_INVALID_VALUE);
   transform.translation[0] = INFINITY;
   EXPECT(kage_renderer_set_group_transform(renderer, 0, &transform), KAGE_RESULT_INVALID_VALUE);
+  transform.translation[0] = 1e20f; /* finite, but beyond the scene extent */
+  EXPECT(kage_renderer_set_group_transform(renderer, 0, &transform), KAGE_RESULT_INVALID_VALUE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "group 0") != NULL && strstr(text, "1e6") != NULL);
   transform.translation[0] = 0;
   transform.rotation[3] = 0;
   EXPECT(kage_renderer_set_group_transform(renderer, 0, &transform), KAGE_RESULT_INVALID_VALUE);

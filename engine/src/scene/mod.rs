@@ -79,6 +79,27 @@ pub struct Group {
     pub transform: Transform,
 }
 
+impl Group {
+    /// The largest coordinate of its meshes along any axis, in object space.
+    pub fn object_reach(&self) -> f32 {
+        let coordinates = self.meshes.iter().flat_map(|m| m.positions.iter().flatten());
+        coordinates.map(|c| c.abs()).fold(0.0, f32::max)
+    }
+}
+
+/// Checks that a group of `object_reach` placed by `translation` and `scale` lies within
+/// [`MAX_EXTENT`] (the one rule for scene files, scenes built in code and moved groups).
+pub fn check_extent(translation: Vec3, scale: f32, object_reach: f32) -> Result<(), SceneError> {
+    let reach = translation.abs().max_element() + scale * object_reach;
+    if reach > MAX_EXTENT {
+        return Err(SceneError::invalid(format!(
+            "it reaches {reach:e} from the origin; scenes must lie within {MAX_EXTENT:e} of it (the \
+             shadow maps fit the whole scene, and f32 depth loses every shadow beyond that)"
+        )));
+    }
+    Ok(())
+}
+
 impl Scene {
     /// Reads a JSON scene file; relative paths inside it are relative to its folder.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
@@ -137,18 +158,9 @@ impl Scene {
             group.transform.validated().map_err(|e| e.within(&place))?;
             for (m, mesh) in group.meshes.iter().enumerate() {
                 mesh.validate().map_err(|e| e.within(&format!("{place}: mesh {m}")))?;
-                let farthest =
-                    mesh.positions.iter().map(|p| Vec3::from(*p).abs().max_element()).fold(0.0, f32::max);
-                let reach =
-                    group.transform.translation.abs().max_element() + group.transform.scale * farthest;
-                if reach > MAX_EXTENT {
-                    return Err(SceneError::invalid(format!(
-                        "{place}: mesh {m} reaches {reach:e} from the origin; scenes must lie within \
-                         {MAX_EXTENT:e} of it (the shadow maps fit the whole scene, and f32 depth loses \
-                         every shadow beyond that)"
-                    )));
-                }
             }
+            let t = &group.transform;
+            check_extent(t.translation, t.scale, group.object_reach()).map_err(|e| e.within(&place))?;
         }
         for (l, light) in self.lights.iter().enumerate() {
             light.validated().map_err(|e| e.within(&format!("scene \"{}\": light {l}", self.name)))?;
