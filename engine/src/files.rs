@@ -82,6 +82,14 @@ fn kind_of(file_type: FileType) -> &'static str {
     }
 }
 
+/// `name` in this test process's own folder for `module`'s unit tests, made if missing.
+#[cfg(test)]
+pub(crate) fn scratch_path(module: &str, name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("kage-{module}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,9 +97,7 @@ mod tests {
     use std::time::{Duration, Instant};
 
     fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("kage-files-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+        scratch_path("files", name)
     }
 
     #[test]

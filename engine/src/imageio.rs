@@ -205,9 +205,7 @@ mod tests {
     use super::*;
 
     fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("kage-imageio-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+        crate::files::scratch_path("imageio", name)
     }
 
     fn sample_image(width: u32, height: u32) -> RgbaF32Image {
