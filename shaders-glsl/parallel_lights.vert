@@ -8,6 +8,8 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 0) out vec3 world_position;
 layout(location = 1) out vec3 world_normal;
+// The same operations as depth_prepass.vert's, which lays the depth down first.
+precise gl_Position;
 
 void main() {
     // Uniform scale only: the model matrix's upper 3x3 keeps normals perpendicular.

@@ -15,7 +15,8 @@ layout(set = 0, binding = 4) uniform sampler2DArray occlusion;
 layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
 layout(set = 0, binding = 6, std140) uniform Dominant { DominantLights dominant; };
 layout(set = 0, binding = 7) uniform sampler2DArrayShadow dominant_shadow;
-layout(set = 0, binding = 8, std140) uniform Sh { ShCoeffs sh; };
+// The exact irradiance of the light L_s is made of (engine/src/frame/irradiance.rs).
+layout(set = 0, binding = 9) uniform sampler2D irradiance;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "dominant.glsl"
 layout(push_constant) uniform Push { PrtDrawPush draw; };
@@ -124,7 +125,8 @@ void main() {
 
     vec3 self_shadowed = self_term;
     if (PIXEL_COSINE) {
-        vec3 unshadowed = max(sh9_irradiance(sh.c, env_world_to_map(normalize(world_normal), frame.env_params.y)), vec3(0.0));
+        vec3 d = env_world_to_map(normalize(world_normal), frame.env_params.y);
+        vec3 unshadowed = textureLod(irradiance, irradiance_uv(d, textureSize(irradiance, 0)), 0.0).rgb;
         self_shadowed = draw.albedo.rgb / KAGE_PI * unshadowed - self_term;
     }
     vec3 radiance = max(self_shadowed - draw.albedo.rgb * blocked, vec3(0.0))

@@ -35,6 +35,8 @@ layout(location = 0) out vec3 self_term;
 layout(location = 1) out vec3 world_position;
 layout(location = 2) out vec3 world_normal;
 layout(location = 3) out vec4 region_transfer[REGION_VEC4];
+// The same operations as depth_prepass.vert's, which lays the depth down first.
+precise gl_Position;
 
 void main() {
     uint texel = draw.mesh.x + uint(gl_VertexIndex);

@@ -13,6 +13,11 @@
 // together have run 65,535 iterations (its loop limiter), which per-ray BVH traversals reached
 // after 1,728 rays from the vertices of a 62-vertex sphere.
 // `rays_cast` counts the rays each vertex really got, so that the host can prove no loop was cut.
+//
+// `back_hits` counts the rays whose closest hit is the back of a surface (its interpolated
+// normal facing along the ray): a vertex whose rays nearly all end so lies inside a closed
+// part of the mesh (a teapot's spout inside its body), and the host fills its transfer from its
+// neighbours (engine/src/prt/buried.rs). Hence closest hits, not any hit, for the visibility.
 #include "constants.glsl"
 #include "layouts.glsl"
 #include "sh.glsl"
@@ -22,6 +27,7 @@ layout(local_size_x = KAGE_PRT_GROUP) in;
 layout(set = 0, binding = KAGE_BVH_BINDINGS, std430) readonly buffer Vertices { PrtVertex vertices[]; };
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) buffer Transfer { float transfer[]; };
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) buffer RaysCast { uint rays_cast[]; };
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer BackHits { uint back_hits[]; };
 layout(push_constant) uniform Push { PrtTransferPush p; };
 
 // PCG output permutation (Jarzynski and Olano 2020, "Hash Functions for GPU Rendering").
@@ -73,7 +79,7 @@ void main() {
     mat4 to_world = bvh_instances[group].object_to_world;
     vec3 world_origin = (to_world * vec4(origin, 1.0)).xyz;
     uint first = p.params.y;
-    uint done = 0u;
+    uint done = 0u, back = 0u;
     for (uint k = first; k < first + p.params.z; ++k) {
         vec2 u = fract(vec2(float(k) / float(rays), float(bitfieldReverse(k)) * to_unit) + shift);
         // Cosine-weighted: a uniform point on the unit disc lifted onto the hemisphere.
@@ -81,10 +87,23 @@ void main() {
         float phi = 2.0 * KAGE_PI * u.y;
         vec3 dir = normalize(r * cos(phi) * tangent + r * sin(phi) * bitangent
                              + sqrt(max(1.0 - u.x, 0.0)) * n);
-        bool blocked = whole_scene
-            ? bvh_occluded(world_origin, normalize(mat3(to_world) * dir), 1e30)
-            : bvh_occluded_object_space(group, origin, dir, 1e30);
-        if (!blocked) {
+        // The hit normal is taken to the space the ray was cast in (the scale is uniform, so
+        // the rotation part carries normals).
+        RayHit hit = RayHit(1e30, KAGE_NO_HIT, 0u, vec2(0.0));
+        vec3 ray_dir = dir;
+        if (whole_scene) {
+            ray_dir = normalize(mat3(to_world) * dir);
+            bvh_traverse(world_origin, ray_dir, false, hit);
+        } else {
+            bvh_traverse_blas(group, origin, dir, false, hit);
+        }
+        if (hit.instance != KAGE_NO_HIT) {
+            BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+            vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
+            vec3 normal = w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz;
+            if (whole_scene) normal = mat3(bvh_instances[hit.instance].object_to_world) * normal;
+            if (dot(normal, ray_dir) > 0.0) ++back;
+        } else {
             vec4 c0, c1, c2, c3, c4, c5, c6;
             sh25_basis(dir, c0, c1, c2, c3, c4, c5, c6);
             s0 += c0; s1 += c1; s2 += c2; s3 += c3; s4 += c4; s5 += c5; s6 += c6;
@@ -103,4 +122,5 @@ void main() {
     add(base, coeffs, 5u, s5, first_dispatch, scale);
     add(base, coeffs, 6u, s6, first_dispatch, scale);
     rays_cast[vertex] = (first_dispatch ? 0u : rays_cast[vertex]) + done;
+    back_hits[vertex] = (first_dispatch ? 0u : back_hits[vertex]) + back;
 }

@@ -21,4 +21,12 @@ vec3 env_world_to_map(vec3 d, float angle) {
     return vec3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
 }
 
+// Where direction d (map frame) lies in a table over directions whose texel (i, k) holds
+// u = i / W, v = k / (H - 1) (engine/src/frame/irradiance.rs): the shift puts each node at a
+// texel centre, so the poles are rows, not points between them.
+vec2 irradiance_uv(vec3 d, ivec2 size) {
+    vec2 uv = env_dir_to_uv(d);
+    return vec2(uv.x + 0.5 / float(size.x), (uv.y * float(size.y - 1) + 0.5) / float(size.y));
+}
+
 #endif

@@ -179,6 +179,10 @@ pub enum DepthTest {
     /// per pixel is shaded whatever the draw order. The prepass must compute `gl_Position` with
     /// the same operations on the same inputs, `precise` (shaders-glsl/depth_prepass.vert).
     Equal,
+    /// Fragments at or nearer than the stored depth pass and write theirs: over a prepass'
+    /// depth, one fragment per pixel is shaded as with `Equal`; into a cleared target it draws
+    /// as `Less` does (for a pipeline used both ways).
+    LessOrEqual,
 }
 
 pub struct GraphicsDesc<'a> {
@@ -271,11 +275,11 @@ impl GraphicsPipeline {
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth != DepthTest::Off)
-            .depth_write_enable(desc.depth == DepthTest::Less)
-            .depth_compare_op(if desc.depth == DepthTest::Equal {
-                vk::CompareOp::EQUAL
-            } else {
-                vk::CompareOp::LESS
+            .depth_write_enable(matches!(desc.depth, DepthTest::Less | DepthTest::LessOrEqual))
+            .depth_compare_op(match desc.depth {
+                DepthTest::Equal => vk::CompareOp::EQUAL,
+                DepthTest::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
+                DepthTest::Off | DepthTest::Less | DepthTest::Nearer => vk::CompareOp::LESS,
             });
         let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
             .color_write_mask(vk::ColorComponentFlags::RGBA)

@@ -1,5 +1,6 @@
-//! The environment map on the GPU: an RGBA32F image (alpha unused) and a sampler that wraps in
-//! longitude and clamps at the poles.
+//! The environment map on the GPU, or a table over directions laid out like it (the irradiance
+//! table): an RGBA32F image (alpha unused) and a sampler that wraps in longitude and clamps at
+//! the poles.
 use crate::backend::{vk, Context, Edge, Image, ImageDesc, Sampler};
 use crate::error::Result;
 use crate::scene::EnvMap;
@@ -12,12 +13,23 @@ pub struct GpuEnvironment {
 
 impl GpuEnvironment {
     pub fn new(ctx: &Arc<Context>, map: &EnvMap) -> Result<GpuEnvironment> {
+        GpuEnvironment::table(ctx, "environment", map.width(), map.height(), map.pixels())
+    }
+
+    /// `width`×`height` RGB texels, row 0 at the top.
+    pub fn table(
+        ctx: &Arc<Context>,
+        name: &str,
+        width: u32,
+        height: u32,
+        pixels: &[[f32; 3]],
+    ) -> Result<GpuEnvironment> {
         let image = Image::new(
             ctx,
             &ImageDesc {
-                name: "environment",
-                width: map.width(),
-                height: map.height(),
+                name,
+                width,
+                height,
                 layers: 1,
                 array: false,
                 format: vk::Format::R32G32B32A32_SFLOAT,
@@ -25,9 +37,9 @@ impl GpuEnvironment {
             },
         )?;
         let texels: Vec<u8> =
-            map.pixels().iter().flat_map(|p| [p[0], p[1], p[2], 0.0]).flat_map(f32::to_ne_bytes).collect();
+            pixels.iter().flat_map(|p| [p[0], p[1], p[2], 0.0]).flat_map(f32::to_ne_bytes).collect();
         image.upload(&texels)?;
-        let sampler = Sampler::new(ctx, "environment.sampler", true, Edge::Repeat, Edge::Clamp)?;
+        let sampler = Sampler::new(ctx, &format!("{name}.sampler"), true, Edge::Repeat, Edge::Clamp)?;
         Ok(GpuEnvironment { image, sampler })
     }
 }

@@ -6,6 +6,7 @@ pub mod background;
 pub mod bounds;
 pub mod environment;
 pub mod gpu_scene;
+pub mod irradiance;
 pub mod regions;
 pub mod scene_pass;
 pub mod sh_projection;

@@ -2,11 +2,12 @@
 //! by a pipeline that reads the mesh vertices (position, normal), with per-draw push constants.
 //! Shared by the unshadowed, parallel-lights, shadowmap and adaptive shadow map techniques.
 //!
-//! The local-light techniques (shadowmap, adaptive shadow maps) lay the depth down first in a
-//! depth-only prepass with the scene pass's own vertex shader, then shade with the depth test
-//! EQUAL: their lighting looks up a shadow map per fragment, and with the scene drawn in any
-//! order a fragment hidden later would pay for it too (the `asm` scene's overdraw made its
-//! ASM lighting pass 2x as long on lavapipe; BENCHMARKS.md).
+//! The techniques with costly fragments (parallel lights, shadowmap, adaptive shadow maps, and
+//! Tamura's PRT technique) lay the depth down first in a depth-only prepass computing the scene
+//! pass's own positions, then shade only what it left visible: their lighting looks up shadow
+//! maps or occlusion layers per fragment, and with the scene drawn in any order a fragment
+//! hidden later would pay for it too (the `asm` scene's overdraw made its ASM lighting pass 2x
+//! as long on lavapipe; BENCHMARKS.md).
 use super::gpu_scene::MESH_VERTICES;
 use super::shadow_depth::depth_only_pipeline;
 use super::shadow_depth::SHADOW_MAPS;
@@ -21,8 +22,6 @@ use crate::pass::{Pass, Resource};
 use glam::Mat4;
 use std::sync::Arc;
 
-/// What a shadow-map technique's scene pass reads.
-pub const SCENE_READS: [Resource; 3] = [FRAME_UNIFORMS, SHADOW_MAPS, COLOR];
 /// What a shadow-map technique's scene pass after a depth prepass reads.
 pub const PREPASS_SCENE_READS: [Resource; 4] = [FRAME_UNIFORMS, SHADOW_MAPS, COLOR, DEPTH];
 
@@ -40,8 +39,8 @@ pub fn scene_pipeline(
     scene_pipeline_with(ctx, name, shaders, bindings, push_size, &[MESH_VERTICES], depth)
 }
 
-/// The depth prepass' pipeline for scene pipelines drawn with shaders-glsl/local_lights.vert
-/// and push constants of `push_size` bytes: depth_prepass.vert, which computes the same
+/// The depth prepass' pipeline for scene pipelines whose push constants (`push_size` bytes)
+/// begin with the model matrix: depth_prepass.vert, which computes the same
 /// `gl_Position` (so the scene pass' EQUAL test meets the same depths), no colour.
 pub fn depth_prepass_pipeline(ctx: &Arc<Context>, name: &str, push_size: usize) -> Result<GraphicsPipeline> {
     depth_only_pipeline(ctx, name, spirv::DEPTH_PREPASS_VERT, &[BindingKind::UniformBuffer], push_size)

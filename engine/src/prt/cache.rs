@@ -36,7 +36,8 @@ use crate::scene::Scene;
 pub const MAGIC: [u8; 8] = *b"KAGEPRT\0";
 /// Version 1: Hammersley points with a per-vertex Cranley–Patterson shift, cosine-weighted.
 /// Version 2: the visibility field.
-pub const FORMAT_VERSION: u32 = 2;
+/// Version 3: buried vertices filled from their neighbours (`prt::buried`).
+pub const FORMAT_VERSION: u32 = 3;
 /// File name extension of cache files.
 pub const EXTENSION: &str = "kageprt";
 const HEADER_BYTES: usize = 72;

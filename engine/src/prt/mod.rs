@@ -12,8 +12,10 @@
 //! - Object space: the transfer rotates with its group, so moving a group never invalidates
 //!   it; the renderer rotates the environment's SH into the group's frame instead.
 //!
-//! [`transfer`] computes a [`TransferSet`] on the GPU, [`cache`] stores it on disk, and
-//! [`lobe`] gives the unshadowed transfer in closed form (the check for convex objects).
+//! [`transfer`] computes a [`TransferSet`] on the GPU, [`buried`] mends the vertices that lie
+//! inside their own mesh, [`cache`] stores it on disk, and [`lobe`] gives the unshadowed
+//! transfer in closed form (the check for convex objects).
+pub mod buried;
 pub mod cache;
 pub mod lobe;
 pub mod transfer;

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::{mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
+use super::{buried, mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
 use crate::backend::MemoryLocation;
 use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context};
 use crate::error::{Error, Result};
@@ -41,7 +41,9 @@ pub fn precompute(
         Vec::new()
     } else {
         let bvh = GpuBvh::new(ctx, &SceneBvh::build(scene)?)?;
-        run_jobs(ctx, scene, &bvh, params, total, progress)?
+        let (mut coefficients, back_hits) = run_jobs(ctx, scene, &bvh, params, total, progress)?;
+        buried::fill(scene, params, &back_hits, &mut coefficients);
+        coefficients
     };
     let mut rest = coefficients.as_slice();
     let meshes = layout
@@ -55,7 +57,8 @@ pub fn precompute(
     Ok(TransferSet { params, seconds: start.elapsed().as_secs_f64(), meshes })
 }
 
-/// Runs the shader over all `total` vertices; returns their coefficients in scene order.
+/// Runs the shader over all `total` vertices; returns their coefficients in scene order and
+/// how many of each vertex's rays ended on the back of a surface.
 fn run_jobs(
     ctx: &Arc<Context>,
     scene: &Scene,
@@ -63,7 +66,7 @@ fn run_jobs(
     params: PrtParams,
     total: usize,
     progress: &mut dyn FnMut(usize, usize),
-) -> Result<Vec<f32>> {
+) -> Result<(Vec<f32>, Vec<u32>)> {
     let too_many = || {
         Error::InvalidArgument(format!(
             "PRT over {total} vertices × {} coefficients exceeds the 32-bit indices of the \
@@ -94,8 +97,9 @@ fn run_jobs(
     };
     let output = readback("prt_transfer", out_floats as u64 * 4)?;
     let rays_cast = readback("prt_rays_cast", total as u64 * 4)?;
+    let back_hits = readback("prt_back_hits", total as u64 * 4)?;
     let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
-    kinds.extend([BindingKind::StorageBuffer; 3]);
+    kinds.extend([BindingKind::StorageBuffer; 4]);
     let pipeline = ComputePipeline::new(
         ctx,
         "prt_transfer",
@@ -108,6 +112,7 @@ fn run_jobs(
         Binding::Storage(&vertex_buffer),
         Binding::Storage(&output),
         Binding::Storage(&rays_cast),
+        Binding::Storage(&back_hits),
     ]);
 
     let mut executor = FrameExecutor::new(ctx, "prt_precompute")?;
@@ -135,12 +140,11 @@ fn run_jobs(
         done += batch.iter().map(|p| p.range[1] as usize).sum::<usize>();
         progress(done, total);
     }
-    let counts = rays_cast.read()?;
-    if let Some((vertex, got)) = counts
-        .chunks_exact(4)
-        .map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]]))
-        .enumerate()
-        .find(|(_, n)| *n != params.rays)
+    let words = |bytes: Vec<u8>| -> Vec<u32> {
+        bytes.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
+    };
+    if let Some((vertex, &got)) =
+        words(rays_cast.read()?).iter().enumerate().find(|(_, n)| **n != params.rays)
     {
         return Err(Error::Unsupported(format!(
             "shader loops as long as the PRT needs: the driver stopped after {got} of {} rays \
@@ -149,7 +153,8 @@ fn run_jobs(
         )));
     }
     let bytes = output.read()?;
-    Ok(bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect())
+    let coefficients = bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+    Ok((coefficients, words(back_hits.read()?)))
 }
 
 /// Splits the meshes into dispatches (a dispatch never spans two meshes: the group is a push

@@ -27,9 +27,11 @@ use crate::error::{Error, Result};
 use crate::frame::bounds::env_rotation;
 use crate::frame::bounds::{group_bounds, scene_sphere, GroupBounds};
 use crate::frame::regions::Regions;
-use crate::frame::scene_pass::{scene_pass, scene_pipeline, SCENE_READS};
+use crate::frame::scene_pass::{
+    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
+};
 use crate::frame::shadow_depth::ShadowMaps;
-use crate::frame::{FrameInputs, FrameState};
+use crate::frame::{FrameInputs, FrameState, GpuMesh};
 use crate::layouts::{bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight};
 use crate::pass::Pass;
 use crate::scene::Scene;
@@ -55,6 +57,7 @@ pub struct ParallelLights {
     /// One map per region.
     shadow_maps: ShadowMaps,
     scene_pipeline: GraphicsPipeline,
+    prepass_pipeline: GraphicsPipeline,
     /// `ParallelLight` per region, `MAX_PARALLEL_LIGHTS` records (the shader's array size).
     lights: Buffer,
     /// World size of a shadow-map texel and of the light depth range this frame.
@@ -86,7 +89,7 @@ impl ParallelLights {
             (spirv::PARALLEL_LIGHTS_VERT, spirv::PARALLEL_LIGHTS_FRAG),
             &[BindingKind::UniformBuffer, BindingKind::UniformBuffer, BindingKind::SampledImage],
             size_of::<ParallelDrawPush>(),
-            DepthTest::Less,
+            DepthTest::Equal,
         )?;
         let lights = Buffer::new(
             ctx,
@@ -103,6 +106,11 @@ impl ParallelLights {
             size: shadow_map_size,
             shadow_maps: ShadowMaps::new(ctx, "parallel_lights", shadow_map_size, q as u32)?,
             scene_pipeline,
+            prepass_pipeline: depth_prepass_pipeline(
+                ctx,
+                "parallel_lights.depth_prepass",
+                size_of::<ParallelDrawPush>(),
+            )?,
             lights,
             texel: 0.0,
             depth_range: 1.0,
@@ -155,15 +163,15 @@ impl Technique for ParallelLights {
             Binding::Uniform(&self.lights),
             self.shadow_maps.binding(),
         ];
-        let scene_pass =
-            scene_pass(inputs, &SCENE_READS, &self.scene_pipeline, bindings, move |mesh, model| {
-                ParallelDrawPush {
-                    model: model.to_cols_array_2d(),
-                    albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
-                    params: [count, size, 0, 0],
-                    shadow,
-                }
-            });
-        vec![shadow_maps, scene_pass]
+        let push = move |mesh: &GpuMesh, model: &Mat4| ParallelDrawPush {
+            model: model.to_cols_array_2d(),
+            albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+            params: [count, size, 0, 0],
+            shadow,
+        };
+        // Its fragments test q shadow maps each: a depth prepass shades each pixel once.
+        let prepass = depth_prepass(inputs, &self.prepass_pipeline, push);
+        let scene_pass = scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, push);
+        vec![shadow_maps, prepass, scene_pass]
     }
 }

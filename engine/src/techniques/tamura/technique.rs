@@ -11,8 +11,11 @@ use crate::backend::{
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::{env_rotation, group_bounds};
+use crate::frame::environment::GpuEnvironment;
 use crate::frame::gpu_scene::MESH_VERTICES;
+use crate::frame::irradiance::gpu_irradiance;
 use crate::frame::regions::Regions;
+use crate::frame::scene_pass::{depth_prepass, depth_prepass_pipeline};
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::frame::{COLOR, DEPTH, FRAME_UNIFORMS};
@@ -23,6 +26,7 @@ use crate::scene::Scene;
 use crate::techniques::sloan::self_shadow::SELF_SHADOW;
 use crate::techniques::sloan::self_shadow::{transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::techniques::{Technique, TechniqueStats};
+use glam::Mat4;
 use std::sync::Arc;
 
 /// How wide the penumbra of a shadow between groups is.
@@ -57,8 +61,9 @@ pub struct OcclusionSettings {
     pub dominant_lights: usize,
     /// Side of a group's depth map along a dominant light, texels.
     pub light_map_size: u32,
-    /// The unshadowed cosine per pixel, only the self-shadow interpolated from the vertices
-    /// (beyond the paper, whose L_s is per vertex).
+    /// The unshadowed light per pixel, from the exact irradiance of L_s's map (`frame::irradiance`),
+    /// only what the group hides of it interpolated from the vertices (beyond the paper, whose
+    /// L_s is per vertex and in 3-band SH).
     pub pixel_cosine: bool,
 }
 
@@ -140,9 +145,14 @@ pub struct PrtTechnique {
     occlusion: Occlusion,
     dominant: DominantMaps,
     scene_pipeline: GraphicsPipeline,
+    /// Lays the depth down before the scene pass, whose fragments are costly (a loop over the
+    /// occlusion layers): hidden surfaces then cost no shading, whatever the draw order.
+    prepass_pipeline: GraphicsPipeline,
     nearest: Sampler,
     /// The first 9 SH coefficients of the light L_s is made of (`ShCoeffs`, the map's frame).
     light_sh: Buffer,
+    /// The exact irradiance of that light, per pixel where `pixel_cosine` is on.
+    irradiance: GpuEnvironment,
 }
 
 impl PrtTechnique {
@@ -197,6 +207,7 @@ impl PrtTechnique {
                         BindingKind::UniformBuffer,
                         BindingKind::SampledImage,
                         BindingKind::UniformBuffer,
+                        BindingKind::SampledImage,
                     ],
                     push_size: size_of::<PrtDrawPush>() as u32,
                     vertex_buffers: &[
@@ -206,7 +217,7 @@ impl PrtTechnique {
                     topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                     color_formats: &[COLOR_FORMAT],
                     depth_format: Some(DEPTH_FORMAT),
-                    depth: DepthTest::Less,
+                    depth: DepthTest::LessOrEqual,
                     additive: false,
                     constants: &[
                         (settings.penumbra == Penumbra::Adaptive) as u32,
@@ -217,6 +228,7 @@ impl PrtTechnique {
                     ],
                 },
             )?,
+            prepass_pipeline: depth_prepass_pipeline(ctx, "prt.depth_prepass", size_of::<PrtDrawPush>())?,
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
             light_sh: Buffer::with_data(
                 ctx,
@@ -224,6 +236,7 @@ impl PrtTechnique {
                 vk::BufferUsageFlags::UNIFORM_BUFFER,
                 bytes_of(&light_sh),
             )?,
+            irradiance: gpu_irradiance(ctx, residual)?,
         })
     }
 }
@@ -252,16 +265,20 @@ impl Technique for PrtTechnique {
         let mut passes = self.prepasses(ctx, scene);
         // What the scene pass reads: the filtered layers where an earlier pass wrote them.
         let reads: &'static [Resource] = if passes.iter().any(|p| p.outputs.contains(&OCCLUSION)) {
-            &[FRAME_UNIFORMS, SELF_SHADOW, OCCLUSION, DOMINANT_MAPS, COLOR]
+            &[FRAME_UNIFORMS, SELF_SHADOW, OCCLUSION, DOMINANT_MAPS, COLOR, DEPTH]
         } else {
-            &[FRAME_UNIFORMS, SELF_SHADOW, DOMINANT_MAPS, COLOR]
+            &[FRAME_UNIFORMS, SELF_SHADOW, DOMINANT_MAPS, COLOR, DEPTH]
         };
+        passes.push(depth_prepass(inputs, &self.prepass_pipeline, move |_, model: &Mat4| PrtDrawPush {
+            model: model.to_cols_array_2d(),
+            ..Default::default()
+        }));
         passes.push(Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
             ctx.begin_rendering(
                 cmd,
                 Some((&targets.color).into()),
                 None,
-                Some(Depth::Clear((&targets.depth).into())),
+                Some(Depth::Keep((&targets.depth).into())),
             );
             self.record_draws(ctx, cmd, uniforms, scene);
             ctx.end_rendering(cmd);
@@ -303,6 +320,7 @@ impl PrtTechnique {
                 lights,
                 shadow,
                 Binding::Uniform(&self.light_sh),
+                Binding::Sampled(&self.irradiance.image, &self.irradiance.sampler),
             ],
         );
         let q = occlusion.region_count() as u32;

@@ -1,0 +1,131 @@
+//! The exact irradiance of an environment map, E(n) = ∫ L(ω) max(n·ω, 0) dω, tabulated over
+//! normals in a small equirectangular map (a CPU convolution, once per renderer).
+//!
+//! Why not 3-band SH: its clamped-cosine kernel rings (the band-2 truncation lets light from
+//! below reach an up-facing normal), which under a map with a bright lower hemisphere leaves an
+//! open floor several percent too bright; this table is exact but for its sampling.
+//!
+//! The table is node-centred in latitude: row k holds v = k/(H−1), so rows 0 and H−1 are the
+//! poles themselves and a floor's normal (straight up) reads an exact value, not one from a
+//! ring a few degrees off it. Column i holds u = i/W. The shader's lookup
+//! (`irradiance_uv` in envmap.glsl) shifts its coordinates to these nodes.
+use super::environment::GpuEnvironment;
+use crate::backend::Context;
+use crate::error::Result;
+use crate::scene::EnvMap;
+use crate::sh::equirect_direction;
+use glam::DVec3;
+use std::sync::Arc;
+
+/// Columns of the table (longitude).
+pub const WIDTH: u32 = 64;
+/// Rows of the table, pole to pole inclusive.
+pub const HEIGHT: u32 = 33;
+/// The map is gathered into at most this many columns (and half as many rows) of bins before
+/// the convolution: 2.8° bins, far finer than the cosine kernel's 180°.
+pub const SOURCE_WIDTH: u32 = 128;
+
+/// `∫ ω dω` over texel (x, y) of a `w`×`h` equirectangular map, in closed form: a bin wholly
+/// above a normal's horizon then adds exactly `L · (n · ∫ω dω)` to its irradiance, so only the
+/// bins the horizon cuts carry an error (and there the cosine is near 0).
+fn texel_moment(w: u32, h: u32, x: u32, y: u32) -> DVec3 {
+    use std::f64::consts::PI;
+    let (t0, t1) = (PI * f64::from(y) / f64::from(h), PI * f64::from(y + 1) / f64::from(h));
+    let (p0, p1) = (2.0 * PI * f64::from(x) / f64::from(w), 2.0 * PI * f64::from(x + 1) / f64::from(w));
+    // ∫ sin²θ dθ and ∫ cosθ sinθ dθ over the row; the direction is (sinθ sinφ, cosθ, −sinθ cosφ).
+    let sin2 = |t: f64| t / 2.0 - (2.0 * t).sin() / 4.0;
+    let (ss, cs) = (sin2(t1) - sin2(t0), (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0);
+    DVec3::new(ss * (p0.cos() - p1.cos()), cs * (p1 - p0), -ss * (p1.sin() - p0.sin()))
+}
+
+/// The map's bins, each as `Σ L ∫ω dω` over its texels, per channel.
+fn bins(map: &EnvMap) -> Vec<[DVec3; 3]> {
+    let (w, h) = (map.width(), map.height());
+    let (bw, bh) = (w.min(SOURCE_WIDTH), h.min(SOURCE_WIDTH / 2));
+    let mut sums = vec![[DVec3::ZERO; 3]; (bw * bh) as usize];
+    for (t, p) in map.pixels().iter().enumerate() {
+        let (x, y) = (t as u32 % w, t as u32 / w);
+        let moment = texel_moment(w, h, x, y);
+        let bin = &mut sums[((y * bh / h) * bw + x * bw / w) as usize];
+        for c in 0..3 {
+            bin[c] += f64::from(p[c]) * moment;
+        }
+    }
+    sums
+}
+
+/// The irradiance table of `map`, [`WIDTH`]×[`HEIGHT`] RGB, row-major (see the module doc for
+/// its nodes).
+pub fn irradiance_table(map: &EnvMap) -> Vec<[f32; 3]> {
+    let bins = bins(map);
+    (0..WIDTH * HEIGHT)
+        .map(|t| {
+            let (i, k) = (t % WIDTH, t / WIDTH);
+            let n = equirect_direction(f64::from(i) / f64::from(WIDTH), f64::from(k) / f64::from(HEIGHT - 1));
+            let mut e = [0.0f64; 3];
+            for bin in &bins {
+                for c in 0..3 {
+                    e[c] += n.dot(bin[c]).max(0.0);
+                }
+            }
+            e.map(|v| v as f32)
+        })
+        .collect()
+}
+
+/// The table on the GPU, sampled bilinearly (wrapping in longitude, clamped at the poles).
+pub fn gpu_irradiance(ctx: &Arc<Context>, map: &EnvMap) -> Result<GpuEnvironment> {
+    GpuEnvironment::table(ctx, "irradiance", WIDTH, HEIGHT, &irradiance_table(map))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn at(table: &[[f32; 3]], i: u32, k: u32) -> [f32; 3] {
+        table[(k * WIDTH + i) as usize]
+    }
+
+    #[test]
+    fn a_constant_map_gives_pi_times_its_radiance_everywhere() {
+        for p in irradiance_table(&EnvMap::constant([1.0, 0.5, 2.0])) {
+            for (got, want) in p.iter().zip([PI, PI / 2.0, 2.0 * PI]) {
+                // Exact for the bins wholly above the horizon; those it cuts (5.6° texels of
+                // this small map) err where the cosine is near 0.
+                assert!((f64::from(*got) / want - 1.0).abs() < 1e-3, "{got} against {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_linear_sky_gives_the_closed_form() {
+        // L(ω) = 1 + ω_y has E(n) = π + (2π/3) n_y; 3-band SH holds it exactly too, so this
+        // checks the table's nodes and directions, the poles included.
+        let (w, h) = (256u32, 128u32);
+        let pixels = (0..w * h)
+            .map(|t| {
+                let y = equirect_direction(0.5 / f64::from(w), (f64::from(t / w) + 0.5) / f64::from(h)).y;
+                [(1.0 + y) as f32; 3]
+            })
+            .collect();
+        let table = irradiance_table(&EnvMap::from_pixels(w, h, pixels).unwrap());
+        for k in [0, 1, HEIGHT / 2, HEIGHT - 2, HEIGHT - 1] {
+            let n_y = (PI * f64::from(k) / f64::from(HEIGHT - 1)).cos();
+            let want = PI + 2.0 * PI / 3.0 * n_y;
+            let got = f64::from(at(&table, 7, k)[0]);
+            assert!((got / want - 1.0).abs() < 2e-3, "row {k}: {got} against {want}");
+        }
+    }
+
+    #[test]
+    fn light_from_below_never_reaches_an_up_facing_normal() {
+        // The lower hemisphere bright, the upper black: E(up) is exactly 0, E(down) π.
+        let (w, h) = (64u32, 32u32);
+        let pixels = (0..w * h).map(|t| if t / w >= h / 2 { [1.0; 3] } else { [0.0; 3] }).collect();
+        let table = irradiance_table(&EnvMap::from_pixels(w, h, pixels).unwrap());
+        assert_eq!(at(&table, 0, 0), [0.0; 3]);
+        let down = f64::from(at(&table, 0, HEIGHT - 1)[0]);
+        assert!((down / PI - 1.0).abs() < 1e-3, "{down}");
+    }
+}
