@@ -6,9 +6,11 @@
  * KAGE_RESULT_BUSY and does nothing; calls on different handles may run at the same time.
  * Compatibility: KAGE_ABI_VERSION rises with every incompatible change to this header, and
  * libkage.so carries it in its SONAME (libkage.so.1); check kage_abi_version() against it at
- * start-up. Every desc struct starts with its size (set it to sizeof the struct): a host
- * compiled against another version of this header gets KAGE_RESULT_INVALID_VALUE, never a
- * misread struct. Bad input of any kind gives an error code, never a crash. */
+ * start-up. Every top-level desc struct (context, Vulkan handles, technique, renderer, scene)
+ * starts with its size (set it to sizeof the struct): a host compiled against another version
+ * of this header gets KAGE_RESULT_INVALID_VALUE, never a misread struct. The small structs
+ * without one (camera, transform, mesh, group, environment) never change within an ABI
+ * version: a change to them raises KAGE_ABI_VERSION and the SONAME. Bad input of any kind gives an error code, never a crash. */
 
 #ifndef KAGE_H
 #define KAGE_H
@@ -394,7 +396,7 @@ typedef uint32_t kage_probe_dering;
  * field added, removed or moved, a function's parameters, an enumeration's values), and
  * libkage.so carries it in its SONAME (`libkage.so.1`). A host checks at start-up that
  * `kage_abi_version()` equals the `KAGE_ABI_VERSION` it was compiled with; beyond that, every
- * desc struct carries its `size`, which each call checks.
+ * top-level desc struct carries its `size`, which each call checks.
  */
 enum kage_abi
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -635,7 +637,8 @@ typedef struct {
 typedef struct {
   float translation[3];
   /**
-   * A unit quaternion (x, y, z, w); one slightly off unit length is renormalized.
+   * A quaternion (x, y, z, w) of any finite, non-zero length: it is normalized, so only its
+   * direction (the rotation) counts; all zeros is refused.
    */
   float rotation[4];
   /**

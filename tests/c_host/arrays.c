@@ -4,12 +4,63 @@
  *
  * Usage: arrays FRAMES SIZE VALIDATION TECHNIQUE, e.g. `arrays 10 64 1 2` (technique values as
  * in kage_technique); `arrays forget-a-scene` leaks a scene on purpose (the memcheck canary). */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, mkfifo */
 #include "common.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* Writes a scene file at `path` of one ball under the map `image` (or a constant sky), or of
+ * the mesh `obj`. */
+static void write_scene(const char *path, const char *image, const char *obj) {
+  FILE *f = fopen(path, "w");
+  REQUIRE(f != NULL);
+  fprintf(f, "{\"camera\": {\"position\": [0, 2, 6], \"target\": [0, 0.5, 0], \"fov_y_deg\": 40},\n");
+  if (image) fprintf(f, " \"environment\": {\"image\": \"%s\"},\n", image);
+  else fprintf(f, " \"environment\": {\"constant\": [1, 1, 1]},\n");
+  if (obj) fprintf(f, " \"groups\": [{\"name\": \"g\", \"meshes\": [{\"obj\": \"%s\", \"albedo\": [0.5, 0.5, 0.5]}]}]}\n", obj);
+  else fprintf(f, " \"groups\": [{\"name\": \"g\", \"meshes\": [{\"sphere\": {\"radius\": 1, \"segments\": 8}, \"albedo\": [0.5, 0.5, 0.5]}]}]}\n");
+  REQUIRE(fclose(f) == 0);
+}
+
+/* Files that lie or are not files, named by a scene file: an image whose header claims 65536 x
+ * 32768 pixels in a few bytes (it once made Kage allocate 24 GiB and abort the host), and a
+ * FIFO as the mesh (it once blocked the host forever). Each is KAGE_RESULT_FILE at once, naming
+ * what is wrong. */
+static void check_hostile_files(void) {
+  char dir[] = "/tmp/kage-arrays-XXXXXX", map[256], obj[256], scene_path[256], text[512];
+  REQUIRE(mkdtemp(dir) != NULL);
+  kage_scene *scene = NULL;
+  snprintf(map, sizeof map, "%s/huge.hdr", dir);
+  FILE *f = fopen(map, "wb");
+  REQUIRE(f != NULL);
+  fputs("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32768 +X 65536\n", f);
+  fputs("\x80\x80\x80\x81", f);
+  REQUIRE(fclose(f) == 0);
+  snprintf(scene_path, sizeof scene_path, "%s/huge-map.json", dir);
+  write_scene(scene_path, map, NULL);
+  EXPECT(kage_scene_load(scene_path, &scene), KAGE_RESULT_FILE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "huge.hdr") != NULL && strstr(text, "65536x32768") != NULL);
+  REQUIRE(scene == NULL);
+
+  snprintf(obj, sizeof obj, "%s/pipe.obj", dir);
+  REQUIRE(mkfifo(obj, 0600) == 0);
+  snprintf(scene_path, sizeof scene_path, "%s/pipe-mesh.json", dir);
+  write_scene(scene_path, NULL, obj);
+  EXPECT(kage_scene_load(scene_path, &scene), KAGE_RESULT_FILE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "pipe.obj") != NULL && strstr(text, "not a regular file") != NULL);
+
+  unlink(map), unlink(obj), unlink(scene_path);
+  snprintf(scene_path, sizeof scene_path, "%s/huge-map.json", dir);
+  unlink(scene_path);
+  rmdir(dir);
+}
 
 /* One triangle under a constant sky, the smallest valid scene. Its arrays are static, so that
  * a check can spoil one field after the call, and the next call makes it whole again. */
@@ -120,6 +171,26 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_scene_create(&desc, &scene), KAGE_RESULT_INVALID_VALUE);
   desc = triangle(), desc.groups = NULL;
   EXPECT(kage_scene_create(&desc, &scene), KAGE_RESULT_NULL_ARGUMENT);
+  desc = triangle(), desc.size -= 8; /* an older host's shorter struct */
+  EXPECT(kage_scene_create(&desc, &scene), KAGE_RESULT_INVALID_VALUE);
+  desc = triangle(), tri_group.transform.translation[0] = 1e20f; /* finite, beyond the extent */
+  EXPECT(kage_scene_create(&desc, &scene), KAGE_RESULT_INVALID_VALUE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "group 0") != NULL && strstr(text, "1e6") != NULL);
+  /* A quaternion of any length is its rotation, in a scene as in a moved group: the renderer
+   * made from it draws (it once failed, naming a rotation [0, 0, 0, 0] never passed). */
+  desc = triangle(), tri_group.transform.rotation[0] = 1e20f, tri_group.transform.rotation[3] = 0;
+  CHECK(kage_scene_create(&desc, &scene));
+  {
+    kage_technique_desc unshadowed;
+    CHECK(kage_technique_desc_default(KAGE_TECHNIQUE_UNSHADOWED, &unshadowed));
+    kage_renderer_desc long_desc = {sizeof(kage_renderer_desc), 8, 8, unshadowed};
+    kage_renderer *drawn = NULL;
+    CHECK(kage_renderer_create(context, scene, &long_desc, &drawn));
+    CHECK(kage_renderer_render(drawn));
+    CHECK(kage_renderer_destroy(drawn));
+  }
+  CHECK(kage_scene_destroy(scene));
   desc = triangle();
   CHECK(kage_scene_create(&desc, &scene));
   CHECK(kage_scene_group_count(scene, &count));
@@ -255,6 +326,16 @@ static void check_bad_arguments(kage_context *context) {
   CHECK(kage_renderer_destroy(renderer));
   EXPECT(kage_renderer_destroy(renderer), KAGE_RESULT_INVALID_HANDLE);
   EXPECT(kage_context_destroy(no_context), KAGE_RESULT_INVALID_HANDLE);
+  /* A destroyed context's handle stays dead when another is made in its place. */
+  {
+    kage_context_desc again = {sizeof(kage_context_desc), NULL, false};
+    kage_context *first = NULL, *second = NULL;
+    CHECK(kage_context_create(&again, &first));
+    CHECK(kage_context_destroy(first));
+    CHECK(kage_context_create(&again, &second));
+    EXPECT(kage_context_destroy(first), KAGE_RESULT_INVALID_HANDLE);
+    CHECK(kage_context_destroy(second));
+  }
   CHECK(kage_scene_destroy(scene));
 }
 
@@ -276,6 +357,7 @@ int main(int argc, char **argv) {
   kage_context *context = NULL;
   CHECK(kage_context_create(&context_desc, &context));
   check_bad_arguments(context);
+  check_hostile_files();
   render_moving_box(context, (uint32_t)atoi(argv[4]), frames, size);
   CHECK(kage_context_destroy(context));
   printf("ok\n");

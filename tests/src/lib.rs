@@ -2,7 +2,7 @@
 //! validation message, small scenes built in code, and scratch folders.
 use kage::backend::{Context, ContextDesc};
 use kage::scene::{Camera, EnvMap, Group, Mesh, Scene, Transform};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// A context with validation on. Dropping it asserts that validation reported nothing, so a
@@ -79,4 +79,38 @@ pub fn shadow_test_transfer(ctx: &Arc<Context>, scene: &Scene) -> Arc<kage::prt:
     use kage::prt::{transfer, PrtParams};
     let params = PrtParams { bands: 3, rays: 128, ..PrtParams::DEFAULT };
     Arc::new(transfer::precompute(ctx, scene, params, &mut |_, _| {}).expect("transfer"))
+}
+
+/// A valid 2 × 1 OpenEXR file whose header then claims `width` × `height` pixels: its
+/// `dataWindow` attribute (box2i: xMin, yMin, xMax, yMax) and `chunkCount` (one block per row,
+/// uncompressed) patched to agree, the pixels left as they were.
+pub fn exr_declaring(path: &Path, width: i32, height: i32) {
+    use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage};
+    let channels = SpecificChannels::rgb(|_: Vec2<usize>| (1.0f32, 1.0f32, 1.0f32));
+    let layer = Layer::new((2, 1), LayerAttributes::default(), Encoding::UNCOMPRESSED, channels);
+    let mut bytes = Vec::new();
+    Image::from_layer(layer).write().to_buffered(std::io::Cursor::new(&mut bytes)).unwrap();
+    let mut patch = |attribute: &[u8], values: &[i32]| {
+        let at = bytes.windows(attribute.len()).position(|w| w == attribute).unwrap() + attribute.len();
+        assert_eq!(bytes[at..at + 4], (4 * values.len() as i32).to_le_bytes(), "the attribute's size");
+        for (i, value) in values.iter().enumerate() {
+            bytes[at + 4 + 4 * i..at + 8 + 4 * i].copy_from_slice(&value.to_le_bytes());
+        }
+    };
+    patch(b"dataWindow\0box2i\0", &[0, 0, width - 1, height - 1]);
+    patch(b"chunkCount\0int\0", &[height]);
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// A Radiance HDR header claiming `width` × `height` pixels, followed by one pixel.
+pub fn hdr_declaring(path: &Path, width: u32, height: u32) {
+    let mut bytes = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n").into_bytes();
+    bytes.extend([128, 128, 128, 129]);
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// A named pipe at `path` (a reader opening it waits for a writer forever).
+pub fn fifo(path: &Path) {
+    let made = std::process::Command::new("mkfifo").arg(path).status().unwrap();
+    assert!(made.success(), "mkfifo {}", path.display());
 }

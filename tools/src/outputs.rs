@@ -1,9 +1,10 @@
-//! Output paths checked before the work that fills them: a wrong extension or a folder that
-//! does not exist fails at once, not after a long render or reference.
+//! Output paths checked before the work that fills them: a wrong extension, a folder that does
+//! not exist or one Kage may not write in fails at once, not after a long render or reference.
 use anyhow::{bail, Result};
 use std::path::Path;
 
-/// Checks that `path`, given as `flag`, ends in one of `extensions` and lies in an existing folder.
+/// Checks that `path`, given as `flag`, ends in one of `extensions` and lies in an existing
+/// folder that Kage can write in.
 pub fn check(path: &Path, flag: &str, extensions: &[&str]) -> Result<()> {
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if !extension.is_some_and(|e| extensions.contains(&e.as_str())) {
@@ -14,5 +15,14 @@ pub fn check(path: &Path, flag: &str, extensions: &[&str]) -> Result<()> {
     if !folder.is_dir() {
         bail!("{flag} {}: the folder {} does not exist", path.display(), folder.display());
     }
-    Ok(())
+    // Permissions alone do not say (root ignores them; a read-only mount does not show in
+    // them): a file made and removed at once does.
+    let probe = folder.join(format!(".kage-write-check-{}", std::process::id()));
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => bail!("{flag} {}: cannot write in the folder {}: {e}", path.display(), folder.display()),
+    }
 }

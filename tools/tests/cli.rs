@@ -173,10 +173,12 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     std::fs::write(&points, r#"{"points": [{"position": [0, 0.5, 0], "normal": [0, 1, 0]}]}"#).unwrap();
     let (points, out_json) = (points.to_str().unwrap(), dir.join("e.json"));
     let no_samples = ["--bounces", "1", "--bounce-samples", "0", "--out", out_json.to_str().unwrap()];
-    let cases: [(&[&str], &str); 18] = [
-        // Outputs are checked before the work that would fill them.
+    let cases: [(&[&str], &str); 19] = [
+        // Outputs are checked before the work that would fill them (the reference's own write
+        // would fail later with another message).
         (&["compare", "a.exr", "b.exr", "--diff", "d.jpg"], "--diff d.jpg: the file must end in .png"),
         (&["reference", "--out", "/no/such/folder/r.exr"], "the folder /no/such/folder does not exist"),
+        (&["reference", "--out", "/proc/r.exr"], "cannot write in the folder /proc"),
         (&[&["reference", "--irradiance", points][..], &no_samples[..]].concat(), "0 samples per vertex"),
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", "asm", "--keyframe", "5"], "scene asm has 5 walkthrough keyframes"),
@@ -198,6 +200,114 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["bench", "probe-count", "--scenes", "probe-room", "--candidates", "1"], "grid level 1"),
     ];
     assert_clear_errors(&cases);
+}
+
+/// Files that lie or are not files, scene values out of range and a probe set that would
+/// exhaust memory, through the program as a user runs it (the engine's own tests cover the
+/// readers one by one): each a clear error naming the file or value, at once (a FIFO read
+/// would hang: the harness's test timeout is the bound), never an abort.
+#[cfg(unix)]
+#[test]
+fn hostile_files_and_values_are_clear_errors_through_the_program() {
+    let dir = scratch_dir("cli-hostile");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let scene = |name: &str, groups: &str, extra: &str| {
+        let json = format!(
+            r#"{{"camera": {{"position": [0, 2, 6], "target": [0, 0.5, 0], "fov_y_deg": 40}},
+                "environment": {{"constant": [1, 1, 1]}}, "groups": [{groups}]{extra}}}"#
+        );
+        std::fs::write(dir.join(name), json).unwrap();
+        path(name)
+    };
+    let ball = r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
+    kage_tests::exr_declaring(&dir.join("huge.exr"), 65536, 32768);
+    kage_tests::hdr_declaring(&dir.join("huge.hdr"), 65536, 32768);
+    kage_tests::fifo(&dir.join("fifo.exr"));
+    kage_tests::fifo(&dir.join("fifo.obj"));
+    let (huge, huge_hdr, fifo_map) = (path("huge.exr"), path("huge.hdr"), path("fifo.exr"));
+    let obj_scene = |name: &str, obj: &str| {
+        scene(
+            name,
+            &format!(r#"{{"name": "g", "meshes": [{{"obj": {obj:?}, "albedo": [0.5, 0.5, 0.5]}}]}}"#),
+            "",
+        )
+    };
+    let fifo_obj = obj_scene("fifo-obj.json", &path("fifo.obj"));
+    let zero_obj = obj_scene("zero-obj.json", "/dev/zero");
+    let far = scene(
+        "far.json",
+        &format!(
+            r#"{{"name": "near", "meshes": [{ball}]}}, {{"name": "far", "translation": [1e20, 0, 0], "meshes": [{ball}]}}"#
+        ),
+        "",
+    );
+    let through = scene(
+        "through.json",
+        &format!(r#"{{"name": "g", "meshes": [{ball}]}}"#),
+        r#", "walkthrough": [{"position": [0, 1, 5], "target": [0, 1, 0], "fov_y_deg": 40},
+                              {"position": [0, 1, -5], "target": [0, 1, 0], "fov_y_deg": 40}]"#,
+    );
+    // Probes on two skew lines: their Delaunay tetrahedra grow with the square of the count
+    // (2 × 2500 would be about 6 million); the bound stops it in about a second.
+    let line = |k: usize| {
+        (0..2500).map(move |i| i as f32 / 2500.0).map(move |t| match k {
+            0 => format!("[{t}, 0, 0]"),
+            _ => format!("[0.5, 1, {t}]"),
+        })
+    };
+    let positions: Vec<String> = line(0).chain(line(1)).collect();
+    std::fs::write(dir.join("skew.json"), format!(r#"{{"positions": [{}]}}"#, positions.join(", "))).unwrap();
+    let (skew, tetrahedra) = (path("skew.json"), path("tetrahedra.json"));
+    let small = ["--width", "8", "--height", "8"];
+    fn with<'a>(args: &[&'a str], small: &[&'a str]) -> Vec<&'a str> {
+        [args, small].concat()
+    }
+    let declared = "65536x32768";
+    let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
+        (vec!["sh", &huge], vec![&huge, declared, "16384x8192"]),
+        (vec!["sh", &huge_hdr], vec![&huge_hdr, declared]),
+        (with(&["render", "--env", &huge], &small), vec![&huge, declared]),
+        (vec!["compare", &huge, &huge], vec![&huge, declared]),
+        (vec!["probes", "capture-image", &huge], vec![&huge, declared]),
+        (vec!["sh", &fifo_map], vec![&fifo_map, "not a regular file"]),
+        (with(&["render", "--scene", &fifo_obj], &small), vec!["fifo.obj", "not a regular file"]),
+        (with(&["render", "--scene", &zero_obj], &small), vec!["/dev/zero", "not a regular file"]),
+        (
+            with(&["render", "--scene", &far, "--technique", "parallel-lights"], &small),
+            vec!["far.json", "1e6"],
+        ),
+        (
+            with(&["render", "--scene", &through], &small),
+            vec!["through.json", "walkthrough between cameras 0 and 1"],
+        ),
+        (
+            with(&["render", "--scene", "asm", "--technique", "asm", "--asm-budget-mb", "inf"], &small),
+            vec!["must be a finite number of MB"],
+        ),
+        (
+            vec!["probes", "tetrahedralize", "--in", &skew, "--out", &tetrahedra],
+            vec!["skew.json", "more than 4194304 tetrahedra"],
+        ),
+    ];
+    for (args, expected) in &cases {
+        let out = kage(args);
+        let all = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {all}");
+        for part in expected {
+            assert!(
+                all.contains("kage: error:") && all.contains(part),
+                "{args:?} does not say {part:?}: {all}"
+            );
+        }
+        assert!(!all.contains("panicked"), "{args:?}: {all}");
+    }
+
+    // A scene file saved with a UTF-8 byte order mark (as some Windows editors do) reads.
+    let plain = scene("plain.json", &format!(r#"{{"name": "g", "meshes": [{ball}]}}"#), "");
+    let bom = dir.join("bom.json");
+    std::fs::write(&bom, format!("\u{feff}{}", std::fs::read_to_string(&plain).unwrap())).unwrap();
+    let out = kage(&with(&["render", "--scene", bom.to_str().unwrap(), "--out", &path("bom.png")], &small));
+    assert!(out.status.success(), "{}", text(&out));
 }
 
 /// `kage scene export` writes its own files, never through a symbolic link to one elsewhere.

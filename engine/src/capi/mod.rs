@@ -22,7 +22,7 @@
 /// field added, removed or moved, a function's parameters, an enumeration's values), and
 /// libkage.so carries it in its SONAME (`libkage.so.1`). A host checks at start-up that
 /// `kage_abi_version()` equals the `KAGE_ABI_VERSION` it was compiled with; beyond that, every
-/// desc struct carries its `size`, which each call checks.
+/// top-level desc struct carries its `size`, which each call checks.
 #[repr(u32)]
 pub enum kage_abi {
     Version = 1,

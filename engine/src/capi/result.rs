@@ -186,6 +186,8 @@ mod tests {
             Error::OutOfDeviceMemoryFor { name: "mask".into(), bytes: 1 << 32, reason: "limit".into() };
         assert_eq!(boundary(|| Err(too_large.into())), kage_result::OutOfMemory);
         assert_eq!(last_message(), "out of device memory for mask (4294967296 bytes): limit");
+        // Kage's own bugs never blame the caller.
+        assert_eq!(boundary(|| Err(Error::Internal("pass order".into()).into())), kage_result::Internal);
     }
 
     #[test]

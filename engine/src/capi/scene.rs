@@ -20,7 +20,8 @@ pub struct kage_scene {
 #[derive(Clone, Copy)]
 pub struct kage_transform {
     pub translation: [f32; 3],
-    /// A unit quaternion (x, y, z, w); one slightly off unit length is renormalized.
+    /// A quaternion (x, y, z, w) of any finite, non-zero length: it is normalized, so only its
+    /// direction (the rotation) counts; all zeros is refused.
     pub rotation: [f32; 4],
     /// Greater than 0.
     pub scale: f32,
@@ -171,7 +172,7 @@ unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
     let pixels = unsafe { args::chunks::<3>(env.pixels, texels, "desc->environment.pixels") }?;
     let environment = EnvMap::from_pixels(env.width, env.height, pixels.to_vec()).map_err(invalid)?;
     let camera = desc.camera.camera()?;
-    Ok(Scene {
+    let scene = Scene {
         name: "host".into(),
         groups,
         environment,
@@ -179,7 +180,11 @@ unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
         camera,
         walkthrough: Vec::new(),
         probes: Vec::new(),
-    })
+    };
+    // The rules every scene meets (its extent among them): refused here, not when a renderer
+    // is made from it.
+    scene.validate().map_err(invalid)?;
+    Ok(scene)
 }
 
 /// # Safety

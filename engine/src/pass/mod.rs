@@ -187,6 +187,19 @@ fn check_data_flow(imports: &[Resource], passes: &[Pass<'_>]) -> Result<()> {
 mod tests {
     use super::*;
 
+    #[test]
+    fn a_pass_reading_what_nothing_wrote_is_an_internal_error() {
+        const A: Resource = Resource("a");
+        const B: Resource = Resource("b");
+        let passes = [Pass::new("first", &[A], &[B], |_| {}), Pass::new("second", &[B], &[], |_| {})];
+        assert!(check_data_flow(&[A], &passes).is_ok());
+        let passes = [Pass::new("second", &[B], &[], |_| {})];
+        let error = check_data_flow(&[A], &passes).unwrap_err();
+        // Kage's own bug, not the caller's: the C ABI gives it KAGE_RESULT_INTERNAL.
+        assert_eq!(error.fault(), crate::error::Fault::Internal);
+        assert!(error.to_string().contains("pass second reads b, which no earlier pass writes"), "{error}");
+    }
+
     /// Lavapipe cannot lose its device on demand, so the answer to the frames after a failure
     /// is tested on its own.
     #[test]
