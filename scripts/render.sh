@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Set-up command 1: installs what is missing, builds Kage and renders the default scene to
-# kage.png (and kage.exr), printing the per-pass GPU timings.
+# Set-up command 1: installs what is missing, builds Kage and renders the default scene with
+# Tamura's soft shadows (the default technique) to kage.png (and kage.exr), printing the
+# per-pass GPU timings.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/deps.sh

@@ -1,7 +1,26 @@
 //! Output paths checked before the work that fills them: a wrong extension, a folder that does
 //! not exist or one Kage may not write in fails at once, not after a long render or reference.
 use anyhow::{bail, Result};
+use clap::Args;
 use std::path::Path;
+
+/// How bright a PNG output is: the radiance is multiplied by it before tonemapping.
+#[derive(Args)]
+pub struct Exposure {
+    /// Exposure multiplier applied before tonemapping (PNG only).
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+}
+
+impl Exposure {
+    /// The multiplier, once checked to be a positive number.
+    pub fn checked(&self) -> Result<f32> {
+        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+            bail!("--exposure must be a positive number, got {}", self.exposure);
+        }
+        Ok(self.exposure)
+    }
+}
 
 /// Checks that `path`, given as `flag`, ends in one of `extensions` and lies in an existing
 /// folder that Kage can write in.

@@ -26,6 +26,8 @@ pub struct ReferenceArgs {
     /// --irradiance, a .json file.
     #[arg(long)]
     out: PathBuf,
+    #[command(flatten)]
+    exposure: crate::outputs::Exposure,
     /// env: the environment map with full visibility; local: the scene's point and spot
     /// lights with hard shadows (no environment, black background; deterministic, so one
     /// sample per pixel is exact and --spp is not used).
@@ -117,13 +119,14 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     // Irradiance results are written as .json, images as .png or .exr.
     let extensions: &[&str] = if args.irradiance.is_some() { &["json"] } else { &["png", "exr"] };
     crate::outputs::check(&args.out, "--out", extensions)?;
+    let exposure = args.exposure.checked()?;
     // Bad input files fail before the GPU is set up.
     let points = args.irradiance.as_deref().map(read_points).transpose()?;
     let scene = args.scene.load()?;
     let ctx = args.gpu.context()?;
     match points {
         Some(points) => run_irradiance(args, &ctx, &scene, &points)?,
-        None => run_image(args, &ctx, &scene)?,
+        None => run_image(args, &ctx, &scene, exposure)?,
     }
     args.gpu.finish(&ctx)
 }
@@ -132,6 +135,7 @@ fn run_image(
     args: &ReferenceArgs,
     ctx: &std::sync::Arc<kage::backend::Context>,
     scene: &Scene,
+    exposure: f32,
 ) -> Result<()> {
     let light = match args.light {
         LightArg::Env => LightMode::Environment,
@@ -159,7 +163,7 @@ fn run_image(
         progressive(&mut renderer, args.spp, args.time_budget, "pixel")?
     };
     let image = renderer.to_image(&statistics);
-    kage::imageio::write(&args.out, &image, 1.0)?;
+    kage::imageio::write(&args.out, &image, exposure)?;
     println!(
         "wrote {} ({}x{}, scene {}, {} light, {} spp, {:.1} s, {})",
         args.out.display(),

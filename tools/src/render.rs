@@ -20,7 +20,9 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct RenderArgs {
-    #[arg(long, value_enum, default_value_t = TechniqueKind::Unshadowed)]
+    /// The lighting technique; the default shows what Kage is for, Tamura's soft shadows
+    /// (its PRT transfer is computed first, in seconds, and cached).
+    #[arg(long, value_enum, default_value_t = TechniqueKind::Tamura)]
     technique: TechniqueKind,
     /// Environment regions q of the Tamura technique (1 to 64) or of parallel-lights (1 to 128).
     #[arg(long, default_value_t = OcclusionSettings::default().regions)]
@@ -104,9 +106,8 @@ pub struct RenderArgs {
     /// Output image: .png (tonemapped, sRGB) or .exr (linear radiance, 32-bit float).
     #[arg(long, default_value = "kage.png")]
     out: PathBuf,
-    /// Exposure multiplier applied before tonemapping (PNG only).
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    #[command(flatten)]
+    exposure: crate::outputs::Exposure,
     /// Write per-pass GPU timings as JSON.
     #[arg(long)]
     timings: Option<PathBuf>,
@@ -175,9 +176,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    if !(args.exposure.is_finite() && args.exposure > 0.0) {
-        anyhow::bail!("--exposure must be a positive number");
-    }
+    let exposure = args.exposure.checked()?;
     crate::outputs::check(&args.out, "--out", &["png", "exr"])?;
     if let Some(timings) = &args.timings {
         crate::outputs::check(timings, "--timings", &["json"])?;
@@ -265,7 +264,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let image = renderer.image()?;
-    kage::imageio::write(&args.out, &image, args.exposure)?;
+    kage::imageio::write(&args.out, &image, exposure)?;
     println!("wrote {} ({}x{}, scene {})", args.out.display(), args.width, args.height, scene.name);
 
     let rows = table.rows();

@@ -36,6 +36,9 @@ fn render_writes_png_exr_and_timings() {
     let png = dir.join("teapot.png");
     let exr = dir.join("teapot.exr");
     let timings = dir.join("timings.json");
+    // The default technique is Tamura's: its transfer goes to the cache given here.
+    let cache = dir.join("cache");
+    let cache = cache.to_str().unwrap();
     let out = kage(&[
         "render",
         "--validate",
@@ -45,9 +48,12 @@ fn render_writes_png_exr_and_timings() {
         "48",
         "--frames",
         "2",
+        "--cache",
+        cache,
         "--out",
         png.to_str().unwrap(),
     ]);
+    assert!(text(&out).contains("transfer: computed"), "{}", text(&out));
     assert!(out.status.success(), "{}", text(&out));
     let out = kage(&[
         "render",
@@ -56,6 +62,8 @@ fn render_writes_png_exr_and_timings() {
         "64",
         "--height",
         "48",
+        "--cache",
+        cache,
         "--out",
         exr.to_str().unwrap(),
         "--timings",
@@ -73,7 +81,21 @@ fn render_writes_png_exr_and_timings() {
     assert!(json["device"].as_str().is_some_and(|d| !d.is_empty()));
     let passes = json["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["sh_project", "sh_reduce", "background", "scene", "readback"]);
+    assert_eq!(
+        names,
+        [
+            "sh_project",
+            "sh_reduce",
+            "background",
+            "self_shadow",
+            "occluder_masks",
+            "blur_horizontal",
+            "blur_vertical",
+            "depth_prepass",
+            "scene",
+            "readback"
+        ]
+    );
     for pass in passes {
         for key in ["median_ms", "min_ms", "max_ms"] {
             assert!(pass[key].as_f64().is_some_and(|ms| ms > 0.0), "{pass}");
@@ -173,12 +195,13 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     std::fs::write(&points, r#"{"points": [{"position": [0, 0.5, 0], "normal": [0, 1, 0]}]}"#).unwrap();
     let (points, out_json) = (points.to_str().unwrap(), dir.join("e.json"));
     let no_samples = ["--bounces", "1", "--bounce-samples", "0", "--out", out_json.to_str().unwrap()];
-    let cases: [(&[&str], &str); 19] = [
+    let cases: [(&[&str], &str); 20] = [
         // Outputs are checked before the work that would fill them (the reference's own write
         // would fail later with another message).
         (&["compare", "a.exr", "b.exr", "--diff", "d.jpg"], "--diff d.jpg: the file must end in .png"),
         (&["reference", "--out", "/no/such/folder/r.exr"], "the folder /no/such/folder does not exist"),
         (&["reference", "--out", "/proc/r.exr"], "cannot write in the folder /proc"),
+        (&["reference", "--exposure", "0", "--out", "r.png"], "--exposure must be a positive number"),
         (&[&["reference", "--irradiance", points][..], &no_samples[..]].concat(), "0 samples per vertex"),
         (&["render", "--scene", "no-such-scene"], "built-in scenes are"),
         (&["render", "--scene", "asm", "--keyframe", "5"], "scene asm has 5 walkthrough keyframes"),
@@ -306,7 +329,10 @@ fn hostile_files_and_values_are_clear_errors_through_the_program() {
     let plain = scene("plain.json", &format!(r#"{{"name": "g", "meshes": [{ball}]}}"#), "");
     let bom = dir.join("bom.json");
     std::fs::write(&bom, format!("\u{feff}{}", std::fs::read_to_string(&plain).unwrap())).unwrap();
-    let out = kage(&with(&["render", "--scene", bom.to_str().unwrap(), "--out", &path("bom.png")], &small));
+    let out = kage(&with(
+        &["render", "--scene", bom.to_str().unwrap(), "--technique", "unshadowed", "--out", &path("bom.png")],
+        &small,
+    ));
     assert!(out.status.success(), "{}", text(&out));
 }
 

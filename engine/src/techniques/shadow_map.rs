@@ -71,7 +71,8 @@ impl ShadowMap {
         let max = constants::MAX_LOCAL_LIGHTS as usize;
         if !(1..=max).contains(&scene.lights.len()) {
             return Err(Error::InvalidArgument(format!(
-                "the shadowmap technique shadows 1 to {max} point or spot lights; scene {} has {}",
+                "the shadowmap technique shadows 1 to {max} point or spot lights; scene {} has {} (the \
+                 built-in scene asm has one)",
                 scene.name,
                 scene.lights.len()
             )));

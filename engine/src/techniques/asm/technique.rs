@@ -215,7 +215,8 @@ impl Asm {
         let settings = settings.validated()?;
         let [light] = scene.lights[..] else {
             return Err(Error::InvalidArgument(format!(
-                "the asm technique shadows exactly one point or spot light; scene {} has {}",
+                "the asm technique shadows exactly one point or spot light; scene {} has {} (the \
+                 built-in scene asm has one)",
                 scene.name,
                 scene.lights.len()
             )));
