@@ -808,6 +808,19 @@ fn probes_capture_image_matches_kage_sh() {
     assert!((e("+y") - e("-y") - odd).abs() < 1e-4 * odd.abs(), "{} {} {odd}", e("+y"), e("-y"));
 }
 
+/// The probes technique on the default scene, whose only static group is a flat floor: its
+/// grid is lifted over the teapot instead of lying in the floor's plane (where no tetrahedron
+/// spans it).
+#[test]
+fn probes_render_on_the_default_scene() {
+    let dir = scratch_dir("cli-probes-default");
+    let png = dir.join("probes.png");
+    let args =
+        ["render", "--technique", "probes", "--probe-cube-size", "8", "--width", "16", "--height", "16"];
+    let out = kage(&[&args[..], &["--validate", "--out", png.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", text(&out));
+}
+
 /// The probe capture's own options: bad values are clear errors.
 #[test]
 fn probe_capture_options_are_checked() {

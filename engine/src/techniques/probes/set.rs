@@ -151,11 +151,31 @@ impl ProbeSettings {
     }
 }
 
-/// The cell centres of a `counts` grid over the static groups' bounding box.
+/// The cell centres of a `counts` grid over the static groups' bounding box. Along an axis
+/// where that box is flat (a floor alone) every probe would lie in one plane, which no
+/// tetrahedron spans: there the grid spans the whole scene's box instead, the moving group as
+/// the scene places it included.
 pub fn grid_lattice(scene: &Scene, counts: [u32; 3]) -> Result<Lattice> {
-    let (lo, hi) = static_bounds_of(scene)?;
+    let (mut lo, mut hi) = static_bounds_of(scene)?;
+    let (all_lo, all_hi) = bounds(scene.groups.iter().flat_map(|group| {
+        let m = group.transform.matrix();
+        group
+            .meshes
+            .iter()
+            .flat_map(move |mesh| mesh.positions.iter().map(move |p| m.transform_point3((*p).into())))
+    }))
+    .unwrap_or((lo, hi));
+    let extent = hi - lo;
+    for axis in 0..3 {
+        if extent[axis] <= FLAT * extent.max_element() {
+            (lo[axis], hi[axis]) = (all_lo[axis], all_hi[axis]);
+        }
+    }
     Ok(Lattice::cell_centres(lo, hi, counts))
 }
+
+/// A box side at most this fraction of its longest is flat (for [`grid_lattice`]).
+const FLAT: f32 = 1e-3;
 
 fn static_bounds_of(scene: &Scene) -> Result<(Vec3, Vec3)> {
     static_bounds(scene).ok_or_else(|| {
