@@ -952,7 +952,8 @@ kage_result kage_last_error_message(char *buffer, size_t capacity, size_t *lengt
 
 /**
  * Loads a scene: a path to a scene file (JSON, see the README), or the name of a built-in
- * scene ("teapot", "teapot-hires-floor"). A path that exists or ends in ".json" is a file.
+ * scene ("teapot", the default scene; an unknown name's error lists the others). A path that
+ * exists or ends in ".json" is a file.
  *
  * On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
  * on failure it is set to NULL, and a bad or missing file is `KAGE_RESULT_FILE`, with the file

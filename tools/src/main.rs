@@ -147,7 +147,8 @@ enum Command {
     /// A technique's settings side by side: error against the reference at several poses, GPU
     /// time per frame, precomputation time and memory, written to DIR/sweep.csv.
     Sweep(sweep::SweepArgs),
-    /// Light probes: tetrahedralize a probe set, look a point up in it.
+    /// Light probes: tetrahedralize a probe set, look a point up in it, capture one from an
+    /// image, place probes in a scene automatically.
     #[command(subcommand)]
     Probes(probes::ProbesCommand),
 }

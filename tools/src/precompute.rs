@@ -10,7 +10,7 @@ use kage::scene::Scene;
 
 #[derive(Args)]
 pub struct PrecomputeArgs {
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room) or a scene file (.json).
+    /// A built-in scene name (those of `kage render --scene`) or a scene file (.json).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[command(flatten)]

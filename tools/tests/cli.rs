@@ -355,6 +355,15 @@ fn scene_export_does_not_write_through_a_symbolic_link() {
     assert_eq!(std::fs::read_to_string(&elsewhere).unwrap(), "keep");
 }
 
+/// The help of `--scene` names every built-in scene, the list the engine keeps.
+#[test]
+fn scene_help_names_every_built_in_scene() {
+    let help = text(&kage(&["render", "--help"]));
+    for name in kage::scene::BUILTIN {
+        assert!(help.contains(name), "`kage render --help` does not name the built-in scene {name}");
+    }
+}
+
 #[test]
 fn info_lists_features() {
     let out = kage(&["info"]);
