@@ -355,6 +355,47 @@ fn scene_export_does_not_write_through_a_symbolic_link() {
     assert_eq!(std::fs::read_to_string(&elsewhere).unwrap(), "keep");
 }
 
+/// `kage compare` for CI: `--json` prints one parsable object, and the thresholds set the exit
+/// status (0 within, 3 beyond, naming the one exceeded; 1 for a bad threshold).
+#[test]
+fn compare_prints_json_and_its_thresholds_set_the_exit_status() {
+    use kage::imageio::RgbaF32Image;
+    let dir = scratch_dir("cli-compare");
+    let image = |name: &str, value: &dyn Fn(usize) -> f32| {
+        let pixels = (0..64).map(|i| [value(i), value(i), value(i), 1.0]).collect();
+        let path = dir.join(name);
+        kage::imageio::write(&path, &RgbaF32Image { width: 8, height: 8, pixels }, 1.0).unwrap();
+        path.to_str().unwrap().to_owned()
+    };
+    // B is 1 everywhere; A is 1.1 (relative RMSE 0.1), then dark in its first half (half the
+    // pixels lit in B only).
+    let b = image("b.exr", &|_| 1.0);
+    let a = image("a.exr", &|_| 1.1);
+    let dark = image("dark.exr", &|i| if i < 32 { 0.0 } else { 1.0 });
+
+    let out = kage(&["compare", &a, &b, "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
+    assert!((json["relative_rmse"].as_f64().unwrap() - 0.1).abs() < 1e-6, "{json}");
+    assert_eq!((json["width"].as_u64(), json["within_thresholds"].as_bool()), (Some(8), Some(true)));
+
+    let status = |args: &[&str]| {
+        let out = kage(args);
+        (out.status.code(), text(&out))
+    };
+    assert_eq!(status(&["compare", &a, &b, "--max-rel-rmse", "0.11"]).0, Some(0));
+    let (code, said) = status(&["compare", &a, &b, "--max-rel-rmse", "0.05"]);
+    assert_eq!(code, Some(3), "{said}");
+    assert!(said.contains("exceeds --max-rel-rmse 0.05"), "{said}");
+    assert_eq!(status(&["compare", &dark, &b, "--max-mismatch", "0.6"]).0, Some(0));
+    let (code, said) = status(&["compare", &dark, &b, "--max-mismatch", "0.4", "--json"]);
+    assert_eq!(code, Some(3), "{said}");
+    assert!(said.contains("shadow mismatch 5.000000e-1 exceeds --max-mismatch 0.4"), "{said}");
+    let (code, said) = status(&["compare", &a, &b, "--max-rel-rmse=-1"]);
+    assert_eq!(code, Some(1), "{said}");
+    assert!(said.contains("--max-rel-rmse must be a number at least 0"), "{said}");
+}
+
 /// The help of `--scene` names every built-in scene, the list the engine keeps.
 #[test]
 fn scene_help_names_every_built_in_scene() {
