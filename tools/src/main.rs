@@ -15,6 +15,7 @@ mod render;
 mod scene_cmd;
 mod sh_cmd;
 mod sweep;
+mod trace;
 mod transfer_source;
 
 use anyhow::{bail, Context as _, Result};

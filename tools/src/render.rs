@@ -111,6 +111,10 @@ pub struct RenderArgs {
     /// Write per-pass GPU timings as JSON.
     #[arg(long)]
     timings: Option<PathBuf>,
+    /// Write every frame's passes as a timeline (.json, Chrome trace event format: open it in
+    /// Perfetto or chrome://tracing).
+    #[arg(long)]
+    trace: Option<PathBuf>,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -181,6 +185,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(timings) = &args.timings {
         crate::outputs::check(timings, "--timings", &["json"])?;
     }
+    if let Some(trace) = &args.trace {
+        crate::outputs::check(trace, "--trace", &["json"])?;
+    }
     if args.animate && args.scene.keyframe.is_some() {
         anyhow::bail!(
             "--animate plays the walkthrough and --keyframe holds one of its cameras: give one of them"
@@ -227,6 +234,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.set_message("rendering");
     let start = Instant::now();
     let mut table = TimingTable::default();
+    let mut trace = crate::trace::Trace::default();
     let mut dropped = 0;
     for frame in 0..args.frames {
         let t = frame as f32 / args.frames as f32;
@@ -235,7 +243,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         } else if let (true, Some(group)) = (args.animate, scene.groups.first()) {
             renderer.set_group_transform(0, animation::pose(group, t).matrix())?;
         }
-        table.add_frame(&renderer.render()?);
+        let frame_start = start.elapsed();
+        let passes = renderer.render()?;
+        let frame_end = start.elapsed();
+        trace.add_frame(
+            frame,
+            1e6 * frame_start.as_secs_f64(),
+            1e6 * (frame_end - frame_start).as_secs_f64(),
+            &passes,
+        );
+        table.add_frame(&passes);
         dropped = dropped.max(renderer.stats().dropped_layers);
         bar.inc(1);
         if start.elapsed().as_secs_f32() < 1.0 {
@@ -291,6 +308,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         };
         std::fs::write(path, serde_json::to_string_pretty(&file)?)
             .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.trace {
+        trace.write(path, &ctx.info().name)?;
     }
     args.gpu.finish(&ctx)
 }

@@ -355,6 +355,55 @@ fn scene_export_does_not_write_through_a_symbolic_link() {
     assert_eq!(std::fs::read_to_string(&elsewhere).unwrap(), "keep");
 }
 
+/// `kage render --trace`: a Chrome trace event file (what Perfetto opens) with one complete
+/// event per frame on the CPU track and one per pass and frame on the GPU track, agreeing with
+/// the pass counts of `--timings`.
+#[test]
+fn render_writes_a_trace_with_one_event_per_pass_and_frame() {
+    let dir = scratch_dir("cli-trace");
+    let (trace, timings) = (dir.join("trace.json"), dir.join("timings.json"));
+    let out = kage(&[
+        "render",
+        "--technique",
+        "unshadowed",
+        "--frames",
+        "3",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        dir.join("t.png").to_str().unwrap(),
+        "--timings",
+        timings.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let read = |path: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    };
+    let (trace, timings) = (read(&trace), read(&timings));
+    let events = trace["traceEvents"].as_array().expect("a traceEvents array");
+    let complete = |cat: &str| -> Vec<&serde_json::Value> {
+        events.iter().filter(|e| e["ph"] == "X" && e["cat"] == cat).collect()
+    };
+    for e in complete("cpu").into_iter().chain(complete("gpu")) {
+        assert!(
+            e["ts"].as_f64().is_some_and(|t| t >= 0.0) && e["dur"].as_f64().is_some_and(|d| d >= 0.0),
+            "{e}"
+        );
+        assert!(e["name"].is_string() && e["pid"].is_number() && e["tid"].is_number(), "{e}");
+    }
+    let frames: Vec<u64> = complete("cpu").iter().map(|e| e["args"]["frame"].as_u64().unwrap()).collect();
+    assert_eq!(frames, [0, 1, 2]);
+    for pass in timings["passes"].as_array().unwrap() {
+        let name = pass["name"].as_str().unwrap();
+        let events = complete("gpu").into_iter().filter(|e| e["name"] == name).count();
+        assert_eq!(events as u64, pass["frames"].as_u64().unwrap(), "events of pass {name}");
+    }
+}
+
 /// `kage compare` for CI: `--json` prints one parsable object, and the thresholds set the exit
 /// status (0 within, 3 beyond, naming the one exceeded; 1 for a bad threshold).
 #[test]

@@ -55,6 +55,9 @@ impl<'a> Pass<'a> {
 pub struct PassTiming {
     pub name: &'static str,
     pub gpu_ms: Option<f64>,
+    /// When the pass started on the device, ms after the frame's first pass started (for a
+    /// timeline; `None` without timestamps).
+    pub start_ms: Option<f64>,
 }
 
 /// Records, submits and times frames; owns the command buffer and timestamp pool it reuses.
@@ -150,12 +153,14 @@ impl FrameExecutor {
         Ok(names
             .into_iter()
             .enumerate()
-            .map(|(i, name)| PassTiming {
-                name,
-                gpu_ms: ticks
-                    .as_ref()
-                    .zip(period_ns)
-                    .map(|(t, period)| t[2 * i + 1].saturating_sub(t[2 * i]) as f64 * period * 1e-6),
+            .map(|(i, name)| {
+                let ms = |from: usize, to: usize| {
+                    ticks
+                        .as_ref()
+                        .zip(period_ns)
+                        .map(|(t, period)| t[to].saturating_sub(t[from]) as f64 * period * 1e-6)
+                };
+                PassTiming { name, gpu_ms: ms(2 * i, 2 * i + 1), start_ms: ms(0, 2 * i) }
             })
             .collect())
     }

@@ -82,8 +82,8 @@ mod tests {
         let mut table = TimingTable::default();
         for ms in [3.0, 1.0, 2.0, 10.0] {
             table.add_frame(&[
-                PassTiming { name: "a", gpu_ms: Some(ms) },
-                PassTiming { name: "b", gpu_ms: Some(1.0) },
+                PassTiming { name: "a", gpu_ms: Some(ms), start_ms: Some(0.0) },
+                PassTiming { name: "b", gpu_ms: Some(1.0), start_ms: Some(ms) },
             ]);
         }
         let rows = table.rows();
