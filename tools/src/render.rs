@@ -100,6 +100,11 @@ pub struct RenderArgs {
     width: u32,
     #[arg(long, default_value_t = 512)]
     height: u32,
+    /// Frames rendered before the timed ones, left out of the timings and the trace: a
+    /// pipeline's first frames include its shader compilation on lavapipe, and one-time passes
+    /// (the environment's SH projection) run in the first frame (`--warmup 0` shows them).
+    #[arg(long, default_value_t = 2)]
+    warmup: u32,
     /// Frames to render; timings are taken over all of them.
     #[arg(long, default_value_t = 1)]
     frames: u32,
@@ -227,7 +232,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
-    let bar = ProgressBar::new(args.frames as u64).with_style(
+    let bar = ProgressBar::new(u64::from(args.warmup) + u64::from(args.frames)).with_style(
         ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
             .expect("static template"),
     );
@@ -236,8 +241,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut table = TimingTable::default();
     let mut trace = crate::trace::Trace::default();
     let mut dropped = 0;
-    for frame in 0..args.frames {
-        let t = frame as f32 / args.frames as f32;
+    for frame in (0..args.warmup).map(|_| None).chain((0..args.frames).map(Some)) {
+        let t = frame.map_or(0.0, |f| f as f32 / args.frames as f32);
         if let (true, Some(camera)) = (args.animate, animation::camera_at(&scene.walkthrough, t)) {
             renderer.set_camera(camera)?;
         } else if let (true, Some(group)) = (args.animate, scene.groups.first()) {
@@ -246,6 +251,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let frame_start = start.elapsed();
         let passes = renderer.render()?;
         let frame_end = start.elapsed();
+        bar.inc(1);
+        if start.elapsed().as_secs_f32() < 1.0 {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        } else {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        let Some(frame) = frame else { continue };
         trace.add_frame(
             frame,
             1e6 * frame_start.as_secs_f64(),
@@ -254,12 +266,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
         table.add_frame(&passes);
         dropped = dropped.max(renderer.stats().dropped_layers);
-        bar.inc(1);
-        if start.elapsed().as_secs_f32() < 1.0 {
-            bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-        } else {
-            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-        }
     }
     bar.finish_and_clear();
     if let Some(stats) = renderer.stats().asm {
