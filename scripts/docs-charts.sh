@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the speed-against-accuracy charts shown in README.md (docs/sweep-*.png) with
+# Regenerates the speed-against-accuracy charts shown in BENCHMARKS.md (docs/sweep-*.png) with
 # `kage sweep`, and keeps each sweep's CSV beside its chart. Run by hand, not in CI: the PRT
 # sweep takes about 15 minutes on a 2-core lavapipe machine once its references are cached
 # (run to 0.5 % noise, they take about 10 more the first time), the ASM sweep about 2 (references cached; 5 more to ray-cast them) and the
