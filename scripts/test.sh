@@ -8,3 +8,5 @@ bash scripts/deps.sh
 # cdylib, which only `cargo build` makes.
 cargo build --release --workspace
 cargo test --release --workspace "$@"
+# The API documentation builds with every intra-doc link resolved.
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --workspace --quiet

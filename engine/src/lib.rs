@@ -7,8 +7,8 @@
 //!   label and a GPU timestamp pair.
 //! - [`frame`]: what several techniques share: the GPU scene, targets, environment, background,
 //!   scene draws, shadow depth, group bounds.
-//! - [`raycast`], then [`reference`] and [`prt`] over it: the BVH, the ground truth, the PRT
-//!   precomputation.
+//! - [`raycast`], then [`reference`](mod@reference) and [`prt`] over it: the BVH, the ground
+//!   truth, the PRT precomputation.
 //! - [`techniques`]: one per file or folder, named and built by [`techniques::description`].
 //! - [`renderer`]: the frame loop; then [`capi`] (and the command line, outside this crate).
 //!
@@ -17,7 +17,14 @@
 //! (opening what a user names) and [`image_size`] (image headers checked before decoding).
 //!
 //! Conventions: right-handed, +Y up; equirectangular maps map direction (x, y, z) to
-//! u = atan2(x, -z) / 2π wrapped into [0, 1), v = acos(y) / π, row 0 at the top (+Y).
+//! u = atan2(x, -z) / 2π wrapped into \[0, 1), v = acos(y) / π, row 0 at the top (+Y).
+//!
+//! The API in one page, a program that renders the default scene with soft shadows
+//! (`engine/examples/soft_shadows.rs`; `cargo run --release -p kage --example soft_shadows`):
+//! make a [`backend::Context`], load a [`scene::Scene`], precompute its transfer with
+//! [`prt::transfer::precompute`], build a [`renderer::Renderer`] with a
+//! [`techniques::description::TechniqueDesc`], then move groups, [`renderer::Renderer::render`]
+//! (each pass's GPU time) and read [`renderer::Renderer::image`].
 #![warn(unsafe_op_in_unsafe_fn)]
 
 pub mod backend;

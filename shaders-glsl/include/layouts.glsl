@@ -270,7 +270,7 @@ struct AsmTilePush {
 };
 
 // Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer is uint
-// words: [0] the number of edge records written; [1, 1 + size.z) a used flag per page table
+// words: `[0]` the number of edge records written; `[1, 1 + size.z)` a used flag per page table
 // node (a pixel's lookup ended there); then up to size.w edge records of 4 words, one per eye
 // pixel on a shadow edge short of resolution: its light uv (2 floats), the node of the finest
 // resident tile holding it, and the levels finer than that tile it needs (at least 1).

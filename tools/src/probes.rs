@@ -13,8 +13,8 @@ use std::time::Instant;
 
 #[derive(Subcommand)]
 pub enum ProbesCommand {
-    /// Delaunay tetrahedralization of a probe set: {"positions": [[x,y,z], ...]} in,
-    /// {"tetrahedra": [[i,j,k,l], ...]} out (input indices, positively oriented).
+    /// Delaunay tetrahedralization of a probe set: `{"positions": [[x,y,z], ...]}` in,
+    /// `{"tetrahedra": [[i,j,k,l], ...]}` out (input indices, positively oriented).
     Tetrahedralize(TetrahedralizeArgs),
     /// The tetrahedron holding a point and its four barycentric weights (outside the hull: those
     /// of the hull's nearest point).
@@ -42,7 +42,7 @@ pub struct PlaceArgs {
     /// What the probes capture besides the sky they see.
     #[arg(long, value_enum, default_value_t = kage::techniques::probes::CapturedLight::SkyAndWalls)]
     probe_light: kage::techniques::probes::CapturedLight,
-    /// Where to write {"positions": [[x,y,z], ...]}.
+    /// Where to write `{"positions": [[x,y,z], ...]}`.
     #[arg(long)]
     out: PathBuf,
     #[command(flatten)]
@@ -51,17 +51,17 @@ pub struct PlaceArgs {
 
 #[derive(Args)]
 pub struct TetrahedralizeArgs {
-    /// The probe set: {"positions": [[x,y,z], ...]}.
+    /// The probe set: `{"positions": [[x,y,z], ...]}`.
     #[arg(long = "in")]
     input: PathBuf,
-    /// Where to write {"tetrahedra": [[i,j,k,l], ...]}.
+    /// Where to write `{"tetrahedra": [[i,j,k,l], ...]}`.
     #[arg(long)]
     out: PathBuf,
 }
 
 #[derive(Args)]
 pub struct LookupArgs {
-    /// The probe set: {"positions": [[x,y,z], ...]}.
+    /// The probe set: `{"positions": [[x,y,z], ...]}`.
     #[arg(long = "in")]
     input: PathBuf,
     /// The point, as x,y,z.

@@ -57,7 +57,7 @@ pub struct RenderArgs {
     asm_test: AsmTest,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`), a file
-    /// {"positions": [[x,y,z], ...]}, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
+    /// `{"positions": [[x,y,z], ...]}`, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
     /// on that grid, outside solids, captured; those the others reproduce within the relative
     /// irradiance error TOL, default 0.05, dropped).
     #[arg(long, default_value = "grid:3,2,3")]

@@ -28,7 +28,7 @@ pub struct Region {
     pub direction: DVec3,
     /// Ω_i in steradians.
     pub solid_angle: f64,
-    /// The solid angle its energy spreads over: 2π·E[θ²], θ the angle to `direction` weighted
+    /// The solid angle its energy spreads over: 2π·E\[θ²\], θ the angle to `direction` weighted
     /// by luminance × solid angle, which is πr² for a uniform disk of angular radius r; the
     /// geometric `solid_angle` for a black region. A sun in a large region of black sky is a
     /// small light: its shadows are sharp however large the region is.

@@ -185,7 +185,7 @@ pub fn shadow_flips(
 }
 
 /// Frames until an error stops falling once the camera has stopped (`errors[0]` the frame it
-/// stopped at): the first frame k from which no later frame's error is below errors[k] −
+/// stopped at): the first frame k from which no later frame's error is below `errors[k]` −
 /// `tolerance`. `None` when the last frame was still more than `tolerance` below an earlier
 /// one (the error was still falling when the series ended) or the series is empty.
 pub fn frames_to_converge(errors: &[f64], tolerance: f64) -> Option<usize> {

@@ -13,7 +13,7 @@
 //!   (j + ½) / height). See [`envmap`] for the details and [`direction_to_uv`] for the code.
 //! - The camera's projection targets Vulkan clip space (depth 0..1) with +Y world up in the image.
 //!
-//! Scenes come from JSON files ([`file`] documents the schema), from the built-in set
+//! Scenes come from JSON files ([`file`](mod@file) documents the schema), from the built-in set
 //! ([`BUILTIN`]), or from code. Every loading error is a [`SceneError`] naming the file and the
 //! problem.
 use glam::Vec3;

@@ -7,7 +7,7 @@
 //!
 //! Passes: `shadow_maps` renders every mesh into layer i of a D32 array image (one depth-only
 //! rendering scope per region, orthographic along ω_i over the scene's bounding sphere, with
-//! the [`ShadowDepth`] pass shared with the shadowmap technique), then
+//! the [`ShadowMaps`] pass shared with the shadowmap technique), then
 //! `scene` loops over the regions in one fragment shader, reading the lights from a uniform
 //! buffer (much cheaper per fragment than a storage buffer on CPU drivers) and the maps with
 //! `texelFetch` and a manual comparison.

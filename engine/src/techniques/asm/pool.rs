@@ -17,7 +17,7 @@
 //! evicting a tile with resident children would cut them off from the lookup's descent) the
 //! least recently used one not used in the current frame goes first; if every evictable tile
 //! was used this frame, the one of least benefit goes, and only for a tile of a benefit
-//! [`EVICTION_MARGIN`] times as large.
+//! `EVICTION_MARGIN` times as large.
 use super::tile::TileKey;
 use crate::error::{Error, Result};
 use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};

@@ -40,7 +40,7 @@ pub const MAX_SWEEPS: usize = 4;
 pub const MAX_RELOCATED: usize = 256;
 
 /// `kept` (indices into `positions`, whose captures are `sh`) with each probe moved while that
-/// lowers [`objective`] (unmoved when there are more than [`MAX_RELOCATED`]); ascending, the
+/// lowers `objective` (unmoved when there are more than `MAX_RELOCATED`); ascending, the
 /// same count.
 pub fn relocate(positions: &[DVec3], sh: &[ShRgb9], mut kept: Vec<usize>) -> Result<Vec<usize>> {
     if kept.len() > MAX_RELOCATED {

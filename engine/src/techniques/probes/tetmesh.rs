@@ -17,7 +17,7 @@ pub enum Across {
 
 /// p ↦ weights of a tetrahedron's vertices: with the vertex at `origin` as p₃ and the others
 /// p₀, p₁, p₂ in order, [a b c]ᵀ = M⁻¹ (p − p₃) and the origin's weight is 1 − a − b − c.
-/// `None` for a sliver (see [`SLIVER`]).
+/// `None` for a sliver (see `SLIVER`).
 #[derive(Clone, Copy, Debug)]
 struct Barycentric {
     origin: usize,
@@ -161,7 +161,7 @@ impl TetMesh {
 
     /// The barycentric weights of p in tetrahedron `tet` (in the order of its vertices). Like any
     /// floating-point solve, they are accurate to about 1e-16 × (longest edge)³ / volume of the
-    /// tetrahedron, relative to the coordinates; in a sliver (see [`SLIVER`]) they are a
+    /// tetrahedron, relative to the coordinates; in a sliver (see `SLIVER`) they are a
     /// face's, which reproduce p to within the sliver's thickness.
     pub fn weights(&self, tet: u32, p: DVec3) -> [f64; 4] {
         let b = &self.barycentric[tet as usize];

@@ -35,7 +35,7 @@ pub struct DominantLight {
     /// Unit direction towards its energy-weighted centroid.
     pub direction: DVec3,
     /// Angular radius (radians) of the uniform disk whose energy spreads as the light's:
-    /// sqrt(2·E[θ²]), θ the angle to `direction` weighted by luminance × solid angle.
+    /// sqrt(2·E\[θ²\]), θ the angle to `direction` weighted by luminance × solid angle.
     pub radius: f64,
     /// Texels it took from the map.
     pub texels: usize,
