@@ -544,7 +544,7 @@ fn sweep_writes_one_csv_row_per_setting() {
         &[
             "prt",
             "--only",
-            "unshadowed,tamura:8",
+            "unshadowed,tamura:32,parallel-lights:32",
             "--poses",
             "0,0.3",
             "--size",
@@ -570,8 +570,12 @@ fn sweep_writes_one_csv_row_per_setting() {
         "scene,env,technique,parameter,value,error_mean,error_t0,error_t0.3,reference_noise_t0,\
          reference_noise_t0.3,frame_ms,precompute_s,memory_mb",
     );
-    assert_eq!(fields.len(), 2, "{csv}");
-    assert_eq!((&*fields[0][2], &*fields[1][2], &*fields[1][4]), ("unshadowed", "tamura", "8"));
+    assert_eq!(fields.len(), 3, "{csv}");
+    assert_eq!((&*fields[0][2], &*fields[1][2], &*fields[1][4]), ("unshadowed", "tamura", "32"));
+    assert_eq!((&*fields[2][2], &*fields[2][4]), ("parallel-lights", "32"));
+    // References at 5 % noise cannot rank two settings a few percent apart, and it says so.
+    assert!(stdout.contains("scene: tamura:32 / parallel-lights:32: error"), "{stdout}");
+    assert!(stdout.contains("too close to rank"), "{stdout}");
     for row in &fields {
         assert!((0.0..1.0).contains(&number(row, 5)), "{row:?}");
         // Each reference ran to the noise asked for.
@@ -580,7 +584,7 @@ fn sweep_writes_one_csv_row_per_setting() {
     }
     assert!(number(&fields[1], 5) < number(&fields[0], 5), "{csv}");
     assert!(
-        number(&fields[1], 11) > 0.0 && fields[0][11].is_empty(),
+        number(&fields[1], 11) > 0.0 && fields[0][11].is_empty() && fields[2][11].is_empty(),
         "precompute seconds only for PRT: {csv}"
     );
     // The references are cached under the cache folder, an EXR and its noise for each pose.

@@ -590,8 +590,18 @@ fn print_ratios(rows: &[Row]) {
             (Some(ms), Some(base)) if base > 0.0 => format!(", frame time {:.2}x", ms / base),
             _ => String::new(),
         };
+        // A difference the references' own noise could make is no ranking.
+        let noise = row.noise.iter().chain(&base.noise).fold(0.0f64, |m, &n| m.max(n));
+        let difference = (row.mean_error() - base.mean_error()).abs();
+        let unranked = match difference < 2.0 * noise {
+            true => format!(
+                " (the references' noise, up to {noise:.4}, is within 2x of the difference {difference:.4}: \
+                 too close to rank)"
+            ),
+            false => String::new(),
+        };
         println!(
-            "{}: {} / {}: error {:.2}x{frame}",
+            "{}: {} / {}: error {:.2}x{frame}{unranked}",
             row.env,
             row.setting.name(),
             baseline.name(),
