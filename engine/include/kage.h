@@ -414,6 +414,31 @@ typedef uint32_t kage_abi;
 #endif // __cplusplus
 
 /**
+ * Kinds of `kage_light_desc`.
+ */
+enum kage_light_kind
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Radiant intensity in every direction.
+   */
+  KAGE_LIGHT_KIND_POINT = 0,
+  /**
+   * Radiant intensity inside a cone of full angle `fov_deg` about `direction`.
+   */
+  KAGE_LIGHT_KIND_SPOT = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_light_kind kage_light_kind;
+#else
+typedef uint32_t kage_light_kind;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * A Vulkan device, queue and memory allocator that scenes are precomputed and rendered with.
  */
 typedef struct kage_context kage_context;
@@ -662,6 +687,31 @@ typedef struct {
 } kage_camera_desc;
 
 /**
+ * A point or spot light, as a scene file's `lights` entry is (README, "Scene format").
+ */
+typedef struct {
+  /**
+   * A `kage_light_kind` value.
+   */
+  uint32_t kind;
+  float position[3];
+  /**
+   * Spot lights: the cone's axis, any non-zero length (it is normalized). Point lights:
+   * unused.
+   */
+  float direction[3];
+  /**
+   * Spot lights: the cone's full angle in degrees, above 0 and at most 170. Point lights:
+   * unused.
+   */
+  float fov_deg;
+  /**
+   * Radiant intensity per channel (W/sr), at least 0.
+   */
+  float intensity[3];
+} kage_light_desc;
+
+/**
  * What a renderer holds and what its last frame had to leave out.
  */
 typedef struct {
@@ -880,6 +930,19 @@ kage_result kage_renderer_set_group_transform(kage_renderer *renderer,
  * `camera` NULL or valid.
  */
 kage_result kage_renderer_set_camera(kage_renderer *renderer, const kage_camera_desc *camera);
+
+/**
+ * Replaces light `index` of the renderer's scene (0 to its light count − 1) for the next
+ * frames, checked as a scene file's light is; a point light may become a spot light and back.
+ * Techniques redo what they derived from it (shadow maps, adaptive shadow map tiles). `light`
+ * is only read during the call.
+ *
+ * # Safety
+ * `light` NULL or valid.
+ */
+kage_result kage_renderer_set_light(kage_renderer *renderer,
+                                    uint32_t index,
+                                    const kage_light_desc *light);
 
 /**
  * Turns the environment about +Y (counter-clockwise seen from above) by `radians` (finite) for

@@ -27,6 +27,40 @@ static void write_scene(const char *path, const char *image, const char *obj) {
   REQUIRE(fclose(f) == 0);
 }
 
+/* A host moves and changes the scene's light: the asm scene's spot light becomes a point light
+ * and moves, each change lighting the next frame (shadowmap technique, 16x16), and bad values
+ * are refused naming the field. */
+static void check_lights(kage_context *context) {
+  kage_scene *scene = NULL;
+  kage_renderer *renderer = NULL;
+  char text[512];
+  CHECK(kage_scene_load("asm", &scene));
+  kage_renderer_desc desc = {sizeof desc, 16, 16, {0}};
+  CHECK(kage_technique_desc_default(KAGE_TECHNIQUE_SHADOW_MAP, &desc.technique));
+  CHECK(kage_renderer_create(context, scene, &desc, &renderer));
+  static uint8_t before[16 * 16 * 16], after[16 * 16 * 16];
+  CHECK(kage_renderer_render(renderer));
+  CHECK(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA32F_LINEAR, 1.0f, before, sizeof before));
+  kage_light_desc light = {KAGE_LIGHT_KIND_POINT, {0, 6, 0}, {0, 0, 0}, 0.0f, {400, 400, 400}};
+  CHECK(kage_renderer_set_light(renderer, 0, &light));
+  CHECK(kage_renderer_render(renderer));
+  CHECK(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA32F_LINEAR, 1.0f, after, sizeof after));
+  REQUIRE(memcmp(before, after, sizeof before) != 0);
+  light.kind = 7;
+  EXPECT(kage_renderer_set_light(renderer, 0, &light), KAGE_RESULT_INVALID_VALUE);
+  light.kind = KAGE_LIGHT_KIND_SPOT, light.fov_deg = 179.0f;
+  EXPECT(kage_renderer_set_light(renderer, 0, &light), KAGE_RESULT_INVALID_VALUE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "light 0") != NULL);
+  light.fov_deg = 60.0f, light.direction[1] = -1.0f, light.position[0] = NAN;
+  EXPECT(kage_renderer_set_light(renderer, 0, &light), KAGE_RESULT_INVALID_VALUE);
+  light.position[0] = 0;
+  CHECK(kage_renderer_set_light(renderer, 0, &light));
+  CHECK(kage_renderer_render(renderer));
+  CHECK(kage_renderer_destroy(renderer));
+  CHECK(kage_scene_destroy(scene));
+}
+
 /* Files that lie or are not files, named by a scene file: an image whose header claims 65536 x
  * 32768 pixels in a few bytes (it once made Kage allocate 24 GiB and abort the host), and a
  * FIFO as the mesh (it once blocked the host forever). Each is KAGE_RESULT_FILE at once, naming
@@ -271,6 +305,14 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_renderer_set_camera(renderer, &camera), KAGE_RESULT_INVALID_VALUE);
   camera.target[1] = 0, camera.target[2] = 0;
   CHECK(kage_renderer_set_camera(renderer, &camera));
+  /* Lights: the triangle has none to replace. */
+  kage_light_desc light = {KAGE_LIGHT_KIND_POINT, {0, 2, 0}, {0, -1, 0}, 60.0f, {1, 1, 1}};
+  EXPECT(kage_renderer_set_light(NULL, 0, &light), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_set_light(renderer, 0, NULL), KAGE_RESULT_NULL_ARGUMENT);
+  EXPECT(kage_renderer_set_light(no_renderer, 0, &light), KAGE_RESULT_INVALID_HANDLE);
+  EXPECT(kage_renderer_set_light(renderer, 0, &light), KAGE_RESULT_INVALID_VALUE);
+  CHECK(kage_last_error_message(text, sizeof text, NULL));
+  REQUIRE(strstr(text, "light 0 does not exist") != NULL);
   EXPECT(kage_renderer_set_env_rotation(NULL, 0.5f), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_set_env_rotation(no_renderer, 0.5f), KAGE_RESULT_INVALID_HANDLE);
   EXPECT(kage_renderer_set_env_rotation(renderer, NAN), KAGE_RESULT_INVALID_VALUE);
@@ -358,6 +400,7 @@ int main(int argc, char **argv) {
   CHECK(kage_context_create(&context_desc, &context));
   check_bad_arguments(context);
   check_hostile_files();
+  check_lights(context);
   render_moving_box(context, (uint32_t)atoi(argv[4]), frames, size);
   CHECK(kage_context_destroy(context));
   printf("ok\n");

@@ -55,6 +55,8 @@ static const struct {
     {"KAGE_PROBE_DERING_NON_NEGATIVE", (uint32_t)KAGE_PROBE_DERING_NON_NEGATIVE},
     {"KAGE_PROBE_DERING_HANNING", (uint32_t)KAGE_PROBE_DERING_HANNING},
     {"KAGE_PROBE_DERING_LANCZOS", (uint32_t)KAGE_PROBE_DERING_LANCZOS},
+    {"KAGE_LIGHT_KIND_POINT", (uint32_t)KAGE_LIGHT_KIND_POINT},
+    {"KAGE_LIGHT_KIND_SPOT", (uint32_t)KAGE_LIGHT_KIND_SPOT},
     {"KAGE_ABI_VERSION", (uint32_t)KAGE_ABI_VERSION},
 };
 
@@ -129,6 +131,17 @@ static size_t touch_kage_transform(kage_transform *d) {
   bytes += sizeof d->translation;
   bytes += sizeof d->rotation;
   bytes += sizeof d->scale;
+  return bytes;
+}
+
+/* Every field of kage_light_desc. */
+static size_t touch_kage_light_desc(kage_light_desc *d) {
+  size_t bytes = 0;
+  bytes += sizeof d->kind;
+  bytes += sizeof d->position;
+  bytes += sizeof d->direction;
+  bytes += sizeof d->fov_deg;
+  bytes += sizeof d->intensity;
   return bytes;
 }
 
@@ -217,6 +230,8 @@ int main(void) {
   fields += touch_kage_transform(&transform_value);
   kage_camera_desc camera_desc_value;
   fields += touch_kage_camera_desc(&camera_desc_value);
+  kage_light_desc light_desc_value;
+  fields += touch_kage_light_desc(&light_desc_value);
   kage_renderer_stats renderer_stats_value;
   fields += touch_kage_renderer_stats(&renderer_stats_value);
   kage_pass_timing pass_timing_value;

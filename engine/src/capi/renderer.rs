@@ -8,6 +8,7 @@ use super::technique::kage_technique_desc;
 use crate::imageio::tonemap_srgb8;
 use crate::pass::PassTiming;
 use crate::renderer::{RenderOptions, Renderer};
+use crate::scene::Light;
 use std::ffi::c_char;
 
 /// A scene on the GPU, lit by one technique, with its render targets.
@@ -142,6 +143,61 @@ pub unsafe extern "C" fn kage_renderer_set_camera(
         // SAFETY: the caller promises NULL or a valid camera.
         let camera = unsafe { args::value(camera, "camera") }?;
         Ok(r.renderer.set_camera(camera.camera()?)?)
+    })
+}
+
+/// Kinds of `kage_light_desc`.
+#[repr(u32)]
+#[derive(Clone, Copy, strum::FromRepr)]
+pub enum kage_light_kind {
+    /// Radiant intensity in every direction.
+    Point = 0,
+    /// Radiant intensity inside a cone of full angle `fov_deg` about `direction`.
+    Spot = 1,
+}
+
+/// A point or spot light, as a scene file's `lights` entry is (README, "Scene format").
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct kage_light_desc {
+    /// A `kage_light_kind` value.
+    pub kind: u32,
+    pub position: [f32; 3],
+    /// Spot lights: the cone's axis, any non-zero length (it is normalized). Point lights:
+    /// unused.
+    pub direction: [f32; 3],
+    /// Spot lights: the cone's full angle in degrees, above 0 and at most 170. Point lights:
+    /// unused.
+    pub fov_deg: f32,
+    /// Radiant intensity per channel (W/sr), at least 0.
+    pub intensity: [f32; 3],
+}
+
+/// Replaces light `index` of the renderer's scene (0 to its light count − 1) for the next
+/// frames, checked as a scene file's light is; a point light may become a spot light and back.
+/// Techniques redo what they derived from it (shadow maps, adaptive shadow map tiles). `light`
+/// is only read during the call.
+///
+/// # Safety
+/// `light` NULL or valid.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_set_light(
+    renderer: *mut kage_renderer,
+    index: u32,
+    light: *const kage_light_desc,
+) -> kage_result {
+    boundary(|| {
+        let mut r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or a valid light.
+        let d = unsafe { args::value(light, "light") }?;
+        let (position, intensity) = (glam::Vec3::from(d.position), d.intensity);
+        let light = match args::enumeration(d.kind, "light->kind", kage_light_kind::from_repr)? {
+            kage_light_kind::Point => Light::Point { position, intensity },
+            kage_light_kind::Spot => {
+                Light::Spot { position, direction: d.direction.into(), fov_deg: d.fov_deg, intensity }
+            }
+        };
+        Ok(r.renderer.set_light(index as usize, light)?)
     })
 }
 
