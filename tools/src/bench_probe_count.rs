@@ -42,8 +42,9 @@ pub const DEFAULT_TOLERANCES: [f32; 6] = [0.5, 0.35, 0.25, 0.1, 0.05, 0.025];
 
 #[derive(Args)]
 pub struct ProbeCountArgs {
-    /// Built-in scene names or scene files, each with a moving group 0.
-    #[arg(long, value_delimiter = ',', default_values_t = ["probe-room".to_string(), "atrium".to_string()])]
+    /// Built-in scene names or scene files, each with a moving group 0 (`--scenes` is the old
+    /// name).
+    #[arg(long = "scene", alias = "scenes", value_delimiter = ',', default_values_t = ["probe-room".to_string(), "atrium".to_string()])]
     scenes: Vec<String>,
     /// Grid levels: probes along the static box's longest side (the others in proportion, at
     /// least 2). The finest level's probes outside solids are automatic placement's candidates.
@@ -71,8 +72,9 @@ pub struct ProbeCountArgs {
     /// Reference samples per point.
     #[arg(long, default_value_t = 8192)]
     spp: u32,
-    /// Texels per side of a probe's cube-map face.
-    #[arg(long, default_value_t = 32)]
+    /// Texels per side of a probe's cube-map face (as `kage render --probe-cube-size`;
+    /// `--cube-size` is the old name).
+    #[arg(long = "probe-cube-size", alias = "cube-size", default_value_t = 32)]
     cube_size: u32,
     /// The light the probes capture: `sky` is what the reference integrates today (the
     /// environment with visibility, no bounce); rerun with the reference's transport when it

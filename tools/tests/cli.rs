@@ -223,7 +223,7 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         (&["env", "sun", "--radius", "0", "--out", "x.exr"], "radius"),
         (&["sweep", "--technique", "prt", "--pick", "--out", "x"], "--pick needs a bound"),
         (&["sweep", "--technique", "asm", "--test-region", "box", "--out", "x"], "--test-region places"),
-        (&["bench", "probe-count", "--scenes", "probe-room", "--candidates", "1"], "grid level 1"),
+        (&["bench", "probe-count", "--scene", "probe-room", "--candidates", "1"], "grid level 1"),
     ];
     assert_clear_errors(&cases);
 }
@@ -827,7 +827,7 @@ fn bench_asm_measures_every_configuration_over_the_walkthrough() {
     let args = [
         "bench",
         "asm",
-        "--configs",
+        "--only",
         "shadowmap:64,shadowmap:512",
         "--frames",
         "2",
@@ -876,8 +876,8 @@ fn bench_asm_measures_every_configuration_over_the_walkthrough() {
 
     let out = out.to_str().unwrap();
     assert_clear_errors(&[
-        (&["bench", "asm", "--configs", "cube:4", "--out", out], "no technique \"cube\""),
-        (&["bench", "asm", "--configs", "shadowmap:8", "--size", "8", "--out", out], "shadow map size 8"),
+        (&["bench", "asm", "--only", "cube:4", "--out", out], "no technique \"cube\""),
+        (&["bench", "asm", "--only", "shadowmap:8", "--size", "8", "--out", out], "shadow map size 8"),
         (&["bench", "asm", "--scene", "teapot", "--out", out], "no camera walkthrough"),
     ]);
 }

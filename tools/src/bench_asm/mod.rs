@@ -40,7 +40,8 @@ pub struct AsmBenchArgs {
     /// The configurations, `KIND:VALUE` each: `shadowmap:SIDE` (a conventional map of SIDE²
     /// texels per light), `asm:MB` (an adaptive shadow map within MB megabytes), `asm-id:MB`
     /// (the same with the paper's polygon-ID test). The first is the one the others' frame times are divided by.
-    #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_CONFIGS.map(String::from))]
+    /// (`--only`, as `kage sweep` names its settings; `--configs` is the old name.)
+    #[arg(long = "only", alias = "configs", value_delimiter = ',', default_values_t = DEFAULT_CONFIGS.map(String::from))]
     configs: Vec<String>,
     /// Frames sampling the walkthrough (t = i / frames, as `kage render --animate`).
     #[arg(long, default_value_t = 40)]
@@ -75,7 +76,7 @@ pub struct AsmBenchArgs {
     gpu: GpuArgs,
 }
 
-/// A technique `--configs` names: `name:VALUE`, VALUE the parameter `settings` turns into the
+/// A technique `--only` names: `name:VALUE`, VALUE the parameter `settings` turns into the
 /// technique's settings. Adding a technique to the benchmark is adding one entry.
 struct ConfigKind {
     name: &'static str,
@@ -140,12 +141,12 @@ pub struct Config {
 fn parse_config(arg: &str) -> Result<Config> {
     let known = || KINDS.iter().map(|k| format!("{}:VALUE", k.name)).collect::<Vec<_>>().join(", ");
     let Some((kind, value)) = arg.split_once(':') else {
-        bail!("--configs {arg}: expected KIND:VALUE, one of {}", known());
+        bail!("--only {arg}: expected KIND:VALUE, one of {}", known());
     };
     let Some(kind) = KINDS.iter().find(|k| k.name == kind) else {
-        bail!("--configs {arg}: no technique {kind:?}; the benchmark knows {}", known());
+        bail!("--only {arg}: no technique {kind:?}; the benchmark knows {}", known());
     };
-    let settings = (kind.settings)(value).with_context(|| format!("--configs {arg}"))?;
+    let settings = (kind.settings)(value).with_context(|| format!("--only {arg}"))?;
     Ok(Config {
         name: arg.to_string(),
         kind: kind.name,
@@ -231,7 +232,7 @@ pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
         bail!("--converge-tolerance must be a fraction of the pixels, 0 or more");
     }
     if args.configs.is_empty() {
-        bail!("--configs needs at least one configuration");
+        bail!("--only needs at least one configuration");
     }
     let configs: Vec<Config> = args.configs.iter().map(|c| parse_config(c)).collect::<Result<_>>()?;
     let scene = Scene::from_arg(&args.scene)?;
