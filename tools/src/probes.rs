@@ -107,7 +107,17 @@ fn place(args: &PlaceArgs) -> Result<()> {
         ..Default::default()
     };
     let start = Instant::now();
-    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings)?;
+    // The capture and the reduction run inside the engine without a callback: a spinner with
+    // the elapsed time shows the work is alive (about 30 s for probe-room on lavapipe).
+    let spinner = indicatif::ProgressBar::new_spinner()
+        .with_message("placing probes: capturing the candidates, then dropping, fitting and moving them");
+    spinner.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})").expect("static template"),
+    );
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings);
+    spinner.finish_and_clear();
+    let set = set?;
     let positions = set.mesh.positions().iter().map(|p| p.to_array()).collect();
     let json = serde_json::to_string(&ProbeFile { positions })?;
     std::fs::write(&args.out, json + "\n").with_context(|| format!("writing {}", args.out.display()))?;
