@@ -145,6 +145,9 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_context_create_from_vulkan(NULL, &made), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_context_create_from_vulkan(&handles, NULL), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_context_create_from_vulkan(&handles, &made), KAGE_RESULT_NULL_ARGUMENT);
+  handles.size -= 8; /* an older host's shorter struct: refused before its handles are read */
+  EXPECT(kage_context_create_from_vulkan(&handles, &made), KAGE_RESULT_INVALID_VALUE);
+  handles.size += 8;
   EXPECT(kage_context_destroy(NULL), KAGE_RESULT_OK);
   EXPECT(kage_context_device_name(NULL, text, sizeof text, &length), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_context_device_name(context, NULL, sizeof text, &length), KAGE_RESULT_NULL_ARGUMENT);
