@@ -134,6 +134,20 @@ fn exr_and_hdr_maps() {
     }
 }
 
+/// The same EXR mutants through `kage compare`'s reader (`imageio::read_exr`, from a file),
+/// which checks the header against its own limits and decodes all four channels.
+#[test]
+fn exr_images() {
+    let seed = seed("map.exr");
+    let path = kage_tests::scratch_dir("fuzz-read-exr").join("image.exr");
+    std::fs::write(&path, &seed).unwrap();
+    kage::imageio::read_exr(&path).expect("the seed image reads");
+    fuzz("image.exr", &seed, 6, |bytes| {
+        std::fs::write(&path, bytes).unwrap();
+        let _ = kage::imageio::read_exr(&path);
+    });
+}
+
 /// Probe positions as little-endian f64 triples (a mutant may hold NaN, infinities, duplicates,
 /// coplanar or nearly coincident points), tetrahedralized with constant SH.
 #[test]
