@@ -40,7 +40,7 @@ pub struct CompareArgs {
 }
 
 /// Exit status of a comparison beyond a threshold (an error is 1).
-pub const BEYOND_THRESHOLD: i32 = 3;
+const BEYOND_THRESHOLD: i32 = 3;
 
 pub fn run(args: &CompareArgs) -> Result<()> {
     for (path, flag) in [(&args.diff, "--diff"), (&args.mismatch_image, "--mismatch-image")] {
@@ -49,8 +49,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         }
     }
     for (bound, flag) in [(args.max_rel_rmse, "--max-rel-rmse"), (args.max_mismatch, "--max-mismatch")] {
-        if bound.is_some_and(|b| !(b.is_finite() && b >= 0.0)) {
-            bail!("{flag} must be a number at least 0, got {}", bound.unwrap_or_default());
+        if let Some(b) = bound.filter(|b| !(b.is_finite() && *b >= 0.0)) {
+            bail!("{flag} must be a number at least 0, got {b}");
         }
     }
     let a = kage::imageio::read_exr(&args.a)?;

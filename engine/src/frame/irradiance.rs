@@ -25,27 +25,34 @@ pub const HEIGHT: u32 = 33;
 /// the convolution: 2.8° bins, far finer than the cosine kernel's 180°.
 pub const SOURCE_WIDTH: u32 = 128;
 
-/// `∫ ω dω` over texel (x, y) of a `w`×`h` equirectangular map, in closed form: a bin wholly
-/// above a normal's horizon then adds exactly `L · (n · ∫ω dω)` to its irradiance, so only the
-/// bins the horizon cuts carry an error (and there the cosine is near 0).
-fn texel_moment(w: u32, h: u32, x: u32, y: u32) -> DVec3 {
-    use std::f64::consts::PI;
-    let (t0, t1) = (PI * f64::from(y) / f64::from(h), PI * f64::from(y + 1) / f64::from(h));
-    let (p0, p1) = (2.0 * PI * f64::from(x) / f64::from(w), 2.0 * PI * f64::from(x + 1) / f64::from(w));
-    // ∫ sin²θ dθ and ∫ cosθ sinθ dθ over the row; the direction is (sinθ sinφ, cosθ, −sinθ cosφ).
-    let sin2 = |t: f64| t / 2.0 - (2.0 * t).sin() / 4.0;
-    let (ss, cs) = (sin2(t1) - sin2(t0), (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0);
-    DVec3::new(ss * (p0.cos() - p1.cos()), cs * (p1 - p0), -ss * (p1.sin() - p0.sin()))
-}
-
-/// The map's bins, each as `Σ L ∫ω dω` over its texels, per channel.
+/// The map's bins, each as `Σ L ∫ω dω` over its texels, per channel. `∫ ω dω` over a texel
+/// is taken in closed form: a bin wholly above a normal's horizon then adds exactly
+/// `L · (n · ∫ω dω)` to its irradiance, so only the bins the horizon cuts carry an error (and
+/// there the cosine is near 0). With the direction (sinθ sinφ, cosθ, −sinθ cosφ), the integral
+/// over a texel is a row factor (∫ sin²θ dθ, ∫ cosθ sinθ dθ) times a column factor.
 fn bins(map: &EnvMap) -> Vec<[DVec3; 3]> {
+    use std::f64::consts::PI;
     let (w, h) = (map.width(), map.height());
+    let sin2 = |t: f64| t / 2.0 - (2.0 * t).sin() / 4.0;
+    let rows: Vec<(f64, f64)> = (0..h)
+        .map(|y| {
+            let (t0, t1) = (PI * f64::from(y) / f64::from(h), PI * f64::from(y + 1) / f64::from(h));
+            (sin2(t1) - sin2(t0), (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0)
+        })
+        .collect();
+    let columns: Vec<(f64, f64, f64)> = (0..w)
+        .map(|x| {
+            let (p0, p1) =
+                (2.0 * PI * f64::from(x) / f64::from(w), 2.0 * PI * f64::from(x + 1) / f64::from(w));
+            (p0.cos() - p1.cos(), p1 - p0, p1.sin() - p0.sin())
+        })
+        .collect();
     let (bw, bh) = (w.min(SOURCE_WIDTH), h.min(SOURCE_WIDTH / 2));
     let mut sums = vec![[DVec3::ZERO; 3]; (bw * bh) as usize];
     for (t, p) in map.pixels().iter().enumerate() {
         let (x, y) = (t as u32 % w, t as u32 / w);
-        let moment = texel_moment(w, h, x, y);
+        let ((ss, cs), (sx, dphi, sz)) = (rows[y as usize], columns[x as usize]);
+        let moment = DVec3::new(ss * sx, cs * dphi, -ss * sz);
         let bin = &mut sums[((y * bh / h) * bw + x * bw / w) as usize];
         for c in 0..3 {
             bin[c] += f64::from(p[c]) * moment;
@@ -73,9 +80,13 @@ pub fn irradiance_table(map: &EnvMap) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// The table on the GPU, sampled bilinearly (wrapping in longitude, clamped at the poles).
-pub fn gpu_irradiance(ctx: &Arc<Context>, map: &EnvMap) -> Result<GpuEnvironment> {
-    GpuEnvironment::table(ctx, "irradiance", WIDTH, HEIGHT, &irradiance_table(map))
+/// The table of `map` on the GPU, sampled bilinearly (wrapping in longitude, clamped at the
+/// poles); for `None` (a pipeline that never reads it) one black texel, not worth computing.
+pub fn gpu_irradiance(ctx: &Arc<Context>, map: Option<&EnvMap>) -> Result<GpuEnvironment> {
+    match map {
+        Some(map) => GpuEnvironment::table(ctx, "irradiance", WIDTH, HEIGHT, &irradiance_table(map)),
+        None => GpuEnvironment::table(ctx, "irradiance.unused", 1, 1, &[[0.0; 3]]),
+    }
 }
 
 #[cfg(test)]

@@ -17,19 +17,17 @@ use crate::scene::Scene;
 pub const BURIED_SHARE: f64 = 0.95;
 
 /// Fills the transfer of every buried vertex of `scene` (`coefficients` in scene order, as the
-/// shader wrote them); returns how many it filled.
-pub(crate) fn fill(scene: &Scene, params: PrtParams, back_hits: &[u32], coefficients: &mut [f32]) -> usize {
+/// shader wrote them).
+pub(crate) fn fill(scene: &Scene, params: PrtParams, back_hits: &[u32], coefficients: &mut [f32]) {
     let n = params.coeffs();
     let threshold = BURIED_SHARE * f64::from(params.rays);
     let mut first = 0;
-    let mut filled = 0;
     for ((_, mesh), (_, _, vertices)) in scene.meshes().zip(mesh_layout(scene)) {
         let buried: Vec<bool> =
             back_hits[first..first + vertices].iter().map(|&b| f64::from(b) >= threshold).collect();
-        filled += fill_mesh(&mesh.indices, &buried, &mut coefficients[first * n..(first + vertices) * n], n);
+        fill_mesh(&mesh.indices, &buried, &mut coefficients[first * n..(first + vertices) * n], n);
         first += vertices;
     }
-    filled
 }
 
 /// One mesh: `coefficients` holds `n` per vertex. Each round gives every buried vertex with a

@@ -18,8 +18,8 @@
 //! are those of the hull's nearest point ([`Location::extrapolated`]), continuous across the hull.
 //!
 //! Duplicate positions are merged, keeping the first ([`TetMesh::merged`]); fewer than four
-//! distinct positions, or all of them in one plane, is an error ([`ProbeError`](crate::error::ProbeError)): there is no
-//! lower-dimensional fallback.
+//! distinct positions, or all of them in one plane, is an error
+//! ([`ProbeError`](crate::error::ProbeError)): there is no lower-dimensional fallback.
 mod capture;
 mod delaunay;
 mod dering;

@@ -157,14 +157,7 @@ impl ProbeSettings {
 /// the scene places it included.
 pub fn grid_lattice(scene: &Scene, counts: [u32; 3]) -> Result<Lattice> {
     let (mut lo, mut hi) = static_bounds_of(scene)?;
-    let (all_lo, all_hi) = bounds(scene.groups.iter().flat_map(|group| {
-        let m = group.transform.matrix();
-        group
-            .meshes
-            .iter()
-            .flat_map(move |mesh| mesh.positions.iter().map(move |p| m.transform_point3((*p).into())))
-    }))
-    .unwrap_or((lo, hi));
+    let (all_lo, all_hi) = world_bounds(scene, |_| true).unwrap_or((lo, hi));
     let extent = hi - lo;
     for axis in 0..3 {
         if extent[axis] <= FLAT * extent.max_element() {
@@ -188,7 +181,12 @@ fn static_bounds_of(scene: &Scene) -> Result<(Vec3, Vec3)> {
 
 /// The world bounding box of the static groups' vertices.
 fn static_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
-    let points = scene.groups.iter().enumerate().filter(|(g, _)| is_static(*g)).flat_map(|(_, group)| {
+    world_bounds(scene, is_static)
+}
+
+/// The world bounding box of the vertices of the groups `keep` takes (by index).
+fn world_bounds(scene: &Scene, keep: impl Fn(usize) -> bool) -> Option<(Vec3, Vec3)> {
+    let points = scene.groups.iter().enumerate().filter(|(g, _)| keep(*g)).flat_map(|(_, group)| {
         let m = group.transform.matrix();
         group
             .meshes

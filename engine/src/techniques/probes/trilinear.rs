@@ -3,8 +3,8 @@
 //! and solids included, so probes are spent where nothing moves; tetrahedra go anywhere.
 use glam::{DVec3, Vec3};
 
-/// Probes at `first + step · (i, j, k)` for i < `counts[0]`, j < `counts[1]`, k < `counts[2]`; probe
-/// (i, j, k) is number `i + counts[0] · (j + counts[1] · k)`.
+/// Probes at `first + step · (i, j, k)` for i < `counts[0]`, j < `counts[1]`,
+/// k < `counts[2]`; probe (i, j, k) is number `i + counts[0] · (j + counts[1] · k)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lattice {
     pub first: DVec3,

@@ -151,7 +151,8 @@ pub struct PrtTechnique {
     nearest: Sampler,
     /// The first 9 SH coefficients of the light L_s is made of (`ShCoeffs`, the map's frame).
     light_sh: Buffer,
-    /// The exact irradiance of that light, per pixel where `pixel_cosine` is on.
+    /// The exact irradiance of that light, read per pixel where `pixel_cosine` is on (else one
+    /// unread texel).
     irradiance: GpuEnvironment,
 }
 
@@ -236,7 +237,7 @@ impl PrtTechnique {
                 vk::BufferUsageFlags::UNIFORM_BUFFER,
                 bytes_of(&light_sh),
             )?,
-            irradiance: gpu_irradiance(ctx, residual)?,
+            irradiance: gpu_irradiance(ctx, settings.pixel_cosine.then_some(residual))?,
         })
     }
 }
