@@ -7,15 +7,19 @@
 // one read: R the coverage unfiltered (a box of 1), G a middle width, B and A the widest
 // (coverage, and coverage x occluder height, which gives the mean occluder height around a
 // pixel). The horizontal pass reads the mask's (coverage, coverage x height) texels; the
-// vertical pass reads its four channels back. Outside the mask counts as empty.
+// vertical pass reads its four channels back. Outside the mask counts as empty. The layers are
+// half floats: coverage sums of at most one, kept to 2^-10 of their value.
 #include "constants.glsl"
 #include "layouts.glsl"
 
 layout(local_size_x = KAGE_BLUR_GROUP) in;
 layout(set = 0, binding = 0, std430) readonly buffer Layers { OcclusionLayer layers[]; };
 layout(set = 0, binding = 1) uniform sampler2DArray source;
-layout(set = 0, binding = 2, rgba32f) uniform writeonly image2DArray target;
+layout(set = 0, binding = 2, rgba16f) uniform writeonly image2DArray target;
 layout(push_constant) uniform Push { BlurPush p; };
+// 0: the paper's one box, 1: the adaptive penumbra's three (a pipeline constant, so that
+// llvmpipe, which runs both sides of a branch, reads only what the mode needs).
+layout(constant_id = 0) const bool ADAPTIVE = false;
 
 vec4 fetch(int along, int line, uint layer, bool from_mask) {
     if (along < 0 || along >= int(p.params.y)) return vec4(0.0);
@@ -30,28 +34,32 @@ void main() {
     int size = int(p.params.y);
     if (line >= size || layer >= p.params.z) return;
     bool from_mask = p.params.x == 0u;
-    // Half-widths per channel (box widths are odd).
     OcclusionLayer l = layers[layer];
-    ivec4 radius = p.params.w == 0u
-        ? ivec4(int(l.axis_u.w) / 2, 0, 0, 0)
-        : ivec4(0, int(l.axis_u.w) / 2, int(l.axis_v.w) / 2, int(l.axis_v.w) / 2);
-    int widest = max(radius.x, max(radius.y, radius.z));
-    vec4 sum = vec4(0.0);
+    if (!ADAPTIVE) {
+        // One box over the coverage.
+        int radius = int(l.axis_u.w) / 2;
+        float sum = 0.0;
+        for (int k = -radius; k <= radius; ++k) sum += fetch(k, line, layer, from_mask).r;
+        float scale = 1.0 / float(2 * radius + 1);
+        for (int x = 0; x < size; ++x) {
+            ivec2 texel = p.params.x == 0u ? ivec2(x, line) : ivec2(line, x);
+            imageStore(target, ivec3(texel, layer), vec4(sum * scale, 0.0, 0.0, 0.0));
+            sum += fetch(x + radius + 1, line, layer, from_mask).r - fetch(x - radius, line, layer, from_mask).r;
+        }
+        return;
+    }
+    // R passes through (a box of 1); G slides the middle box, B and A the widest.
+    int middle = int(l.axis_u.w) / 2, widest = int(l.axis_v.w) / 2;
+    vec3 sum = vec3(0.0);
     for (int k = -widest; k <= widest; ++k) {
         vec4 t = fetch(k, line, layer, from_mask);
-        sum += mix(vec4(0.0), t, lessThanEqual(ivec4(abs(k)), radius));
+        sum += vec3(abs(k) <= middle ? t.g : 0.0, t.ba);
     }
-    vec4 scale = 1.0 / vec4(2 * radius + 1);
+    vec3 scale = 1.0 / vec3(2 * middle + 1, 2 * widest + 1, 2 * widest + 1);
     for (int x = 0; x < size; ++x) {
         ivec2 texel = p.params.x == 0u ? ivec2(x, line) : ivec2(line, x);
-        imageStore(target, ivec3(texel, layer), sum * scale);
-        // Slide each channel's box by one texel (B and A share their width).
-        vec4 enter = vec4(fetch(x + radius.x + 1, line, layer, from_mask).r,
-                          fetch(x + radius.y + 1, line, layer, from_mask).g,
-                          fetch(x + radius.z + 1, line, layer, from_mask).ba);
-        vec4 leave = vec4(fetch(x - radius.x, line, layer, from_mask).r,
-                          fetch(x - radius.y, line, layer, from_mask).g,
-                          fetch(x - radius.z, line, layer, from_mask).ba);
-        sum += enter - leave;
+        imageStore(target, ivec3(texel, layer), vec4(fetch(x, line, layer, from_mask).r, sum * scale));
+        sum += vec3(fetch(x + middle + 1, line, layer, from_mask).g, fetch(x + widest + 1, line, layer, from_mask).ba)
+            - vec3(fetch(x - middle, line, layer, from_mask).g, fetch(x - widest, line, layer, from_mask).ba);
     }
 }

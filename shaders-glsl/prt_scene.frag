@@ -32,7 +32,8 @@ layout(constant_id = 4) const bool PIXEL_COSINE = false;
 layout(location = 0) in vec3 self_term;
 layout(location = 1) in vec3 world_position;
 layout(location = 2) in vec3 world_normal;
-layout(location = 3) in vec4 region_transfer[REGION_VEC4];
+layout(location = 3) flat in uvec4 candidates[KAGE_LAYER_UVEC4];
+layout(location = 3 + KAGE_LAYER_UVEC4) in vec4 region_transfer[REGION_VEC4];
 layout(location = 0) out vec4 color;
 
 // The adaptive penumbra (beyond the paper): a box as wide as sqrt(Omega_i) times this pixel's
@@ -64,61 +65,44 @@ void main() {
         lit[j] = c > 0.0 ? c * dominant_self_visibility(j, draw.layers.z, world_position, n, c) : 0.0;
         dominant_light += dominant.lights[j].energy.rgb * lit[j];
     }
-    // The sources this point receives light from: regions with T > 0, then the dominant lights
-    // that reach it. A layer of any other source would take nothing away, so it is not read.
-    // Constant indices: see prt_scene.vert.
     uint regions = draw.mesh.w;
-    uvec2 receives = uvec2(0u);
-    [[unroll]] for (uint k = 0u; k < REGION_VEC4; ++k) {
-        [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-            uint r = 4u * k + c;
-            if (region_transfer[k][c] > 0.0) receives[r / 32u] |= 1u << (r % 32u);
-        }
-    }
-    [[unroll]] for (uint j = 0u; j < DOMINANT_LIGHTS; ++j) {
-        uint r = regions + j;
-        if (lit[j] > 0.0) receives[r / 32u] |= 1u << (r % 32u);
-    }
     // Layers come sorted by source (regions, then dominant lights), so each one's V_o is
-    // complete when the source changes.
+    // complete when the source changes. A region this point's transfer does not reach (T <= 0,
+    // SH ringing), or a dominant light it faces away from, loses nothing to a shadow.
     vec3 blocked = vec3(0.0), dominant_blocked = vec3(0.0);
     uint source = KAGE_NO_HIT;
     float occluded = 0.0;
-    uint first = draw.layers.x, count = draw.layers.y;
-    for (uint base = 0u; base < count; base += 32u) {
-        // Most of a receiver lies outside any one occluder's shadow. The cheap footprint tests
-        // come first, over every layer with indices the same for all fragments (llvmpipe loads
-        // such a record once per SIMD group); the texture reads then loop over the hits only:
-        // a branch around a read would not save it where the lanes of a SIMD group disagree
-        // (llvmpipe runs both sides of every branch), but a loop ends when all its lanes are
-        // done.
-        uint hits = 0u;
-        for (uint k = 0u; k < min(count - base, 32u); ++k) {
-            OcclusionLayer layer = layers[first + base + k];
-            bool receiving = (receives[layer.region / 32u] & (1u << (layer.region % 32u))) != 0u;
-            hits |= uint(receiving && within_footprint(layer, world_position)) << k;
-        }
-        while (hits != 0u) {
-            uint k = uint(findLSB(hits));
+    uint first = draw.layers.x;
+    // llvmpipe runs both sides of every branch and tests a loop's condition after its body
+    // (a loop whose lanes are all done at the start still runs its body once), so the layers
+    // are walked in one bottom-tested loop per 32 of them, as many times as the SIMD group's
+    // busiest lane has candidates: the layers its triangle can reach (see prt_scene.vert).
+    uint words = (draw.layers.y + 31u) / 32u, w = 0u;
+    do {
+        uint hits = candidates[w / 4u][w % 4u];
+        do {
+            bool live = hits != 0u;
+            uint l = first + 32u * w + (live ? uint(findLSB(hits)) : 0u);
             hits &= hits - 1u;
-            uint l = first + base + k;
             OcclusionLayer layer = layers[l];
-            if (layer.region != source) {
-                // Two occluders overlapping in one source never take it away twice.
-                if (source < regions) {
-                    blocked += region_energy[source].rgb * region_transfer[source / 4u][source % 4u] * min(occluded, 1.0);
-                } else if (source != KAGE_NO_HIT) {
-                    dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
+            if (live) {
+                if (layer.region != source) {
+                    // Two occluders overlapping in one source never take it away twice.
+                    if (source < regions) {
+                        blocked += region_energy[source].rgb * max(region_transfer[source / 4u][source % 4u], 0.0) * min(occluded, 1.0);
+                    } else if (source != KAGE_NO_HIT) {
+                        dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
+                    }
+                    source = layer.region;
+                    occluded = 0.0;
                 }
-                source = layer.region;
-                occluded = 0.0;
+                vec4 boxes = textureLod(occlusion, vec3(occlusion_uv(layer, world_position), float(l)), 0.0);
+                occluded += ADAPTIVE_PENUMBRA == 0u ? boxes.r : adaptive_occlusion(layer, boxes);
             }
-            vec4 boxes = textureLod(occlusion, vec3(occlusion_uv(layer, world_position), float(l)), 0.0);
-            occluded += ADAPTIVE_PENUMBRA == 0u ? boxes.r : adaptive_occlusion(layer, boxes);
-        }
-    }
+        } while (hits != 0u);
+    } while (++w < words);
     if (source < regions) {
-        blocked += region_energy[source].rgb * region_transfer[source / 4u][source % 4u] * min(occluded, 1.0);
+        blocked += region_energy[source].rgb * max(region_transfer[source / 4u][source % 4u], 0.0) * min(occluded, 1.0);
     } else if (source != KAGE_NO_HIT) {
         dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
     }

@@ -10,11 +10,13 @@
 #include "layouts.glsl"
 #include "sh.glsl"
 #include "envmap.glsl"
+#include "occlusion.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D self_shadow;
 layout(set = 0, binding = 2, std430) readonly buffer Basis { RegionBasis region_basis[]; };
 // The SH of the light L_s is made of (the map less its dominant lights), in the map's frame.
+layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
 layout(set = 0, binding = 8, std140) uniform Sh { ShCoeffs sh; };
 layout(push_constant) uniform Push { PrtDrawPush draw; };
 // Pipeline constants (see GraphicsDesc::constants; id 0 is the fragment shader's): vec4s of
@@ -34,7 +36,10 @@ layout(location = 2) in vec4 transfer[KAGE_TRANSFER_VEC4];
 layout(location = 0) out vec3 self_term;
 layout(location = 1) out vec3 world_position;
 layout(location = 2) out vec3 world_normal;
-layout(location = 3) out vec4 region_transfer[REGION_VEC4];
+// Bit k: the receiver's occlusion layer k may hold a shadow somewhere on a triangle this vertex
+// provokes (prt_scene.frag's candidates).
+layout(location = 3) flat out uvec4 candidates[KAGE_LAYER_UVEC4];
+layout(location = 3 + KAGE_LAYER_UVEC4) out vec4 region_transfer[REGION_VEC4];
 // The same operations as depth_prepass.vert's, which lays the depth down first.
 precise gl_Position;
 
@@ -62,5 +67,17 @@ void main() {
     }
     vec4 world = draw.model * vec4(position, 1.0);
     world_position = world.xyz;
+    // Which layers' footprints a triangle with this corner can reach: every point of the
+    // triangle lies within the mesh's longest edge of it, which a layer's uv scale turns into
+    // mask units. The fragments then read only these layers, not all of the receiver's.
+    uvec4 bits[KAGE_LAYER_UVEC4];
+    [[unroll]] for (uint w = 0u; w < KAGE_LAYER_UVEC4; ++w) bits[w] = uvec4(0u);
+    for (uint k = 0u; k < draw.layers.y; ++k) {
+        OcclusionLayer layer = layers[draw.layers.x + k];
+        if (within_footprint(layer, world_position, draw.albedo.a * layer.centre.w)) {
+            bits[k / 128u][(k / 32u) % 4u] |= 1u << (k % 32u);
+        }
+    }
+    [[unroll]] for (uint w = 0u; w < KAGE_LAYER_UVEC4; ++w) candidates[w] = bits[w];
     gl_Position = frame.view_proj * world;
 }

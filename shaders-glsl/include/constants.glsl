@@ -50,6 +50,8 @@
 // fragment than a storage buffer on CPU drivers), 80 bytes each, within the 16 KiB every
 // Vulkan device offers. A multiple of 32: the scene pass keeps one bit per layer.
 #define KAGE_MAX_OCCLUSION_LAYERS 192
+// uvec4s of one bit per occlusion layer (prt_scene's candidates).
+#define KAGE_LAYER_UVEC4 2
 // Invocations per workgroup of the occlusion box filter (one row or column each).
 #define KAGE_BLUR_GROUP 64
 // Most dominant lights (a sun, studio lamps) the Tamura technique lights per pixel beside its

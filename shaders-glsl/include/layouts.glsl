@@ -163,7 +163,7 @@ struct RegionBasis {
 // Push constants of the PRT scene pass (Sloan and Tamura): one draw per mesh.
 struct PrtDrawPush {
     mat4 model;
-    vec4 albedo; // rgb: diffuse albedo, a: unused
+    vec4 albedo; // rgb: diffuse albedo, a: the mesh's longest triangle edge in world units
     uvec4 mesh; // x: first self-shadow texel, y: texture width, z: group, w: regions (0: self-shadow only)
     uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: the group's slot among the dominant lights' self-shadow maps plus one (0: none), w: mask size in texels
 };
@@ -213,7 +213,7 @@ struct DominantLights {
 
 // Push constants of the occlusion box filter.
 struct BlurPush {
-    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: 0 the paper's one box, 1 the adaptive penumbra's three boxes (see occlusion_blur.comp)
+    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: unused
 };
 
 // One region of the parallel-lights baseline as a directional light with a binary shadow map.

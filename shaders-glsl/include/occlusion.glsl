@@ -16,9 +16,10 @@ float occlusion_height(OcclusionLayer layer, vec3 world) {
     return dot(world - layer.centre.xyz, cross(layer.axis_u.xyz, layer.axis_v.xyz));
 }
 
-// Whether a read of the layer at `world` can return anything but 0 (see OcclusionLayer).
-bool within_footprint(OcclusionLayer layer, vec3 world) {
+// Whether a read of the layer within `margin` (mask uv units) of `world` can return anything
+// but 0 (see OcclusionLayer).
+bool within_footprint(OcclusionLayer layer, vec3 world, float margin) {
     vec2 uv = occlusion_uv(layer, world);
-    return all(greaterThanEqual(uv, layer.footprint.xy)) && all(lessThanEqual(uv, layer.footprint.zw));
+    return all(greaterThanEqual(uv, layer.footprint.xy - margin)) && all(lessThanEqual(uv, layer.footprint.zw + margin));
 }
 #endif

@@ -59,7 +59,7 @@ fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
 fn texel_bytes(format: vk::Format) -> Option<u64> {
     match format {
         vk::Format::R32G32B32A32_SFLOAT => Some(16),
-        vk::Format::R32G32_SFLOAT => Some(8),
+        vk::Format::R32G32_SFLOAT | vk::Format::R16G16B16A16_SFLOAT => Some(8),
         vk::Format::R8G8B8A8_UNORM
         | vk::Format::R8G8B8A8_SRGB
         | vk::Format::R32_SFLOAT

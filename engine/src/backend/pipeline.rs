@@ -103,12 +103,28 @@ impl ComputePipeline {
         bindings: &[BindingKind],
         push_size: u32,
     ) -> Result<ComputePipeline> {
+        ComputePipeline::specialized(ctx, name, spirv, bindings, push_size, &[])
+    }
+
+    /// With specialization constants, `constant_id` 0, 1, … in order (see
+    /// [`GraphicsDesc::constants`]).
+    pub fn specialized(
+        ctx: &Arc<Context>,
+        name: &str,
+        spirv: &[u8],
+        bindings: &[BindingKind],
+        push_size: u32,
+        constants: &[u32],
+    ) -> Result<ComputePipeline> {
         let module = Module::new(ctx, &format!("{name}.comp"), spirv, bindings)?;
         let layout = create_layout(ctx, name, bindings, push_size)?;
+        let (entries, constant_bytes) = specialization_entries(constants);
+        let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&constant_bytes);
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
-            .name(c"main");
+            .name(c"main")
+            .specialization_info(&specialization);
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline);
         // SAFETY: valid device, module and layout.
         let raw =
@@ -207,6 +223,14 @@ pub struct GraphicsDesc<'a> {
     pub constants: &'a [u32],
 }
 
+/// The map entries and data of 32-bit specialization constants with ids 0, 1, … in order.
+fn specialization_entries(constants: &[u32]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
+    let entries = (0..constants.len() as u32)
+        .map(|id| vk::SpecializationMapEntry { constant_id: id, offset: 4 * id, size: 4 })
+        .collect();
+    (entries, constants.iter().flat_map(|c| c.to_ne_bytes()).collect())
+}
+
 pub struct GraphicsPipeline {
     ctx: Arc<Context>,
     raw: vk::Pipeline,
@@ -219,10 +243,7 @@ impl GraphicsPipeline {
         let vs = Module::new(ctx, &format!("{}.vert", desc.name), desc.vertex_spirv, desc.bindings)?;
         let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv, desc.bindings)?;
         let layout = create_layout(ctx, desc.name, desc.bindings, desc.push_size)?;
-        let entries: Vec<vk::SpecializationMapEntry> = (0..desc.constants.len() as u32)
-            .map(|id| vk::SpecializationMapEntry { constant_id: id, offset: 4 * id, size: 4 })
-            .collect();
-        let constant_bytes: Vec<u8> = desc.constants.iter().flat_map(|c| c.to_ne_bytes()).collect();
+        let (entries, constant_bytes) = specialization_entries(desc.constants);
         let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&constant_bytes);
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()

@@ -27,6 +27,8 @@ pub struct GpuMesh {
     pub index_count: u32,
     pub vertex_count: u32,
     pub albedo: [f32; 3],
+    /// [`crate::scene::Mesh::longest_edge`], object units.
+    pub longest_edge: f32,
     pub group: usize,
     /// Index of the mesh within its group.
     pub mesh: usize,
@@ -74,6 +76,7 @@ impl GpuScene {
                     vertex_count: mesh.positions.len() as u32,
                     mesh: m,
                     albedo: mesh.albedo,
+                    longest_edge: mesh.longest_edge(),
                     group: g,
                     clusters,
                 });

@@ -64,6 +64,17 @@ impl Mesh {
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
+
+    /// The longest edge of any triangle (object units): every point of a triangle lies within
+    /// it of each of the triangle's corners.
+    pub fn longest_edge(&self) -> f32 {
+        let at = |i: u32| Vec3::from(self.positions[i as usize]);
+        self.indices
+            .chunks_exact(3)
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| at(a).distance(at(b)))
+            .fold(0.0, f32::max)
+    }
 }
 
 /// The checks of [`Mesh::new`] and [`Mesh::validate`] that do not involve normals.

@@ -114,12 +114,15 @@ pub struct Occlusion {
 
 /// The masks: coverage, and coverage × occluder height.
 const MASK_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
-/// The filtered layers: up to three box widths side by side, and the occluder heights.
-const FILTERED_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// The filtered layers: up to three box widths side by side, and the occluder heights. Half
+/// floats: the scene pass reads one per layer per pixel, and coverage needs no more than their
+/// 2^-10 of relative precision.
+pub const FILTERED_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 // The scene pass reads the layers from a uniform buffer (16 KiB on every device) and keeps one
 // bit per layer in 32-bit words.
 const _: () = assert!(constants::MAX_OCCLUSION_LAYERS as usize * size_of::<OcclusionLayer>() <= 16 * 1024);
 const _: () = assert!(constants::MAX_OCCLUSION_LAYERS % 32 == 0);
+const _: () = assert!(constants::LAYER_UVEC4 * 128 >= constants::MAX_OCCLUSION_LAYERS);
 /// Texels of margin on each side of a mask beyond the occluder and its filter's reach.
 const MASK_MARGIN_TEXELS: f32 = 1.5;
 /// How far behind the receiver's surface, in mask texels, an occluder fragment still counts as
@@ -221,12 +224,13 @@ impl Occlusion {
         Ok(Occlusion {
             receiver_pipeline: mask_pipeline(ctx, "occluder_mask.receiver", DepthTest::Less)?,
             mask_pipeline: mask_pipeline(ctx, "occluder_mask", DepthTest::Nearer)?,
-            blur: ComputePipeline::new(
+            blur: ComputePipeline::specialized(
                 ctx,
                 "occlusion_blur",
                 spirv::OCCLUSION_BLUR_COMP,
                 &[BindingKind::StorageBuffer, BindingKind::SampledImage, BindingKind::StorageImage],
                 size_of::<BlurPush>() as u32,
+                &[(penumbra == Penumbra::Adaptive) as u32],
             )?,
             mask: layered(
                 ctx,
@@ -447,8 +451,7 @@ impl Occlusion {
         let count = self.in_use.len() as u32;
         let groups = [self.resolution.div_ceil(constants::BLUR_GROUP), count, 1];
         let blur = move |cmd, horizontal: bool, source: &Image, target: &Image| {
-            let mode = (self.penumbra == Penumbra::Adaptive) as u32;
-            let push = BlurPush { params: [u32::from(!horizontal), self.resolution, count, mode] };
+            let push = BlurPush { params: [u32::from(!horizontal), self.resolution, count, 0] };
             self.blur.dispatch(
                 cmd,
                 &[

@@ -327,9 +327,12 @@ impl PrtTechnique {
         let q = occlusion.region_count() as u32;
         for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| (self.drawn)(m.group)) {
             let (first_layer, layer_count) = occlusion.ranges[mesh.group];
+            let model = scene.transforms[mesh.group];
+            // Groups scale uniformly (scene::Transform).
+            let reach = mesh.longest_edge * model.x_axis.truncate().length();
             let push = PrtDrawPush {
-                model: scene.transforms[mesh.group].to_cols_array_2d(),
-                albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 0.0],
+                model: model.to_cols_array_2d(),
+                albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], reach],
                 mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
                 layers: [first_layer, layer_count, self.dominant.slot(mesh.group), occlusion.resolution],
             };
