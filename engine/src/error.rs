@@ -94,6 +94,8 @@ impl Error {
 /// What can be wrong with a light probe set or a lookup point (the probes technique).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProbeError {
+    #[error("not a probe file {{\"positions\": [[x, y, z], ...]}}: {problem}")]
+    File { problem: String },
     #[error("probe {index} at {position:?}: {problem}")]
     BadPosition { index: usize, position: [f64; 3], problem: &'static str },
     #[error("lookup point {position:?}: {problem}")]

@@ -60,6 +60,12 @@ pub fn read(path: &Path, limit: Limit) -> Result<Vec<u8>, ReadError> {
     Ok(data)
 }
 
+/// `bytes` without a leading UTF-8 byte order mark, which some editors write at the start of a
+/// file and JSON forbids.
+pub fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
+}
+
 #[cfg(unix)]
 fn kind_of(file_type: FileType) -> &'static str {
     use std::os::unix::fs::FileTypeExt;

@@ -1,5 +1,5 @@
 //! A bounded mutation fuzzer over the readers of what users hand Kage: scene JSON, OBJ, EXR and
-//! HDR maps, and probe positions (tetrahedralized). Each starts from its committed seed
+//! HDR maps, probe position files, and probe positions (tetrahedralized). Each starts from its committed seed
 //! (tests/fuzz/seeds/), which must read cleanly, and reads `KAGE_FUZZ_ITERATIONS` (default 2,000)
 //! mutants of it: bytes flipped, inserted, deleted, repeated, and numbers replaced by extreme
 //! ones. Every read must return, Ok or a clear error: a panic or an abort fails the test. The
@@ -8,7 +8,7 @@
 use glam::DVec3;
 use kage::scene::{parse_obj, EnvMap, Scene};
 use kage::sh::ShRgb9;
-use kage::techniques::probes::ProbeSet;
+use kage::techniques::probes::{positions_file, ProbeSet};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -168,5 +168,19 @@ fn probe_sets() {
     fuzz("probes.bin", &seed, 5, |bytes| {
         let points = positions(bytes);
         let _ = ProbeSet::tetrahedral(&points, vec![ShRgb9::default(); points.len()]);
+    });
+}
+
+/// Probe position files as `kage probes place` writes them and `probes tetrahedralize`,
+/// `probes lookup` and `render --probe-positions` read them, each set read tetrahedralized.
+#[test]
+fn probe_files() {
+    let seed = seed("probes.json");
+    let points = positions_file::parse(&seed).expect("the seed file reads");
+    ProbeSet::tetrahedral(&points, vec![ShRgb9::default(); points.len()]).expect("the seed set builds");
+    fuzz("probes.json", &seed, 6, |bytes| {
+        if let Ok(points) = positions_file::parse(bytes) {
+            let _ = ProbeSet::tetrahedral(&points, vec![ShRgb9::default(); points.len()]);
+        }
     });
 }

@@ -6,8 +6,10 @@ use glam::DVec3;
 use kage::files;
 use kage::frame::GpuScene;
 use kage::scene::Scene;
-use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker};
-use serde::{Deserialize, Serialize};
+use kage::techniques::probes::{
+    positions_file, CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker,
+};
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -69,12 +71,6 @@ pub struct LookupArgs {
     at: [f64; 3],
 }
 
-#[derive(Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-struct ProbeFile {
-    positions: Vec<[f64; 3]>,
-}
-
 #[derive(Serialize)]
 struct TetFile<'a> {
     tetrahedra: &'a [[u32; 4]],
@@ -118,9 +114,8 @@ fn place(args: &PlaceArgs) -> Result<()> {
     let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings);
     spinner.finish_and_clear();
     let set = set?;
-    let positions = set.mesh.positions().iter().map(|p| p.to_array()).collect();
-    let json = serde_json::to_string(&ProbeFile { positions })?;
-    std::fs::write(&args.out, json + "\n").with_context(|| format!("writing {}", args.out.display()))?;
+    let json = positions_file::to_json(set.mesh.positions());
+    std::fs::write(&args.out, json).with_context(|| format!("writing {}", args.out.display()))?;
     println!(
         "{} of {} candidate probes kept in {:.1} s; written to {}",
         set.probe_count(),
@@ -134,9 +129,7 @@ fn place(args: &PlaceArgs) -> Result<()> {
 /// The positions of a probe file.
 pub fn read_positions(path: &Path) -> Result<Vec<DVec3>> {
     let bytes = files::read(path, files::JSON).with_context(|| format!("reading {}", path.display()))?;
-    let file: ProbeFile = serde_json::from_slice(&bytes)
-        .with_context(|| format!("{}: not a probe file {{\"positions\": [[x,y,z], ...]}}", path.display()))?;
-    Ok(file.positions.into_iter().map(DVec3::from_array).collect())
+    positions_file::parse(&bytes).with_context(|| path.display().to_string())
 }
 
 /// Reads and tetrahedralizes a probe file, warning about merged duplicates.

@@ -8,12 +8,9 @@ use super::file::{EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, SceneFile};
 use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, SceneProbe, Transform};
 use crate::files;
 
-/// The UTF-8 byte order mark, which some editors write at the start of a file and JSON forbids.
-const BOM: &[u8] = b"\xEF\xBB\xBF";
-
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let bytes = files::read(path, files::JSON).map_err(|e| SceneError::in_file(path, e.to_string()))?;
-    let json = bytes.strip_prefix(BOM).unwrap_or(&bytes);
+    let json = files::without_bom(&bytes);
     let file: SceneFile = serde_json::from_slice(json)
         .map_err(|e| SceneError::in_file(path, format!("invalid scene JSON: {e}")))?;
     let folder = path.parent().unwrap_or(Path::new(""));

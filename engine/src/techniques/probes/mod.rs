@@ -27,6 +27,7 @@ mod extrapolate;
 pub mod fit;
 mod input;
 mod lookup;
+pub mod positions_file;
 mod predicates;
 mod reduce;
 mod relocate;
