@@ -7,13 +7,10 @@
 //! - the `struct`s of `shaders-glsl/include/layouts.glsl` become `#[repr(C)]` Rust structs with
 //!   std430 offsets in `$OUT_DIR/layouts.rs`, with compile-time size and offset assertions.
 //!
-//! Linking shaderc: `.cargo/config.toml` points `SHADERC_LIB_DIR` at `.deps/shaderc`, where
-//! scripts/deps.sh merges Debian's static glslang/SPIRV-Tools/shaderc archives into one
-//! `libshaderc_combined.a` (libstdc++ comes through shaderc-sys's `link-cplusplus` dependency).
-//! If that archive is missing, shaderc-sys only prints a warning and falls back to building
-//! glslang from source (about ten minutes on two cores). This script cannot stop that: build
-//! dependencies are built before it runs. It does check for the archive afterwards so that the
-//! cause is at least named; run scripts/deps.sh (then `cargo clean -p shaderc-sys`) to fix it.
+//! Linking shaderc: `.cargo/config.toml` points `SHADERC_LIB_DIR` at `build/shaderc`, whose
+//! `libshaderc_shared.so` is a GNU ld script naming Debian's static shaderc, glslang and
+//! SPIRV-Tools archives (vendor-notes.md, "Building shaders"): shaderc-sys links it as a shared
+//! library, so it never falls back to building glslang from source.
 
 mod constants;
 mod layouts;
@@ -36,7 +33,6 @@ fn main() {
         .unwrap_or_else(|e| panic!("cannot find shaders-glsl/ next to engine/: {e}"));
     let include_dir = shader_dir.join("include");
 
-    check_shaderc_archive(&manifest_dir);
     // The C ABI's version in libkage.so's SONAME, so that the dynamic loader refuses to pair a
     // host with a library of another ABI (the same number as `kage_abi::Version` in
     // src/capi/mod.rs; the C host tests check that they agree).
@@ -70,20 +66,6 @@ fn env(name: &str) -> String {
 
 fn write(path: &Path, text: impl AsRef<[u8]>) {
     fs::write(path, text).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
-}
-
-fn check_shaderc_archive(manifest_dir: &Path) {
-    println!("cargo:rerun-if-env-changed=SHADERC_LIB_DIR");
-    let dir = std::env::var_os("SHADERC_LIB_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| manifest_dir.join("../.deps/shaderc"));
-    if !dir.join("libshaderc_combined.a").is_file() {
-        println!(
-            "cargo:warning={}/libshaderc_combined.a is missing, so shaderc-sys built glslang from \
-             source; run scripts/deps.sh, then `cargo clean -p shaderc-sys`",
-            dir.display()
-        );
-    }
 }
 
 /// Plain files directly in `dir`, sorted so that generated code is deterministic.

@@ -177,8 +177,13 @@ impl Renderer {
         passes.extend(self.technique.passes(&inputs));
         let targets = &self.targets;
         passes.push(Pass::new("readback", &[COLOR], &[], move |cmd| targets.record_readback(cmd)));
-        let frame = self.executor.run(&imports, passes)?;
+        let mut frame = self.executor.run(&imports, passes)?;
         self.technique.timed(&frame);
+        // Starts count from the frame's first pass: this submission's follow the analysis's end.
+        let analysis_end = crate::pass::frame_ms(&timings).unwrap_or(0.0);
+        for t in &mut frame {
+            t.start_ms = t.start_ms.map(|ms| ms + analysis_end);
+        }
         timings.extend(frame);
         self.env_dirty = false;
         Ok(timings)

@@ -18,7 +18,7 @@
 //! catches passes recorded in the wrong order.
 mod timings;
 
-pub use timings::{median, TimingRow, TimingTable};
+pub use timings::{frame_ms, median, TimingRow, TimingTable};
 
 use crate::backend::{Context, TimestampPool};
 use crate::error::{Error, Result};

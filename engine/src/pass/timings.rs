@@ -32,19 +32,30 @@ pub fn median(values: &[f64]) -> f64 {
     }
 }
 
+/// A frame's device time: from its first pass's start to its last pass's end, the time between
+/// passes included (lavapipe writes a compute pass's timestamps when it next flushes, so part
+/// of a pass's work can fall between passes; vendor-notes.md). The sum of the passes' times
+/// where they have no start; `None` without timestamps.
+pub fn frame_ms(frame: &[PassTiming]) -> Option<f64> {
+    let ends = frame.iter().map(|t| Some(t.start_ms? + t.gpu_ms?)).collect::<Option<Vec<f64>>>();
+    match ends {
+        Some(ends) if !ends.is_empty() => Some(ends.into_iter().fold(0.0, f64::max)),
+        _ => frame.iter().any(|t| t.gpu_ms.is_some()).then(|| frame.iter().filter_map(|t| t.gpu_ms).sum()),
+    }
+}
+
 impl TimingTable {
-    /// Adds one frame's timings; passes without a GPU time (no timestamps) are left out.
+    /// Adds one frame's timings ([`frame_ms`]); passes without a GPU time (no timestamps) are
+    /// left out.
     pub fn add_frame(&mut self, frame: &[PassTiming]) {
-        let mut total = 0.0;
         for timing in frame {
             let Some(ms) = timing.gpu_ms else { continue };
-            total += ms;
             match self.passes.iter_mut().find(|(name, _)| name == timing.name) {
                 Some((_, samples)) => samples.push(ms),
                 None => self.passes.push((timing.name.to_owned(), vec![ms])),
             }
         }
-        if frame.iter().any(|t| t.gpu_ms.is_some()) {
+        if let Some(total) = frame_ms(frame) {
             self.frames.push(total);
         }
     }
@@ -63,7 +74,7 @@ impl TimingTable {
             .collect()
     }
 
-    /// Median over frames of the summed GPU time of all passes of a frame.
+    /// Median over frames of [`frame_ms`].
     pub fn frame_median_ms(&self) -> f64 {
         median(&self.frames)
     }
@@ -90,6 +101,18 @@ mod tests {
         assert_eq!(rows[0].name, "a");
         assert_eq!((rows[0].median_ms, rows[0].min_ms, rows[0].max_ms), (2.5, 1.0, 10.0));
         assert_eq!(rows[1].frames, 4);
+        // Each frame from a's start to b's end: 4, 2, 3 and 11 ms.
         assert_eq!(table.frame_median_ms(), 3.5);
+    }
+
+    /// Time between passes counts (a pass's work lavapipe times late); without starts, the sum.
+    #[test]
+    fn a_frame_spans_its_first_start_to_its_last_end() {
+        let pass = |name, gpu_ms, start_ms| PassTiming { name, gpu_ms, start_ms };
+        let gap = [pass("a", Some(2.0), Some(0.0)), pass("b", Some(1.0), Some(9.0))];
+        assert_eq!(frame_ms(&gap), Some(10.0));
+        let unplaced = [pass("a", Some(2.0), None), pass("b", Some(1.0), None)];
+        assert_eq!(frame_ms(&unplaced), Some(3.0));
+        assert_eq!(frame_ms(&[pass("a", None, None)]), None);
     }
 }

@@ -318,7 +318,7 @@ fn walk(
             timings[c] = renderers[c].render()?;
         }
         let images: Vec<RgbaF32Image> = renderers.iter().map(|r| r.image()).collect::<kage::Result<_>>()?;
-        let frame_ms = |c: usize| timings[c].iter().filter_map(|t| t.gpu_ms).sum::<f64>();
+        let frame_ms = |c: usize| kage::pass::frame_ms(&timings[c]).unwrap_or(0.0);
         for (c, image) in images.iter().enumerate() {
             let mismatch = shadow_mismatch(image, &truth, SHADOW_THRESHOLD)?;
             let flips = match (&previous, slow) {
