@@ -983,6 +983,17 @@ kage_result kage_renderer_read_pixels(const kage_renderer *renderer,
                                       size_t size);
 
 /**
+ * Writes the last frame's device time in milliseconds to `*milliseconds`: from its first
+ * pass's start to its last pass's end, the time between passes included (what `kage render`
+ * reports as the frame); -1 before the first frame or on a device without timestamps. A host
+ * that calls it after every frame has the series `kage render --trace` records.
+ *
+ * # Safety
+ * `milliseconds` NULL or writable.
+ */
+kage_result kage_renderer_frame_time(const kage_renderer *renderer, double *milliseconds);
+
+/**
  * Copies the last frame's per-pass GPU timings, in the order the passes ran, into `timings`
  * (room for `capacity`), and writes how many passes the frame had to `*count`. When `capacity`
  * is smaller, the first `capacity` are written and `KAGE_RESULT_BUFFER_TOO_SMALL` is returned;

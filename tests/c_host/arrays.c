@@ -334,6 +334,13 @@ static void check_bad_arguments(kage_context *context) {
          KAGE_RESULT_INVALID_VALUE); /* no frame yet */
   CHECK(kage_renderer_timings(renderer, NULL, 0, &passes));
   REQUIRE(passes == 0);
+  {
+    double frame_ms = 0.0;
+    CHECK(kage_renderer_frame_time(renderer, &frame_ms));
+    REQUIRE(frame_ms == -1.0); /* no frame yet */
+    EXPECT(kage_renderer_frame_time(renderer, NULL), KAGE_RESULT_NULL_ARGUMENT);
+    EXPECT(kage_renderer_frame_time(NULL, &frame_ms), KAGE_RESULT_NULL_ARGUMENT);
+  }
   EXPECT(kage_renderer_render(NULL), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_render((kage_renderer *)scene), KAGE_RESULT_INVALID_HANDLE);
   CHECK(kage_renderer_render(renderer));

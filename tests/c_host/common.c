@@ -180,6 +180,11 @@ static void run_frames(kage_context *context, kage_scene *scene, const kage_tech
       total += timings[i].milliseconds;
     }
     REQUIRE(total > 0.0);
+    /* The frame spans its first pass's start to its last pass's end: never less than the sum of
+     * the passes that ran one after another... up to rounding of the tick conversion. */
+    double frame_ms = 0.0;
+    CHECK(kage_renderer_frame_time(renderer, &frame_ms));
+    REQUIRE(frame_ms >= 0.999 * total);
     REQUIRE(has_pass(timings, count, "background") && has_pass(timings, count, "scene") &&
             has_pass(timings, count, "readback"));
     /* The environment's SH projection and Tamura's self-shadowing run when their input changed:
@@ -193,7 +198,7 @@ static void run_frames(kage_context *context, kage_scene *scene, const kage_tech
     REQUIRE(stats.gpu_bytes > 0 && stats.dropped_layers == 0);
     if (frame == 0) first_stats = stats;
     REQUIRE(stats.gpu_bytes == first_stats.gpu_bytes);
-    printf("frame %u: box at column %.1f, %zu passes, %.3f ms:", frame, column, count, total);
+    printf("frame %u: box at column %.1f, %zu passes, %.3f ms (passes %.3f):", frame, column, count, frame_ms, total);
     for (size_t i = 0; i < count; i++) printf(" %s %.3f", timings[i].name, timings[i].milliseconds);
     printf("\n");
   }

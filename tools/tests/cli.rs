@@ -947,3 +947,41 @@ fn probe_capture_options_are_checked() {
     ];
     assert_clear_errors(&cases);
 }
+
+/// Every option README's command table names exists under that name in the command's `--help`:
+/// the table and the program cannot drift apart (a renamed flag fails here). Each row's command
+/// is its leading lowercase words (`kage probes place …`, `kage sweep --technique prt …`).
+#[test]
+fn every_option_readme_names_is_one_the_program_takes() {
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
+    let is_word = |w: &str| {
+        !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-')
+    };
+    let mut checked = 0;
+    for row in readme.lines().filter(|l| l.starts_with("| `kage ")) {
+        // The first cell; `\|` inside it is an escaped alternative, not a cell's end.
+        let row = row.replace("\\|", "/");
+        let usage = row.split('|').nth(1).unwrap().trim().trim_matches('`');
+        let command: Vec<&str> = usage.split_whitespace().skip(1).take_while(|w| is_word(w)).collect();
+        let help = kage(&[command.as_slice(), &["--help"]].concat());
+        assert!(help.status.success(), "`kage {} --help` fails (README row: {row})", command.join(" "));
+        let help = String::from_utf8_lossy(&help.stdout).into_owned();
+        let options =
+            usage.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-')).filter(|w| w.starts_with("--"));
+        for option in options {
+            assert!(
+                help.contains(&format!("{option} "))
+                    || help.contains(&format!("{option}\n"))
+                    || help.contains(&format!("{option}="))
+                    || help.contains(&format!("{option},")),
+                "README names `{option}` for `kage {}`, which its --help does not list",
+                command.join(" ")
+            );
+            checked += 1;
+        }
+    }
+    assert!(
+        checked >= 120,
+        "only {checked} options found in README's table (133 on 2026-12-03): is the table still there?"
+    );
+}

@@ -329,6 +329,27 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
     })
 }
 
+/// Writes the last frame's device time in milliseconds to `*milliseconds`: from its first
+/// pass's start to its last pass's end, the time between passes included (what `kage render`
+/// reports as the frame); -1 before the first frame or on a device without timestamps. A host
+/// that calls it after every frame has the series `kage render --trace` records.
+///
+/// # Safety
+/// `milliseconds` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_frame_time(
+    renderer: *const kage_renderer,
+    milliseconds: *mut f64,
+) -> kage_result {
+    boundary(|| {
+        let r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or writable.
+        let milliseconds = unsafe { args::out(milliseconds, "milliseconds") }?;
+        *milliseconds = r.timings.as_deref().and_then(crate::pass::frame_ms).unwrap_or(-1.0);
+        Ok(())
+    })
+}
+
 /// Copies the last frame's per-pass GPU timings, in the order the passes ran, into `timings`
 /// (room for `capacity`), and writes how many passes the frame had to `*count`. When `capacity`
 /// is smaller, the first `capacity` are written and `KAGE_RESULT_BUFFER_TOO_SMALL` is returned;
