@@ -213,7 +213,7 @@ struct DominantLights {
 
 // Push constants of the occlusion box filter.
 struct BlurPush {
-    uvec4 params; // x: 0 horizontal, 1 vertical, y: mask size in texels, z: layer count, w: unused
+    uvec4 params; // x: unused (the pass is a pipeline constant), y: mask size in texels, z: layer count, w: unused
 };
 
 // One region of the parallel-lights baseline as a directional light with a binary shadow map.

@@ -86,10 +86,12 @@ pub struct Occlusion {
     /// The receiver's depth, then the occluder's coverage in front of it.
     receiver_pipeline: GraphicsPipeline,
     mask_pipeline: GraphicsPipeline,
-    blur: ComputePipeline,
+    /// The two filter passes: along the masks' rows, then along the columns.
+    blur: [ComputePipeline; 2],
     mask: Image,
     mask_depth: Image,
-    temp: Image,
+    /// The horizontal pass's boxes (f32 RGBA per texel), which the vertical pass reads.
+    temp: Buffer,
     /// V_o, one layer per (receiver, occluder, region) in use this frame.
     pub filtered: Image,
     pub sampler: Sampler,
@@ -221,17 +223,25 @@ impl Occlusion {
             .flat_map(f32::to_ne_bytes)
             .collect();
         energy.write(0, &rgb)?;
+        let blur = |vertical: bool| {
+            ComputePipeline::specialized(
+                ctx,
+                if vertical { "occlusion_blur.vertical" } else { "occlusion_blur.horizontal" },
+                spirv::OCCLUSION_BLUR_COMP,
+                &[
+                    BindingKind::StorageBuffer,
+                    BindingKind::SampledImage,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageImage,
+                ],
+                size_of::<BlurPush>() as u32,
+                &[(penumbra == Penumbra::Adaptive) as u32, vertical as u32],
+            )
+        };
         Ok(Occlusion {
             receiver_pipeline: mask_pipeline(ctx, "occluder_mask.receiver", DepthTest::Less)?,
             mask_pipeline: mask_pipeline(ctx, "occluder_mask", DepthTest::Nearer)?,
-            blur: ComputePipeline::specialized(
-                ctx,
-                "occlusion_blur",
-                spirv::OCCLUSION_BLUR_COMP,
-                &[BindingKind::StorageBuffer, BindingKind::SampledImage, BindingKind::StorageImage],
-                size_of::<BlurPush>() as u32,
-                &[(penumbra == Penumbra::Adaptive) as u32],
-            )?,
+            blur: [blur(false)?, blur(true)?],
             mask: layered(
                 ctx,
                 "occlusion.mask",
@@ -250,13 +260,14 @@ impl Occlusion {
                     vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
                 ),
             )?,
-            temp: layered(
+            temp: Buffer::new(
                 ctx,
-                "occlusion.temp",
-                resolution,
-                layer_count,
-                FILTERED_FORMAT,
-                vk::ImageUsageFlags::STORAGE,
+                &BufferDesc {
+                    name: "occlusion.temp",
+                    size: u64::from(layer_count) * u64::from(resolution) * u64::from(resolution) * 16,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::GpuOnly,
+                },
             )?,
             filtered: layered(
                 ctx,
@@ -450,14 +461,15 @@ impl Occlusion {
         }
         let count = self.in_use.len() as u32;
         let groups = [self.resolution.div_ceil(constants::BLUR_GROUP), count, 1];
-        let blur = move |cmd, horizontal: bool, source: &Image, target: &Image| {
-            let push = BlurPush { params: [u32::from(!horizontal), self.resolution, count, 0] };
-            self.blur.dispatch(
+        let blur = move |cmd, pipeline: &ComputePipeline| {
+            let push = BlurPush { params: [0, self.resolution, count, 0] };
+            pipeline.dispatch(
                 cmd,
                 &[
                     Binding::Storage(&self.layers),
-                    Binding::Sampled(source, &self.nearest),
-                    Binding::StorageImage(target),
+                    Binding::Sampled(&self.mask, &self.nearest),
+                    Binding::Storage(&self.temp),
+                    Binding::StorageImage(&self.filtered),
                 ],
                 bytes_of(&push),
                 groups,
@@ -488,12 +500,8 @@ impl Occlusion {
                     ctx.end_rendering(cmd);
                 }
             }),
-            Pass::new("blur_horizontal", &[MASKS], &[HALF_FILTERED], move |cmd| {
-                blur(cmd, true, &self.mask, &self.temp)
-            }),
-            Pass::new("blur_vertical", &[HALF_FILTERED], &[OCCLUSION], move |cmd| {
-                blur(cmd, false, &self.temp, &self.filtered)
-            }),
+            Pass::new("blur_horizontal", &[MASKS], &[HALF_FILTERED], move |cmd| blur(cmd, &self.blur[0])),
+            Pass::new("blur_vertical", &[HALF_FILTERED], &[OCCLUSION], move |cmd| blur(cmd, &self.blur[1])),
         ]
     }
 }
