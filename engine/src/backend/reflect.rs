@@ -124,7 +124,7 @@ mod tests {
         assert_eq!(used(spirv::BACKGROUND_FRAG), [(0, UniformBuffer), (1, SampledImage)]);
         assert_eq!(
             used(spirv::OCCLUSION_BLUR_COMP),
-            [(0, StorageBuffer), (1, SampledImage), (2, StorageImage)]
+            [(0, StorageBuffer), (1, SampledImage), (2, StorageBuffer), (3, StorageImage)]
         );
     }
 
