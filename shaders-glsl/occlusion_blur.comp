@@ -17,20 +17,20 @@ layout(local_size_x = KAGE_BLUR_GROUP) in;
 layout(set = 0, binding = 0, std430) readonly buffer Layers { OcclusionLayer layers[]; };
 layout(set = 0, binding = 1) uniform sampler2DArray mask;
 // The horizontal pass's boxes, [layer][row][column], read back by the vertical pass.
-layout(set = 0, binding = 2, std430) buffer Half { vec4 half_filtered[]; };
+layout(set = 0, binding = 2, std430) buffer RowBoxes { vec4 row_boxes[]; };
 layout(set = 0, binding = 3, rgba16f) uniform writeonly image2DArray target;
 layout(push_constant) uniform Push { BlurPush p; };
 // 0: the paper's one box, 1: the adaptive penumbra's three (a pipeline constant, so that
 // llvmpipe, which runs both sides of a branch, reads only what the mode needs).
 layout(constant_id = 0) const bool ADAPTIVE = false;
-// 0: the horizontal pass (mask rows to half_filtered), 1: the vertical one (its columns to the
+// 0: the horizontal pass (mask rows to row_boxes), 1: the vertical one (its columns to the
 // filtered layers).
 layout(constant_id = 1) const bool VERTICAL = false;
 
 vec4 fetch(int along, int line, uint layer) {
     if (along < 0 || along >= int(p.params.y)) return vec4(0.0);
     int size = int(p.params.y);
-    return VERTICAL ? half_filtered[(int(layer) * size + along) * size + line]
+    return VERTICAL ? row_boxes[(int(layer) * size + along) * size + line]
                     : texelFetch(mask, ivec3(along, line, layer), 0).rrrg;
 }
 
@@ -39,7 +39,7 @@ void store(int along, int line, uint layer, vec4 value) {
     if (VERTICAL) {
         imageStore(target, ivec3(line, along, layer), value);
     } else {
-        half_filtered[(int(layer) * size + line) * size + along] = value;
+        row_boxes[(int(layer) * size + line) * size + along] = value;
     }
 }
 

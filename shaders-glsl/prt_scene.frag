@@ -53,6 +53,19 @@ float adaptive_occlusion(OcclusionLayer layer, vec4 boxes) {
         : mix(boxes.g, boxes.b, widest > middle ? min((width - middle) / (widest - middle), 1.0) : 0.0);
 }
 
+// What the occluders hide of `source`, V_o summed over them: two occluders overlapping in one
+// source never take it away twice. A region this point's transfer does not reach (T <= 0, SH
+// ringing), or a dominant light it faces away from, loses nothing.
+void take_away(uint source, float occluded, float lit[KAGE_MAX_DOMINANT_LIGHTS], inout vec3 blocked,
+               inout vec3 dominant_blocked) {
+    uint regions = draw.mesh.w;
+    if (source < regions) {
+        blocked += region_energy[source].rgb * max(region_transfer[source / 4u][source % 4u], 0.0) * min(occluded, 1.0);
+    } else if (source != KAGE_NO_HIT) {
+        dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
+    }
+}
+
 void main() {
     // The dominant lights' exact cosine and self-shadow: B_j max(n . w_j, 0) v_j (constant
     // indices), before the other groups' shadows take their share. Two-sided surfaces, as in
@@ -65,10 +78,8 @@ void main() {
         lit[j] = c > 0.0 ? c * dominant_self_visibility(j, draw.layers.z, world_position, n, c) : 0.0;
         dominant_light += dominant.lights[j].energy.rgb * lit[j];
     }
-    uint regions = draw.mesh.w;
     // Layers come sorted by source (regions, then dominant lights), so each one's V_o is
-    // complete when the source changes. A region this point's transfer does not reach (T <= 0,
-    // SH ringing), or a dominant light it faces away from, loses nothing to a shadow.
+    // complete when the source changes.
     vec3 blocked = vec3(0.0), dominant_blocked = vec3(0.0);
     uint source = KAGE_NO_HIT;
     float occluded = 0.0;
@@ -87,12 +98,7 @@ void main() {
             OcclusionLayer layer = layers[l];
             if (live) {
                 if (layer.region != source) {
-                    // Two occluders overlapping in one source never take it away twice.
-                    if (source < regions) {
-                        blocked += region_energy[source].rgb * max(region_transfer[source / 4u][source % 4u], 0.0) * min(occluded, 1.0);
-                    } else if (source != KAGE_NO_HIT) {
-                        dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
-                    }
+                    take_away(source, occluded, lit, blocked, dominant_blocked);
                     source = layer.region;
                     occluded = 0.0;
                 }
@@ -101,11 +107,7 @@ void main() {
             }
         } while (hits != 0u);
     } while (++w < words);
-    if (source < regions) {
-        blocked += region_energy[source].rgb * max(region_transfer[source / 4u][source % 4u], 0.0) * min(occluded, 1.0);
-    } else if (source != KAGE_NO_HIT) {
-        dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
-    }
+    take_away(source, occluded, lit, blocked, dominant_blocked);
 
     vec3 self_shadowed = self_term;
     if (PIXEL_COSINE) {

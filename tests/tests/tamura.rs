@@ -2,13 +2,12 @@
 use exr::prelude::f16;
 use glam::{Mat3, Mat4, Vec3};
 use kage::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Edge, Image, ImageDesc, MemoryLocation,
-    Sampler,
+    vk, Binding, Buffer, BufferDesc, ComputePipeline, Edge, Image, ImageDesc, MemoryLocation, Sampler,
 };
 use kage::frame::bounds::group_bounds;
 use kage::frame::regions::Regions;
 use kage::frame::GpuScene;
-use kage::layouts::{bytes_of, bytes_of_slice, spirv, BlurPush, OcclusionLayer};
+use kage::layouts::{bytes_of, bytes_of_slice, BlurPush, OcclusionLayer};
 use kage::pass::Resource;
 use kage::pass::{FrameExecutor, Pass};
 use kage::prt::{transfer, PrtParams, TransferSet};
@@ -17,7 +16,7 @@ use kage::scene::animation::pose;
 use kage::scene::{Camera, Scene};
 use kage::sh;
 use kage::techniques::description::TechniqueDesc;
-use kage::techniques::tamura::occlusion::{Occlusion, RegionSize, FILTERED_FORMAT};
+use kage::techniques::tamura::occlusion::{filter_pipeline, Occlusion, RegionSize, FILTERED_FORMAT};
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use kage_tests::Validated;
 use std::sync::Arc;
@@ -78,23 +77,8 @@ fn filter_layer(
         Buffer::with_data(ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer]))
             .unwrap();
     let nearest = Sampler::new(ctx, "nearest", false, Edge::Clamp, Edge::Clamp).unwrap();
-    let kinds = [
-        BindingKind::StorageBuffer,
-        BindingKind::SampledImage,
-        BindingKind::StorageBuffer,
-        BindingKind::StorageImage,
-    ];
-    let pass = |vertical: bool| {
-        ComputePipeline::specialized(
-            ctx,
-            "occlusion_blur",
-            spirv::OCCLUSION_BLUR_COMP,
-            &kinds,
-            size_of::<BlurPush>() as u32,
-            &[adaptive as u32, vertical as u32],
-        )
-        .unwrap()
-    };
+    let penumbra = if adaptive { Penumbra::Adaptive } else { Penumbra::Fixed };
+    let pass = |vertical| filter_pipeline(ctx, penumbra, vertical).unwrap();
     let (horizontal, vertical) = (pass(false), pass(true));
     let filter = |cmd, blur: &ComputePipeline| {
         let push = BlurPush { params: [0, size, 1, 0] };

@@ -131,6 +131,25 @@ const MASK_MARGIN_TEXELS: f32 = 1.5;
 /// behind it: surfaces that touch (a teapot's base on the floor) must not shadow each other.
 const CONTACT_BIAS_TEXELS: f32 = 0.25;
 
+/// One of the two filter passes (occlusion_blur.comp): along the masks' rows, or `vertical`ly.
+/// Bindings: the layers, the masks (sampled), the horizontal pass's boxes (storage buffer, f32
+/// RGBA per texel), the filtered layers (storage image).
+pub fn filter_pipeline(ctx: &Arc<Context>, penumbra: Penumbra, vertical: bool) -> Result<ComputePipeline> {
+    ComputePipeline::specialized(
+        ctx,
+        if vertical { "occlusion_blur.vertical" } else { "occlusion_blur.horizontal" },
+        spirv::OCCLUSION_BLUR_COMP,
+        &[
+            BindingKind::StorageBuffer,
+            BindingKind::SampledImage,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageImage,
+        ],
+        size_of::<BlurPush>() as u32,
+        &[(penumbra == Penumbra::Adaptive) as u32, vertical as u32],
+    )
+}
+
 /// `layers` square layers of `size`² texels of `format`, read by the filter passes' texel fetches.
 fn layered(
     ctx: &Arc<Context>,
@@ -223,25 +242,10 @@ impl Occlusion {
             .flat_map(f32::to_ne_bytes)
             .collect();
         energy.write(0, &rgb)?;
-        let blur = |vertical: bool| {
-            ComputePipeline::specialized(
-                ctx,
-                if vertical { "occlusion_blur.vertical" } else { "occlusion_blur.horizontal" },
-                spirv::OCCLUSION_BLUR_COMP,
-                &[
-                    BindingKind::StorageBuffer,
-                    BindingKind::SampledImage,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageImage,
-                ],
-                size_of::<BlurPush>() as u32,
-                &[(penumbra == Penumbra::Adaptive) as u32, vertical as u32],
-            )
-        };
         Ok(Occlusion {
             receiver_pipeline: mask_pipeline(ctx, "occluder_mask.receiver", DepthTest::Less)?,
             mask_pipeline: mask_pipeline(ctx, "occluder_mask", DepthTest::Nearer)?,
-            blur: [blur(false)?, blur(true)?],
+            blur: [filter_pipeline(ctx, penumbra, false)?, filter_pipeline(ctx, penumbra, true)?],
             mask: layered(
                 ctx,
                 "occlusion.mask",
@@ -264,7 +268,9 @@ impl Occlusion {
                 ctx,
                 &BufferDesc {
                     name: "occlusion.temp",
-                    size: u64::from(layer_count) * u64::from(resolution) * u64::from(resolution) * 16,
+                    size: u64::from(layer_count)
+                        * u64::from(resolution * resolution)
+                        * size_of::<[f32; 4]>() as u64,
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::GpuOnly,
                 },
