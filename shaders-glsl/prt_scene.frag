@@ -61,7 +61,7 @@ void take_away(uint source, float occluded, float lit[KAGE_MAX_DOMINANT_LIGHTS],
     uint regions = draw.mesh.w;
     if (source < regions) {
         blocked += region_energy[source].rgb * max(region_transfer[source / 4u][source % 4u], 0.0) * min(occluded, 1.0);
-    } else if (source != KAGE_NO_HIT) {
+    } else if (DOMINANT_LIGHTS > 0u && source != KAGE_NO_HIT) {
         dominant_blocked += dominant.lights[source - regions].energy.rgb * lit[source - regions] * min(occluded, 1.0);
     }
 }
@@ -108,6 +108,13 @@ void main() {
         } while (hits != 0u);
     } while (++w < words);
     take_away(source, occluded, lit, blocked, dominant_blocked);
+    // The dominant lights a sheet hides wholly, which have no layers (the regions it hides are
+    // in self_term: see prt_scene.vert).
+    [[unroll]] for (uint j = 0u; j < DOMINANT_LIGHTS; ++j) {
+        uint s = draw.mesh.w + j;
+        bool gone = (draw.covered[s / 32u] & (1u << (s % 32u))) != 0u;
+        dominant_blocked += gone ? dominant.lights[j].energy.rgb * lit[j] : vec3(0.0);
+    }
 
     vec3 self_shadowed = self_term;
     if (PIXEL_COSINE) {

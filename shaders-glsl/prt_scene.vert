@@ -15,6 +15,7 @@
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D self_shadow;
 layout(set = 0, binding = 2, std430) readonly buffer Basis { RegionBasis region_basis[]; };
+layout(set = 0, binding = 3, std140) uniform Energy { vec4 region_energy[KAGE_MAX_REGIONS]; };
 // The SH of the light L_s is made of (the map less its dominant lights), in the map's frame.
 layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
 layout(set = 0, binding = 8, std140) uniform Sh { ShCoeffs sh; };
@@ -32,7 +33,8 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 transfer[KAGE_TRANSFER_VEC4];
 
-// L_s, or with PIXEL_COSINE albedo / pi E(n) - L_s.
+// L_s, or with PIXEL_COSINE albedo / pi E(n) - L_s; less, or more, what occluder sheets hide
+// (albedo B_i T_i of the regions they take away whole).
 layout(location = 0) out vec3 self_term;
 layout(location = 1) out vec3 world_position;
 layout(location = 2) out vec3 world_normal;
@@ -49,12 +51,18 @@ void main() {
     uint regions = draw.mesh.w, first = draw.mesh.z * regions;
     // The basis at each region's direction is evaluated exactly on the host once per group and
     // frame (Cartesian real SH, no table); here only the dot products remain.
+    // The regions an occluder sheet hides wholly from this group take their whole share,
+    // B_i max(T_i, 0), here (they have no occlusion layers).
+    vec3 hidden = vec3(0.0);
     [[unroll]] for (uint k = 0u; k < REGION_VEC4; ++k) {
         vec4 t = vec4(0.0);
         [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-            if (4u * k + c < regions) {
-                RegionBasis b = region_basis[first + 4u * k + c];
+            uint i = 4u * k + c;
+            if (i < regions) {
+                RegionBasis b = region_basis[first + i];
                 [[unroll]] for (uint j = 0u; j < BASIS_VEC4; ++j) t[c] += dot(transfer[j], b.y[j]);
+                bool gone = (draw.covered[i / 32u] & (1u << (i % 32u))) != 0u;
+                hidden += gone ? region_energy[i].rgb * max(t[c], 0.0) : vec3(0.0);
             }
         }
         region_transfer[k] = t;
@@ -65,6 +73,7 @@ void main() {
         vec3 unshadowed = max(sh9_irradiance(sh.c, env_world_to_map(normalize(world_normal), frame.env_params.y)), vec3(0.0));
         self_term = draw.albedo.rgb / KAGE_PI * unshadowed - self_term;
     }
+    self_term += (PIXEL_COSINE ? 1.0 : -1.0) * draw.albedo.rgb * hidden;
     vec4 world = draw.model * vec4(position, 1.0);
     world_position = world.xyz;
     // Which layers' footprints a triangle with this corner can reach: every point of the

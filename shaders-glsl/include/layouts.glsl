@@ -166,6 +166,7 @@ struct PrtDrawPush {
     vec4 albedo; // rgb: diffuse albedo, a: the mesh's longest triangle edge in world units
     uvec4 mesh; // x: first self-shadow texel, y: texture width, z: group, w: regions (0: self-shadow only)
     uvec4 layers; // x: first occlusion layer of this receiver, y: its layer count, z: the group's slot among the dominant lights' self-shadow maps plus one (0: none), w: mask size in texels
+    uvec4 covered; // bit s (of 128): an occluder sheet hides light source s (regions, then dominant lights) from the whole group
 };
 
 // One occlusion layer: the shadow of one occluder group on one receiver group for one region.

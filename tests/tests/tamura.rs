@@ -17,6 +17,7 @@ use kage::scene::{Camera, Scene};
 use kage::sh;
 use kage::techniques::description::TechniqueDesc;
 use kage::techniques::tamura::occlusion::{filter_pipeline, Occlusion, RegionSize, FILTERED_FORMAT};
+use kage::techniques::tamura::sheet::Sheet;
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use kage_tests::Validated;
 use std::sync::Arc;
@@ -341,7 +342,8 @@ fn filtered_layers_are_zero_outside_their_footprint() {
             size: RegionSize::Energy,
             ..Default::default()
         };
-        let mut occlusion = Occlusion::new(&ctx, regions, &[], 3, bounds, &settings).unwrap();
+        let sheets = scene.groups.iter().map(Sheet::of).collect();
+        let mut occlusion = Occlusion::new(&ctx, regions, &[], 3, bounds, sheets, &settings).unwrap();
         let mut executor = FrameExecutor::new(&ctx, "footprint").unwrap();
         for t in [0.0, 0.1, 0.3, 0.6] {
             let mut transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
@@ -392,7 +394,10 @@ fn the_floor_gets_no_layer_over_the_teapot_from_above() {
     let (teapot, floor) = (0usize, 1usize);
     let regions = Regions::new(&scene.environment, 32).unwrap();
     let settings = OcclusionSettings { mask_size: 16, ..Default::default() };
-    let mut occlusion = Occlusion::new(&ctx, regions, &[], 3, group_bounds(&scene), &settings).unwrap();
+    let directions: Vec<Vec3> = regions.regions.iter().map(|r| r.direction.as_vec3()).collect();
+    let sheets = scene.groups.iter().map(Sheet::of).collect();
+    let mut occlusion =
+        Occlusion::new(&ctx, regions, &[], 3, group_bounds(&scene), sheets, &settings).unwrap();
     let transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
     occlusion.update(&transforms, Mat3::IDENTITY).unwrap();
     let layers = occlusion.layers_in_use();
@@ -410,4 +415,20 @@ fn the_floor_gets_no_layer_over_the_teapot_from_above() {
     }
     let from_above = of(floor).iter().filter(|l| l.occluder as usize == teapot && w(l).y > 0.0).count();
     assert!(from_above >= 16, "only {from_above} layers of the teapot on the floor from above");
+    // From below, the floor (a sheet) hides the teapot standing on it wholly from every region
+    // steep enough that the teapot's shadow stays on it: those regions are taken away whole,
+    // with no layer; only regions near the horizon keep a layer from the floor.
+    // The teapot is 1 tall and about 1.6 wide on a 6 × 6 floor: from 45° below the horizon
+    // its shadow cylinder with the penumbra stays on the floor, from 15° below it runs off.
+    let covered = occlusion.covered[teapot];
+    let is_covered = |i: usize| covered[i / 32] >> (i % 32) & 1 == 1;
+    let elevation = |i: usize| directions[i].y.asin().to_degrees();
+    for i in 0..directions.len() {
+        let e = elevation(i);
+        assert!(!is_covered(i) || e < -15.0, "region {i} at {e:.0}° hidden by the floor");
+        assert!(is_covered(i) || e > -45.0, "region {i} at {e:.0}° not hidden by the floor");
+    }
+    assert!((0..directions.len()).filter(|&i| is_covered(i)).count() >= 4);
+    assert!(of(teapot).iter().all(|l| !is_covered(l.region as usize)), "a hidden region kept a layer");
+    assert_eq!(occlusion.covered[floor], [0; 4], "the teapot is no sheet");
 }

@@ -213,8 +213,9 @@ pub struct GraphicsDesc<'a> {
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
     pub depth: DepthTest,
-    /// Add to the colour target instead of replacing it (accumulating lights).
-    pub additive: bool,
+    /// Write the colour targets; false draws depth only into a scope that has colour targets
+    /// (the fragment shader's outputs are dropped).
+    pub write_color: bool,
     /// Specialization constants of both stages, `constant_id` 0, 1, … in order (a stage ignores
     /// the ids it does not declare): choices fixed for the pipeline's life, so the shader
     /// compiler removes the branches not taken and sizes arrays to what is used (llvmpipe runs
@@ -302,15 +303,12 @@ impl GraphicsPipeline {
                 DepthTest::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
                 DepthTest::Off | DepthTest::Less | DepthTest::Nearer => vk::CompareOp::LESS,
             });
-        let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA)
-            .blend_enable(desc.additive)
-            .src_color_blend_factor(vk::BlendFactor::ONE)
-            .dst_color_blend_factor(vk::BlendFactor::ONE)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
-            .alpha_blend_op(vk::BlendOp::ADD);
+        let blend_attachment =
+            vk::PipelineColorBlendAttachmentState::default().color_write_mask(if desc.write_color {
+                vk::ColorComponentFlags::RGBA
+            } else {
+                vk::ColorComponentFlags::empty()
+            });
         let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];

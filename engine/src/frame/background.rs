@@ -28,7 +28,7 @@ impl Background {
                 color_formats: &[COLOR_FORMAT],
                 depth_format: None,
                 depth: DepthTest::Off,
-                additive: false,
+                write_color: true,
                 constants: &[],
             },
         )?;

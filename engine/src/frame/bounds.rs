@@ -26,13 +26,7 @@ impl GroupBounds {
 
     /// The world positions of the box's corners, with `transform` placing the group.
     pub fn corners(&self, transform: &Mat4) -> [Vec3; 8] {
-        std::array::from_fn(|c| {
-            transform.transform_point3(Vec3::new(
-                if c & 1 == 0 { self.min.x } else { self.max.x },
-                if c & 2 == 0 { self.min.y } else { self.max.y },
-                if c & 4 == 0 { self.min.z } else { self.max.z },
-            ))
-        })
+        box_corners(self.min, self.max, transform)
     }
 
     /// Whether this group (placed by `transform`) lies wholly on the far side of a world axis
@@ -66,6 +60,17 @@ impl GroupBounds {
             .map(|c| (*c - origin).dot(w))
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
     }
+}
+
+/// The corners of the box `min`..`max`, placed by `transform`.
+pub fn box_corners(min: Vec3, max: Vec3, transform: &Mat4) -> [Vec3; 8] {
+    std::array::from_fn(|c| {
+        transform.transform_point3(Vec3::new(
+            if c & 1 == 0 { min.x } else { max.x },
+            if c & 2 == 0 { min.y } else { max.y },
+            if c & 4 == 0 { min.z } else { max.z },
+        ))
+    })
 }
 
 /// The object-space bounds of every group.

@@ -85,7 +85,7 @@ pub fn scene_pipeline_with(
             color_formats: &[COLOR_FORMAT],
             depth_format: Some(DEPTH_FORMAT),
             depth,
-            additive: false,
+            write_color: true,
             constants: &[],
         },
     )

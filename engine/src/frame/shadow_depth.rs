@@ -49,7 +49,7 @@ pub fn depth_only_pipeline(
             color_formats: &[],
             depth_format: Some(DEPTH_FORMAT),
             depth: DepthTest::Less,
-            additive: false,
+            write_color: true,
             constants: &[],
         },
     )

@@ -272,7 +272,7 @@ impl IdPages {
                 color_formats: &[ID_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth: DepthTest::Less,
-                additive: false,
+                write_color: true,
                 constants: &[],
             },
         )?;

@@ -34,7 +34,7 @@ use crate::backend::{
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::scene_sphere;
-use crate::frame::bounds::{group_bounds, GroupBounds};
+use crate::frame::bounds::{box_corners, group_bounds, GroupBounds};
 use crate::frame::scene_pass::{
     depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
 };
@@ -522,13 +522,9 @@ fn draw_triangles(draws: &[(usize, u32, u32)]) -> u64 {
 
 /// The light-uv bounds of the object-space box `min`..`max` under `transform`.
 fn box_rect(view_proj: &Mat4, transform: &Mat4, min: Vec3, max: Vec3) -> UvRect {
-    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for corner in 0..8 {
-        let pick = |bit: usize, a: f32, b: f32| if corner >> bit & 1 == 0 { a } else { b };
-        let local = Vec3::new(pick(0, min.x, max.x), pick(1, min.y, max.y), pick(2, min.z, max.z));
-        let world = transform.transform_point3(local);
-        (lo, hi) = (lo.min(world), hi.max(world));
-    }
+    let (lo, hi) = box_corners(min, max, transform)
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(*c), hi.max(*c)));
     UvRect::of_box(view_proj, lo, hi)
 }
 

@@ -128,7 +128,7 @@ impl SelfShadow {
                 color_formats: &[vk::Format::R32G32B32A32_SFLOAT],
                 depth_format: None,
                 depth: DepthTest::Off,
-                additive: false,
+                write_color: true,
                 constants: &[],
             },
         )?;

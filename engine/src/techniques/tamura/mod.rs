@@ -4,4 +4,5 @@
 pub mod dominant;
 pub mod dominant_maps;
 pub mod occlusion;
+pub mod sheet;
 pub mod technique;

@@ -21,13 +21,14 @@
 //!   the light than the receiver; occluders whose shadow cylinder misses the receiver's sphere.
 //!   A group alone runs no occlusion pass at all.
 use super::dominant::DominantLight;
+use super::sheet::Sheet;
 use super::technique::{OcclusionSettings, Penumbra};
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
     GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
 use crate::error::Result;
-use crate::frame::bounds::{rotation_of, GroupBounds};
+use crate::frame::bounds::{box_corners, rotation_of, GroupBounds};
 use crate::frame::gpu_scene::MESH_POSITIONS;
 use crate::frame::regions::{Region, Regions};
 use crate::frame::{GpuScene, DEPTH_FORMAT};
@@ -35,6 +36,7 @@ use crate::layouts::{
     bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
 };
 use crate::pass::{Pass, Resource};
+use crate::scene::clusters::Cluster;
 
 /// The occluder masks before filtering.
 pub const MASKS: Resource = Resource("occlusion_masks");
@@ -79,6 +81,8 @@ pub struct Occlusion {
     regions: usize,
     bands: usize,
     bounds: Vec<GroupBounds>,
+    /// Per group: the sheet it is, if it is one.
+    sheets: Vec<Option<Sheet>>,
     pub resolution: u32,
     capacity: u32,
     pub penumbra: Penumbra,
@@ -106,6 +110,9 @@ pub struct Occlusion {
     pub region_basis: Buffer,
     /// Per receiver group: its first layer and layer count.
     pub ranges: Vec<(u32, u32)>,
+    /// Per receiver group, bit s: an occluder sheet hides source s from the whole group, which
+    /// loses it with no layer (`Sheet`).
+    pub covered: Vec<[u32; 4]>,
     /// The layers in use this frame, as uploaded to `layers`.
     in_use: Vec<OcclusionLayer>,
     /// The receiver group of each layer in use.
@@ -184,8 +191,9 @@ pub fn plane_axes(w: Vec3) -> (Vec3, Vec3) {
     (u, w.cross(u))
 }
 
-/// The mask pipelines: `depth` Less for the receiver's surface, Nearer for the occluder.
-fn mask_pipeline(ctx: &Arc<Context>, name: &str, depth: DepthTest) -> Result<GraphicsPipeline> {
+/// The mask pipelines: the receiver's surface (depth only), then the occluder's coverage in
+/// front of it.
+fn mask_pipeline(ctx: &Arc<Context>, name: &str, occluder: bool) -> Result<GraphicsPipeline> {
     GraphicsPipeline::new(
         ctx,
         &GraphicsDesc {
@@ -198,8 +206,8 @@ fn mask_pipeline(ctx: &Arc<Context>, name: &str, depth: DepthTest) -> Result<Gra
             topology: vk::PrimitiveTopology::TRIANGLE_LIST,
             color_formats: &[MASK_FORMAT],
             depth_format: Some(DEPTH_FORMAT),
-            depth,
-            additive: false,
+            depth: if occluder { DepthTest::Nearer } else { DepthTest::Less },
+            write_color: occluder,
             constants: &[],
         },
     )
@@ -214,6 +222,7 @@ impl Occlusion {
         lights: &[DominantLight],
         bands: usize,
         bounds: Vec<GroupBounds>,
+        sheets: Vec<Option<Sheet>>,
         settings: &OcclusionSettings,
     ) -> Result<Occlusion> {
         let (resolution, penumbra, size) = (settings.mask_size, settings.penumbra, settings.size);
@@ -243,8 +252,8 @@ impl Occlusion {
             .collect();
         energy.write(0, &rgb)?;
         Ok(Occlusion {
-            receiver_pipeline: mask_pipeline(ctx, "occluder_mask.receiver", DepthTest::Less)?,
-            mask_pipeline: mask_pipeline(ctx, "occluder_mask", DepthTest::Nearer)?,
+            receiver_pipeline: mask_pipeline(ctx, "occluder_mask.receiver", false)?,
+            mask_pipeline: mask_pipeline(ctx, "occluder_mask", true)?,
             blur: [filter_pipeline(ctx, penumbra, false)?, filter_pipeline(ctx, penumbra, true)?],
             mask: layered(
                 ctx,
@@ -291,6 +300,7 @@ impl Occlusion {
             energy,
             region_basis: host_buffer(ctx, "occlusion.region_basis", groups * q * size_of::<RegionBasis>())?,
             ranges: vec![(0, 0); groups],
+            covered: vec![[0; 4]; groups],
             in_use: Vec::new(),
             receivers: Vec::new(),
             dropped: 0,
@@ -298,6 +308,7 @@ impl Occlusion {
             regions: q,
             bands,
             bounds,
+            sheets,
             resolution,
             capacity,
         })
@@ -394,6 +405,21 @@ impl Occlusion {
         })
     }
 
+    /// Whether occluder `o`, a sheet, hides the whole receiver `r` from direction `w`, with the
+    /// penumbra `layer` would give (half its box, and the bilinear read's texel) to spare.
+    fn hides(&self, transforms: &[Mat4], r: usize, o: usize, w: Vec3, layer: &OcclusionLayer) -> bool {
+        let Some(sheet) = &self.sheets[o] else { return false };
+        let texel = 1.0 / (layer.centre[3] * self.resolution as f32);
+        let widest = layer.axis_v[3] * texel;
+        // The adaptive box grows with the distance to the occluder (up to the widest); the
+        // paper's is one width.
+        let margin = |distance: f32| match self.penumbra {
+            Penumbra::Fixed => 0.5 * widest + texel,
+            Penumbra::Adaptive => 0.5 * (layer.widen * texel * distance).min(widest) + texel,
+        };
+        sheet.hides(&transforms[o], &self.bounds[r].corners(&transforms[r]), w, margin)
+    }
+
     /// Chooses this frame's layers and uploads them, with each group's region basis.
     pub fn update(&mut self, transforms: &[Mat4], env: Mat3) -> Result<()> {
         let q = self.region_count();
@@ -401,6 +427,7 @@ impl Occlusion {
             self.sources.iter().map(|r| (env * r.direction.as_vec3()).normalize()).collect();
 
         let mut jobs = Vec::new();
+        self.covered.iter_mut().for_each(|c| *c = [0; 4]);
         for r in 0..transforms.len() {
             let to_object = rotation_of(&transforms[r]).transpose();
             for (i, region) in self.sources.iter().enumerate() {
@@ -409,8 +436,15 @@ impl Occlusion {
                 if energy <= 0.0 || self.bounds[r].faces_away_from(to_object * w) {
                     continue;
                 }
+                let wanted = jobs.len();
                 for o in (0..transforms.len()).filter(|&o| o != r) {
                     if let Some(layer) = self.layer(transforms, r, o, i, w) {
+                        if self.hides(transforms, r, o, w, &layer) {
+                            // The source is gone whole: no other occluder can take more of it.
+                            self.covered[r][i / 32] |= 1 << (i % 32);
+                            jobs.truncate(wanted);
+                            break;
+                        }
                         jobs.push(Job { receiver: r, weight: energy, layer });
                     }
                 }
@@ -485,14 +519,23 @@ impl Occlusion {
             let layer = &self.in_use[l];
             let bias = CONTACT_BIAS_TEXELS / (layer.centre[3] * self.resolution as f32);
             pipeline.bind(cmd, &[Binding::Storage(&self.layers)]);
+            let model = scene.transforms[group];
             for mesh in scene.meshes.iter().filter(|m| m.group == group) {
                 let push = MaskPush {
-                    model: scene.transforms[group].to_cols_array_2d(),
+                    model: model.to_cols_array_2d(),
                     layer: [l as u32, role, 0, 0],
                     bias: [bias, 0.0, 0.0, 0.0],
                 };
                 pipeline.push(cmd, bytes_of(&push));
-                ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+                if role == 1 {
+                    ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
+                    continue;
+                }
+                // The receiver's depth matters only under the occluder: its triangle clusters
+                // beyond the footprint are not drawn (most of a floor is).
+                for (first, count) in runs_within(layer, &model, &mesh.clusters) {
+                    ctx.draw_indexed_range(cmd, &[&mesh.vertices], &mesh.indices, first, count);
+                }
             }
         };
         vec![
@@ -510,4 +553,30 @@ impl Occlusion {
             Pass::new("blur_vertical", &[HALF_FILTERED], &[OCCLUSION], move |cmd| blur(cmd, &self.blur[1])),
         ]
     }
+}
+
+/// The index runs of `clusters` (a mesh's, placed by `model`) whose bounds reach `layer`'s
+/// footprint, neighbours merged: (first index, count).
+fn runs_within(layer: &OcclusionLayer, model: &Mat4, clusters: &[Cluster]) -> Vec<(u32, u32)> {
+    let centre = Vec3::from_slice(&layer.centre[..3]);
+    let axes = [Vec3::from_slice(&layer.axis_u[..3]), Vec3::from_slice(&layer.axis_v[..3])];
+    let f = &layer.footprint;
+    let mut runs: Vec<(u32, u32)> = Vec::new();
+    for c in clusters {
+        let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
+        for corner in box_corners(c.min, c.max, model) {
+            for k in 0..2 {
+                let uv = (corner - centre).dot(axes[k]) * layer.centre[3] + 0.5;
+                (lo[k], hi[k]) = (lo[k].min(uv), hi[k].max(uv));
+            }
+        }
+        if hi[0] < f[0] || lo[0] > f[2] || hi[1] < f[1] || lo[1] > f[3] {
+            continue;
+        }
+        match runs.last_mut() {
+            Some(last) if last.0 + last.1 == c.first => last.1 += c.count,
+            _ => runs.push((c.first, c.count)),
+        }
+    }
+    runs
 }

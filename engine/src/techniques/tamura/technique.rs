@@ -5,6 +5,7 @@ use super::dominant_maps::DOMINANT_MAPS;
 use super::dominant_maps::{self, DominantMaps};
 use super::occlusion::OCCLUSION;
 use super::occlusion::{Occlusion, RegionSize};
+use super::sheet::Sheet;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline,
     Sampler, VertexBuffer,
@@ -184,13 +185,14 @@ impl PrtTechnique {
         }
         let transfer_attributes = transfer_vertex_buffer(2);
         let bounds = group_bounds(scene);
+        let sheets = scene.groups.iter().map(Sheet::of).collect();
         // prt_scene.vert's pipeline constants: vec4s of region transfers and of SH coefficients.
         let region_vec4 = regions.regions.len().div_ceil(4).max(1) as u32;
         let basis_vec4 = (bands * bands).div_ceil(4) as u32;
         Ok(PrtTechnique {
             drawn: |_| true,
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
-            occlusion: Occlusion::new(ctx, regions, &split.lights, bands, bounds.clone(), &settings)?,
+            occlusion: Occlusion::new(ctx, regions, &split.lights, bands, bounds.clone(), sheets, &settings)?,
             dominant: DominantMaps::new(ctx, split.lights, bounds, settings.light_map_size)?,
             scene_pipeline: GraphicsPipeline::new(
                 ctx,
@@ -219,7 +221,7 @@ impl PrtTechnique {
                     color_formats: &[COLOR_FORMAT],
                     depth_format: Some(DEPTH_FORMAT),
                     depth: DepthTest::LessOrEqual,
-                    additive: false,
+                    write_color: true,
                     constants: &[
                         (settings.penumbra == Penumbra::Adaptive) as u32,
                         region_vec4,
@@ -335,6 +337,7 @@ impl PrtTechnique {
                 albedo: [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], reach],
                 mesh: [self_shadow.first_texel[i], constants::SELF_SHADOW_WIDTH, mesh.group as u32, q],
                 layers: [first_layer, layer_count, self.dominant.slot(mesh.group), occlusion.resolution],
+                covered: occlusion.covered[mesh.group],
             };
             self.scene_pipeline.push(cmd, bytes_of(&push));
             ctx.draw_indexed(
