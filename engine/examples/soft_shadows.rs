@@ -18,6 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let prt = PrtParams::DEFAULT;
     let transfer = transfer::precompute(&ctx, &scene, prt, &mut |done, total| {
         eprint!("\rtransfer: {done} of {total} vertices");
+        true // go on
     })?;
     eprintln!();
     let technique = TechniqueDesc::Tamura { prt, occlusion: OcclusionSettings::default() };

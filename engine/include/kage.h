@@ -94,6 +94,11 @@ enum kage_result
    * nothing was done.
    */
   KAGE_RESULT_BUSY = 14,
+  /**
+   * The host's progress callback returned false: the work stopped, and nothing it was to
+   * change was changed.
+   */
+  KAGE_RESULT_CANCELLED = 15,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -819,6 +824,38 @@ typedef struct {
   kage_camera_desc camera;
 } kage_scene_desc;
 
+/**
+ * Hears how far long work has come (`fraction`, 0 to 1, rising) and answers whether to go on:
+ * false stops the work, and the call that started it returns `KAGE_RESULT_CANCELLED`, having
+ * changed nothing. Called on the thread of that call, between steps of the work (about one
+ * per submission to the device); `user` is the pointer the host gave beside it.
+ */
+typedef bool (*kage_progress_fn)(void *user, double fraction);
+
+/**
+ * How `kage_precompute_with` caches and reports its work. All zero but `size`: no disk cache,
+ * no progress.
+ */
+typedef struct {
+  /**
+   * `sizeof(kage_precompute_options)` as the host's kage.h declares it.
+   */
+  uint32_t size;
+  /**
+   * The PRT disk cache's folder (UTF-8), the one `kage precompute --cache` and `kage render`
+   * use: NULL for no disk cache; "" for the default folder (`KAGE_CACHE_DIR`, else
+   * `XDG_CACHE_HOME/kage`, else `HOME/.cache/kage`; an error when none is set). A file there
+   * made for the same geometry, bands, rays and visibility is read instead of computing;
+   * otherwise the result is computed and written there (the folder is created).
+   */
+  const char *cache_dir;
+  /**
+   * NULL for none.
+   */
+  kage_progress_fn progress;
+  void *user;
+} kage_precompute_options;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1084,7 +1121,8 @@ kage_result kage_technique_desc_default(uint32_t technique, kage_technique_desc 
  * it in the scene for `kage_renderer_create`: for Sloan and Tamura the per-vertex PRT transfer
  * (seconds to minutes: it casts `prt_rays` rays per vertex; for `KAGE_TECHNIQUE_SLOAN_SCENE`
  * against the whole scene as its group transforms stand); for the other techniques nothing.
- * A later call replaces what an earlier one computed.
+ * A later call replaces what an earlier one computed. The same as `kage_precompute_with`
+ * without options: no disk cache, no progress.
  *
  * The scene keeps no reference to the context.
  *
@@ -1095,6 +1133,19 @@ kage_result kage_technique_desc_default(uint32_t technique, kage_technique_desc 
 kage_result kage_precompute(const kage_context *context,
                             kage_scene *scene,
                             const kage_technique_desc *technique);
+
+/**
+ * `kage_precompute` with a disk cache and a progress callback that may cancel the work
+ * (`options` NULL: neither). On `KAGE_RESULT_CANCELLED` the scene keeps what it had.
+ *
+ * # Safety
+ * `technique` and `options` NULL or valid; `options->cache_dir` NULL or a NUL-terminated
+ * string; `options->progress` NULL or a function that may be called with `options->user`.
+ */
+kage_result kage_precompute_with(const kage_context *context,
+                                 kage_scene *scene,
+                                 const kage_technique_desc *technique,
+                                 const kage_precompute_options *options);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -38,6 +38,9 @@ pub enum Error {
     Probes(#[from] ProbeError),
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// The caller's progress callback asked to stop.
+    #[error("{0} was cancelled by the caller")]
+    Cancelled(&'static str),
     /// A bug in Kage, not in what it was given: a pass reading what no pass wrote, a write past
     /// a buffer the engine sized itself.
     #[error("internal error (please report): {0}")]
@@ -73,7 +76,9 @@ impl Error {
             Error::Scene(e) if e.file().is_some() => Fault::File,
             Error::Image(_) => Fault::File,
             Error::Probes(ProbeError::FitDiverged { .. }) => Fault::Internal,
-            Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) => Fault::Caller,
+            Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) | Error::Cancelled(_) => {
+                Fault::Caller
+            }
             Error::Internal(_) => Fault::Internal,
         }
     }

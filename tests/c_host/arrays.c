@@ -391,6 +391,59 @@ static void check_bad_arguments(kage_context *context) {
   CHECK(kage_scene_destroy(scene));
 }
 
+/* What a progress callback heard; it answers "stop" at its `stop_at`-th call (0: never). */
+typedef struct {
+  int calls;
+  double last;
+  int stop_at;
+} progress_log;
+
+static bool hear(void *user, double fraction) {
+  progress_log *log = user;
+  log->calls++;
+  REQUIRE(fraction >= log->last && fraction <= 1.0);
+  log->last = fraction;
+  return log->calls != log->stop_at;
+}
+
+/* kage_precompute_with: a progress callback that cancels, and the disk cache. */
+static void check_precompute_options(kage_context *context) {
+  kage_scene *scene = make_scene();
+  kage_technique_desc technique;
+  CHECK(kage_technique_desc_default(KAGE_TECHNIQUE_SLOAN_SELF, &technique));
+  technique.prt_rays = 64;
+  kage_renderer_desc renderer_desc = {sizeof(kage_renderer_desc), 8, 8, technique};
+  kage_renderer *renderer = NULL;
+  progress_log log = {0, 0.0, 1};
+  kage_precompute_options options = {sizeof(kage_precompute_options), NULL, hear, &log};
+  EXPECT(kage_precompute_with(context, scene, &technique, &options), KAGE_RESULT_CANCELLED);
+  REQUIRE(log.calls == 1);
+  /* Cancelled before it had a transfer: the scene still has none. */
+  EXPECT(kage_renderer_create(context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_VALUE);
+  options.size = 3;
+  EXPECT(kage_precompute_with(context, scene, &technique, &options), KAGE_RESULT_INVALID_VALUE);
+  options.size = sizeof(kage_precompute_options);
+
+  /* Computed and written once, with progress up to 1; read back the second time, silently. */
+  char dir[] = "/tmp/kage-c-cache-XXXXXX";
+  REQUIRE(mkdtemp(dir) != NULL);
+  options.cache_dir = dir;
+  log = (progress_log){0, 0.0, 0};
+  CHECK(kage_precompute_with(context, scene, &technique, &options));
+  REQUIRE(log.calls >= 2 && log.last == 1.0);
+  log = (progress_log){0, 0.0, 0};
+  CHECK(kage_precompute_with(context, scene, &technique, &options));
+  REQUIRE(log.calls == 0);
+  CHECK(kage_renderer_create(context, scene, &renderer_desc, &renderer));
+  CHECK(kage_renderer_render(renderer));
+  CHECK(kage_renderer_destroy(renderer));
+  /* One cache file, which goes with its folder. */
+  char command[128];
+  snprintf(command, sizeof command, "test $(ls %s | wc -l) -eq 1 && rm -r %s", dir, dir);
+  REQUIRE(system(command) == 0);
+  CHECK(kage_scene_destroy(scene));
+}
+
 int main(int argc, char **argv) {
   if (argc == 2 && strcmp(argv[1], "forget-a-scene") == 0) {
     /* The canary of the memcheck test: valgrind must report this scene as lost, which proves
@@ -411,6 +464,7 @@ int main(int argc, char **argv) {
   check_bad_arguments(context);
   check_hostile_files();
   check_lights(context);
+  check_precompute_options(context);
   render_moving_box(context, (uint32_t)atoi(argv[4]), frames, size);
   CHECK(kage_context_destroy(context));
   printf("ok\n");

@@ -114,7 +114,7 @@ fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, RenderOpt
             ctx,
             scene,
             PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
-            &mut |_, _| {},
+            &mut |_, _| true,
         )
         .unwrap(),
     );
@@ -307,7 +307,7 @@ fn meshes_without_triangles_are_errors_and_empty_groups_draw_nothing() {
             &ctx,
             &empty_mesh,
             PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
-            &mut |_, _| {},
+            &mut |_, _| true,
         ),
         &expected,
     );
@@ -495,7 +495,7 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
             &ctx,
             &scene,
             PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
-            &mut |_, _| {},
+            &mut |_, _| true,
         )
         .unwrap(),
     );

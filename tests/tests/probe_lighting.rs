@@ -66,7 +66,7 @@ fn static_groups_keep_their_own_prt_lighting_beside_the_probe_lit_bunny() {
     let ctx = Validated::new();
     let scene = Scene::builtin("probe-room").unwrap();
     let params = PrtParams { bands: 3, rays: 16, ..kage::prt::PrtParams::DEFAULT };
-    let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| {}).unwrap());
+    let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| true).unwrap());
     let probes = ProbeSettings {
         placement: ProbePlacement::Grid([2, 2, 2]),
         capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },

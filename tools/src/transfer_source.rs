@@ -81,6 +81,7 @@ impl PrtArgs {
             if start.elapsed().as_secs_f32() >= 1.0 && bar.is_hidden() {
                 bar.set_draw_target(ProgressDrawTarget::stderr());
             }
+            true
         })
         .context("precomputing the transfer on the GPU")?;
         bar.finish_and_clear();

@@ -44,6 +44,9 @@ pub enum kage_result {
     /// The handle is in use by a call on another thread (calls on one handle must not overlap);
     /// nothing was done.
     Busy = 14,
+    /// The host's progress callback returned false: the work stopped, and nothing it was to
+    /// change was changed.
+    Cancelled = 15,
 }
 
 /// A failure on its way to the host: the code and the message for `kage_last_error_message`.
@@ -87,6 +90,7 @@ fn code_of(error: &Error) -> kage_result {
             kage_result::Internal
         }
         Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) => kage_result::InvalidValue,
+        Error::Cancelled(_) => kage_result::Cancelled,
     }
 }
 

@@ -4,7 +4,7 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
-use crate::prt::{transfer, PrtParams};
+use crate::prt::{cache, transfer, PrtParams};
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
 use crate::techniques::description::{TechniqueDesc, TechniqueKind};
@@ -15,6 +15,8 @@ use crate::techniques::probes::{
 };
 use crate::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use glam::DVec3;
+use std::ffi::{c_char, c_void};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Where the light probes go (the values of `kage_technique_desc.probe_placement`).
@@ -266,11 +268,35 @@ pub unsafe extern "C" fn kage_technique_desc_default(
     })
 }
 
+/// Hears how far long work has come (`fraction`, 0 to 1, rising) and answers whether to go on:
+/// false stops the work, and the call that started it returns `KAGE_RESULT_CANCELLED`, having
+/// changed nothing. Called on the thread of that call, between steps of the work (about one
+/// per submission to the device); `user` is the pointer the host gave beside it.
+pub type kage_progress_fn = Option<unsafe extern "C" fn(user: *mut c_void, fraction: f64) -> bool>;
+
+/// How `kage_precompute_with` caches and reports its work. All zero but `size`: no disk cache,
+/// no progress.
+#[repr(C)]
+pub struct kage_precompute_options {
+    /// `sizeof(kage_precompute_options)` as the host's kage.h declares it.
+    pub size: u32,
+    /// The PRT disk cache's folder (UTF-8), the one `kage precompute --cache` and `kage render`
+    /// use: NULL for no disk cache; "" for the default folder (`KAGE_CACHE_DIR`, else
+    /// `XDG_CACHE_HOME/kage`, else `HOME/.cache/kage`; an error when none is set). A file there
+    /// made for the same geometry, bands, rays and visibility is read instead of computing;
+    /// otherwise the result is computed and written there (the folder is created).
+    pub cache_dir: *const c_char,
+    /// NULL for none.
+    pub progress: kage_progress_fn,
+    pub user: *mut c_void,
+}
+
 /// Computes on the context's device what `technique` needs before its first frame, and keeps
 /// it in the scene for `kage_renderer_create`: for Sloan and Tamura the per-vertex PRT transfer
 /// (seconds to minutes: it casts `prt_rays` rays per vertex; for `KAGE_TECHNIQUE_SLOAN_SCENE`
 /// against the whole scene as its group transforms stand); for the other techniques nothing.
-/// A later call replaces what an earlier one computed.
+/// A later call replaces what an earlier one computed. The same as `kage_precompute_with`
+/// without options: no disk cache, no progress.
 ///
 /// The scene keeps no reference to the context.
 ///
@@ -283,15 +309,70 @@ pub unsafe extern "C" fn kage_precompute(
     scene: *mut kage_scene,
     technique: *const kage_technique_desc,
 ) -> kage_result {
+    // SAFETY: the caller's promises, and no options.
+    unsafe { kage_precompute_with(context, scene, technique, std::ptr::null()) }
+}
+
+/// `kage_precompute` with a disk cache and a progress callback that may cancel the work
+/// (`options` NULL: neither). On `KAGE_RESULT_CANCELLED` the scene keeps what it had.
+///
+/// # Safety
+/// `technique` and `options` NULL or valid; `options->cache_dir` NULL or a NUL-terminated
+/// string; `options->progress` NULL or a function that may be called with `options->user`.
+#[no_mangle]
+pub unsafe extern "C" fn kage_precompute_with(
+    context: *const kage_context,
+    scene: *mut kage_scene,
+    technique: *const kage_technique_desc,
+    options: *const kage_precompute_options,
+) -> kage_result {
     boundary(|| {
         let (context, mut scene) = (handles::get(context, "context")?, handles::get(scene, "scene")?);
         // SAFETY: the caller promises NULL or a valid desc (its probe positions included).
         let desc = unsafe { args::sized(technique, "technique")?.desc() }?;
-        if let Some(params) = desc.precomputation() {
-            let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut |_, _| {});
-            kage_context::check_validation(&context.ctx)?;
-            scene.transfer = Some(Arc::new(set?));
+        let (cache_dir, progress, user) = if options.is_null() {
+            (None, None, std::ptr::null_mut())
+        } else {
+            // SAFETY: the caller promises a valid options struct.
+            let options = unsafe { args::sized(options, "options") }?;
+            let dir = if options.cache_dir.is_null() {
+                None
+            } else {
+                // SAFETY: the caller promises a NUL-terminated string.
+                match unsafe { args::text(options.cache_dir, "options.cache_dir") }? {
+                    "" => Some(cache::default_dir().ok_or_else(|| {
+                        Failure::invalid(
+                            "options.cache_dir is \"\" (the default folder), but none of KAGE_CACHE_DIR, \
+                             XDG_CACHE_HOME and HOME is set",
+                        )
+                    })?),
+                    dir => Some(PathBuf::from(dir)),
+                }
+            };
+            (dir, options.progress, options.user)
+        };
+        let Some(params) = desc.precomputation() else { return Ok(()) };
+        let params = params.validated()?;
+        let key = cache::CacheKey::new(&scene.scene, params);
+        let path = cache_dir.map(|dir| dir.join(key.file_name(&scene.scene.name)));
+        if let Some(set) = path.as_ref().and_then(|p| cache::load(p, &key).ok()) {
+            scene.transfer = Some(Arc::new(set));
+            return Ok(());
         }
+        let mut report = |done: usize, total: usize| match progress {
+            // SAFETY: the caller promises a callable function for its own pointer.
+            Some(progress) => unsafe {
+                progress(user, if total == 0 { 1.0 } else { done as f64 / total as f64 })
+            },
+            None => true,
+        };
+        let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut report);
+        kage_context::check_validation(&context.ctx)?;
+        let set = set?;
+        if let Some(path) = &path {
+            cache::save(path, &set, &key).map_err(|e| Failure::new(kage_result::File, e.to_string()))?;
+        }
+        scene.transfer = Some(Arc::new(set));
         Ok(())
     })
 }

@@ -26,12 +26,13 @@ pub const RAYS_PER_DISPATCH: u32 = 32;
 
 /// Computes the transfer of every vertex of `scene`: builds and uploads the BVH, runs the
 /// compute jobs and reads the result back. `progress(done, total)` is called with vertex counts
-/// after each submission. [`TransferSet::seconds`] is the wall-clock time of all of it.
+/// after each submission; when it returns false the work stops with [`Error::Cancelled`].
+/// [`TransferSet::seconds`] is the wall-clock time of all of it.
 pub fn precompute(
     ctx: &Arc<Context>,
     scene: &Scene,
     params: PrtParams,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<TransferSet> {
     let params = params.validated()?;
     let start = Instant::now();
@@ -65,7 +66,7 @@ fn run_jobs(
     bvh: &GpuBvh,
     params: PrtParams,
     total: usize,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<(Vec<f32>, Vec<u32>)> {
     let too_many = || {
         Error::InvalidArgument(format!(
@@ -117,7 +118,10 @@ fn run_jobs(
 
     let mut executor = FrameExecutor::new(ctx, "prt_precompute")?;
     let mut done = 0;
-    progress(done, total);
+    let cancelled = || Error::Cancelled("the PRT precomputation");
+    if !progress(done, total) {
+        return Err(cancelled());
+    }
     for batch in submissions(&mesh_layout(scene), params) {
         let pass = Pass::new("prt_transfer", &[BVH], &[Resource("prt_transfer")], |cmd| {
             for first_ray in (0..params.rays).step_by(RAYS_PER_DISPATCH as usize) {
@@ -138,7 +142,9 @@ fn run_jobs(
         });
         executor.run(&[BVH], vec![pass])?;
         done += batch.iter().map(|p| p.range[1] as usize).sum::<usize>();
-        progress(done, total);
+        if !progress(done, total) {
+            return Err(cancelled());
+        }
     }
     let words = |bytes: Vec<u8>| -> Vec<u32> {
         bytes.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
