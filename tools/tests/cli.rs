@@ -985,3 +985,97 @@ fn every_option_readme_names_is_one_the_program_takes() {
         "only {checked} options found in README's table (133 on 2026-12-03): is the table still there?"
     );
 }
+
+/// The other way round: every option a command's `--help` lists is named in README's rows of
+/// that command (usage or description), so that the table shows all a command takes; the
+/// options every command takes are named once, in the table's preamble.
+#[test]
+fn every_option_the_program_takes_is_in_readmes_table() {
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
+    let is_word = |w: &str| {
+        !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-')
+    };
+    let words = |text: &str| -> Vec<String> {
+        text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-')).map(str::to_string).collect()
+    };
+    // Each command's rows, joined.
+    let mut rows: std::collections::BTreeMap<Vec<String>, Vec<String>> = Default::default();
+    for row in readme.lines().filter(|l| l.starts_with("| `kage ")) {
+        let row = row.replace("\\|", "/");
+        let usage = row.split('|').nth(1).unwrap().trim().trim_matches('`');
+        let command =
+            usage.split_whitespace().skip(1).take_while(|w| is_word(w)).map(str::to_string).collect();
+        rows.entry(command).or_default().extend(words(&row));
+    }
+    let section = readme.split("## Command line").nth(1).unwrap().split("\n| ").next().unwrap();
+    let everywhere = words(section);
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for (command, named) in &rows {
+        let help = String::from_utf8_lossy(
+            &kage(&[command.iter().map(String::as_str).collect::<Vec<_>>().as_slice(), &["--help"]].concat())
+                .stdout,
+        )
+        .into_owned();
+        // Option lines: "  -s, --scene <SCENE>" or "      --force".
+        let options = help.lines().filter_map(|l| {
+            let l = l.trim_start();
+            let l = if l.starts_with('-') && !l.starts_with("--") { l.split_once(", ")?.1 } else { l };
+            l.starts_with("--").then(|| l.split([' ', '=', '<']).next().unwrap().to_string())
+        });
+        for option in options.filter(|o| o != "--help" && o != "--version") {
+            if !named.contains(&option) && !everywhere.contains(&option) {
+                missing.push(format!("kage {} {option}", command.join(" ")));
+            }
+            checked += 1;
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "README's command table lacks {} option(s):\n{}",
+        missing.len(),
+        missing.join("\n")
+    );
+    assert!(checked >= 120, "only {checked} options found in the commands' --help");
+}
+
+/// README's scene-format section and the scene parser agree: its example parses, and every
+/// field and variant the parser accepts, at every level, is named in the section. The parser
+/// lists what it accepts itself: an unknown key at a level makes serde name the expected ones.
+#[test]
+fn readmes_scene_format_names_every_field_the_parser_takes() {
+    use kage::scene::file::SceneFile;
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
+    let section = readme.split("\n## Scene format").nth(1).unwrap().split("\n## ").next().unwrap();
+    let example = section.split("```json").nth(1).unwrap().split("```").next().unwrap();
+    serde_json::from_str::<SceneFile>(example).unwrap_or_else(|e| panic!("README's example scene: {e}"));
+    // A bogus key (or variant) at each level of the format.
+    let levels = [
+        r#"{"zzz": 0}"#,
+        r#"{"camera": {"zzz": 0}}"#,
+        r#"{"environment": {"zzz": 0}}"#,
+        r#"{"groups": [{"zzz": 0}]}"#,
+        r#"{"groups": [{"meshes": [{"zzz": 0}]}]}"#,
+        r#"{"groups": [{"meshes": [{"plane": {"zzz": 0}}]}]}"#,
+        r#"{"groups": [{"meshes": [{"sphere": {"zzz": 0}}]}]}"#,
+        r#"{"lights": [{"zzz": {}}]}"#,
+        r#"{"lights": [{"point": {"zzz": 0}}]}"#,
+        r#"{"lights": [{"spot": {"zzz": 0}}]}"#,
+        r#"{"probes": [{"zzz": 0}]}"#,
+        r#"{"probes": [{"position": [0, 0, 0], "role": "zzz"}]}"#,
+    ];
+    let mut names = Vec::new();
+    for json in levels {
+        let error = serde_json::from_str::<SceneFile>(json).expect_err(json).to_string();
+        let expected = error.split("expected").nth(1).unwrap_or_else(|| panic!("{json}: {error}"));
+        let listed: Vec<String> = expected.split('`').skip(1).step_by(2).map(str::to_string).collect();
+        assert!(!listed.is_empty(), "{json}: {error}");
+        names.extend(listed);
+    }
+    let unnamed: Vec<&String> = names
+        .iter()
+        .filter(|name| ["`", "\"", "**"].iter().all(|q| !section.contains(&format!("{q}{name}{q}"))))
+        .collect();
+    assert!(unnamed.is_empty(), "README's scene format does not name {unnamed:?}, which the parser takes");
+    assert!(names.len() >= 30, "only {} names found: {names:?}", names.len());
+}
