@@ -79,5 +79,5 @@ echo "== shadowmap 2048² (16 MiB) vs reference"
 "$kage" compare "$work/map.exr" "$work/asm-reference.exr" --shadow-mismatch --mismatch-image docs/asm-mismatch-map.png
 echo "wrote docs/asm-reference.png docs/asm-asm.png docs/asm-mismatch-asm.png docs/asm-mismatch-map.png"
 
-"$kage" render --scene probe-room --width "$SIZE" --height "$SIZE" --technique probes --probe-statics sloan --exposure 4 --out docs/probes-room.png
+"$kage" render --scene probe-room --width "$SIZE" --height "$SIZE" --technique probes --probe-statics sloan --out docs/probes-room.png
 echo "wrote docs/probes-room.png"

@@ -48,6 +48,7 @@ pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Sce
         lights: vec![],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera,
     }
 }

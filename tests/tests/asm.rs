@@ -207,6 +207,7 @@ fn grazing_light_with_the_id_and_the_bias_test() {
         }],
         walkthrough: vec![],
         probes: vec![],
+        exposure: 1.0,
         camera: Camera {
             position: Vec3::new(0.0, 3.0, 3.0),
             target: Vec3::new(1.0, 0.0, 0.0),

@@ -55,6 +55,7 @@ fn scene(groups: Vec<Group>) -> Scene {
         lights: vec![],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: Camera {
             position: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

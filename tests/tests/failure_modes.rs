@@ -68,6 +68,7 @@ fn scene(groups: Vec<Group>) -> Scene {
         lights: vec![spot()],
         walkthrough: vec![],
         probes: vec![],
+        exposure: 1.0,
         camera: camera(),
     }
 }

@@ -27,6 +27,7 @@ fn constant_environment_with_no_walls_captures_its_own_sh() {
         lights: vec![],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
     };
     let gpu = GpuScene::new(&ctx, &scene).unwrap();

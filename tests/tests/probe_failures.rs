@@ -35,6 +35,7 @@ fn sun_scene() -> Scene {
         lights: vec![],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: Camera { position: Vec3::new(0.0, 1.0, 3.0), target: Vec3::Y, up: Vec3::Y, fov_y_deg: 40.0 },
     }
 }

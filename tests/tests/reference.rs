@@ -115,6 +115,7 @@ fn tilted_planes_under_a_real_map_match_cpu_integration() {
             lights: vec![],
             walkthrough: vec![],
             probes: Vec::new(),
+            exposure: 1.0,
             camera: Camera { position: 2.0 * n, target: Vec3::ZERO, up, fov_y_deg: 40.0 },
         };
         let stats = render(&ctx, &scene, 16, LightMode::Environment, 10 + k as u32, 256);
@@ -184,6 +185,7 @@ fn a_blocker_darkens_the_floor_by_its_form_factor() {
         lights: vec![],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: side_camera(),
     };
     let size = 33;
@@ -209,6 +211,7 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
         lights,
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: side_camera(),
     };
     let size = 33;
@@ -250,6 +253,7 @@ fn spot_light_lights_only_inside_its_cone() {
             lights: vec![spot(direction).validated().unwrap()],
             walkthrough: vec![],
             probes: Vec::new(),
+            exposure: 1.0,
             camera: side_camera(),
         };
         let stats = render(&ctx, &scene, size, LightMode::Local, 0, 1);

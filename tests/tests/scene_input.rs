@@ -165,6 +165,16 @@ fn bad_scene_values_are_rejected() {
             "unknown field `rings`",
         ),
         ("zero-scale", scene_json(r#", "scale": 0"#, sphere, ""), "scale"),
+        (
+            "zero-exposure",
+            scene_json("", sphere, r#", "exposure": 0"#),
+            "exposure 0 is not a positive number",
+        ),
+        (
+            "negative-exposure",
+            scene_json("", sphere, r#", "exposure": -1"#),
+            "exposure -1 is not a positive number",
+        ),
         ("negative-scale", scene_json(r#", "scale": -2"#, sphere, ""), "scale"),
         ("infinite-translation", scene_json(r#", "translation": [0, 1e39, 0]"#, sphere, ""), "translation"),
         ("infinite-rotation", scene_json(r#", "rotation_deg": [1e39, 0, 0]"#, sphere, ""), "rotation"),
@@ -289,8 +299,11 @@ fn exported_builtins_read_back_identical() {
     let teapot = Scene::builtin("teapot").unwrap();
     let floor = teapot.groups.iter().find(|g| g.name == "floor").unwrap();
     assert_eq!(floor.meshes[0].vertex_count(), 31 * 31);
-    // The asm scene adds box meshes, a spot light and a camera walkthrough.
-    for scene in [teapot, Scene::builtin("asm").unwrap()] {
+    // The asm scene adds box meshes, a spot light and a camera walkthrough; probe-room its
+    // exposure.
+    let room = Scene::builtin("probe-room").unwrap();
+    assert_eq!((teapot.exposure, room.exposure), (1.0, 4.0));
+    for scene in [teapot, Scene::builtin("asm").unwrap(), room] {
         let dir = temp_dir(&format!("export-{}", scene.name));
         scene.export(&dir).unwrap();
         let back = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
@@ -301,6 +314,7 @@ fn exported_builtins_read_back_identical() {
         assert_eq!(back.camera, scene.camera);
         assert_eq!(back.lights, scene.lights);
         assert_eq!(back.walkthrough, scene.walkthrough);
+        assert_eq!(back.exposure, scene.exposure);
         for (a, b) in back.groups.iter().zip(&scene.groups) {
             assert_eq!((&a.name, a.transform), (&b.name, b.transform));
             for (m, n) in a.meshes.iter().zip(&b.meshes) {

@@ -34,6 +34,7 @@ fn box_over_floor_lit_from(light: Vec3) -> Scene {
         lights: vec![spot_at(light)],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: Camera {
             position: Vec3::new(0.0, 2.5, 3.5),
             target: Vec3::ZERO,

@@ -196,6 +196,7 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
         lights: vec![],
         walkthrough: vec![],
         probes: Vec::new(),
+        exposure: 1.0,
         camera: base.camera,
     };
     let lower = sphere_group("lower", radius, Vec3::new(0.0, low, 0.0));

@@ -7,18 +7,20 @@ use std::path::Path;
 /// How bright a PNG output is: the radiance is multiplied by it before tonemapping.
 #[derive(Args)]
 pub struct Exposure {
-    /// Exposure multiplier applied before tonemapping (PNG only).
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    /// Exposure multiplier applied before tonemapping (PNG only; default: the scene's
+    /// `exposure`, 1 for most scenes, 4 for probe-room)
+    #[arg(long)]
+    exposure: Option<f32>,
 }
 
 impl Exposure {
-    /// The multiplier, once checked to be a positive number.
-    pub fn checked(&self) -> Result<f32> {
-        if !(self.exposure.is_finite() && self.exposure > 0.0) {
-            bail!("--exposure must be a positive number, got {}", self.exposure);
+    /// The multiplier given, once checked to be a positive number, else `scene`'s.
+    pub fn checked(&self, scene: &kage::scene::Scene) -> Result<f32> {
+        match self.exposure {
+            Some(e) if !(e.is_finite() && e > 0.0) => bail!("--exposure must be a positive number, got {e}"),
+            Some(e) => Ok(e),
+            None => Ok(scene.exposure),
         }
-        Ok(self.exposure)
     }
 }
 

@@ -119,10 +119,10 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     // Irradiance results are written as .json, images as .png or .exr.
     let extensions: &[&str] = if args.irradiance.is_some() { &["json"] } else { &["png", "exr"] };
     crate::outputs::check(&args.out, "--out", extensions)?;
-    let exposure = args.exposure.checked()?;
     // Bad input files fail before the GPU is set up.
     let points = args.irradiance.as_deref().map(read_points).transpose()?;
     let scene = args.scene.load()?;
+    let exposure = args.exposure.checked(&scene)?;
     let ctx = args.gpu.context()?;
     match points {
         Some(points) => run_irradiance(args, &ctx, &scene, &points)?,

@@ -185,7 +185,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    let exposure = args.exposure.checked()?;
     crate::outputs::check(&args.out, "--out", &["png", "exr"])?;
     if let Some(timings) = &args.timings {
         crate::outputs::check(timings, "--timings", &["json"])?;
@@ -199,6 +198,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let scene = args.scene.load()?;
+    let exposure = args.exposure.checked(&scene)?;
     let ctx = args.gpu.context()?;
     let technique = technique(args, &scene)?;
     let transfer = match technique.precomputation() {

@@ -181,6 +181,7 @@ unsafe fn scene_from_desc(desc: &kage_scene_desc) -> Result<Scene, Failure> {
         camera,
         walkthrough: Vec::new(),
         probes: Vec::new(),
+        exposure: 1.0,
     };
     // The rules every scene meets (its extent among them): refused here, not when a renderer
     // is made from it.

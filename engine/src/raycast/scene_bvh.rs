@@ -223,6 +223,7 @@ mod tests {
             lights: vec![],
             walkthrough: vec![],
             probes: Vec::new(),
+            exposure: 1.0,
             camera: Camera { position: Vec3::Z * 5.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
         }
     }

@@ -142,6 +142,7 @@ pub fn asm_scene() -> Result<Scene, SceneError> {
             camera([0.4, 0.7, 2.4], [-1.6, 0.0, 1.2], 35.0),
         ],
         probes: Vec::new(),
+        exposure: 1.0,
     })
 }
 

@@ -22,10 +22,11 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
             up: Vec3::Y,
             fov_y_deg: 70.0,
         };
-        return courtyard_scene(name, probe_room::groups, camera);
+        // The room is lit through its open front only: it reads at four times the light.
+        return courtyard_scene(name, probe_room::groups, camera, 4.0);
     }
     if name == "atrium" {
-        return courtyard_scene(name, atrium::groups, atrium::camera());
+        return courtyard_scene(name, atrium::groups, atrium::camera(), 1.0);
     }
     // Floor grid vertices per side: 31×31 is the paper's low-resolution receiver, 111×111 its
     // high-resolution one.
@@ -61,6 +62,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         lights: Vec::new(),
         walkthrough: Vec::new(),
         probes: Vec::new(),
+        exposure: 1.0,
         camera: Camera {
             position: Vec3::new(0.0, 2.2, 4.2),
             target: Vec3::new(0.0, 0.4, 0.0),
@@ -83,6 +85,7 @@ fn courtyard_scene(
     name: &str,
     groups: fn() -> Result<Vec<Group>, SceneError>,
     camera: Camera,
+    exposure: f32,
 ) -> Result<Scene, SceneError> {
     let context = context(name);
     Ok(Scene {
@@ -92,6 +95,7 @@ fn courtyard_scene(
         lights: Vec::new(),
         walkthrough: Vec::new(),
         probes: Vec::new(),
+        exposure,
         camera,
     })
 }

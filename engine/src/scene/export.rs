@@ -73,6 +73,7 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
             .iter()
             .map(|p| ProbeDesc { position: p.position.to_array(), role: p.role })
             .collect(),
+        exposure: scene.exposure,
     };
     let path = output(dir, SCENE_FILE)?;
     let json = serde_json::to_string_pretty(&file)

@@ -26,6 +26,8 @@
 //!   visits in order.
 //! - `probes` (optional): light probes placed by hand, `{"position": [x, y, z], "role": "sky"}`
 //!   with `role` optional, one of `sky`, `bounce`, `bleed` ([`super::ProbeRole`]).
+//! - `exposure` (optional, > 0, default 1): what a PNG of the scene is multiplied by before
+//!   tonemapping when the command names no `--exposure`.
 //! - Relative paths are relative to the folder of the scene file.
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +45,12 @@ pub struct SceneFile {
     pub walkthrough: Vec<CameraDesc>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub probes: Vec<ProbeDesc>,
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub exposure: f32,
+}
+
+fn is_one(value: &f32) -> bool {
+    *value == 1.0
 }
 
 #[derive(Debug, Serialize, Deserialize)]

@@ -62,7 +62,8 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
             Ok(SceneProbe { position, role: p.role })
         })
         .collect::<Result<_, _>>()?;
-    let scene = Scene { name, groups, environment, lights, camera, walkthrough, probes };
+    let scene =
+        Scene { name, groups, environment, lights, camera, walkthrough, probes, exposure: file.exposure };
     // The rules every scene meets however it was made (its extent among them), checked here
     // too so that a file's fault is named with the file, not found when a renderer is made.
     scene.validate()?;

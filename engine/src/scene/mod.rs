@@ -69,6 +69,9 @@ pub struct Scene {
     pub walkthrough: Vec<Camera>,
     /// Light probes placed by hand (`probes` in a scene file); empty for most scenes.
     pub probes: Vec<SceneProbe>,
+    /// What a PNG of the scene is multiplied by before tonemapping when the user names no
+    /// exposure (`exposure` in a scene file, default 1): a dim room reads at 4.
+    pub exposure: f32,
 }
 
 /// Meshes that move together.
@@ -168,6 +171,12 @@ impl Scene {
         self.camera.validated().map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         animation::check_walkthrough(&self.walkthrough)
             .map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
+        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+            return Err(SceneError::invalid(format!(
+                "scene \"{}\": exposure {} is not a positive number",
+                self.name, self.exposure
+            )));
+        }
         Ok(())
     }
 

@@ -103,6 +103,7 @@ mod tests {
             lights: vec![],
             walkthrough: vec![],
             probes: vec![],
+            exposure: 1.0,
             camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
         }
     }
