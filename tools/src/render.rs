@@ -240,6 +240,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let start = Instant::now();
     let mut table = TimingTable::default();
     let mut trace = crate::trace::Trace::default();
+    let mut trace_origin_ns = None;
     let mut dropped = 0;
     for frame in (0..args.warmup).map(|_| None).chain((0..args.frames).map(Some)) {
         let t = frame.map_or(0.0, |f| f as f32 / args.frames as f32);
@@ -248,9 +249,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         } else if let (true, Some(group)) = (args.animate, scene.groups.first()) {
             renderer.set_group_transform(0, animation::pose(group, t).matrix())?;
         }
+        // With a trace, the device's and host's clocks read around the frame where they can be.
+        let calibrate = || if args.trace.is_some() { ctx.calibrate() } else { Ok(None) };
+        let before = calibrate()?;
         let frame_start = start.elapsed();
         let passes = renderer.render()?;
         let frame_end = start.elapsed();
+        let after = calibrate()?;
         bar.inc(1);
         if start.elapsed().as_secs_f32() < 1.0 {
             bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -258,12 +263,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         }
         let Some(frame) = frame else { continue };
-        trace.add_frame(
-            frame,
-            1e6 * frame_start.as_secs_f64(),
-            1e6 * (frame_end - frame_start).as_secs_f64(),
-            &passes,
-        );
+        if let (Some(before), Some(after)) = (before, after) {
+            let origin = *trace_origin_ns.get_or_insert(before.host_ns as f64);
+            let us = |host_ns: f64| (host_ns - origin) * 1e-3;
+            trace.calibrated(before.deviation_ns.max(after.deviation_ns));
+            trace.add_frame(
+                frame,
+                us(before.host_ns as f64),
+                us(after.host_ns as f64) - us(before.host_ns as f64),
+                &passes,
+                |p| p.start_ticks.map(|t| us(after.host_ns_at(t))),
+            );
+        } else {
+            let cpu_start_us = 1e6 * frame_start.as_secs_f64();
+            trace.add_frame(
+                frame,
+                cpu_start_us,
+                1e6 * (frame_end - frame_start).as_secs_f64(),
+                &passes,
+                |p| p.start_ms.map(|ms| cpu_start_us + 1e3 * ms),
+            );
+        }
         table.add_frame(&passes);
         dropped = dropped.max(renderer.stats().dropped_layers);
     }

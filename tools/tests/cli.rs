@@ -405,6 +405,26 @@ fn render_writes_a_trace_with_one_event_per_pass_and_frame() {
         let events = complete("gpu").into_iter().filter(|e| e["name"] == name).count();
         assert_eq!(events as u64, pass["frames"].as_u64().unwrap(), "events of pass {name}");
     }
+    // On one clock where the device has VK_EXT_calibrated_timestamps (lavapipe has): then the
+    // device ran every pass between the host's recording of its frame and the image being
+    // ready, within the clocks' deviation.
+    let info = text(&kage(&["info"]));
+    let has = info.lines().any(|l| l.contains("[x] VK_EXT_calibrated_timestamps"));
+    assert_eq!(trace["otherData"]["gpu_clock"], if has { "calibrated" } else { "uncalibrated" });
+    if has {
+        let slack_us = 1e-3 * trace["otherData"]["max_deviation_ns"].as_f64().unwrap() + 1.0;
+        for gpu in complete("gpu") {
+            let cpu =
+                complete("cpu").into_iter().find(|c| c["args"]["frame"] == gpu["args"]["frame"]).unwrap();
+            let (start, end) =
+                (cpu["ts"].as_f64().unwrap(), cpu["ts"].as_f64().unwrap() + cpu["dur"].as_f64().unwrap());
+            let (ts, dur) = (gpu["ts"].as_f64().unwrap(), gpu["dur"].as_f64().unwrap());
+            assert!(
+                ts >= start - slack_us && ts + dur <= end + slack_us,
+                "pass {gpu} outside its frame {cpu}"
+            );
+        }
+    }
 }
 
 /// `kage compare` for CI: `--json` prints one parsable object, and the thresholds set the exit

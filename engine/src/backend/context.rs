@@ -37,6 +37,25 @@ pub struct HostVulkan {
     pub debug_utils: bool,
 }
 
+/// The device's timestamp clock against the host's monotonic clock ([`Context::calibrate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Calibration {
+    /// The two clocks read together.
+    pub device_ticks: u64,
+    pub host_ns: u64,
+    /// How far apart the two readings may be, in ns (the driver's bound).
+    pub deviation_ns: u64,
+    /// Nanoseconds per device tick.
+    pub period_ns: f64,
+}
+
+impl Calibration {
+    /// The host's monotonic time, in ns, at device timestamp `ticks`.
+    pub fn host_ns_at(&self, ticks: u64) -> f64 {
+        self.host_ns as f64 + (ticks as f64 - self.device_ticks as f64) * self.period_ns
+    }
+}
+
 /// What `kage info` reports about the device.
 #[derive(Clone, Debug)]
 pub struct DeviceInfo {
@@ -68,6 +87,8 @@ pub struct Context {
     pub(crate) device: ash::Device,
     pub(crate) dynamic_rendering: ash::khr::dynamic_rendering::Device,
     pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
+    /// Device and host clocks read together ([`Context::calibrate`]), where enabled.
+    calibration: Option<ash::ext::calibrated_timestamps::Device>,
     queue: Mutex<vk::Queue>,
     /// The queue's family, for each recorder's command pool.
     pub(crate) queue_family: u32,
@@ -91,6 +112,8 @@ struct Parts {
     queue: vk::Queue,
     info: DeviceInfo,
     owns_device: bool,
+    /// Whether VK_EXT_calibrated_timestamps is enabled on the device.
+    calibrated: bool,
 }
 
 impl Context {
@@ -167,14 +190,18 @@ impl Context {
 
         let wanted = desc.device.clone().or_else(|| std::env::var("KAGE_DEVICE").ok());
         let (physical, queue_family) = device::pick(&instance, wanted.as_deref())?;
-        let info = device::probe(&instance, physical, queue_family, debug_utils, &layers)?;
+        let info = device::probe(&entry, &instance, physical, queue_family, debug_utils, &layers)?;
 
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let device_ext_ptrs =
-            [ash::khr::dynamic_rendering::NAME.as_ptr(), ash::khr::push_descriptor::NAME.as_ptr()];
+        let mut device_ext_ptrs =
+            vec![ash::khr::dynamic_rendering::NAME.as_ptr(), ash::khr::push_descriptor::NAME.as_ptr()];
+        let calibrated = info.has(device::CALIBRATED_TIMESTAMPS);
+        if calibrated {
+            device_ext_ptrs.push(ash::ext::calibrated_timestamps::NAME.as_ptr());
+        }
         let mut dynamic_rendering_features =
             vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
         let enabled = vk::PhysicalDeviceFeatures::default()
@@ -206,6 +233,7 @@ impl Context {
             queue,
             info,
             owns_device: true,
+            calibrated,
         })?;
         std::mem::forget(guard);
         Ok(ctx)
@@ -228,8 +256,14 @@ impl Context {
             .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
         // SAFETY: the caller promises a valid instance from this loader.
         let instance = unsafe { ash::Instance::load(entry.static_fn(), host.instance) };
-        let info =
-            device::probe(&instance, host.physical_device, host.queue_family, host.debug_utils, &layers)?;
+        let info = device::probe(
+            &entry,
+            &instance,
+            host.physical_device,
+            host.queue_family,
+            host.debug_utils,
+            &layers,
+        )?;
         // SAFETY: the caller promises a valid device of this instance.
         let device = unsafe { ash::Device::load(instance.fp_v1_0(), host.device) };
         // A device created without an extension gives no entry points for it (Vulkan 1.3 and
@@ -247,6 +281,16 @@ impl Context {
                 )));
             }
         }
+        // The host may not have enabled the calibration extension: only its entry point tells.
+        // SAFETY: a valid device and a NUL-terminated name.
+        let calibrated = info.has(device::CALIBRATED_TIMESTAMPS)
+            && unsafe {
+                (instance.fp_v1_0().get_device_proc_addr)(
+                    host.device,
+                    c"vkGetCalibratedTimestampsEXT".as_ptr(),
+                )
+            }
+            .is_some();
         Context::assemble(Parts {
             entry,
             instance,
@@ -260,6 +304,7 @@ impl Context {
             queue: host.queue,
             info,
             owns_device: false,
+            calibrated,
         })
     }
 
@@ -280,6 +325,9 @@ impl Context {
             debug: parts.debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
             dynamic_rendering: ash::khr::dynamic_rendering::Device::new(&instance, &device),
             push_descriptor: ash::khr::push_descriptor::Device::new(&instance, &device),
+            calibration: parts
+                .calibrated
+                .then(|| ash::ext::calibrated_timestamps::Device::new(&instance, &device)),
             _entry: entry,
             instance,
             debug_instance: parts.debug_instance,
@@ -295,6 +343,27 @@ impl Context {
         };
         ctx.set_name(queue, "kage.queue");
         Ok(Arc::new(ctx))
+    }
+
+    /// The device's timestamp clock and the host's monotonic clock (CLOCK_MONOTONIC, which
+    /// `std::time::Instant` reads on Linux) read together; `None` where the device cannot
+    /// (`device::CALIBRATED_TIMESTAMPS`).
+    pub fn calibrate(&self) -> Result<Option<Calibration>> {
+        let Some(ext) = &self.calibration else { return Ok(None) };
+        let infos = [
+            vk::CalibratedTimestampInfoEXT::default().time_domain(vk::TimeDomainEXT::DEVICE),
+            vk::CalibratedTimestampInfoEXT::default().time_domain(vk::TimeDomainEXT::CLOCK_MONOTONIC),
+        ];
+        // SAFETY: the extension is enabled on this device; the infos are well formed.
+        let (stamps, deviation) = unsafe { ext.get_calibrated_timestamps(&infos) }
+            .map_err(Error::vk("vkGetCalibratedTimestampsEXT"))?;
+        let period_ns = self.info.timestamp_period_ns.unwrap_or(1.0);
+        Ok(Some(Calibration {
+            device_ticks: stamps[0],
+            host_ns: stamps[1],
+            deviation_ns: deviation,
+            period_ns,
+        }))
     }
 
     pub fn info(&self) -> &DeviceInfo {

@@ -18,6 +18,7 @@ fn version_string(v: u32) -> String {
 /// Describes `physical` and its `queue_family`; fails when a feature Kage requires is missing.
 /// `debug_utils`: whether the instance has VK_EXT_debug_utils; `layers`: the installed layers.
 pub(crate) fn probe(
+    entry: &ash::Entry,
     instance: &ash::Instance,
     physical: vk::PhysicalDevice,
     queue_family: u32,
@@ -53,6 +54,16 @@ pub(crate) fn probe(
     let rgba32f_linear =
         rgba32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
 
+    // Traces put device and host events on one timeline when the device reads both clocks
+    // together.
+    let calibrated = has_extension(&device_exts, ash::ext::calibrated_timestamps::NAME) && {
+        let ext = ash::ext::calibrated_timestamps::Instance::new(entry, instance);
+        // SAFETY: valid physical device of this instance, which has the extension.
+        let domains =
+            unsafe { ext.get_physical_device_calibrateable_time_domains(physical) }.unwrap_or_default();
+        [vk::TimeDomainEXT::DEVICE, vk::TimeDomainEXT::CLOCK_MONOTONIC].iter().all(|d| domains.contains(d))
+    };
+
     let mut driver = vk::PhysicalDeviceDriverProperties::default();
     let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
     // SAFETY: Vulkan 1.2 device (checked above); the chain is well formed.
@@ -80,6 +91,7 @@ pub(crate) fn probe(
             ),
             ("RGBA32F linear filtering (required)", rgba32f_linear),
             ("timestamps on the graphics/compute queue (pass timings)", timestamps),
+            (CALIBRATED_TIMESTAMPS, timestamps && calibrated),
             ("VK_EXT_debug_utils (object names, labels)", debug_utils),
             (
                 "VK_LAYER_KHRONOS_validation (installed)",
@@ -105,6 +117,12 @@ pub(crate) fn probe(
     }
     Ok(info)
 }
+
+/// Reading the device's timestamp clock and the host's monotonic clock together
+/// (`Context::calibrate`): traces then place passes and frames on one timeline. Enabled where
+/// the device has it.
+pub const CALIBRATED_TIMESTAMPS: &str =
+    "VK_EXT_calibrated_timestamps, device and monotonic clocks (traces on one timeline)";
 
 /// The feature that lets fragment shaders read gl_PrimitiveID (SPIR-V's Geometry capability):
 /// the polygon IDs of adaptive shadow maps. Enabled where the device has it.

@@ -16,9 +16,9 @@ mod validation;
 
 pub use buffer::{Buffer, BufferDesc};
 pub use commands::CommandRecorder;
-pub use context::{Context, ContextDesc, DeviceInfo, HostVulkan};
+pub use context::{Calibration, Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
-pub use device::{FRAGMENT_STORES, GEOMETRY_SHADER};
+pub use device::{CALIBRATED_TIMESTAMPS, FRAGMENT_STORES, GEOMETRY_SHADER};
 pub use image::{Edge, Image, ImageDesc, Sampler};
 pub use pipeline::{
     ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,

@@ -58,6 +58,8 @@ pub struct PassTiming {
     /// When the pass started on the device, ms after the frame's first pass started (for a
     /// timeline; `None` without timestamps).
     pub start_ms: Option<f64>,
+    /// The device's timestamp of the pass's start, in ticks (for [`crate::backend::Calibration`]).
+    pub start_ticks: Option<u64>,
 }
 
 /// Records, submits and times frames; owns the command buffer and timestamp pool it reuses.
@@ -160,7 +162,12 @@ impl FrameExecutor {
                         .zip(period_ns)
                         .map(|(t, period)| t[to].saturating_sub(t[from]) as f64 * period * 1e-6)
                 };
-                PassTiming { name, gpu_ms: ms(2 * i, 2 * i + 1), start_ms: ms(0, 2 * i) }
+                PassTiming {
+                    name,
+                    gpu_ms: ms(2 * i, 2 * i + 1),
+                    start_ms: ms(0, 2 * i),
+                    start_ticks: ticks.as_ref().map(|t| t[2 * i]),
+                }
             })
             .collect())
     }

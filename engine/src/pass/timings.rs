@@ -93,8 +93,8 @@ mod tests {
         let mut table = TimingTable::default();
         for ms in [3.0, 1.0, 2.0, 10.0] {
             table.add_frame(&[
-                PassTiming { name: "a", gpu_ms: Some(ms), start_ms: Some(0.0) },
-                PassTiming { name: "b", gpu_ms: Some(1.0), start_ms: Some(ms) },
+                PassTiming { name: "a", gpu_ms: Some(ms), start_ms: Some(0.0), start_ticks: None },
+                PassTiming { name: "b", gpu_ms: Some(1.0), start_ms: Some(ms), start_ticks: None },
             ]);
         }
         let rows = table.rows();
@@ -108,7 +108,7 @@ mod tests {
     /// Time between passes counts (a pass's work lavapipe times late); without starts, the sum.
     #[test]
     fn a_frame_spans_its_first_start_to_its_last_end() {
-        let pass = |name, gpu_ms, start_ms| PassTiming { name, gpu_ms, start_ms };
+        let pass = |name, gpu_ms, start_ms| PassTiming { name, gpu_ms, start_ms, start_ticks: None };
         let gap = [pass("a", Some(2.0), Some(0.0)), pass("b", Some(1.0), Some(9.0))];
         assert_eq!(frame_ms(&gap), Some(10.0));
         let unplaced = [pass("a", Some(2.0), None), pass("b", Some(1.0), None)];
