@@ -432,3 +432,46 @@ fn the_floor_gets_no_layer_over_the_teapot_from_above() {
     assert!(of(teapot).iter().all(|l| !is_covered(l.region as usize)), "a hidden region kept a layer");
     assert_eq!(occlusion.covered[floor], [0; 4], "the teapot is no sheet");
 }
+
+/// Every pass of a Tamura frame that does work reports a plausible share of the frame (issue:
+/// the second filter pass once read 0.01 ms beside the first's 5–16 ms for the same work). The
+/// two filter passes step over the same texels, so their times must agree within 10× (lavapipe
+/// writes a timestamp at its next flush, which can move part of one pass's work into its
+/// neighbour: up to ~3× measured; a pass timed at nothing is hundreds of times off); and the
+/// passes' times together must hold most of the frame's span (at least 70 %: gaps between
+/// passes are the device's own work, ~13 % of the frame when a pass's work went untimed).
+#[test]
+fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
+    let ctx = Validated::new();
+    let scene = Scene::builtin("teapot").unwrap();
+    let transfer = transfer_of(&ctx, &scene);
+    let mut renderer = Renderer::new(&ctx, &scene, &tamura(&transfer, 32, 128)).unwrap();
+    for _ in 0..2 {
+        renderer.render().unwrap(); // warm-up: shader compilation
+    }
+    let frames: Vec<Vec<kage::pass::PassTiming>> = (0..5).map(|_| renderer.render().unwrap()).collect();
+    let median = |name: &str| {
+        let mut ms: Vec<f64> =
+            frames.iter().flatten().filter(|t| t.name == name).map(|t| t.gpu_ms.unwrap()).collect();
+        assert_eq!(ms.len(), frames.len(), "pass {name} in every frame");
+        ms.sort_by(f64::total_cmp);
+        ms[ms.len() / 2]
+    };
+    let (horizontal, vertical) = (median("blur_horizontal"), median("blur_vertical"));
+    assert!(horizontal > 0.0 && vertical > 0.0);
+    let ratio = vertical / horizontal;
+    assert!((0.1..=10.0).contains(&ratio), "filter passes {horizontal:.3} and {vertical:.3} ms");
+    for frame in &frames {
+        let span = kage::pass::frame_ms(frame).unwrap();
+        let sum: f64 = frame.iter().map(|t| t.gpu_ms.unwrap()).sum();
+        assert!(sum >= 0.7 * span && sum <= span * 1.001, "passes {sum:.2} ms of a {span:.2} ms frame");
+        for t in frame.iter().filter(|t| t.name != "readback") {
+            assert!(
+                t.gpu_ms.unwrap() > 1e-3 * span,
+                "{} reads {:?} ms of a {span:.2} ms frame",
+                t.name,
+                t.gpu_ms
+            );
+        }
+    }
+}
