@@ -53,6 +53,16 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             bail!("{flag} must be a number at least 0, got {b}");
         }
     }
+    for path in [&args.a, &args.b] {
+        let exr = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if !exr {
+            bail!(
+                "{}: kage compare reads linear radiance from .exr files (a .png is tonemapped and \
+                 clipped); render and reference with --out FILE.exr",
+                path.display()
+            );
+        }
+    }
     let a = kage::imageio::read_exr(&args.a)?;
     let b = kage::imageio::read_exr(&args.b)?;
     let m = compare(&a, &b)

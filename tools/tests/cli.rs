@@ -198,10 +198,11 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     std::fs::write(&points, r#"{"points": [{"position": [0, 0.5, 0], "normal": [0, 1, 0]}]}"#).unwrap();
     let (points, out_json) = (points.to_str().unwrap(), dir.join("e.json"));
     let no_samples = ["--bounces", "1", "--bounce-samples", "0", "--out", out_json.to_str().unwrap()];
-    let cases: [(&[&str], &str); 20] = [
+    let cases: [(&[&str], &str); 21] = [
         // Outputs are checked before the work that would fill them (the reference's own write
         // would fail later with another message).
         (&["compare", "a.exr", "b.exr", "--diff", "d.jpg"], "--diff d.jpg: the file must end in .png"),
+        (&["compare", "a.png", "b.exr"], "a.png: kage compare reads linear radiance from .exr files"),
         (&["reference", "--out", "/no/such/folder/r.exr"], "the folder /no/such/folder does not exist"),
         (&["reference", "--out", "/proc/r.exr"], "cannot write in the folder /proc"),
         (&["reference", "--exposure", "0", "--out", "r.png"], "--exposure must be a positive number"),
