@@ -663,6 +663,14 @@ typedef struct {
 } kage_renderer_desc;
 
 /**
+ * Hears how far long work has come (`fraction`, 0 to 1, rising) and answers whether to go on:
+ * false stops the work, and the call that started it returns `KAGE_RESULT_CANCELLED`, having
+ * changed nothing. Called on the thread of that call, between steps of the work (about one
+ * per submission to the device); `user` is the pointer the host gave beside it.
+ */
+typedef bool (*kage_progress_fn)(void *user, double fraction);
+
+/**
  * A group's rigid placement: uniform `scale`, then `rotation`, then `translation`.
  */
 typedef struct {
@@ -825,14 +833,6 @@ typedef struct {
 } kage_scene_desc;
 
 /**
- * Hears how far long work has come (`fraction`, 0 to 1, rising) and answers whether to go on:
- * false stops the work, and the call that started it returns `KAGE_RESULT_CANCELLED`, having
- * changed nothing. Called on the thread of that call, between steps of the work (about one
- * per submission to the device); `user` is the pointer the host gave beside it.
- */
-typedef bool (*kage_progress_fn)(void *user, double fraction);
-
-/**
  * How `kage_precompute_with` caches and reports its work. All zero but `size`: no disk cache,
  * no progress.
  */
@@ -925,7 +925,8 @@ kage_result kage_context_device_name(const kage_context *context,
 /**
  * Uploads the scene and builds the technique's pipelines and targets. `kage_precompute` with
  * the same technique (at least the same SH bands) must have run on the scene first for
- * techniques that need it, else `KAGE_RESULT_INVALID_VALUE`.
+ * techniques that need it, else `KAGE_RESULT_INVALID_VALUE`. The same as
+ * `kage_renderer_create_with` without a progress callback.
  *
  * The renderer copies what it needs: the scene may be destroyed afterwards. It holds a
  * reference to the context's device, which stays alive until the renderer is destroyed even if
@@ -940,6 +941,22 @@ kage_result kage_renderer_create(const kage_context *context,
                                  const kage_scene *scene,
                                  const kage_renderer_desc *desc,
                                  kage_renderer **renderer);
+
+/**
+ * `kage_renderer_create` with `progress` (NULL: none) hearing its long work, the light
+ * probes' capture (`KAGE_TECHNIQUE_PROBES`: one unit per probe, and one for the automatic
+ * placement after them; seconds to a minute on a CPU driver), and able to cancel it
+ * (`KAGE_RESULT_CANCELLED`, `*renderer` NULL).
+ *
+ * # Safety
+ * As `kage_renderer_create`; `progress` NULL or a function that may be called with `user`.
+ */
+kage_result kage_renderer_create_with(const kage_context *context,
+                                      const kage_scene *scene,
+                                      const kage_renderer_desc *desc,
+                                      kage_progress_fn progress,
+                                      void *user,
+                                      kage_renderer **renderer);
 
 /**
  * Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The

@@ -36,6 +36,7 @@ pub mod image_size;
 pub mod imageio;
 pub mod layouts;
 pub mod pass;
+pub mod progress;
 pub mod prt;
 pub mod raycast;
 pub mod reference;

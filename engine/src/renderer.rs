@@ -9,6 +9,7 @@ use crate::frame::{FrameInputs, FrameState, GpuScene, Targets, COLOR, ENVIRONMEN
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
+use crate::progress::Progress;
 use crate::prt::TransferSet;
 use crate::scene::{check_extent, Light, Scene};
 use crate::techniques::description::TechniqueDesc;
@@ -53,11 +54,22 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, options: &RenderOptions) -> Result<Renderer> {
+        Renderer::with_progress(ctx, scene, options, &mut crate::progress::silent)
+    }
+
+    /// [`Renderer::new`], with `progress` hearing its long work (the light probes' capture).
+    pub fn with_progress(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        options: &RenderOptions,
+        progress: &mut Progress,
+    ) -> Result<Renderer> {
         scene.validate()?;
         let targets = Targets::new(ctx, options.width, options.height)?;
         let gpu = GpuScene::new(ctx, scene)?;
         let size = (options.width, options.height);
-        let technique = options.technique.build(ctx, scene, &gpu, options.transfer.as_ref(), size)?;
+        let technique =
+            options.technique.build(ctx, scene, &gpu, options.transfer.as_ref(), size, progress)?;
         Ok(Renderer {
             reach: scene.groups.iter().map(|g| g.object_reach()).collect(),
             ctx: ctx.clone(),

@@ -444,6 +444,31 @@ static void check_precompute_options(kage_context *context) {
   CHECK(kage_scene_destroy(scene));
 }
 
+/* kage_renderer_create_with: the light probes' capture heard probe by probe, and cancelled. */
+static void check_renderer_progress(kage_context *context) {
+  /* The room: its probes' grid lies inside it (the arrays scene's static box would hold them). */
+  kage_scene *scene = NULL;
+  CHECK(kage_scene_load("probe-room", &scene));
+  kage_technique_desc technique;
+  CHECK(kage_technique_desc_default(KAGE_TECHNIQUE_PROBES, &technique));
+  technique.probe_placement = KAGE_PROBE_PLACEMENT_GRID;
+  technique.probe_grid[0] = technique.probe_grid[1] = technique.probe_grid[2] = 2;
+  technique.probe_cube_size = 8;
+  technique.probe_light = KAGE_PROBE_LIGHT_SKY;
+  kage_renderer_desc desc = {sizeof(kage_renderer_desc), 8, 8, technique};
+  kage_renderer *renderer = NULL;
+  progress_log log = {0, 0.0, 3};
+  EXPECT(kage_renderer_create_with(context, scene, &desc, hear, &log, &renderer), KAGE_RESULT_CANCELLED);
+  REQUIRE(log.calls == 3 && renderer == NULL);
+  /* Eight probes: a call before each capture, one before the placement, one at the end. */
+  log = (progress_log){0, 0.0, 0};
+  CHECK(kage_renderer_create_with(context, scene, &desc, hear, &log, &renderer));
+  REQUIRE(log.calls == 10 && log.last == 1.0);
+  CHECK(kage_renderer_render(renderer));
+  CHECK(kage_renderer_destroy(renderer));
+  CHECK(kage_scene_destroy(scene));
+}
+
 int main(int argc, char **argv) {
   if (argc == 2 && strcmp(argv[1], "forget-a-scene") == 0) {
     /* The canary of the memcheck test: valgrind must report this scene as lost, which proves
@@ -465,6 +490,7 @@ int main(int argc, char **argv) {
   check_hostile_files();
   check_lights(context);
   check_precompute_options(context);
+  check_renderer_progress(context);
   render_moving_box(context, (uint32_t)atoi(argv[4]), frames, size);
   CHECK(kage_context_destroy(context));
   printf("ok\n");

@@ -79,7 +79,7 @@ pub fn render_once(
 pub fn shadow_test_transfer(ctx: &Arc<Context>, scene: &Scene) -> Arc<kage::prt::TransferSet> {
     use kage::prt::{transfer, PrtParams};
     let params = PrtParams { bands: 3, rays: 128, ..PrtParams::DEFAULT };
-    Arc::new(transfer::precompute(ctx, scene, params, &mut |_, _| true).expect("transfer"))
+    Arc::new(transfer::precompute(ctx, scene, params, &mut kage::progress::silent).expect("transfer"))
 }
 
 /// A valid 2 × 1 OpenEXR file whose header then claims `width` × `height` pixels: its

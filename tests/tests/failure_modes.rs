@@ -115,7 +115,7 @@ fn techniques(ctx: &Arc<Context>, scene: &Scene) -> Vec<(&'static str, RenderOpt
             ctx,
             scene,
             PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
-            &mut |_, _| true,
+            &mut kage::progress::silent,
         )
         .unwrap(),
     );
@@ -308,7 +308,7 @@ fn meshes_without_triangles_are_errors_and_empty_groups_draw_nothing() {
             &ctx,
             &empty_mesh,
             PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
-            &mut |_, _| true,
+            &mut kage::progress::silent,
         ),
         &expected,
     );
@@ -496,7 +496,7 @@ fn requests_that_cannot_fit_are_out_of_memory_errors() {
             &ctx,
             &scene,
             PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT },
-            &mut |_, _| true,
+            &mut kage::progress::silent,
         )
         .unwrap(),
     );

@@ -88,7 +88,14 @@ fn a_tiny_sun_rings_negative_the_shading_clamps_it_and_deringing_removes_it() {
     // power times k₂(n·s), whose minimum is −0.0396 against a peak of 1.0625 (dering.rs): −3.7%.
     let capture = |dering| {
         let gpu = kage::frame::GpuScene::new(&ctx, &scene).unwrap();
-        let set = kage::techniques::probes::ProbeSet::capture(&ctx, &scene, &gpu, &probes(dering)).unwrap();
+        let set = kage::techniques::probes::ProbeSet::capture(
+            &ctx,
+            &scene,
+            &gpu,
+            &probes(dering),
+            &mut kage::progress::silent,
+        )
+        .unwrap();
         irradiance_range(&set.sh[4])
     };
     let (raw_min, raw_max) = capture(Dering::Off);
@@ -144,7 +151,14 @@ fn a_probe_inside_a_wall_is_detected_and_left_out() {
     assert!(positions[..8].iter().all(|p| capture.back_faces(p.as_vec3()) == 0.0));
 
     let gpu = kage::frame::GpuScene::new(&ctx, &scene).unwrap();
-    let set = kage::techniques::probes::ProbeSet::capture(&ctx, &scene, &gpu, &settings).unwrap();
+    let set = kage::techniques::probes::ProbeSet::capture(
+        &ctx,
+        &scene,
+        &gpu,
+        &settings,
+        &mut kage::progress::silent,
+    )
+    .unwrap();
     assert_eq!(set.invalid.len(), 1);
     assert_eq!((set.invalid[0].index, set.invalid[0].position), (8, inside));
     assert_eq!(set.mesh.positions().len(), 8, "the probe in the slab is not tetrahedralized");

@@ -66,7 +66,7 @@ fn static_groups_keep_their_own_prt_lighting_beside_the_probe_lit_bunny() {
     let ctx = Validated::new();
     let scene = Scene::builtin("probe-room").unwrap();
     let params = PrtParams { bands: 3, rays: 16, ..kage::prt::PrtParams::DEFAULT };
-    let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| true).unwrap());
+    let prt = Arc::new(transfer::precompute(&ctx, &scene, params, &mut kage::progress::silent).unwrap());
     let probes = ProbeSettings {
         placement: ProbePlacement::Grid([2, 2, 2]),
         capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
@@ -122,7 +122,7 @@ fn interpolated_irradiance_matches_the_ray_cast_reference_within_its_derived_bou
         capture: CaptureSettings { cube_size: 64, light: CapturedLight::Sky, ..Default::default() },
         ..Default::default()
     };
-    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings).unwrap();
+    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings, &mut kage::progress::silent).unwrap();
 
     let points: Vec<Point> = POINTS.iter().map(|&(position, normal)| Point { position, normal }).collect();
     let mut reference = IrradianceReference::new(&ctx, &scene, &points, 7).unwrap();

@@ -26,7 +26,14 @@ fn automatic_placement_drops_redundant_candidates_in_probe_room() {
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
     let auto = |tolerance| {
         let placement = ProbePlacement::Auto { tolerance, candidates: Some([3, 3, 3]) };
-        ProbeSet::capture(&ctx, &scene, &gpu, &tiny(placement, ProbeInterpolation::Tetrahedral)).unwrap()
+        ProbeSet::capture(
+            &ctx,
+            &scene,
+            &gpu,
+            &tiny(placement, ProbeInterpolation::Tetrahedral),
+            &mut kage::progress::silent,
+        )
+        .unwrap()
     };
     // A loose tolerance keeps few of the 27 candidates (the room has no solid inside); a
     // tighter one keeps at least as many: the greedy pass only drops what it reproduces.

@@ -22,8 +22,13 @@ fn scene_of(groups: Vec<Vec<Mesh>>) -> Scene {
 }
 
 fn precompute(ctx: &Validated, scene: &Scene, bands: u32, rays: u32) -> TransferSet {
-    transfer::precompute(ctx, scene, PrtParams { bands, rays, ..PrtParams::DEFAULT }, &mut |_, _| true)
-        .unwrap()
+    transfer::precompute(
+        ctx,
+        scene,
+        PrtParams { bands, rays, ..PrtParams::DEFAULT },
+        &mut kage::progress::silent,
+    )
+    .unwrap()
 }
 
 /// An open box (a cup) of half-width 1 and height `height` standing on y = 0, every face a
@@ -219,7 +224,7 @@ fn cache_round_trips_and_detects_every_kind_of_stale_file() {
         vec![cup(1.0), shapes::sphere("small", 0.3, 6, [0.2; 3]).unwrap()],
     ]);
     let params = PrtParams { bands: 3, rays: 32, ..PrtParams::DEFAULT };
-    let set = transfer::precompute(&ctx, &scene, params, &mut |_, _| true).unwrap();
+    let set = transfer::precompute(&ctx, &scene, params, &mut kage::progress::silent).unwrap();
     let key = CacheKey::new(&scene, params);
     let path = dir.join(key.file_name(&scene.name));
     assert_eq!(cache::load(&path, &key), Err(Stale::Missing));
@@ -288,7 +293,7 @@ fn bad_parameters_are_errors_not_panics() {
             &ctx,
             &scene,
             PrtParams { bands, rays, ..PrtParams::DEFAULT },
-            &mut |_, _| true,
+            &mut kage::progress::silent,
         )
         .unwrap_err()
         .to_string();

@@ -192,7 +192,7 @@ fn an_open_floor_gets_the_exact_irradiance() {
     scene.camera =
         Camera { position: Vec3::new(0.0, 4.0, 0.0), target: Vec3::ZERO, up: -Vec3::Z, fov_y_deg: 20.0 };
     let params = PrtParams { rays: 2048, ..PrtParams::DEFAULT };
-    let transfer = Arc::new(transfer::precompute(&ctx, &scene, params, &mut |_, _| true).unwrap());
+    let transfer = Arc::new(transfer::precompute(&ctx, &scene, params, &mut kage::progress::silent).unwrap());
     let mut renderer = Renderer::new(&ctx, &scene, &tamura(&transfer, 32, 16)).unwrap();
     renderer.render().unwrap();
     let image = renderer.image().unwrap();

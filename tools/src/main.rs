@@ -10,6 +10,7 @@ mod outputs;
 mod precompute;
 mod probe_image;
 mod probes;
+mod progress;
 mod reference;
 mod render;
 mod scene_cmd;

@@ -103,16 +103,11 @@ fn place(args: &PlaceArgs) -> Result<()> {
         ..Default::default()
     };
     let start = Instant::now();
-    // The capture and the reduction run inside the engine without a callback: a spinner with
-    // the elapsed time shows the work is alive (about 30 s for probe-room on lavapipe).
-    let spinner = indicatif::ProgressBar::new_spinner()
-        .with_message("placing probes: capturing the candidates, then dropping, fitting and moving them");
-    spinner.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})").expect("static template"),
+    let set = crate::progress::with_bar(
+        "placing probes: capturing the candidates, then dropping, fitting and moving them",
+        "captures",
+        |progress| ProbeSet::capture(&ctx, &scene, &gpu, &settings, progress),
     );
-    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
-    let set = ProbeSet::capture(&ctx, &scene, &gpu, &settings);
-    spinner.finish_and_clear();
     let set = set?;
     let json = positions_file::to_json(set.mesh.positions());
     std::fs::write(&args.out, json).with_context(|| format!("writing {}", args.out.display()))?;

@@ -216,7 +216,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     let setup = Instant::now();
     let options = RenderOptions { width: args.width, height: args.height, technique, transfer };
-    let mut renderer = Renderer::new(&ctx, &scene, &options).context("setting up the renderer")?;
+    let mut renderer =
+        crate::progress::with_bar("setting up (capturing the light probes)", "captures", |progress| {
+            Renderer::with_progress(&ctx, &scene, &options, progress)
+        })
+        .context("setting up the renderer")?;
     if let Some(counts) = renderer.stats().probes {
         let seconds = setup.elapsed().as_secs_f64();
         let left_out = match counts.inside_geometry {

@@ -2,13 +2,11 @@
 //! then the cache). Shared by `kage precompute` and the PRT techniques of `kage render`.
 use anyhow::{Context as _, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use kage::backend::Context;
 use kage::prt::{cache, transfer, PrtParams, TransferSet};
 use kage::scene::Scene;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Instant;
 
 #[derive(Args, Clone, Debug)]
 pub struct PrtArgs {
@@ -66,25 +64,10 @@ impl PrtArgs {
                 Err(reason) => eprintln!("cache: rebuilding {}: {reason}", path.display()),
             }
         }
-        let bar = ProgressBar::hidden().with_style(
-            ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} vertices, {elapsed} elapsed, {eta} left",
-            )
-            .expect("static template"),
-        );
-        bar.set_message("precomputing transfer");
-        let start = Instant::now();
-        let set = transfer::precompute(ctx, scene, params, &mut |done, total| {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-            // Only work that lasts shows a bar.
-            if start.elapsed().as_secs_f32() >= 1.0 && bar.is_hidden() {
-                bar.set_draw_target(ProgressDrawTarget::stderr());
-            }
-            true
+        let set = crate::progress::with_bar("precomputing transfer", "vertices", |progress| {
+            transfer::precompute(ctx, scene, params, progress)
         })
         .context("precomputing the transfer on the GPU")?;
-        bar.finish_and_clear();
         let file_bytes = cache::save(&path, &set, &key)?;
         Ok((set, Origin::Computed { path, file_bytes }))
     }

@@ -4,12 +4,12 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::{kage_camera_desc, kage_scene, kage_transform};
-use super::technique::kage_technique_desc;
+use super::technique::{kage_progress_fn, kage_technique_desc};
 use crate::imageio::tonemap_srgb8;
 use crate::pass::PassTiming;
 use crate::renderer::{RenderOptions, Renderer};
 use crate::scene::Light;
-use std::ffi::c_char;
+use std::ffi::{c_char, c_void};
 
 /// A scene on the GPU, lit by one technique, with its render targets.
 pub struct kage_renderer {
@@ -54,7 +54,8 @@ pub struct kage_pass_timing {
 
 /// Uploads the scene and builds the technique's pipelines and targets. `kage_precompute` with
 /// the same technique (at least the same SH bands) must have run on the scene first for
-/// techniques that need it, else `KAGE_RESULT_INVALID_VALUE`.
+/// techniques that need it, else `KAGE_RESULT_INVALID_VALUE`. The same as
+/// `kage_renderer_create_with` without a progress callback.
 ///
 /// The renderer copies what it needs: the scene may be destroyed afterwards. It holds a
 /// reference to the context's device, which stays alive until the renderer is destroyed even if
@@ -71,6 +72,26 @@ pub unsafe extern "C" fn kage_renderer_create(
     desc: *const kage_renderer_desc,
     renderer: *mut *mut kage_renderer,
 ) -> kage_result {
+    // SAFETY: the caller's promises, and no callback.
+    unsafe { kage_renderer_create_with(context, scene, desc, None, std::ptr::null_mut(), renderer) }
+}
+
+/// `kage_renderer_create` with `progress` (NULL: none) hearing its long work, the light
+/// probes' capture (`KAGE_TECHNIQUE_PROBES`: one unit per probe, and one for the automatic
+/// placement after them; seconds to a minute on a CPU driver), and able to cancel it
+/// (`KAGE_RESULT_CANCELLED`, `*renderer` NULL).
+///
+/// # Safety
+/// As `kage_renderer_create`; `progress` NULL or a function that may be called with `user`.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_create_with(
+    context: *const kage_context,
+    scene: *const kage_scene,
+    desc: *const kage_renderer_desc,
+    progress: kage_progress_fn,
+    user: *mut c_void,
+    renderer: *mut *mut kage_renderer,
+) -> kage_result {
     boundary(|| {
         // SAFETY: the caller promises NULL or a writable pointer.
         let out = unsafe { args::handle_out(renderer, "renderer") }?;
@@ -85,7 +106,9 @@ pub unsafe extern "C" fn kage_renderer_create(
             technique,
             transfer: scene.transfer.clone(),
         };
-        let made = Renderer::new(&context.ctx, &scene.scene, &options);
+        // SAFETY: the caller promises a callable function for its own pointer.
+        let mut report = |done, total| unsafe { super::technique::report(progress, user, done, total) };
+        let made = Renderer::with_progress(&context.ctx, &scene.scene, &options, &mut report);
         kage_context::check_validation(&context.ctx)?;
         let made = kage_renderer { renderer: made?, ctx: context.ctx.clone(), timings: None };
         *out = handles::register(made);

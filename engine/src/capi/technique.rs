@@ -274,6 +274,21 @@ pub unsafe extern "C" fn kage_technique_desc_default(
 /// per submission to the device); `user` is the pointer the host gave beside it.
 pub type kage_progress_fn = Option<unsafe extern "C" fn(user: *mut c_void, fraction: f64) -> bool>;
 
+/// Calls the host's `progress` (when there is one) with the fraction `done` of `total`.
+///
+/// # Safety
+/// `progress` NULL or a function that may be called with `user`.
+pub(crate) unsafe fn report(
+    progress: kage_progress_fn,
+    user: *mut c_void,
+    done: usize,
+    total: usize,
+) -> bool {
+    let fraction = if total == 0 { 1.0 } else { done as f64 / total as f64 };
+    // SAFETY: the caller's promise.
+    progress.is_none_or(|progress| unsafe { progress(user, fraction) })
+}
+
 /// How `kage_precompute_with` caches and reports its work. All zero but `size`: no disk cache,
 /// no progress.
 #[repr(C)]
@@ -359,13 +374,8 @@ pub unsafe extern "C" fn kage_precompute_with(
             scene.transfer = Some(Arc::new(set));
             return Ok(());
         }
-        let mut report = |done: usize, total: usize| match progress {
-            // SAFETY: the caller promises a callable function for its own pointer.
-            Some(progress) => unsafe {
-                progress(user, if total == 0 { 1.0 } else { done as f64 / total as f64 })
-            },
-            None => true,
-        };
+        // SAFETY: the caller promises a callable function for its own pointer.
+        let mut report = |done, total| unsafe { report(progress, user, done, total) };
         let set = transfer::precompute(&context.ctx, &scene.scene, params, &mut report);
         kage_context::check_validation(&context.ctx)?;
         let set = set?;

@@ -12,6 +12,7 @@ use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeli
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, PrtTransferPush, PrtVertex};
 use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::progress::Progress;
 use crate::raycast::BVH;
 use crate::raycast::{GpuBvh, SceneBvh};
 use crate::scene::Scene;
@@ -32,7 +33,7 @@ pub fn precompute(
     ctx: &Arc<Context>,
     scene: &Scene,
     params: PrtParams,
-    progress: &mut dyn FnMut(usize, usize) -> bool,
+    progress: &mut Progress,
 ) -> Result<TransferSet> {
     let params = params.validated()?;
     let start = Instant::now();
@@ -66,7 +67,7 @@ fn run_jobs(
     bvh: &GpuBvh,
     params: PrtParams,
     total: usize,
-    progress: &mut dyn FnMut(usize, usize) -> bool,
+    progress: &mut Progress,
 ) -> Result<(Vec<f32>, Vec<u32>)> {
     let too_many = || {
         Error::InvalidArgument(format!(

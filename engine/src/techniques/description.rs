@@ -17,6 +17,7 @@ use super::{sloan, Technique};
 use crate::backend::Context;
 use crate::error::{Error, Result};
 use crate::frame::GpuScene;
+use crate::progress::Progress;
 use crate::prt::{PrtParams, TransferSet, Visibility};
 use crate::scene::Scene;
 use std::sync::Arc;
@@ -206,7 +207,8 @@ impl TechniqueDesc {
     }
 
     /// Builds the technique for `scene` (on the GPU as `gpu`) and images of `size`, after
-    /// [`Self::validated`]; `transfer` is the result of [`Self::precomputation`].
+    /// [`Self::validated`]; `transfer` is the result of [`Self::precomputation`]. `progress`
+    /// hears the long work of building (the light probes' capture).
     pub fn build(
         &self,
         ctx: &Arc<Context>,
@@ -214,6 +216,7 @@ impl TechniqueDesc {
         gpu: &GpuScene,
         transfer: Option<&Arc<TransferSet>>,
         size: (u32, u32),
+        progress: &mut Progress,
     ) -> Result<Box<dyn Technique>> {
         let desc = self.clone().validated()?;
         let transfer = desc.transfer(transfer)?;
@@ -238,7 +241,7 @@ impl TechniqueDesc {
             }
             TechniqueDesc::ShadowMap { size } => Box::new(ShadowMap::new(ctx, scene, *size)?),
             TechniqueDesc::Probes { probes, .. } => {
-                Box::new(ProbeTechnique::new(ctx, scene, gpu, probes, transfer)?)
+                Box::new(ProbeTechnique::new(ctx, scene, gpu, probes, transfer, progress)?)
             }
             TechniqueDesc::Asm(settings) => Box::new(Asm::new(ctx, scene, gpu, *settings, size)?),
         })

@@ -11,6 +11,7 @@ use super::{TetMesh, Walker};
 use crate::backend::Context;
 use crate::error::{Error, Result};
 use crate::frame::GpuScene;
+use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::sh::ShRgb9;
 use glam::{DVec3, Vec3};
@@ -229,12 +230,14 @@ pub struct ProbeSet {
 
 impl ProbeSet {
     /// Places the probes, leaves out those inside geometry, tetrahedralizes the others and
-    /// captures each (the static groups of `gpu`, which holds `scene`).
+    /// captures each (the static groups of `gpu`, which holds `scene`). `progress` hears the
+    /// probes captured, one more unit for the placement after them, and may stop the work.
     pub fn capture(
         ctx: &Arc<Context>,
         scene: &Scene,
         gpu: &GpuScene,
         settings: &ProbeSettings,
+        progress: &mut Progress,
     ) -> Result<ProbeSet> {
         let settings = settings.clone().validated()?;
         let mut capture = ProbeCapture::new(ctx, scene, settings.capture)?;
@@ -251,9 +254,18 @@ impl ProbeSet {
                 100.0 * probe.back_faces
             );
         }
-        let sh: Vec<ShRgb9> =
-            positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect::<Result<_>>()?;
         let candidates = positions.len();
+        let cancelled = || Error::Cancelled("the light probes' capture");
+        let mut sh: Vec<ShRgb9> = Vec::with_capacity(candidates);
+        for p in &positions {
+            if !progress(sh.len(), candidates + 1) {
+                return Err(cancelled());
+            }
+            sh.push(capture.capture(gpu, is_static, p.as_vec3())?);
+        }
+        if !progress(candidates, candidates + 1) {
+            return Err(cancelled());
+        }
         let mut set = match (&settings.placement, settings.interpolation) {
             (ProbePlacement::Auto { tolerance, .. }, _) => ProbeSet::placed(&positions, &sh, *tolerance)?,
             (ProbePlacement::Grid(counts), ProbeInterpolation::Trilinear) => {
@@ -270,6 +282,7 @@ impl ProbeSet {
         };
         set.candidates = candidates;
         set.invalid = invalid;
+        progress(candidates + 1, candidates + 1);
         Ok(set)
     }
 

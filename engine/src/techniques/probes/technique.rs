@@ -17,6 +17,7 @@ use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
 use crate::layouts::{bytes_of, spirv, ProbeLight};
 use crate::pass::{Pass, Resource};
+use crate::progress::Progress;
 use crate::prt::TransferSet;
 use crate::scene::Scene;
 use crate::techniques::sloan;
@@ -47,14 +48,15 @@ pub struct ProbeTechnique {
 }
 
 impl ProbeTechnique {
-    /// Captures the probes (see [`ProbeSet::capture`]). `transfer`: the PRT transfer, which
-    /// static groups lit by Sloan's PRT need.
+    /// Captures the probes (see [`ProbeSet::capture`], which `progress` hears). `transfer`: the
+    /// PRT transfer, which static groups lit by Sloan's PRT need.
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
         gpu: &GpuScene,
         settings: &ProbeSettings,
         transfer: Option<&TransferSet>,
+        progress: &mut Progress,
     ) -> Result<ProbeTechnique> {
         let statics = match (settings.statics, transfer) {
             (StaticLighting::Unshadowed, _) => Statics::Unshadowed(Unshadowed::new(ctx)?),
@@ -75,7 +77,7 @@ impl ProbeTechnique {
         Ok(ProbeTechnique {
             statics,
             pipeline: lighting_pipeline(ctx, "scene_probes", spirv::PROBE_SCENE_FRAG)?,
-            set: ProbeSet::capture(ctx, scene, gpu, settings)?,
+            set: ProbeSet::capture(ctx, scene, gpu, settings, progress)?,
             centre,
             walker: Walker::default(),
             light: Buffer::new(
