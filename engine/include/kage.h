@@ -1006,6 +1006,13 @@ kage_result kage_renderer_set_light(kage_renderer *renderer,
 kage_result kage_renderer_set_env_rotation(kage_renderer *renderer, float radians);
 
 /**
+ * Poses every group that has keyframes (a scene file's `keyframes`; the built-in scenes' hop,
+ * a one-second loop) at `seconds` (finite) of its motion for the next frames, as
+ * `kage render --time` does; the other groups stay as they are.
+ */
+kage_result kage_renderer_set_time(kage_renderer *renderer, float seconds);
+
+/**
  * Writes the renderer's statistics to `*stats`.
  *
  * # Safety

@@ -50,6 +50,9 @@ pub struct Renderer {
     executor: FrameExecutor,
     /// Each group's [`crate::scene::Group::object_reach`], for `set_group_transform`.
     reach: Vec<f32>,
+    /// The groups that move by themselves ([`crate::scene::Group::motion`]), as the scene has
+    /// them: what [`Renderer::set_time`] poses.
+    moving: Vec<(usize, crate::scene::Group)>,
 }
 
 impl Renderer {
@@ -72,6 +75,13 @@ impl Renderer {
             options.technique.build(ctx, scene, &gpu, options.transfer.as_ref(), size, progress)?;
         Ok(Renderer {
             reach: scene.groups.iter().map(|g| g.object_reach()).collect(),
+            moving: scene
+                .groups
+                .iter()
+                .enumerate()
+                .filter(|(_, g)| g.motion.is_some())
+                .map(|(i, g)| (i, crate::scene::Group { meshes: Vec::new(), ..g.clone() }))
+                .collect(),
             ctx: ctx.clone(),
             scene: gpu,
             camera: scene.camera,
@@ -136,6 +146,19 @@ impl Renderer {
         check_extent(transform.w_axis.truncate(), scale, self.reach[group])
             .map_err(|e| e.within(&format!("group {group}")))?;
         *slot = transform;
+        Ok(())
+    }
+
+    /// Poses every group that has a motion at `time` seconds of it (the others stay).
+    pub fn set_time(&mut self, time: f32) -> Result<()> {
+        if !time.is_finite() {
+            return Err(Error::InvalidArgument(format!("time {time} is not finite")));
+        }
+        for (g, group) in &self.moving {
+            let transform = group.pose_at(time).matrix();
+            let slot = &mut self.scene.transforms[*g];
+            *slot = transform;
+        }
         Ok(())
     }
 

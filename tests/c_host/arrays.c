@@ -465,6 +465,11 @@ static void check_renderer_progress(kage_context *context) {
   CHECK(kage_renderer_create_with(context, scene, &desc, hear, &log, &renderer));
   REQUIRE(log.calls == 10 && log.last == 1.0);
   CHECK(kage_renderer_render(renderer));
+  /* probe-room's bunny hops: any instant of its motion renders; a time must be finite. */
+  CHECK(kage_renderer_set_time(renderer, 0.25f));
+  CHECK(kage_renderer_render(renderer));
+  EXPECT(kage_renderer_set_time(renderer, NAN), KAGE_RESULT_INVALID_VALUE);
+  EXPECT(kage_renderer_set_time(NULL, 0.0f), KAGE_RESULT_NULL_ARGUMENT);
   CHECK(kage_renderer_destroy(renderer));
   CHECK(kage_scene_destroy(scene));
 }

@@ -43,7 +43,12 @@ impl Drop for Validated {
 pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Scene {
     Scene {
         name: "test".into(),
-        groups: vec![Group { name: "object".into(), meshes: vec![mesh], transform: Transform::default() }],
+        groups: vec![Group {
+            name: "object".into(),
+            meshes: vec![mesh],
+            transform: Transform::default(),
+            motion: None,
+        }],
         environment,
         lights: vec![],
         walkthrough: vec![],

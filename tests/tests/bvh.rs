@@ -91,6 +91,7 @@ fn random_scene(rng: &mut Rng, groups: usize, triangles: usize) -> Scene {
                 })
                 .collect(),
             transform: random_transform(rng),
+            motion: None,
         })
         .collect();
     scene(groups)
@@ -369,7 +370,8 @@ fn scenes_without_triangles_miss_everything() {
     let mut caster = RayCaster::new(&ctx).unwrap();
     let mut rng = Rng(4);
     let rays: Vec<(Vec3, Vec3, f32)> = (0..64).map(|_| (rng.vec(2.0), rng.direction(), INFINITE)).collect();
-    let empty_group = Group { name: "empty".into(), meshes: vec![], transform: Transform::default() };
+    let empty_group =
+        Group { name: "empty".into(), meshes: vec![], transform: Transform::default(), motion: None };
     for groups in [vec![], vec![empty_group]] {
         let instances = groups.len() as u32;
         let mut bvh = SceneBvh::build(&scene(groups)).unwrap();

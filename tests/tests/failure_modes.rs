@@ -74,7 +74,12 @@ fn scene(groups: Vec<Group>) -> Scene {
 }
 
 fn group(name: &str, meshes: Vec<Mesh>, translation: Vec3) -> Group {
-    Group { name: name.into(), meshes, transform: Transform { translation, ..Transform::default() } }
+    Group {
+        name: name.into(),
+        meshes,
+        transform: Transform { translation, ..Transform::default() },
+        motion: None,
+    }
 }
 
 /// The static group: a floor and a box on it, so that the probe grid over it is 3D.
@@ -323,7 +328,8 @@ fn meshes_without_triangles_are_errors_and_empty_groups_draw_nothing() {
     );
     assert_error_says(Renderer::new(&ctx, &stray_index, &RenderOptions::default()), &["vertex index 99"]);
 
-    let nothing = Group { name: "nothing".into(), meshes: vec![], transform: Transform::default() };
+    let nothing =
+        Group { name: "nothing".into(), meshes: vec![], transform: Transform::default(), motion: None };
     for scene in [scene(vec![]), scene(vec![nothing.clone()]), scene(vec![nothing, room()])] {
         let groups = scene.groups.len();
         for (name, options) in techniques(&ctx, &scene) {

@@ -24,6 +24,7 @@ fn sun_scene() -> Scene {
         name: name.into(),
         meshes: vec![mesh],
         transform: Transform { translation: Vec3::new(0.0, y, 0.0), ..Transform::default() },
+        motion: None,
     };
     Scene {
         name: "sun".into(),

@@ -16,7 +16,12 @@ fn scene_of(groups: Vec<Vec<Mesh>>) -> Scene {
     scene.groups = groups
         .into_iter()
         .enumerate()
-        .map(|(i, meshes)| Group { name: format!("group{i}"), meshes, transform: Transform::default() })
+        .map(|(i, meshes)| Group {
+            name: format!("group{i}"),
+            meshes,
+            transform: Transform::default(),
+            motion: None,
+        })
         .collect();
     scene
 }

@@ -2,6 +2,7 @@
 //! panic), and an exported scene reads back identical. No GPU needed.
 use std::path::{Path, PathBuf};
 
+use glam::Vec3;
 use kage::scene::{ProbeRole, Scene, BUILTIN};
 
 /// A fresh, empty folder under the system temp dir, unique to this process and test.
@@ -364,5 +365,60 @@ fn scene_file_probes_round_trip_and_bad_ones_are_named() {
         );
         let error = Scene::load(&path).unwrap_err().to_string();
         assert!(error.contains(expected), "{extra}: {error}");
+    }
+}
+
+/// A group's keyframes in a scene file: read, sampled (exact at keys, linear and slerped
+/// between, looped), written back by export identical; bad ones named with the file, the group
+/// and the key.
+#[test]
+fn keyframes_in_a_scene_file_move_their_group_and_bad_ones_are_named() {
+    let dir = temp_dir("keyframes");
+    let sphere = r#"{"sphere": {"radius": 0.5, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
+    let keys = r#", "keyframes": [
+        {"time": 0, "translation": [0, 1, 0]},
+        {"time": 2, "translation": [4, 1, 0], "rotation_deg": [0, 90, 0]}], "loop_seconds": 4"#;
+    let path = write(&dir, "moving.json", &scene_json(keys, sphere, ""));
+    let scene = Scene::load(&path).unwrap();
+    let group = &scene.groups[0];
+    assert_eq!(scene.duration(), 4.0);
+    assert_eq!(group.pose_at(2.0).translation, Vec3::new(4.0, 1.0, 0.0));
+    let half = group.pose_at(1.0);
+    assert!((half.translation - Vec3::new(2.0, 1.0, 0.0)).length() < 1e-6);
+    assert!(half.rotation.abs_diff_eq(glam::Quat::from_rotation_y(std::f32::consts::FRAC_PI_4), 1e-5));
+    // Looped: from the last key back to the first over the remaining two seconds.
+    assert!((group.pose_at(3.0).translation.x - 2.0).abs() < 1e-6);
+    assert_eq!(group.pose_at(4.0), group.pose_at(0.0));
+    // Export writes the keyframes back.
+    let out = temp_dir("keyframes-export");
+    scene.export(&out).unwrap();
+    let back = Scene::load(&out.join(kage::scene::SCENE_FILE)).unwrap();
+    assert_eq!(back.groups[0].motion, scene.groups[0].motion);
+    let cases = [
+        (
+            r#", "keyframes": [{"time": 1, "translation": [0, 0, 0]}, {"time": 1, "translation": [1, 0, 0]}]"#,
+            "keyframe 1: time 1 does not come after",
+        ),
+        (
+            r#", "keyframes": [{"time": 0, "translation": [0, 0, 0], "rotation_deg": [0, 0, 0], "rotation_quat": [0, 0, 0, 1]}]"#,
+            "keyframe 0: give either",
+        ),
+        (
+            r#", "keyframes": [{"time": 0, "translation": [0, 0, 0], "rotation_quat": [0, 0, 0, 3]}]"#,
+            "not a unit quaternion",
+        ),
+        (
+            r#", "keyframes": [{"time": 0, "translation": [0, 0, 0]}, {"time": 3, "translation": [0, 0, 0]}], "loop_seconds": 2"#,
+            "loop_seconds 2",
+        ),
+        (r#", "loop_seconds": 2"#, "loop_seconds without keyframes"),
+        (r#", "keyframes": [{"time": 0, "translation": [0, 0, 0], "scale": 2}]"#, "unknown field `scale`"),
+    ];
+    for (k, (extra, problem)) in cases.iter().enumerate() {
+        let file = format!("bad{k}.json");
+        let path = write(&dir, &file, &scene_json(extra, sphere, ""));
+        assert_rejected(&path, &file, problem);
+        let message = Scene::load(&path).unwrap_err().to_string();
+        assert!(message.contains("group 0") || message.contains("unknown field"), "{message}");
     }
 }

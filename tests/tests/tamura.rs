@@ -12,7 +12,6 @@ use kage::pass::Resource;
 use kage::pass::{FrameExecutor, Pass};
 use kage::prt::{transfer, PrtParams, TransferSet};
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::animation::pose;
 use kage::scene::{Camera, Scene};
 use kage::sh;
 use kage::techniques::description::TechniqueDesc;
@@ -347,7 +346,7 @@ fn filtered_layers_are_zero_outside_their_footprint() {
         let mut executor = FrameExecutor::new(&ctx, "footprint").unwrap();
         for t in [0.0, 0.1, 0.3, 0.6] {
             let mut transforms: Vec<Mat4> = scene.groups.iter().map(|g| g.transform.matrix()).collect();
-            transforms[0] = pose(&scene.groups[0], t).matrix();
+            transforms[0] = scene.groups[0].pose_at(t).matrix();
             occlusion.update(&transforms, Mat3::IDENTITY).unwrap();
             let layers = occlusion.layers_in_use().to_vec();
             assert!(!layers.is_empty(), "pose {t}: no occlusion layer");

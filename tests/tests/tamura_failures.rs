@@ -13,7 +13,6 @@ use kage::raycast::closest_hit_brute_force;
 use kage::reference::irradiance::Point;
 use kage::reference::{compare, IrradianceReference, LightMode, ReferenceOptions, ReferenceRenderer};
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::animation::pose;
 use kage::scene::{shapes, EnvMap, Group, Scene, Transform};
 use kage::techniques::description::TechniqueDesc;
 use kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
@@ -166,6 +165,7 @@ fn sphere_group(name: &str, radius: f32, centre: Vec3) -> Group {
         name: name.into(),
         meshes: vec![shapes::sphere(name, radius, 32, [0.75; 3]).unwrap()],
         transform: Transform { translation: centre, ..Transform::default() },
+        motion: None,
     }
 }
 
@@ -187,6 +187,7 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
         name: "floor".into(),
         meshes: vec![shapes::plane("floor", [6.0, 6.0], [31, 31], [0.6; 3]).unwrap()],
         transform: Transform::default(),
+        motion: None,
     };
     let base = Scene::builtin("teapot").unwrap();
     let scene_of = |name: &str, spheres: Vec<Group>| Scene {
@@ -247,7 +248,7 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
 fn contact_with_the_floor_darkens_the_floor_beside_the_base() {
     let ctx = Validated::new();
     let mut scene = Scene::builtin("teapot").unwrap();
-    scene.groups[0].transform = pose(&scene.groups[0], 0.0);
+    scene.groups[0].transform = scene.groups[0].pose_at(0.0);
     let rest = scene.groups[0].transform.matrix();
     let size = 64;
     let (near, far) = (Vec3::new(0.0, 0.0, 0.6), Vec3::new(-1.0, 0.0, 1.8));

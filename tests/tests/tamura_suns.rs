@@ -12,7 +12,6 @@ use kage::imageio::RgbaF32Image;
 use kage::raycast::closest_hit_brute_force;
 use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
 use kage::sh::{equirect_direction, equirect_texel_solid_angle};
 use kage::techniques::description::{TechniqueDesc, TechniqueKind};
@@ -122,7 +121,7 @@ impl Case {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sun").join(map_name);
         let mut scene = Scene::builtin("teapot").unwrap();
         scene.environment = EnvMap::load(&path).unwrap();
-        scene.groups[0].transform = pose(&scene.groups[0], t);
+        scene.groups[0].transform = scene.groups[0].pose_at(t);
         let floor_group = scene.groups.iter().position(|g| g.name == "floor").unwrap();
         let albedo = scene.groups[floor_group].meshes[0].albedo[1];
 

@@ -3,7 +3,7 @@
 //! for automatic placement with tetrahedral interpolation (Morishige 2014).
 //!
 //! Test points: random points in the moving group's bounding box at random times of its
-//! scripted motion (`--animate`), those inside a solid dropped, each with random normals.
+//! motion (`--animate`: its keyframes), those inside a solid dropped, each with random normals.
 //! Truth: the reference's irradiance E(p, n) (the moving group moved far away, as the probes
 //! leave it out), cached. Error: the RMS of |E_probes − E| over points, normals and channels
 //! divided by the RMS of E (a relative error that dark normals cannot blow up).
@@ -24,7 +24,7 @@ use kage::files;
 use kage::frame::GpuScene;
 use kage::reference::irradiance::{IrradianceFile, Point};
 use kage::reference::IrradianceReference;
-use kage::scene::{animation, Scene};
+use kage::scene::Scene;
 use kage::sh::ShRgb9;
 use kage::techniques::probes::{
     bounds, capture_at, grid_lattice, CaptureSettings, Lattice, ProbeSet, Solids, Walker, MAX_GRID,
@@ -313,7 +313,7 @@ fn path_bounds(group: &kage::scene::Group, static_box: (Vec3, Vec3)) -> Option<(
     let corners = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
     let (lo, hi) = bounds(corners)?;
     let swept = (0..64).flat_map(|s| {
-        let m = animation::pose(group, s as f32 / 64.0).matrix();
+        let m = group.pose_at(s as f32 / 64.0).matrix();
         (0..8).map(move |c| {
             let corner = Vec3::new(
                 if c & 1 == 0 { lo.x } else { hi.x },
@@ -473,7 +473,7 @@ fn test_points(
         // The time is drawn for both regions, so that each keeps the random stream it had.
         let t = rng.next();
         let local = lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next());
-        let p = moving.map_or(local, |g| animation::pose(g, t).matrix().transform_point3(local));
+        let p = moving.map_or(local, |g| g.pose_at(t).matrix().transform_point3(local));
         if solids.contains(p) {
             continue;
         }

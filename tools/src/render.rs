@@ -88,10 +88,13 @@ pub struct RenderArgs {
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
-    /// Play the scene's camera walkthrough over the frames, or, for a scene without one, the
-    /// scripted motion of its first group (see README).
+    /// Play the scene's motion over the frames: its camera walkthrough, and the keyframes of
+    /// its groups (one pass of the longest; see README's scene format).
     #[arg(long)]
     animate: bool,
+    /// Render the instant T seconds into the scene's motion (its groups' keyframes).
+    #[arg(long, value_name = "T")]
+    time: Option<f32>,
     #[command(flatten)]
     prt: PrtArgs,
     #[command(flatten)]
@@ -192,6 +195,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(trace) = &args.trace {
         crate::outputs::check(trace, "--trace", &["json"])?;
     }
+    if let (true, Some(_)) = (args.animate, args.time) {
+        anyhow::bail!(
+            "--animate plays the scene's motion and --time holds one instant of it: give one of them"
+        );
+    }
+    if args.time.is_some_and(|t| !t.is_finite()) {
+        anyhow::bail!("--time must be a number of seconds");
+    }
     if args.animate && args.scene.keyframe.is_some() {
         anyhow::bail!(
             "--animate plays the walkthrough and --keyframe holds one of its cameras: give one of them"
@@ -221,6 +232,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             Renderer::with_progress(&ctx, &scene, &options, progress)
         })
         .context("setting up the renderer")?;
+    if let Some(time) = args.time {
+        renderer.set_time(time)?;
+    }
     if let Some(counts) = renderer.stats().probes {
         let seconds = setup.elapsed().as_secs_f64();
         let left_out = match counts.inside_geometry {
@@ -248,10 +262,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut dropped = 0;
     for frame in (0..args.warmup).map(|_| None).chain((0..args.frames).map(Some)) {
         let t = frame.map_or(0.0, |f| f as f32 / args.frames as f32);
-        if let (true, Some(camera)) = (args.animate, animation::camera_at(&scene.walkthrough, t)) {
-            renderer.set_camera(camera)?;
-        } else if let (true, Some(group)) = (args.animate, scene.groups.first()) {
-            renderer.set_group_transform(0, animation::pose(group, t).matrix())?;
+        if args.animate {
+            if let Some(camera) = animation::camera_at(&scene.walkthrough, t) {
+                renderer.set_camera(camera)?;
+            }
+            renderer.set_time(t * scene.duration())?;
         }
         // With a trace, the device's and host's clocks read around the frame where they can be.
         let calibrate = || if args.trace.is_some() { ctx.calibrate() } else { Ok(None) };

@@ -1077,6 +1077,7 @@ fn readmes_scene_format_names_every_field_the_parser_takes() {
         r#"{"environment": {"zzz": 0}}"#,
         r#"{"groups": [{"zzz": 0}]}"#,
         r#"{"groups": [{"meshes": [{"zzz": 0}]}]}"#,
+        r#"{"groups": [{"keyframes": [{"zzz": 0}]}]}"#,
         r#"{"groups": [{"meshes": [{"plane": {"zzz": 0}}]}]}"#,
         r#"{"groups": [{"meshes": [{"sphere": {"zzz": 0}}]}]}"#,
         r#"{"lights": [{"zzz": {}}]}"#,
@@ -1099,4 +1100,37 @@ fn readmes_scene_format_names_every_field_the_parser_takes() {
         .collect();
     assert!(unnamed.is_empty(), "README's scene format does not name {unnamed:?}, which the parser takes");
     assert!(names.len() >= 30, "only {} names found: {names:?}", names.len());
+}
+
+/// `--time T` renders one instant of the scene's own motion: a group with keyframes moves, a
+/// scene without any stays put (`--animate` no longer moves a group the scene does not move);
+/// `--time` with `--animate` is an error.
+#[test]
+fn render_time_plays_the_scenes_keyframes_and_nothing_else() {
+    let dir = scratch_dir("cli-time");
+    let ball = r#"{"name": "ball", "translation": [0, 0.5, 0], "meshes": [{"sphere": {"radius": 0.5, "segments": 12}, "albedo": [0.8, 0.8, 0.8]}]KEYS}"#;
+    let floor = r#"{"name": "floor", "meshes": [{"plane": {"size": [6, 6], "vertices": [2, 2]}, "albedo": [0.6, 0.6, 0.6]}]}"#;
+    let scene = |keys: &str| {
+        format!(
+            r#"{{"camera": {{"position": [0, 2, 5], "target": [0, 0.5, 0], "fov_y_deg": 40}}, "environment": {{"constant": [1, 1, 1]}}, "groups": [{}, {floor}]}}"#,
+            ball.replace("KEYS", keys)
+        )
+    };
+    let keys = r#", "keyframes": [{"time": 0, "translation": [0, 0.5, 0]}, {"time": 1, "translation": [1.5, 0.5, 0]}]"#;
+    let (moving, still) = (dir.join("moving.json"), dir.join("still.json"));
+    std::fs::write(&moving, scene(keys)).unwrap();
+    std::fs::write(&still, scene("")).unwrap();
+    let render = |scene: &std::path::Path, time: &str| {
+        let out = dir.join(format!("{}-{time}.exr", scene.file_stem().unwrap().to_str().unwrap()));
+        let args =
+            ["render", "--scene", scene.to_str().unwrap(), "--technique", "unshadowed", "--time", time];
+        let result =
+            kage(&[&args[..], &["--width", "32", "--height", "32", "--out", out.to_str().unwrap()]].concat());
+        assert!(result.status.success(), "{}", text(&result));
+        kage::imageio::read_exr(&out).unwrap().pixels
+    };
+    assert!(render(&moving, "0") != render(&moving, "1"), "the keyframed ball moved");
+    assert!(render(&still, "0") == render(&still, "1"), "a scene without keyframes stays put");
+    let both = kage(&["render", "--scene", moving.to_str().unwrap(), "--animate", "--time", "1"]);
+    assert!(!both.status.success() && text(&both).contains("give one of them"), "{}", text(&both));
 }

@@ -235,6 +235,17 @@ pub extern "C" fn kage_renderer_set_env_rotation(renderer: *mut kage_renderer, r
     })
 }
 
+/// Poses every group that has keyframes (a scene file's `keyframes`; the built-in scenes' hop,
+/// a one-second loop) at `seconds` (finite) of its motion for the next frames, as
+/// `kage render --time` does; the other groups stay as they are.
+#[no_mangle]
+pub extern "C" fn kage_renderer_set_time(renderer: *mut kage_renderer, seconds: f32) -> kage_result {
+    boundary(|| {
+        let mut r = handles::get(renderer, "renderer")?;
+        Ok(r.renderer.set_time(seconds)?)
+    })
+}
+
 /// What a renderer holds and what its last frame had to leave out.
 #[repr(C)]
 #[derive(Clone, Copy, Default)]

@@ -225,7 +225,7 @@ unsafe fn group(at: usize, desc: &kage_group_desc) -> Result<Group, Failure> {
                 .map_err(|e| place(e.within(&format!("mesh {m}"))))
         })
         .collect::<Result<_, _>>()?;
-    Ok(Group { name, meshes, transform })
+    Ok(Group { name, meshes, transform, motion: None })
 }
 
 /// The host's data is at fault (no file is involved).

@@ -215,6 +215,7 @@ mod tests {
             name: name.into(),
             meshes: vec![shapes::sphere(name, 1.0, 12, [0.5; 3]).unwrap()],
             transform: Transform { translation: Vec3::new(x, 0.0, 0.0), ..Transform::default() },
+            motion: None,
         };
         Scene {
             name: "spheres".into(),

@@ -106,7 +106,12 @@ pub fn asm_scene() -> Result<Scene, SceneError> {
     let bunny = obj::parse_obj(BUNNY_OBJ, "bunny", [0.8; 3]).map_err(context)?;
     let boxes =
         |name: &str, bars: Vec<Bar>, albedo: f32| shapes::boxes(name, &bars, [albedo; 3]).map_err(context);
-    let group = |name: &str, mesh, transform| Group { name: name.into(), meshes: vec![mesh], transform };
+    let group = |name: &str, mesh, transform| Group {
+        name: name.into(),
+        meshes: vec![mesh],
+        transform,
+        motion: None,
+    };
     let bunny_transform = Transform {
         translation: Vec3::new(-1.2, 0.0, 0.6),
         rotation: Quat::from_rotation_y(30f32.to_radians()),

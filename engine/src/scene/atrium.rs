@@ -12,6 +12,7 @@
 //!   and back. The scene has no walkthrough, so `--animate` moves the bunny.
 //!
 //! 1,440 triangles (120 boxes) besides the bunny's 3,674: light for lavapipe.
+use super::motion;
 use glam::Vec3;
 
 use super::{obj, shapes, Camera, Group, Mesh, SceneError, Transform};
@@ -145,8 +146,13 @@ pub fn groups() -> Result<Vec<Group>, SceneError> {
     let bunny_transform =
         Transform { translation: bunny_rest(), scale: BUNNY_SIZE / BUNNY_HEIGHT, ..Transform::default() };
     Ok(vec![
-        Group { name: "bunny".into(), meshes: vec![bunny], transform: bunny_transform },
-        Group { name: "building".into(), meshes, transform: Transform::default() },
+        motion::hopping(Group {
+            name: "bunny".into(),
+            meshes: vec![bunny],
+            transform: bunny_transform,
+            motion: None,
+        }),
+        Group { name: "building".into(), meshes, transform: Transform::default(), motion: None },
     ])
 }
 
@@ -163,7 +169,7 @@ pub fn camera() -> Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{animation, Scene};
+    use crate::scene::Scene;
     use crate::techniques::probes::Solids;
 
     #[test]
@@ -196,7 +202,7 @@ mod tests {
         let solids = Solids::of_static(&scene);
         let bunny = &scene.groups[0];
         let above = |t: f32| {
-            let top = animation::pose(bunny, t).matrix().transform_point3(Vec3::new(0.0, BUNNY_HEIGHT, 0.0));
+            let top = bunny.pose_at(t).matrix().transform_point3(Vec3::new(0.0, BUNNY_HEIGHT, 0.0));
             solids.first_hit(top, Vec3::Y)
         };
         // At a quarter cycle it is 90 cm into the gallery (+X), under the roof; at three
@@ -207,8 +213,7 @@ mod tests {
         // opening is wider than the bunny.
         for s in 0..32 {
             let t = s as f32 / 32.0;
-            let middle =
-                animation::pose(bunny, t).matrix().transform_point3(Vec3::new(0.0, 0.5 * BUNNY_HEIGHT, 0.0));
+            let middle = bunny.pose_at(t).matrix().transform_point3(Vec3::new(0.0, 0.5 * BUNNY_HEIGHT, 0.0));
             assert!(!solids.contains(middle), "t = {t}: {middle}");
             assert!(middle.z.abs() < 0.5 * (COLUMN_SPACING - COLUMN), "{middle}");
         }

@@ -1,6 +1,7 @@
 //! Scenes compiled into the library, so that Kage renders something with no file on disk.
 //! Their assets live in `engine/assets/` (licences in `engine/assets/LICENSES.md`): copies of
 //! the shared reference assets, embedded so the library needs no file at run time.
+use super::motion;
 use glam::Vec3;
 
 use super::{atrium, obj, probe_room, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
@@ -55,8 +56,18 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     Ok(Scene {
         name: name.to_string(),
         groups: vec![
-            Group { name: "teapot".into(), meshes: vec![teapot], transform: teapot_transform },
-            Group { name: "floor".into(), meshes: vec![floor], transform: Transform::default() },
+            motion::hopping(Group {
+                name: "teapot".into(),
+                meshes: vec![teapot],
+                transform: teapot_transform,
+                motion: None,
+            }),
+            Group {
+                name: "floor".into(),
+                meshes: vec![floor],
+                transform: Transform::default(),
+                motion: None,
+            },
         ],
         environment,
         lights: Vec::new(),

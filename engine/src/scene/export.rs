@@ -4,7 +4,8 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use super::file::{
-    CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, PointDesc, ProbeDesc, SceneFile, SpotDesc,
+    CameraDesc, EnvironmentDesc, GroupDesc, KeyframeDesc, LightDesc, MeshDesc, PointDesc, ProbeDesc,
+    SceneFile, SpotDesc,
 };
 use super::{obj, Camera, Light, Scene, SceneError};
 
@@ -52,6 +53,18 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
             rotation_quat: Some(t.rotation.to_array()),
             scale: t.scale,
             meshes,
+            keyframes: group
+                .motion
+                .iter()
+                .flat_map(|m| &m.keys)
+                .map(|k| KeyframeDesc {
+                    time: k.time,
+                    translation: k.translation.to_array(),
+                    rotation_deg: None,
+                    rotation_quat: Some(k.rotation.to_array()),
+                })
+                .collect(),
+            loop_seconds: group.motion.as_ref().and_then(|m| m.loop_seconds),
         });
     }
 

@@ -26,6 +26,9 @@
 //!   visits in order.
 //! - `probes` (optional): light probes placed by hand, `{"position": [x, y, z], "role": "sky"}`
 //!   with `role` optional, one of `sky`, `bounce`, `bleed` ([`super::ProbeRole`]).
+//! - `keyframes` (optional, per group): `{"time": seconds, "translation": [x, y, z],
+//!   "rotation_deg" or "rotation_quat"}` in increasing time, with `loop_seconds` (optional) to
+//!   repeat them: the group's motion (`super::motion`), its scale its own.
 //! - `exposure` (optional, > 0, default 1): what a PNG of the scene is multiplied by before
 //!   tonemapping when the command names no `--exposure`.
 //! - Relative paths are relative to the folder of the scene file.
@@ -99,6 +102,21 @@ pub struct GroupDesc {
     #[serde(default = "one")]
     pub scale: f32,
     pub meshes: Vec<MeshDesc>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keyframes: Vec<KeyframeDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loop_seconds: Option<f32>,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeDesc {
+    pub time: f32,
+    pub translation: [f32; 3],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation_deg: Option<[f32; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation_quat: Option<[f32; 4]>,
 }
 
 fn one() -> f32 {

@@ -1,5 +1,6 @@
 //! Turning a parsed scene file into a validated [`Scene`]. Errors name the scene file and where
 //! in it the problem is; errors in a referenced file name that file too.
+use super::motion::{Key, Motion};
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
@@ -86,15 +87,20 @@ fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneErr
     map.scaled(desc.intensity)
 }
 
-fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
-    let rotation = match (desc.rotation_deg, desc.rotation_quat) {
-        (None, None) => Quat::IDENTITY,
-        (Some(degrees), None) => Transform::rotation_from_euler_deg(degrees),
-        (None, Some(q)) => Quat::from_array(q),
+/// A rotation given as Euler angles in degrees or as a quaternion, or neither (none).
+fn rotation_of(degrees: Option<[f32; 3]>, quat: Option<[f32; 4]>) -> Result<Quat, SceneError> {
+    match (degrees, quat) {
+        (None, None) => Ok(Quat::IDENTITY),
+        (Some(degrees), None) => Ok(Transform::rotation_from_euler_deg(degrees)),
+        (None, Some(q)) => Ok(Quat::from_array(q)),
         (Some(_), Some(_)) => {
-            return Err(SceneError::invalid("give either \"rotation_deg\" or \"rotation_quat\", not both"))
+            Err(SceneError::invalid("give either \"rotation_deg\" or \"rotation_quat\", not both"))
         }
-    };
+    }
+}
+
+fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
+    let rotation = rotation_of(desc.rotation_deg, desc.rotation_quat)?;
     let transform =
         Transform { translation: Vec3::from(desc.translation), rotation, scale: desc.scale }.validated()?;
     if desc.meshes.is_empty() {
@@ -106,7 +112,22 @@ fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
         .enumerate()
         .map(|(at, m)| mesh(m, folder).map_err(|e| e.within(&format!("mesh {at}"))))
         .collect::<Result<_, _>>()?;
-    Ok(Group { name: desc.name, meshes, transform })
+    let keys = desc
+        .keyframes
+        .iter()
+        .enumerate()
+        .map(|(k, key)| {
+            let rotation = rotation_of(key.rotation_deg, key.rotation_quat)
+                .map_err(|e| e.within(&format!("keyframe {k}")))?;
+            Ok(Key { time: key.time, translation: Vec3::from(key.translation), rotation })
+        })
+        .collect::<Result<Vec<Key>, SceneError>>()?;
+    let motion = match (keys.is_empty(), desc.loop_seconds) {
+        (true, None) => None,
+        (true, Some(_)) => return Err(SceneError::invalid("loop_seconds without keyframes")),
+        (false, loop_seconds) => Some(Motion { keys, loop_seconds }),
+    };
+    Ok(Group { name: desc.name, meshes, transform, motion })
 }
 
 fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {

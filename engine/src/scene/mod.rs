@@ -32,6 +32,7 @@ pub mod file;
 mod light;
 mod load;
 mod mesh;
+pub mod motion;
 mod obj;
 mod probe;
 mod probe_room;
@@ -46,6 +47,7 @@ pub use error::SceneError;
 pub use export::{ENVIRONMENT_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
 pub use mesh::Mesh;
+pub use motion::Motion;
 pub use obj::{load_obj, parse_obj, write_obj};
 pub use probe::{ProbeRole, SceneProbe};
 pub use sun_map::SunMap;
@@ -79,7 +81,10 @@ pub struct Scene {
 pub struct Group {
     pub name: String,
     pub meshes: Vec<Mesh>,
+    /// Its pose at rest; with a motion, its scale holds and its motion gives the rest.
     pub transform: Transform,
+    /// Its keyframes (`keyframes` in a scene file), which `--animate` and `--time` play.
+    pub motion: Option<Motion>,
 }
 
 impl Group {
@@ -164,6 +169,13 @@ impl Scene {
             }
             let t = &group.transform;
             check_extent(t.translation, t.scale, group.object_reach()).map_err(|e| e.within(&place))?;
+            if let Some(motion) = &group.motion {
+                motion.validate().map_err(|e| e.within(&place))?;
+                for key in &motion.keys {
+                    check_extent(key.translation, t.scale, group.object_reach())
+                        .map_err(|e| e.within(&place))?;
+                }
+            }
         }
         for (l, light) in self.lights.iter().enumerate() {
             light.validated().map_err(|e| e.within(&format!("scene \"{}\": light {l}", self.name)))?;
@@ -178,6 +190,16 @@ impl Scene {
             )));
         }
         Ok(())
+    }
+
+    /// How long one pass of its groups' motions lasts, seconds: the longest (0 without any).
+    pub fn duration(&self) -> f32 {
+        self.groups.iter().filter_map(|g| g.motion.as_ref()).map(Motion::duration).fold(0.0, f32::max)
+    }
+
+    /// Its groups' transforms at `time` seconds of their motions.
+    pub fn poses_at(&self, time: f32) -> Vec<Transform> {
+        self.groups.iter().map(|g| g.pose_at(time)).collect()
     }
 
     pub fn meshes(&self) -> impl Iterator<Item = (&Group, &Mesh)> {

@@ -2,6 +2,7 @@
 //! red wall (−X), a green wall (+X), a blue wall (−Z) and grey floor, front wall and ceiling,
 //! a 1.2 × 1.2 opening in the ceiling through which the sky shows, and the Stanford bunny
 //! standing under the opening as group 0 (the group `--animate` moves).
+use super::motion;
 use glam::Vec3;
 
 use super::{obj, shapes, Group, Mesh, SceneError, Transform};
@@ -43,8 +44,13 @@ pub fn groups() -> Result<Vec<Group>, SceneError> {
         panel("ceiling_right", v(o, top, -o), v(h, top, o), Vec3::NEG_Y, GREY)?,
     ];
     Ok(vec![
-        Group { name: "bunny".into(), meshes: vec![bunny], transform: bunny_transform },
-        Group { name: "room".into(), meshes: room, transform: Transform::default() },
+        motion::hopping(Group {
+            name: "bunny".into(),
+            meshes: vec![bunny],
+            transform: bunny_transform,
+            motion: None,
+        }),
+        Group { name: "room".into(), meshes: room, transform: Transform::default(), motion: None },
     ])
 }
 

@@ -18,7 +18,6 @@ use kage::pass::TimingTable;
 use kage::prt::{PrtParams, TransferSet};
 use kage::reference::compare;
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::animation::pose;
 use kage::scene::{EnvMap, Scene};
 use kage::techniques::description::{TechniqueDesc, TechniqueKind};
 use kage::techniques::tamura::technique::OcclusionSettings;
@@ -52,8 +51,9 @@ pub struct SweepArgs {
     /// Environment maps to sweep over, each replacing the scene's (default: the scene's own).
     #[arg(long = "env")]
     envs: Vec<PathBuf>,
-    /// Poses of the scripted motion (fractions of its cycle) at which the error is measured;
-    /// 0 is the scene pose (the teapot standing on the floor: contact).
+    /// Times in the scene's motion (seconds of its groups' keyframes; the built-in scenes' hop
+    /// loops in one) at which the error is measured; 0 is the scene pose (the teapot standing on
+    /// the floor: contact).
     #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.125, 0.6])]
     poses: Vec<f32>,
     /// Only these settings, e.g. `unshadowed,sloan-self:3,tamura:32,parallel-lights:32` (prt) or
@@ -373,7 +373,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             let memory_mb = (ctx.allocated_bytes() - before) as f64 / (1 << 20) as f64;
             let mut errors = Vec::new();
             for (&t, reference) in args.poses.iter().zip(&references) {
-                renderer.set_group_transform(0, pose(&lit.groups[0], t).matrix())?;
+                renderer.set_time(t)?;
                 renderer.render()?;
                 errors.push(compare(&renderer.image()?, &reference.image)?.relative_rmse);
                 bar.inc(1);
@@ -516,21 +516,24 @@ pub(crate) fn print_picks(
     }
 }
 
-/// `scene` with its first group at time `t` of the scripted motion.
+/// `scene` with its groups at `t` seconds of their motions.
 fn posed(scene: &Scene, t: f32) -> Scene {
     let mut scene = scene.clone();
-    scene.groups[0].transform = pose(&scene.groups[0], t);
+    let poses = scene.poses_at(t);
+    for (group, pose) in scene.groups.iter_mut().zip(poses) {
+        group.transform = pose;
+    }
     scene
 }
 
-/// Median GPU milliseconds per frame over `frames` frames of the scripted motion.
+/// Median GPU milliseconds per frame over `frames` frames through one pass of the scene's motion.
 fn frame_time(ctx: &Arc<Context>, scene: &Scene, options: &RenderOptions, frames: u32) -> Result<f64> {
     let mut renderer = Renderer::new(ctx, scene, options)?;
     // One untimed frame: pipelines are compiled on first use on CPU drivers.
     renderer.render()?;
     let mut table = TimingTable::default();
     for frame in 0..frames {
-        renderer.set_group_transform(0, pose(&scene.groups[0], frame as f32 / frames as f32).matrix())?;
+        renderer.set_time(frame as f32 / frames as f32 * scene.duration())?;
         table.add_frame(&renderer.render()?);
     }
     Ok(table.frame_median_ms())

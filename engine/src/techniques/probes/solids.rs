@@ -95,6 +95,7 @@ mod tests {
             name: name.into(),
             meshes: vec![mesh],
             transform: Transform::default(),
+            motion: None,
         };
         Scene {
             name: "column".into(),

@@ -184,7 +184,7 @@ mod tests {
             .collect();
         let normals = vec![[0.0, 1.0, 0.0]; positions.len()];
         let mesh = Mesh { name: "grid".into(), positions, normals, indices, albedo: [0.5; 3] };
-        Group { name: "floor".into(), meshes: vec![mesh], transform: Transform::default() }
+        Group { name: "floor".into(), meshes: vec![mesh], transform: Transform::default(), motion: None }
     }
 
     fn corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
