@@ -1,5 +1,5 @@
-//! A bounded mutation fuzzer over the readers of what users hand Kage: scene JSON, OBJ, EXR and
-//! HDR maps, probe position files, and probe positions (tetrahedralized). Each starts from its committed seed
+//! A bounded mutation fuzzer over the readers of what users hand Kage: scene JSON, glTF, OBJ, EXR
+//! and HDR maps, probe position files, and probe positions (tetrahedralized). Each starts from its committed seed
 //! (tests/fuzz/seeds/), which must read cleanly, and reads `KAGE_FUZZ_ITERATIONS` (default 2,000)
 //! mutants of it: bytes flipped, inserted, deleted, repeated, and numbers replaced by extreme
 //! ones. Every read must return, Ok or a clear error: a panic or an abort fails the test. The
@@ -182,5 +182,17 @@ fn probe_files() {
         if let Ok(points) = positions_file::parse(bytes) {
             let _ = ProbeSet::tetrahedral(&points, vec![ShRgb9::default(); points.len()]);
         }
+    });
+}
+
+#[test]
+fn gltf_files() {
+    let seed = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/gltf/two-groups.gltf")).unwrap();
+    let path = scratch().join("mutant.gltf");
+    std::fs::write(&path, &seed).unwrap();
+    Scene::load(&path).expect("the seed glTF loads");
+    fuzz("two-groups.gltf", &seed, 8, |bytes| {
+        std::fs::write(&path, bytes).unwrap();
+        let _ = Scene::load(&path);
     });
 }

@@ -30,7 +30,7 @@ pub enum BenchCommand {
 
 #[derive(Args)]
 pub struct RaysArgs {
-    /// A built-in scene name (those of `kage render --scene`) or a scene file (.json).
+    /// A built-in scene name (those of `kage render --scene`) or a scene file (.json, or glTF 2.0: .gltf, .glb).
     #[arg(long, default_value = "teapot")]
     scene: String,
     /// Rays per cast, rounded down to a square number for the camera's square image.

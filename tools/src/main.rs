@@ -62,7 +62,7 @@ impl GpuArgs {
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneArgs {
     /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium), a scene
-    /// file (.json), or a folder holding scene.json.
+    /// file (.json), a glTF 2.0 file (.gltf, .glb), or a folder holding scene.json.
     #[arg(long, default_value = "teapot")]
     scene: String,
     /// Look from keyframe K (from 0) of the scene's camera walkthrough instead of its camera.

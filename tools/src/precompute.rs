@@ -10,7 +10,7 @@ use kage::scene::Scene;
 
 #[derive(Args)]
 pub struct PrecomputeArgs {
-    /// A built-in scene name (those of `kage render --scene`) or a scene file (.json).
+    /// A built-in scene name (those of `kage render --scene`) or a scene file (.json, or glTF 2.0: .gltf, .glb).
     #[arg(long, default_value = "teapot")]
     scene: String,
     #[command(flatten)]

@@ -32,7 +32,7 @@ pub enum ProbesCommand {
 
 #[derive(Args)]
 pub struct PlaceArgs {
-    /// A built-in scene name or a scene file (.json).
+    /// A built-in scene name or a scene file (.json, or glTF 2.0: .gltf, .glb).
     #[arg(long, default_value = "probe-room")]
     scene: String,
     /// `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (see `kage render --probes`).

@@ -101,7 +101,7 @@ pub struct kage_scene_desc {
     pub camera: kage_camera_desc,
 }
 
-/// Loads a scene: a path to a scene file (JSON, see the README), or the name of a built-in
+/// Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb; see the README), or the name of a built-in
 /// scene ("teapot", the default scene; an unknown name's error lists the others). A path that
 /// exists or ends in ".json" is a file.
 ///

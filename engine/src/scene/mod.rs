@@ -29,6 +29,7 @@ pub mod envmap;
 mod error;
 mod export;
 pub mod file;
+pub mod gltf;
 mod light;
 mod load;
 mod mesh;
@@ -109,9 +110,14 @@ pub fn check_extent(translation: Vec3, scale: f32, object_reach: f32) -> Result<
 }
 
 impl Scene {
-    /// Reads a JSON scene file; relative paths inside it are relative to its folder.
+    /// Reads a scene file: JSON (relative paths inside it are relative to its folder), or glTF
+    /// 2.0 by its extension, .gltf or .glb ([`gltf`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        load::load(path)
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match extension.as_deref() {
+            Some("gltf" | "glb") => gltf::load(path),
+            _ => load::load(path),
+        }
     }
 
     /// One of the scenes in [`BUILTIN`]; an unknown name is an error that lists them.
@@ -128,7 +134,7 @@ impl Scene {
         let path = Path::new(arg);
         if path.join(SCENE_FILE).is_file() {
             Scene::load(&path.join(SCENE_FILE))
-        } else if path.is_file() || arg.ends_with(".json") {
+        } else if path.is_file() || [".json", ".gltf", ".glb"].iter().any(|e| arg.ends_with(e)) {
             Scene::load(path)
         } else if BUILTIN.contains(&arg) {
             Scene::builtin(arg)

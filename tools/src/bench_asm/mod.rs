@@ -34,7 +34,7 @@ pub const DEFAULT_CONFIGS: [&str; 6] =
 
 #[derive(Args)]
 pub struct AsmBenchArgs {
-    /// A built-in scene name or a scene file (.json) with local lights and a `walkthrough`.
+    /// A built-in scene name or a scene file (.json, or glTF 2.0: .gltf, .glb) with local lights and a `walkthrough`.
     #[arg(long, default_value = "asm")]
     scene: String,
     /// The configurations, `KIND:VALUE` each: `shadowmap:SIDE` (a conventional map of SIDE²

@@ -44,7 +44,7 @@ pub enum SweptTechnique {
 pub struct SweepArgs {
     #[arg(long, value_enum)]
     technique: SweptTechnique,
-    /// A built-in scene name or a scene file (.json); default: teapot (prt), asm (asm),
+    /// A built-in scene name or a scene file (.json, or glTF 2.0: .gltf, .glb); default: teapot (prt), asm (asm),
     /// probe-room (probes).
     #[arg(long)]
     scene: Option<String>,

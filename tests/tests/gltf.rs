@@ -1,0 +1,144 @@
+//! glTF 2.0 scenes: tests/assets/gltf/two-groups.gltf (made by tests/assets/gltf/make.py) read
+//! against the values the script wrote, and hostile variants of it refused with errors naming
+//! the file and the element.
+use glam::{Quat, Vec3};
+use kage::scene::{Light, Scene};
+use kage_tests::scratch_dir;
+use serde_json::Value;
+use std::path::PathBuf;
+
+fn asset() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/two-groups.gltf")
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-5
+}
+
+#[test]
+fn groups_transforms_albedo_camera_lights_and_animation_are_read() {
+    let scene = Scene::from_arg(asset().to_str().unwrap()).unwrap();
+    assert_eq!(scene.name, "two-groups");
+    let names: Vec<&str> = scene.groups.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, ["box", "floor"], "root nodes with meshes; camera and lamps are no groups");
+    let (cube, floor) = (&scene.groups[0], &scene.groups[1]);
+    assert!(
+        close(cube.transform.translation, Vec3::new(0.0, 0.5, 0.0))
+            && (cube.transform.scale - 0.5).abs() < 1e-6
+    );
+    // The child node's offset (0.2 along X) is baked into the cube's vertices.
+    let xs = cube.meshes[0].positions.iter().map(|p| p[0]);
+    let (lo, hi) = xs.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+    assert!((lo + 0.3).abs() < 1e-6 && (hi - 0.7).abs() < 1e-6, "{lo} {hi}");
+    assert_eq!(cube.meshes[0].triangle_count(), 12);
+    assert_eq!(cube.meshes[0].albedo, [0.8, 0.2, 0.2]);
+    assert_eq!(floor.meshes[0].albedo, [0.6, 0.6, 0.6]);
+    assert!(floor.motion.is_none());
+    // The camera: at (0, 2, 5), tilted 0.3 rad down, 0.7 rad vertical field of view.
+    let camera = scene.camera;
+    assert!(close(camera.position, Vec3::new(0.0, 2.0, 5.0)));
+    let forward = (camera.target - camera.position).normalize();
+    assert!((forward.y + 0.3f32.sin()).abs() < 1e-5, "{forward}");
+    assert!((camera.fov_y_deg - 0.7f32.to_degrees()).abs() < 1e-4);
+    match scene.lights[..] {
+        [Light::Point { position, intensity }, Light::Spot { position: at, direction, fov_deg, intensity: spot }] =>
+        {
+            assert!(close(position, Vec3::new(0.0, 3.0, 0.0)) && intensity == [5.0; 3]);
+            assert!(close(at, Vec3::new(2.0, 3.0, 0.0)) && close(direction.normalize(), Vec3::NEG_Y));
+            assert!((fov_deg - 1.0f32.to_degrees()).abs() < 1e-4 && spot == [9.0, 4.5, 4.5]);
+        }
+        _ => panic!("lights {:?}", scene.lights),
+    }
+    // The box slides to x = 1 turning 90° about +Y at 1 s and back at 2 s; then holds.
+    let motion = cube.motion.as_ref().unwrap();
+    assert_eq!(motion.keys.iter().map(|k| k.time).collect::<Vec<_>>(), [0.0, 1.0, 2.0]);
+    assert_eq!(scene.duration(), 2.0);
+    let at_one = cube.pose_at(1.0);
+    assert!(close(at_one.translation, Vec3::new(1.0, 0.5, 0.0)) && at_one.scale == 0.5);
+    assert!(at_one.rotation.abs_diff_eq(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2), 1e-5));
+    assert!(close(cube.pose_at(0.5).translation, Vec3::new(0.5, 0.5, 0.0)));
+    assert_eq!(cube.pose_at(5.0), cube.pose_at(2.0));
+}
+
+/// Writes `two-groups.gltf` changed by `edit` and returns the error of reading it.
+fn error_of(name: &str, edit: impl Fn(&mut Value)) -> String {
+    let mut gltf: Value = serde_json::from_str(&std::fs::read_to_string(asset()).unwrap()).unwrap();
+    edit(&mut gltf);
+    let path = scratch_dir("gltf").join(format!("{name}.gltf"));
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    let message = Scene::load(&path).unwrap_err().to_string();
+    assert!(message.contains(&format!("{name}.gltf")), "{message}: names no file");
+    message
+}
+
+#[test]
+fn hostile_gltf_is_refused_naming_the_file_and_the_element() {
+    type Edit<'a> = &'a dyn Fn(&mut Value);
+    let cases: [(&str, Edit, &str); 9] = [
+        ("cycle", &|g| g["nodes"][0]["children"] = serde_json::json!([0]), "node 0 is met twice"),
+        (
+            "lines",
+            &|g| g["meshes"][0]["primitives"][0]["mode"] = 1.into(),
+            "mesh 0 (\"cube\") primitive 0: mode Lines",
+        ),
+        (
+            "short-buffer",
+            &|g| g["buffers"][0]["byteLength"] = 100000.into(),
+            "not a glTF 2.0 file Kage can read",
+        ),
+        (
+            "garbage-uri",
+            &|g| g["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@@".into(),
+            "not a glTF 2.0 file",
+        ),
+        (
+            "huge-count",
+            &|g| g["accessors"][0]["count"] = 1_000_000_000u64.into(),
+            "mesh 0 (\"cube\") primitive 0: positions missing, or beyond their buffer",
+        ),
+        (
+            "step",
+            &|g| g["animations"][0]["samplers"][0]["interpolation"] = "STEP".into(),
+            "animation 0 channel 0: Step sampling",
+        ),
+        (
+            "child-moves",
+            &|g| g["animations"][0]["channels"][1]["target"]["node"] = 1.into(),
+            "moves node 1 inside a group",
+        ),
+        ("skin", &|g| g["skins"] = serde_json::json!([{"joints": [1]}]), "skin 0"),
+        ("stretched", &|g| g["nodes"][0]["scale"] = serde_json::json!([1, 2, 1]), "node 0: scale"),
+    ];
+    for (name, edit, expected) in cases {
+        let message = error_of(name, edit);
+        assert!(message.contains(expected), "{name}: {message:?} does not say {expected:?}");
+    }
+    // A child offset beyond f32 turns the baked vertices infinite.
+    let infinite = error_of("infinite", |g| g["nodes"][1]["translation"] = serde_json::json!([1e39, 0, 0]));
+    assert!(
+        infinite.contains("mesh 0 (\"cube\") primitive 0") && infinite.contains("NaN or infinite"),
+        "{infinite}"
+    );
+}
+
+/// A binary glTF whose JSON chunk claims more bytes than the file holds.
+#[test]
+fn a_glb_with_a_wrong_chunk_length_is_an_error() {
+    let json = std::fs::read(asset()).unwrap();
+    let padded = json.len().div_ceil(4) * 4;
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(((12 + 8 + padded) as u32).to_le_bytes());
+    glb.extend(((padded + 64) as u32).to_le_bytes()); // the lie
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.resize(12 + 8 + padded, b' ');
+    let path = scratch_dir("gltf").join("lying.glb");
+    std::fs::write(&path, glb).unwrap();
+    let message = Scene::from_arg(path.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        message.contains("lying.glb") && message.contains("not a glTF 2.0 file Kage can read"),
+        "{message}"
+    );
+}
