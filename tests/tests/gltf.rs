@@ -142,3 +142,27 @@ fn a_glb_with_a_wrong_chunk_length_is_an_error() {
         "{message}"
     );
 }
+
+/// A file written by another tool (COLLADA2GLTF: the Khronos sample Box, CC BY 4.0, see
+/// tests/assets/gltf/khronos-box/README.md): its root node's matrix turns the box -90° about X,
+/// its child's identity matrix leaves the cube's 24 vertices where they are.
+#[test]
+fn the_khronos_sample_box_is_read() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box/Box.gltf");
+    let scene = Scene::load(&path).unwrap();
+    assert_eq!(scene.groups.len(), 1);
+    let group = &scene.groups[0];
+    assert_eq!(group.name, "node 0");
+    let turned = |v: Vec3| group.transform.rotation * v;
+    assert!(
+        close(turned(Vec3::Y), Vec3::NEG_Z)
+            && close(turned(Vec3::Z), Vec3::Y)
+            && close(turned(Vec3::X), Vec3::X)
+    );
+    assert!(close(group.transform.translation, Vec3::ZERO) && group.transform.scale == 1.0);
+    let mesh = &group.meshes[0];
+    assert_eq!((mesh.vertex_count(), mesh.triangle_count()), (24, 12));
+    assert!(mesh.positions.iter().flatten().all(|c| c.abs() == 0.5));
+    assert_eq!(mesh.albedo, [0.8, 0.0, 0.0]);
+    assert!(scene.lights.is_empty() && group.motion.is_none());
+}
