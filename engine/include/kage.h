@@ -1086,7 +1086,7 @@ kage_result kage_renderer_timings(const kage_renderer *renderer,
 kage_result kage_last_error_message(char *buffer, size_t capacity, size_t *length);
 
 /**
- * Loads a scene: a path to a scene file (JSON, see the README), or the name of a built-in
+ * Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb; see the README), or the name of a built-in
  * scene ("teapot", the default scene; an unknown name's error lists the others). A path that
  * exists or ends in ".json" is a file.
  *
@@ -1097,7 +1097,8 @@ kage_result kage_last_error_message(char *buffer, size_t capacity, size_t *lengt
  * # Safety
  * `path` must be NULL or a NUL-terminated UTF-8 string; `scene` NULL or writable.
  */
-kage_result kage_scene_load(const char *path, kage_scene **scene);
+kage_result kage_scene_load(const char *path,
+                            kage_scene **scene);
 
 /**
  * Builds a scene from the host's arrays. Everything is copied during the call: the host may
