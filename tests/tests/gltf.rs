@@ -97,9 +97,9 @@ fn hostile_gltf_is_refused_naming_the_file_and_the_element() {
             "mesh 0 (\"cube\") primitive 0: positions missing, or beyond their buffer",
         ),
         (
-            "step",
-            &|g| g["animations"][0]["samplers"][0]["interpolation"] = "STEP".into(),
-            "animation 0 channel 0: Step sampling",
+            "short-spline",
+            &|g| g["animations"][0]["samplers"][0]["interpolation"] = "CUBICSPLINE".into(),
+            "animation 0 channel 0: 3 values for 3 times (CubicSpline sampling)",
         ),
         (
             "child-moves",
@@ -165,4 +165,18 @@ fn the_khronos_sample_box_is_read() {
     assert!(mesh.positions.iter().flatten().all(|c| c.abs() == 0.5));
     assert_eq!(mesh.albedo, [0.8, 0.0, 0.0]);
     assert!(scene.lights.is_empty() && group.motion.is_none());
+}
+
+/// Step sampling holds each key's value until the next key.
+#[test]
+fn step_sampling_holds_each_value_until_the_next_key() {
+    let mut gltf: Value = serde_json::from_str(&std::fs::read_to_string(asset()).unwrap()).unwrap();
+    gltf["animations"][0]["samplers"][0]["interpolation"] = "STEP".into();
+    let path = scratch_dir("gltf").join("step.gltf");
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    let cube = &scene.groups[0];
+    assert!(close(cube.pose_at(0.9).translation, Vec3::new(0.0, 0.5, 0.0)), "held at the first key");
+    assert!(close(cube.pose_at(1.0).translation, Vec3::new(1.0, 0.5, 0.0)));
+    assert!(close(cube.pose_at(1.5).translation, Vec3::new(1.0, 0.5, 0.0)));
 }

@@ -10,17 +10,17 @@
 //! - the first perspective camera (without one, a view of the whole scene, with a note);
 //! - KHR_lights_punctual point and spot lights (colour × intensity, read as Kage's radiant
 //!   intensity; a spot's full cone is twice its outer cone angle);
-//! - animations' linear translation and rotation channels on root nodes: the groups' keyframes.
+//! - animations' translation and rotation channels on root nodes: the groups' keyframes (linear;
+//!   step and cubic-spline sampled into linear keys, see `linear_track`).
 //!
 //! What is refused, by name: skins and morph targets (a rigid group cannot follow them), other
-//! primitive modes, animation channels on nodes inside a group or with step or cubic-spline
-//! sampling, orthographic cameras, non-uniform scale on a root node, data out of its buffer.
+//! primitive modes, animation channels on nodes inside a group, orthographic cameras, non-uniform scale on a root node, data out of its buffer.
 //! What is not used (directional lights, scale channels, extensions, textures other than the
 //! base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
 //! sky of radiance 1 (a note says so; `--env` or a scene file gives another).
 use super::motion::{Key, Motion};
 use super::{Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
 use gltf::animation::{Interpolation, Property};
 use std::path::Path;
@@ -339,30 +339,21 @@ fn motions(
                     node.index()
                 )));
             };
-            if channel.sampler().interpolation() != Interpolation::Linear {
-                return Err(at(format!(
-                    "{:?} sampling: Kage reads linear keyframes",
-                    channel.sampler().interpolation()
-                )));
-            }
+            let interpolation = channel.sampler().interpolation();
             let reader = channel.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let times: Vec<f32> =
                 reader.read_inputs().ok_or_else(|| at("times beyond their buffer".into()))?.collect();
             match reader.read_outputs().ok_or_else(|| at("values beyond their buffer".into()))? {
                 ReadOutputs::Translations(values) => {
-                    tracks[g].0 = Some((times, values.map(Vec3::from).collect()))
+                    let values: Vec<Vec3> = values.map(Vec3::from).collect();
+                    tracks[g].0 = Some(linear_track(&times, &values, interpolation, |v| v).map_err(at)?);
                 }
                 ReadOutputs::Rotations(values) => {
-                    tracks[g].1 = Some((times, values.into_f32().map(Quat::from_array).collect()))
+                    let values: Vec<Vec4> = values.into_f32().map(Vec4::from_array).collect();
+                    let track = linear_track(&times, &values, interpolation, Vec4::normalize).map_err(at)?;
+                    tracks[g].1 = Some((track.0, track.1.into_iter().map(Quat::from_vec4).collect()));
                 }
                 _ => unreachable!("scale and weights are skipped above"),
-            }
-            let counts = (
-                tracks[g].0.as_ref().map(|t| (t.0.len(), t.1.len())),
-                tracks[g].1.as_ref().map(|t| (t.0.len(), t.1.len())),
-            );
-            if [counts.0, counts.1].into_iter().flatten().any(|(t, v)| t != v || t == 0) {
-                return Err(at("as many values as times needed".into()));
             }
         }
     }
@@ -396,6 +387,75 @@ fn motions(
     Ok(())
 }
 
+/// Sub-steps per key interval of a cubic-spline channel, sampled into linear keys: the spline's
+/// deviation from its chords falls with their square (1/64 of one chord's).
+const SPLINE_STEPS: usize = 8;
+
+/// A channel's keys as keys to interpolate linearly between: linear as they are; step as each
+/// value held until a ten-thousandth of its interval before the next key; cubic spline (values
+/// with in- and out-tangents, glTF's Hermite form) sampled `SPLINE_STEPS` times per interval.
+/// `normalize` maps each sampled value (rotations back to unit length).
+fn linear_track<T>(
+    times: &[f32],
+    values: &[T],
+    interpolation: Interpolation,
+    normalize: impl Fn(T) -> T,
+) -> Result<(Vec<f32>, Vec<T>), String>
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<f32, Output = T>,
+{
+    let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+    if times.is_empty() || values.len() != per_key * times.len() {
+        return Err(format!(
+            "{} values for {} times ({interpolation:?} sampling)",
+            values.len(),
+            times.len()
+        ));
+    }
+    if !times.iter().all(|t| t.is_finite()) || times.windows(2).any(|w| w[0] >= w[1]) {
+        return Err("its times are not finite and increasing".into());
+    }
+    let (mut out_times, mut out_values) = (Vec::new(), Vec::new());
+    let n = times.len();
+    match interpolation {
+        Interpolation::Linear => return Ok((times.to_vec(), values.to_vec())),
+        Interpolation::Step => {
+            for k in 0..n {
+                out_times.push(times[k]);
+                out_values.push(values[k]);
+                if k + 1 < n {
+                    out_times.push(times[k + 1] - 1e-4 * (times[k + 1] - times[k]));
+                    out_values.push(values[k]);
+                }
+            }
+        }
+        Interpolation::CubicSpline => {
+            // values: [in-tangent, value, out-tangent] per key.
+            let (value, out_tangent, in_tangent) =
+                (|k: usize| values[3 * k + 1], |k: usize| values[3 * k + 2], |k: usize| values[3 * k]);
+            for k in 0..n {
+                out_times.push(times[k]);
+                out_values.push(normalize(value(k)));
+                if k + 1 == n {
+                    break;
+                }
+                let span = times[k + 1] - times[k];
+                for j in 1..SPLINE_STEPS {
+                    let s = j as f32 / SPLINE_STEPS as f32;
+                    let (s2, s3) = (s * s, s * s * s);
+                    let point = value(k) * (2.0 * s3 - 3.0 * s2 + 1.0)
+                        + out_tangent(k) * (span * (s3 - 2.0 * s2 + s))
+                        + value(k + 1) * (-2.0 * s3 + 3.0 * s2)
+                        + in_tangent(k + 1) * (span * (s3 - s2));
+                    out_times.push(times[k] + s * span);
+                    out_values.push(normalize(point));
+                }
+            }
+        }
+    }
+    Ok((out_times, out_values))
+}
+
 /// A channel's value at `time`: interpolated between its keys, held beyond them.
 fn sample<T: Copy>(times: &[f32], values: &[T], time: f32, mix: impl Fn(T, T, f32) -> T) -> T {
     let k = times.partition_point(|&t| t <= time);
@@ -406,5 +466,28 @@ fn sample<T: Copy>(times: &[f32], values: &[T], time: f32, mix: impl Fn(T, T, f3
             let s = (time - times[k - 1]) / (times[k] - times[k - 1]);
             mix(values[k - 1], values[k], s)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn step_and_cubic_spline_channels_become_linear_keys() {
+        let times = [0.0, 1.0];
+        let (t, v) = linear_track(&times, &[0.0f32, 4.0], Interpolation::Step, |v| v).unwrap();
+        assert_eq!((t, v), (vec![0.0, 0.9999, 1.0], vec![0.0, 0.0, 4.0]));
+        // Zero tangents: the Hermite curve is a smoothstep, 3s² - 2s³ of the way.
+        let spline = [9.0f32, 0.0, 0.0, 0.0, 4.0, 9.0];
+        let (t, v) = linear_track(&times, &spline, Interpolation::CubicSpline, |v| v).unwrap();
+        assert_eq!(t.len(), SPLINE_STEPS + 1);
+        assert_eq!((t[2], v[2]), (0.25, 4.0 * 0.15625));
+        assert_eq!((t[4], v[4]), (0.5, 2.0));
+        assert_eq!(v[SPLINE_STEPS], 4.0);
+        let short = linear_track(&times, &[1.0f32, 2.0], Interpolation::CubicSpline, |v| v).unwrap_err();
+        assert!(short.contains("2 values for 2 times"), "{short}");
+        let backwards = linear_track(&[1.0, 0.0], &[1.0f32, 2.0], Interpolation::Linear, |v| v).unwrap_err();
+        assert!(backwards.contains("increasing"), "{backwards}");
     }
 }
