@@ -200,6 +200,15 @@ fn srgb_oetf(x: f32) -> f32 {
     }
 }
 
+/// Its inverse: an sRGB-encoded value in [0, 1] back to linear (texture colours).
+pub fn srgb_eotf(x: f32) -> f32 {
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,6 +226,13 @@ mod tests {
             })
             .collect();
         RgbaF32Image { width, height, pixels }
+    }
+
+    #[test]
+    fn srgb_eotf_inverts_the_encoding() {
+        for x in [0.0, 0.001, 0.0031308, 0.2, 0.5, 1.0] {
+            assert!((srgb_eotf(srgb_oetf(x)) - x).abs() < 1e-6, "{x}");
+        }
     }
 
     #[test]

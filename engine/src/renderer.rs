@@ -50,8 +50,8 @@ pub struct Renderer {
     executor: FrameExecutor,
     /// Each group's [`crate::scene::Group::object_reach`], for `set_group_transform`.
     reach: Vec<f32>,
-    /// The groups that move by themselves ([`crate::scene::Group::motion`]), as the scene has
-    /// them: what [`Renderer::set_time`] poses.
+    /// The groups that move by themselves ([`crate::scene::Group::motion`]), their meshes left
+    /// out: what [`Renderer::set_time`] poses.
     moving: Vec<(usize, crate::scene::Group)>,
 }
 
@@ -80,7 +80,10 @@ impl Renderer {
                 .iter()
                 .enumerate()
                 .filter(|(_, g)| g.motion.is_some())
-                .map(|(i, g)| (i, crate::scene::Group { meshes: Vec::new(), ..g.clone() }))
+                .map(|(i, g)| {
+                    let (name, transform, motion) = (g.name.clone(), g.transform, g.motion.clone());
+                    (i, crate::scene::Group { name, meshes: Vec::new(), transform, motion })
+                })
                 .collect(),
             ctx: ctx.clone(),
             scene: gpu,
@@ -155,9 +158,7 @@ impl Renderer {
             return Err(Error::InvalidArgument(format!("time {time} is not finite")));
         }
         for (g, group) in &self.moving {
-            let transform = group.pose_at(time).matrix();
-            let slot = &mut self.scene.transforms[*g];
-            *slot = transform;
+            self.scene.transforms[*g] = group.pose_at(time).matrix();
         }
         Ok(())
     }

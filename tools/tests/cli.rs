@@ -969,21 +969,35 @@ fn probe_capture_options_are_checked() {
     assert_clear_errors(&cases);
 }
 
+/// README's command table: per row, its command (the leading lowercase words after `kage`), its
+/// usage (the first cell) and the whole row; `\|` inside a cell is an escaped alternative, read as
+/// `/`, not a cell's end.
+fn readme_rows() -> Vec<(Vec<String>, String, String)> {
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
+    let is_word = |w: &str| {
+        !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-')
+    };
+    readme
+        .lines()
+        .filter(|l| l.starts_with("| `kage "))
+        .map(|row| {
+            let row = row.replace("\\|", "/");
+            let usage = row.split('|').nth(1).unwrap().trim().trim_matches('`').to_string();
+            let command =
+                usage.split_whitespace().skip(1).take_while(|w| is_word(w)).map(str::to_string).collect();
+            (command, usage, row)
+        })
+        .collect()
+}
+
 /// Every option README's command table names exists under that name in the command's `--help`:
 /// the table and the program cannot drift apart (a renamed flag fails here). Each row's command
 /// is its leading lowercase words (`kage probes place …`, `kage sweep --technique prt …`).
 #[test]
 fn every_option_readme_names_is_one_the_program_takes() {
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
-    let is_word = |w: &str| {
-        !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-')
-    };
     let mut checked = 0;
-    for row in readme.lines().filter(|l| l.starts_with("| `kage ")) {
-        // The first cell; `\|` inside it is an escaped alternative, not a cell's end.
-        let row = row.replace("\\|", "/");
-        let usage = row.split('|').nth(1).unwrap().trim().trim_matches('`');
-        let command: Vec<&str> = usage.split_whitespace().skip(1).take_while(|w| is_word(w)).collect();
+    for (command, usage, row) in readme_rows() {
+        let command: Vec<&str> = command.iter().map(String::as_str).collect();
         let help = kage(&[command.as_slice(), &["--help"]].concat());
         assert!(help.status.success(), "`kage {} --help` fails (README row: {row})", command.join(" "));
         let help = String::from_utf8_lossy(&help.stdout).into_owned();
@@ -1013,19 +1027,12 @@ fn every_option_readme_names_is_one_the_program_takes() {
 #[test]
 fn every_option_the_program_takes_is_in_readmes_table() {
     let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
-    let is_word = |w: &str| {
-        !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-')
-    };
     let words = |text: &str| -> Vec<String> {
         text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-')).map(str::to_string).collect()
     };
     // Each command's rows, joined.
     let mut rows: std::collections::BTreeMap<Vec<String>, Vec<String>> = Default::default();
-    for row in readme.lines().filter(|l| l.starts_with("| `kage ")) {
-        let row = row.replace("\\|", "/");
-        let usage = row.split('|').nth(1).unwrap().trim().trim_matches('`');
-        let command =
-            usage.split_whitespace().skip(1).take_while(|w| is_word(w)).map(str::to_string).collect();
+    for (command, _, row) in readme_rows() {
         rows.entry(command).or_default().extend(words(&row));
     }
     let section = readme.split("## Command line").nth(1).unwrap().split("\n| ").next().unwrap();

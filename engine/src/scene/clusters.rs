@@ -66,6 +66,18 @@ fn morton(p: Vec3) -> u32 {
     spread(p.x) | spread(p.y) << 1 | spread(p.z) << 2
 }
 
+/// The index runs of `clusters` (in buffer order), neighbours merged: (first index, count).
+pub fn runs<'a>(clusters: impl IntoIterator<Item = &'a Cluster>) -> Vec<(u32, u32)> {
+    let mut runs: Vec<(u32, u32)> = Vec::new();
+    for c in clusters {
+        match runs.last_mut() {
+            Some(last) if last.0 + last.1 == c.first => last.1 += c.count,
+            _ => runs.push((c.first, c.count)),
+        }
+    }
+    runs
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -237,14 +237,7 @@ fn mean_colour(image: &gltf::image::Data) -> Option<[f32; 3]> {
         gltf::image::Format::R8G8B8A8 => 4,
         _ => return None,
     };
-    let linear = |c: u8| {
-        let c = c as f32 / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
+    let linear = |c: u8| crate::imageio::srgb_eotf(c as f32 / 255.0);
     let texels = image.pixels.chunks_exact(channels);
     let count = texels.len().max(1) as f32;
     let sum =

@@ -44,7 +44,7 @@ use crate::frame::{GpuMesh, GpuScene};
 use crate::frame::{DEPTH, FRAME_UNIFORMS};
 use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, LocalDrawPush, ShadowLight};
 use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
-use crate::scene::clusters::Cluster;
+use crate::scene::clusters::{runs, Cluster};
 use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
 use crate::techniques::{Technique, TechniqueStats};
@@ -488,12 +488,8 @@ fn tile_draws(
     let square = UvRect::of_tile(key);
     let mut draws: Vec<(usize, u32, u32)> = Vec::new();
     for (m, ((_, clusters), rects)) in clusters.iter().zip(rects).enumerate() {
-        for (c, _) in clusters.iter().zip(rects).filter(|(_, r)| r.overlaps(&square)) {
-            match draws.last_mut() {
-                Some(last) if last.0 == m && last.1 + last.2 == c.first => last.2 += c.count,
-                _ => draws.push((m, c.first, c.count)),
-            }
-        }
+        let over = clusters.iter().zip(rects).filter(|(_, r)| r.overlaps(&square)).map(|(c, _)| c);
+        draws.extend(runs(over).into_iter().map(|(first, count)| (m, first, count)));
     }
     draws
 }

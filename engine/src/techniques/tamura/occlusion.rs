@@ -36,7 +36,7 @@ use crate::layouts::{
     bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
 };
 use crate::pass::{Pass, Resource};
-use crate::scene::clusters::Cluster;
+use crate::scene::clusters::{runs, Cluster};
 
 /// The occluder masks before filtering.
 pub const MASKS: Resource = Resource("occlusion_masks");
@@ -561,8 +561,7 @@ fn runs_within(layer: &OcclusionLayer, model: &Mat4, clusters: &[Cluster]) -> Ve
     let centre = Vec3::from_slice(&layer.centre[..3]);
     let axes = [Vec3::from_slice(&layer.axis_u[..3]), Vec3::from_slice(&layer.axis_v[..3])];
     let f = &layer.footprint;
-    let mut runs: Vec<(u32, u32)> = Vec::new();
-    for c in clusters {
+    let reaches = |c: &&Cluster| {
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
         for corner in box_corners(c.min, c.max, model) {
             for k in 0..2 {
@@ -570,13 +569,7 @@ fn runs_within(layer: &OcclusionLayer, model: &Mat4, clusters: &[Cluster]) -> Ve
                 (lo[k], hi[k]) = (lo[k].min(uv), hi[k].max(uv));
             }
         }
-        if hi[0] < f[0] || lo[0] > f[2] || hi[1] < f[1] || lo[1] > f[3] {
-            continue;
-        }
-        match runs.last_mut() {
-            Some(last) if last.0 + last.1 == c.first => last.1 += c.count,
-            _ => runs.push((c.first, c.count)),
-        }
-    }
-    runs
+        hi[0] >= f[0] && lo[0] <= f[2] && hi[1] >= f[1] && lo[1] <= f[3]
+    };
+    runs(clusters.iter().filter(reaches))
 }
