@@ -3,6 +3,7 @@
 use kage::backend::{Context, ContextDesc};
 use kage::scene::{Camera, EnvMap, Group, Mesh, Scene, Transform};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// A context with validation on. Dropping it asserts that validation reported nothing, so a
@@ -58,9 +59,12 @@ pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Sce
     }
 }
 
-/// A fresh, empty folder under the system temp folder, unique per test.
+/// A fresh, empty folder under the system temp folder, unique per call: tests of one binary run
+/// in parallel, so two calls with the same name must not share (and wipe) one folder.
 pub fn scratch_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("kage-tests-{}-{test}", std::process::id()));
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("kage-tests-{}-{test}-{call}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp folder");
     dir
