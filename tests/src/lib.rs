@@ -1,7 +1,14 @@
 //! Helpers shared by Kage's integration tests: a validated context that fails the test on any
-//! validation message, small scenes built in code, and scratch folders.
+//! validation message, small scenes built in code, every technique at cheap settings, and
+//! scratch folders.
 use kage::backend::{Context, ContextDesc};
+use kage::prt::{transfer, PrtParams, TransferSet};
+use kage::renderer::RenderOptions;
 use kage::scene::{Camera, EnvMap, Group, Mesh, Scene, Transform};
+use kage::techniques::asm::AsmSettings;
+use kage::techniques::description::{TechniqueDesc, TechniqueKind};
+use kage::techniques::probes::{CaptureSettings, ProbePlacement, ProbeSettings};
+use kage::techniques::tamura::technique::OcclusionSettings;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -68,6 +75,53 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp folder");
     dir
+}
+
+/// Every technique (each [`TechniqueKind`]) at its cheapest settings, with the PRT transfer it
+/// needs computed for `scene` (once per kind of visibility); the callers set the image size.
+pub fn every_technique(ctx: &Arc<Context>, scene: &Scene) -> Vec<(TechniqueKind, RenderOptions)> {
+    let prt = PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT };
+    let occlusion = OcclusionSettings { regions: 4, mask_size: 16, ..Default::default() };
+    let mut transfers: Vec<Arc<TransferSet>> = Vec::new();
+    let kinds = (0..=u8::MAX as u32).filter_map(TechniqueKind::from_repr);
+    kinds
+        .map(|kind| {
+            let technique = match TechniqueDesc::new(kind) {
+                TechniqueDesc::Unshadowed => TechniqueDesc::Unshadowed,
+                TechniqueDesc::SloanSelf { .. } => TechniqueDesc::SloanSelf { prt },
+                TechniqueDesc::SloanScene { .. } => TechniqueDesc::SloanScene { prt },
+                TechniqueDesc::Tamura { .. } => TechniqueDesc::Tamura { prt, occlusion },
+                TechniqueDesc::TamuraPaper { .. } => {
+                    TechniqueDesc::TamuraPaper { prt, regions: 4, mask_size: 16 }
+                }
+                TechniqueDesc::ParallelLights { .. } => {
+                    TechniqueDesc::ParallelLights { regions: 4, shadow_map_size: 16 }
+                }
+                TechniqueDesc::ShadowMap { .. } => TechniqueDesc::ShadowMap { size: 16 },
+                TechniqueDesc::Probes { .. } => TechniqueDesc::Probes {
+                    probes: ProbeSettings {
+                        placement: ProbePlacement::Grid([2, 2, 2]),
+                        capture: CaptureSettings { cube_size: 8, samples: 16, ..Default::default() },
+                        ..Default::default()
+                    },
+                    prt,
+                },
+                TechniqueDesc::Asm(_) => {
+                    TechniqueDesc::Asm(AsmSettings { budget_mb: 1.0, ..AsmSettings::default() })
+                }
+            };
+            let transfer = technique.precomputation().map(|params| {
+                if let Some(done) = transfers.iter().find(|t| t.params == params) {
+                    return done.clone();
+                }
+                let made =
+                    transfer::precompute(ctx, scene, params, &mut kage::progress::silent).expect("transfer");
+                transfers.push(Arc::new(made));
+                transfers.last().unwrap().clone()
+            });
+            (kind, RenderOptions { width: 0, height: 0, technique, transfer })
+        })
+        .collect()
 }
 
 /// Renders one frame of `scene` at `width`x`height` and reads it back.

@@ -1,9 +1,11 @@
 //! glTF 2.0 scenes: tests/assets/gltf/two-groups.gltf (made by tests/assets/gltf/make.py) read
-//! against the values the script wrote, and hostile variants of it refused with errors naming
-//! the file and the element.
+//! against the values the script wrote, hostile variants of it refused with errors naming the
+//! file and the element, a file written by another tool, scene files that take their geometry
+//! from glTF, and Kage's own glTF export rendering the same pixels as the scene it came from.
 use glam::{Quat, Vec3};
-use kage::scene::{Light, Scene};
-use kage_tests::scratch_dir;
+use kage::renderer::{RenderOptions, Renderer};
+use kage::scene::{Light, Scene, SceneFormat, SCENE_FILE};
+use kage_tests::{every_technique, scratch_dir, Validated};
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -74,7 +76,7 @@ fn error_of(name: &str, edit: impl Fn(&mut Value)) -> String {
 #[test]
 fn hostile_gltf_is_refused_naming_the_file_and_the_element() {
     type Edit<'a> = &'a dyn Fn(&mut Value);
-    let cases: [(&str, Edit, &str); 9] = [
+    let cases: [(&str, Edit, &str); 10] = [
         ("cycle", &|g| g["nodes"][0]["children"] = serde_json::json!([0]), "node 0 is met twice"),
         (
             "lines",
@@ -108,6 +110,17 @@ fn hostile_gltf_is_refused_naming_the_file_and_the_element() {
         ),
         ("skin", &|g| g["skins"] = serde_json::json!([{"joints": [1]}]), "skin 0"),
         ("stretched", &|g| g["nodes"][0]["scale"] = serde_json::json!([1, 2, 1]), "node 0: scale"),
+        (
+            "stretching",
+            &|g| {
+                // The translations (x from 0 to 1, y 0.5) as scales: not uniform.
+                let samplers = g["animations"][0]["samplers"].as_array_mut().unwrap();
+                samplers.push(serde_json::json!({"input": 5, "output": 6}));
+                let channel = serde_json::json!({"sampler": samplers.len() - 1, "target": {"node": 0, "path": "scale"}});
+                g["animations"][0]["channels"].as_array_mut().unwrap().push(channel);
+            },
+            "channel 2: scale [0, 0.5, 0] is not uniform",
+        ),
     ];
     for (name, edit, expected) in cases {
         let message = error_of(name, edit);
@@ -179,4 +192,119 @@ fn step_sampling_holds_each_value_until_the_next_key() {
     assert!(close(cube.pose_at(0.9).translation, Vec3::new(0.0, 0.5, 0.0)), "held at the first key");
     assert!(close(cube.pose_at(1.0).translation, Vec3::new(1.0, 0.5, 0.0)));
     assert!(close(cube.pose_at(1.5).translation, Vec3::new(1.0, 0.5, 0.0)));
+}
+
+/// A scene file that takes its groups, lights and camera from a glTF file and adds what glTF has
+/// no place for; its own camera replaces the glTF one, `gltf_camera` picks one by name, its
+/// lights are added; mixing in groups, or naming a camera the file lacks, is an error.
+#[test]
+fn a_scene_file_takes_its_geometry_from_gltf() {
+    let dir = scratch_dir("gltf-scene-file");
+    std::fs::copy(asset(), dir.join("two-groups.gltf")).unwrap();
+    let write = |name: &str, extra: &str| {
+        let path = dir.join(name);
+        let json = format!(
+            r#"{{"gltf": "two-groups.gltf", "environment": {{"constant": [0.5, 0.5, 0.5]}},
+                "probes": [{{"position": [0, 1, 0]}}], "exposure": 2{extra}}}"#
+        );
+        std::fs::write(&path, json).unwrap();
+        path
+    };
+    let scene = Scene::load(&write("plain.json", "")).unwrap();
+    let from_gltf = Scene::load(&asset()).unwrap();
+    assert_eq!((scene.name.as_str(), scene.exposure, scene.probes.len()), ("plain", 2.0, 1));
+    assert!(scene.groups == from_gltf.groups && scene.lights == from_gltf.lights);
+    assert_eq!(scene.camera, from_gltf.camera);
+    assert_eq!(scene.environment.pixels()[0], [0.5; 3]);
+
+    let camera = r#"{"position": [0, 1, 9], "target": [0, 0, 0], "fov_y_deg": 30}"#;
+    let light = r#"{"point": {"position": [0, 4, 0], "intensity": [1, 1, 1]}}"#;
+    let walk = format!(r#", "camera": {camera}, "lights": [{light}], "walkthrough": [{camera}, {camera}]"#);
+    let own = Scene::load(&write("own.json", &walk)).unwrap();
+    assert_eq!((own.camera.position, own.camera.fov_y_deg), (Vec3::new(0.0, 1.0, 9.0), 30.0));
+    assert_eq!((own.lights.len(), own.walkthrough.len()), (3, 2));
+    assert_eq!(own.lights[2], Light::Point { position: Vec3::new(0.0, 4.0, 0.0), intensity: [1.0; 3] });
+
+    let named = Scene::load(&write("named.json", r#", "gltf_camera": "camera""#)).unwrap();
+    assert_eq!(named.camera, from_gltf.camera, "the camera's node is named \"camera\"");
+    for (file, extra, expected) in [
+        (
+            "missing.json",
+            r#", "gltf_camera": "nobody""#,
+            "no camera named \"nobody\" (its cameras and their nodes: \"camera\")",
+        ),
+        (
+            "both.json",
+            r#", "groups": [{"name": "g", "meshes": [{"sphere": {"radius": 1, "segments": 8}, "albedo": [1, 1, 1]}]}]"#,
+            "both \"gltf\" and \"groups\"",
+        ),
+    ] {
+        let message = Scene::load(&write(file, extra)).unwrap_err().to_string();
+        assert!(message.contains(file) && message.contains(expected), "{message}");
+    }
+    let lone = dir.join("lone.json");
+    std::fs::write(&lone, r#"{"gltf_camera": "camera", "environment": {"constant": [1, 1, 1]}, "camera": {"position": [0, 0, 1], "target": [0, 0, 0], "fov_y_deg": 40}}"#).unwrap();
+    let message = Scene::load(&lone).unwrap_err().to_string();
+    assert!(message.contains("\"gltf_camera\" without a \"gltf\" file"), "{message}");
+}
+
+/// Kage's own look-at in a camera node's extras is taken while it agrees with the node; once
+/// another tool moved the node (leaving the extras as they were), the node is what is read.
+#[test]
+fn kage_extras_that_disagree_with_their_node_are_ignored() {
+    let scene = Scene::builtin("teapot").unwrap();
+    let dir = scratch_dir("gltf-extras");
+    scene.export(&dir, SceneFormat::Gltf).unwrap();
+    let glb_path = dir.join(kage::scene::GLTF_FILE);
+    let bytes = std::fs::read(&glb_path).unwrap();
+    let glb = gltf::binary::Glb::from_slice(&bytes).unwrap();
+    let mut json: Value = serde_json::from_slice(&glb.json).unwrap();
+    let camera_node =
+        json["nodes"].as_array().unwrap().iter().position(|n| n.get("camera").is_some()).unwrap();
+    json["nodes"][camera_node]["translation"] = serde_json::json!([0.0, 2.2, 6.0]);
+    let json = serde_json::to_vec(&json).unwrap();
+    let moved = gltf::binary::Glb { header: glb.header, json: json.into(), bin: glb.bin.clone() };
+    let moved_path = dir.join("moved.glb");
+    std::fs::write(&moved_path, moved.to_vec().unwrap()).unwrap();
+    let exact = Scene::load(&glb_path).unwrap();
+    let edited = Scene::load(&moved_path).unwrap();
+    assert_eq!(exact.camera, scene.camera, "Kage's extras, bit for bit");
+    assert_eq!(edited.camera.position, Vec3::new(0.0, 2.2, 6.0), "the node as the other tool left it");
+    let (a, b) = (scene.camera.target - scene.camera.position, edited.camera.target - edited.camera.position);
+    assert!(a.normalize().dot(b.normalize()) > 1.0 - 1e-6, "the same direction, from the node's rotation");
+}
+
+/// The default scene (with a spot light added for the local-light techniques) exported with its
+/// geometry as OBJ and as glTF reads back as two scenes that render the same pixels, with every
+/// technique, at an instant of the teapot's hop: the glTF path loses nothing the renderer uses.
+#[test]
+fn the_default_scene_as_gltf_renders_the_same_pixels_with_every_technique() {
+    let ctx = Validated::new();
+    let mut scene = Scene::builtin("teapot").unwrap();
+    scene.lights.push(Light::Spot {
+        position: Vec3::new(1.5, 3.0, 1.0),
+        direction: Vec3::new(-1.5, -3.0, -1.0).normalize(),
+        fov_deg: 60.0,
+        intensity: [6.0, 5.0, 4.0],
+    });
+    let written = |format: SceneFormat| {
+        let dir = scratch_dir("gltf-default");
+        scene.export(&dir, format).unwrap();
+        Scene::load(&dir.join(SCENE_FILE)).unwrap()
+    };
+    let (json, gltf) = (written(SceneFormat::Json), written(SceneFormat::Gltf));
+    let render = |scene: &Scene, options: RenderOptions| {
+        let options = RenderOptions { width: 48, height: 48, ..options };
+        let mut renderer = Renderer::new(&ctx, scene, &options).unwrap();
+        renderer.set_time(0.3).unwrap();
+        renderer.render().unwrap();
+        renderer.image().unwrap().pixels
+    };
+    let techniques = every_technique(&ctx, &json).into_iter().zip(every_technique(&ctx, &gltf));
+    for ((kind, from_json), (_, from_gltf)) in techniques {
+        let (a, b) = (render(&json, from_json), render(&gltf, from_gltf));
+        let differing = a.iter().zip(&b).filter(|(p, q)| p != q).count();
+        assert_eq!(differing, 0, "{kind:?}: {differing} of {} pixels differ", a.len());
+        assert!(a.iter().any(|p| p[0] > 0.0), "{kind:?} rendered black");
+    }
 }

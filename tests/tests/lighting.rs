@@ -197,14 +197,3 @@ fn bad_render_arguments_are_errors() {
     assert!(renderer.set_group_transform(7, Mat4::IDENTITY).unwrap_err().to_string().contains("group 7"));
     assert!(renderer.set_group_transform(0, Mat4::from_translation(Vec3::NAN)).is_err());
 }
-
-#[test]
-fn exported_scene_renders_the_same_picture() {
-    let ctx = Validated::new();
-    let scene = Scene::builtin("teapot").unwrap();
-    let dir = kage_tests::scratch_dir("export");
-    scene.export(&dir).unwrap();
-    let reloaded = Scene::load(&dir.join(kage::scene::SCENE_FILE)).unwrap();
-    let render = |s: &Scene| render_once(&ctx, s, 48, 48).pixels;
-    assert!(render(&scene) == render(&reloaded), "exported scene renders differently");
-}

@@ -1141,3 +1141,28 @@ fn render_time_plays_the_scenes_keyframes_and_nothing_else() {
     let both = kage(&["render", "--scene", moving.to_str().unwrap(), "--animate", "--time", "1"]);
     assert!(!both.status.success() && text(&both).contains("give one of them"), "{}", text(&both));
 }
+
+/// `kage scene export --format gltf` writes scene.glb beside scene.json; the folder renders, and
+/// the .glb alone plays the teapot's hop: `--time` instants differ, `--animate` runs.
+#[test]
+fn scene_export_as_gltf_renders_and_plays_its_motion() {
+    let dir = scratch_dir("cli-export-gltf");
+    let out = dir.join("teapot");
+    let export =
+        kage(&["scene", "export", "--scene", "teapot", "--format", "gltf", "--out", out.to_str().unwrap()]);
+    assert!(export.status.success() && text(&export).contains("scene.glb"), "{}", text(&export));
+    let render = |scene: &std::path::Path, extra: &[&str], name: &str| {
+        let image = dir.join(format!("{name}.exr"));
+        let args =
+            ["render", "--scene", scene.to_str().unwrap(), "--technique", "unshadowed", "--width", "32"];
+        let run = kage(&[&args[..], &["--height", "32", "--out", image.to_str().unwrap()], extra].concat());
+        assert!(run.status.success(), "{}", text(&run));
+        (kage::imageio::read_exr(&image).unwrap().pixels, text(&run))
+    };
+    render(&out, &[], "folder");
+    let glb = out.join("scene.glb");
+    let (start, notes) = render(&glb, &["--time", "0"], "start");
+    assert!(notes.contains("no environment"), "{notes}");
+    assert!(start != render(&glb, &["--time", "0.125"], "hop").0, "the teapot hopped");
+    render(&glb, &["--animate", "--frames", "3"], "animated");
+}

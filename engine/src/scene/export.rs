@@ -1,5 +1,7 @@
 //! Writing a scene as a self-contained folder that [`Scene::load`] reads back identically:
-//! `scene.json`, one OBJ per mesh and the environment as 32-bit float EXR.
+//! `scene.json` and the environment as 32-bit float EXR, with the geometry as one OBJ per mesh
+//! ([`SceneFormat::Json`]) or as `scene.glb` ([`SceneFormat::Gltf`]: groups, meshes, lights,
+//! camera and motion; the JSON then holds what glTF has no place for).
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
@@ -11,6 +13,19 @@ use super::{obj, Camera, Light, Scene, SceneError};
 
 pub const SCENE_FILE: &str = "scene.json";
 pub const ENVIRONMENT_FILE: &str = "environment.exr";
+pub const GLTF_FILE: &str = "scene.glb";
+
+/// How an exported scene holds its geometry.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum SceneFormat {
+    /// Groups, lights and camera in the scene file, one OBJ per mesh.
+    #[default]
+    Json,
+    /// Groups, lights, camera and motion in a binary glTF file beside the scene file, which
+    /// Blender, three.js and other glTF tools open.
+    Gltf,
+}
 
 /// `dir/name`, unless a symbolic link is there: the export writes its own files, never through
 /// a link to a file elsewhere.
@@ -24,11 +39,53 @@ fn output(dir: &Path, name: &str) -> Result<PathBuf, SceneError> {
     }
 }
 
-pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
+pub fn export(scene: &Scene, dir: &Path, format: SceneFormat) -> Result<(), SceneError> {
     std::fs::create_dir_all(dir)
         .map_err(|e| SceneError::in_file(dir, format!("cannot create folder: {e}")))?;
     scene.environment.write_exr(&output(dir, ENVIRONMENT_FILE)?)?;
+    let camera = |c: &Camera| CameraDesc {
+        position: c.position.to_array(),
+        target: c.target.to_array(),
+        up: c.up.to_array(),
+        fov_y_deg: c.fov_y_deg,
+    };
+    let mut file = SceneFile {
+        name: Some(scene.name.clone()),
+        gltf: None,
+        gltf_camera: None,
+        camera: None,
+        environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
+        groups: Vec::new(),
+        lights: Vec::new(),
+        walkthrough: scene.walkthrough.iter().map(camera).collect(),
+        probes: scene
+            .probes
+            .iter()
+            .map(|p| ProbeDesc { position: p.position.to_array(), role: p.role })
+            .collect(),
+        exposure: scene.exposure,
+    };
+    match format {
+        SceneFormat::Json => {
+            file.camera = Some(camera(&scene.camera));
+            file.groups = groups(scene, dir)?;
+            file.lights = scene.lights.iter().map(light).collect();
+        }
+        SceneFormat::Gltf => {
+            let path = output(dir, GLTF_FILE)?;
+            std::fs::write(&path, super::gltf::write_glb(scene))
+                .map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))?;
+            file.gltf = Some(GLTF_FILE.into());
+        }
+    }
+    let path = output(dir, SCENE_FILE)?;
+    let json = serde_json::to_string_pretty(&file)
+        .map_err(|e| SceneError::in_file(&path, format!("cannot encode scene: {e}")))?;
+    std::fs::write(&path, json + "\n").map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))
+}
 
+/// The groups as the scene file gives them, each mesh written as an OBJ in `dir`.
+fn groups(scene: &Scene, dir: &Path) -> Result<Vec<GroupDesc>, SceneError> {
     let mut used_files = HashSet::new();
     let mut groups = Vec::with_capacity(scene.groups.len());
     for group in &scene.groups {
@@ -62,39 +119,16 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<(), SceneError> {
                     translation: k.translation.to_array(),
                     rotation_deg: None,
                     rotation_quat: Some(k.rotation.to_array()),
+                    scale: (k.scale != t.scale).then_some(k.scale),
                 })
                 .collect(),
             loop_seconds: group.motion.as_ref().and_then(|m| m.loop_seconds),
         });
     }
-
-    let camera = |c: &Camera| CameraDesc {
-        position: c.position.to_array(),
-        target: c.target.to_array(),
-        up: c.up.to_array(),
-        fov_y_deg: c.fov_y_deg,
-    };
-    let file = SceneFile {
-        name: Some(scene.name.clone()),
-        camera: camera(&scene.camera),
-        environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
-        groups,
-        lights: scene.lights.iter().map(light).collect(),
-        walkthrough: scene.walkthrough.iter().map(camera).collect(),
-        probes: scene
-            .probes
-            .iter()
-            .map(|p| ProbeDesc { position: p.position.to_array(), role: p.role })
-            .collect(),
-        exposure: scene.exposure,
-    };
-    let path = output(dir, SCENE_FILE)?;
-    let json = serde_json::to_string_pretty(&file)
-        .map_err(|e| SceneError::in_file(&path, format!("cannot encode scene: {e}")))?;
-    std::fs::write(&path, json + "\n").map_err(|e| SceneError::in_file(&path, format!("cannot write: {e}")))
+    Ok(groups)
 }
 
-fn light(light: &Light) -> LightDesc {
+pub(super) fn light(light: &Light) -> LightDesc {
     match *light {
         Light::Point { position, intensity } => {
             LightDesc::Point(PointDesc { position: position.to_array(), intensity })

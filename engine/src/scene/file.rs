@@ -27,10 +27,17 @@
 //! - `probes` (optional): light probes placed by hand, `{"position": [x, y, z], "role": "sky"}`
 //!   with `role` optional, one of `sky`, `bounce`, `bleed` ([`super::ProbeRole`]).
 //! - `keyframes` (optional, per group): `{"time": seconds, "translation": [x, y, z],
-//!   "rotation_deg" or "rotation_quat"}` in increasing time, with `loop_seconds` (optional) to
-//!   repeat them: the group's motion (`super::motion`), its scale its own.
+//!   "rotation_deg" or "rotation_quat", "scale"}` in increasing time (`scale` optional, default
+//!   the group's), with `loop_seconds` (optional) to repeat them: the group's motion
+//!   (`super::motion`).
 //! - `exposure` (optional, > 0, default 1): what a PNG of the scene is multiplied by before
 //!   tonemapping when the command names no `--exposure`.
+//! - `gltf` (optional): a glTF 2.0 file (.gltf or .glb) whose groups, lights and camera the
+//!   scene takes ([`super::gltf`]), `groups` then left out; the file adds what glTF has no
+//!   place for (the environment, probes, walkthrough, exposure). Its `camera`, where given,
+//!   replaces the glTF one; `gltf_camera` names the glTF camera to take (a camera's or its
+//!   node's name) instead of the first; its `lights` are added to the glTF ones.
+//! - `camera` is required unless a glTF file gives one.
 //! - Relative paths are relative to the folder of the scene file.
 use serde::{Deserialize, Serialize};
 
@@ -39,8 +46,14 @@ use serde::{Deserialize, Serialize};
 pub struct SceneFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    pub camera: CameraDesc,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gltf: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gltf_camera: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera: Option<CameraDesc>,
     pub environment: EnvironmentDesc,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groups: Vec<GroupDesc>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<LightDesc>,
@@ -117,6 +130,8 @@ pub struct KeyframeDesc {
     pub rotation_deg: Option<[f32; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotation_quat: Option<[f32; 4]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f32>,
 }
 
 fn one() -> f32 {

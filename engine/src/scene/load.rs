@@ -24,7 +24,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
     let camera_of =
         |c: &super::file::CameraDesc| Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg);
-    let camera = camera_of(&file.camera)?;
+    let camera = file.camera.as_ref().map(camera_of).transpose()?;
     let walkthrough = file
         .walkthrough
         .iter()
@@ -33,10 +33,26 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .collect::<Result<Vec<_>, _>>()?;
     super::animation::check_walkthrough(&walkthrough)?;
     let environment = environment(&file.environment, folder)?;
-    if file.groups.is_empty() {
-        return Err(SceneError::invalid("it has no groups"));
-    }
-    let groups = file
+    let (mut groups, mut lights, gltf_camera) = match (&file.gltf, &file.gltf_camera) {
+        (Some(gltf), wanted) => {
+            if !file.groups.is_empty() {
+                return Err(SceneError::invalid(
+                    "it gives both \"gltf\" and \"groups\": the groups come from one or the other",
+                ));
+            }
+            let parts = super::gltf::parts(&folder.join(gltf), wanted.as_deref())?;
+            (parts.groups, parts.lights, parts.camera)
+        }
+        (None, Some(_)) => return Err(SceneError::invalid("\"gltf_camera\" without a \"gltf\" file")),
+        (None, None) if file.groups.is_empty() => return Err(SceneError::invalid("it has no groups")),
+        (None, None) => (Vec::new(), Vec::new(), None),
+    };
+    let camera = match (camera, gltf_camera) {
+        (Some(camera), _) | (None, Some(camera)) => camera,
+        (None, None) if file.gltf.is_some() => super::gltf::overview(&groups),
+        (None, None) => return Err(SceneError::invalid("it has no \"camera\"")),
+    };
+    let listed: Vec<Group> = file
         .groups
         .into_iter()
         .enumerate()
@@ -45,12 +61,14 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
             group(g, folder).map_err(|e| e.within(&place))
         })
         .collect::<Result<_, _>>()?;
-    let lights = file
+    groups.extend(listed);
+    let listed: Vec<Light> = file
         .lights
         .into_iter()
         .enumerate()
         .map(|(at, l)| light(l).map_err(|e| e.within(&format!("light {at}"))))
         .collect::<Result<_, _>>()?;
+    lights.extend(listed);
     let probes = file
         .probes
         .iter()
@@ -119,7 +137,12 @@ fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
         .map(|(k, key)| {
             let rotation = rotation_of(key.rotation_deg, key.rotation_quat)
                 .map_err(|e| e.within(&format!("keyframe {k}")))?;
-            Ok(Key { time: key.time, translation: Vec3::from(key.translation), rotation })
+            Ok(Key {
+                time: key.time,
+                translation: Vec3::from(key.translation),
+                rotation,
+                scale: key.scale.unwrap_or(transform.scale),
+            })
         })
         .collect::<Result<Vec<Key>, SceneError>>()?;
     let motion = match (keys.is_empty(), desc.loop_seconds) {
@@ -146,7 +169,7 @@ fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
     Ok(mesh)
 }
 
-fn light(desc: LightDesc) -> Result<Light, SceneError> {
+pub(super) fn light(desc: LightDesc) -> Result<Light, SceneError> {
     let light = match desc {
         LightDesc::Point(p) => Light::Point { position: Vec3::from(p.position), intensity: p.intensity },
         LightDesc::Spot(s) => Light::Spot {

@@ -45,7 +45,7 @@ pub use builtin::BUILTIN;
 pub use camera::{Camera, FAR, NEAR};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use error::SceneError;
-pub use export::{ENVIRONMENT_FILE, SCENE_FILE};
+pub use export::{SceneFormat, ENVIRONMENT_FILE, GLTF_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
 pub use mesh::Mesh;
 pub use motion::Motion;
@@ -82,7 +82,7 @@ pub struct Scene {
 pub struct Group {
     pub name: String,
     pub meshes: Vec<Mesh>,
-    /// Its pose at rest; with a motion, its scale holds and its motion gives the rest.
+    /// Its pose at rest; with a motion, its motion gives its pose.
     pub transform: Transform,
     /// Its keyframes (`keyframes` in a scene file), which `--animate` and `--time` play.
     pub motion: Option<Motion>,
@@ -154,11 +154,12 @@ impl Scene {
         }
     }
 
-    /// Writes `dir/`[`SCENE_FILE`], one OBJ per mesh and the environment as 32-bit float EXR,
-    /// such that [`Scene::load`] of the written scene file gives back this scene exactly
-    /// (meshes made by [`Mesh::new`] keep their vertex order; see [`Mesh`]).
-    pub fn export(&self, dir: &Path) -> Result<(), SceneError> {
-        export::export(self, dir)
+    /// Writes `dir/`[`SCENE_FILE`] and the environment as 32-bit float EXR, with the geometry
+    /// as one OBJ per mesh or as `dir/`[`GLTF_FILE`] ([`SceneFormat`]), such that
+    /// [`Scene::load`] of the written scene file gives back this scene exactly (meshes made by
+    /// [`Mesh::new`] keep their vertex order; see [`Mesh`]).
+    pub fn export(&self, dir: &Path, format: SceneFormat) -> Result<(), SceneError> {
+        export::export(self, dir, format)
     }
 
     /// Checks what loading guarantees, for a scene built or changed in code (its fields are
@@ -178,7 +179,7 @@ impl Scene {
             if let Some(motion) = &group.motion {
                 motion.validate().map_err(|e| e.within(&place))?;
                 for key in &motion.keys {
-                    check_extent(key.translation, t.scale, group.object_reach())
+                    check_extent(key.translation, key.scale, group.object_reach())
                         .map_err(|e| e.within(&place))?;
                 }
             }

@@ -1,6 +1,6 @@
-//! A group's motion as data: keyframes of its translation and rotation over time (seconds), which
-//! `kage render --animate` and `--time` play and the sweep's poses sample. The group's scale
-//! stays. Between keys the translation is interpolated linearly and the rotation along the
+//! A group's motion as data: keyframes of its translation, rotation and (uniform) scale over time
+//! (seconds), which `kage render --animate` and `--time` play and the sweep's poses sample.
+//! Between keys the translation and scale are interpolated linearly and the rotation along the
 //! shorter arc (slerp); at a key's time the pose is the key's exactly. With a loop length the
 //! motion repeats; without, it holds its first key before it and its last key after it.
 use super::{Group, SceneError, Transform};
@@ -14,6 +14,14 @@ pub struct Key {
     pub translation: Vec3,
     /// Unit length.
     pub rotation: Quat,
+    /// Uniform, > 0.
+    pub scale: f32,
+}
+
+impl Key {
+    fn transform(&self) -> Transform {
+        Transform { translation: self.translation, rotation: self.rotation, scale: self.scale }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -26,8 +34,8 @@ pub struct Motion {
 }
 
 impl Motion {
-    /// The translation and rotation at `time` seconds.
-    pub fn at(&self, time: f32) -> (Vec3, Quat) {
+    /// The pose at `time` seconds.
+    pub fn at(&self, time: f32) -> Transform {
         let (keys, period) = (&self.keys, self.loop_seconds);
         let time = period.filter(|p| *p > 0.0).map_or(time, |p| time.rem_euclid(p));
         let (first, last) = (&keys[0], &keys[keys.len() - 1]);
@@ -36,16 +44,20 @@ impl Motion {
         let k = keys.partition_point(|key| key.time <= time);
         let (a, a_time, b, b_time) = match (k, period) {
             (0, Some(p)) => (last, last.time - p, first, first.time),
-            (0, None) => return (first.translation, first.rotation),
+            (0, None) => return first.transform(),
             (k, Some(p)) if k == keys.len() => (last, last.time, first, first.time + p),
-            (k, None) if k == keys.len() => return (last.translation, last.rotation),
+            (k, None) if k == keys.len() => return last.transform(),
             (k, _) => (&keys[k - 1], keys[k - 1].time, &keys[k], keys[k].time),
         };
         if time <= a_time || b_time <= a_time {
-            return (a.translation, a.rotation);
+            return a.transform();
         }
         let s = ((time - a_time) / (b_time - a_time)).min(1.0);
-        (a.translation.lerp(b.translation, s), a.rotation.slerp(b.rotation, s))
+        Transform {
+            translation: a.translation.lerp(b.translation, s),
+            rotation: a.rotation.slerp(b.rotation, s),
+            scale: a.scale + (b.scale - a.scale) * s,
+        }
     }
 
     /// How long one pass of the motion lasts: its loop length, else its last key's time.
@@ -54,7 +66,7 @@ impl Motion {
     }
 
     /// Checks the keys: at least one, finite, times from 0 in strictly increasing order, unit
-    /// rotations, and a loop no shorter than the last key's time.
+    /// rotations, positive scales, and a loop no shorter than the last key's time.
     pub fn validate(&self) -> Result<(), SceneError> {
         if self.keys.is_empty() {
             return Err(SceneError::invalid(
@@ -77,6 +89,9 @@ impl Motion {
             if !(key.rotation.is_finite() && (key.rotation.length() - 1.0).abs() < 1e-3) {
                 return Err(at(format!("rotation {} is not a unit quaternion", key.rotation)));
             }
+            if !(key.scale.is_finite() && key.scale > 0.0) {
+                return Err(at(format!("scale {} is not a positive number", key.scale)));
+            }
         }
         if let Some(period) = self.loop_seconds {
             let last = self.keys.last().map_or(0.0, |k| k.time);
@@ -91,16 +106,9 @@ impl Motion {
 }
 
 impl Group {
-    /// Its transform at `time` seconds: its motion's, with its own scale; its transform when it
-    /// has no motion.
+    /// Its transform at `time` seconds: its motion's; its transform when it has no motion.
     pub fn pose_at(&self, time: f32) -> Transform {
-        match &self.motion {
-            Some(motion) => {
-                let (translation, rotation) = motion.at(time);
-                Transform { translation, rotation, scale: self.transform.scale }
-            }
-            None => self.transform,
-        }
+        self.motion.as_ref().map_or(self.transform, |motion| motion.at(time))
     }
 }
 
@@ -129,6 +137,7 @@ pub fn hop(group: &Group) -> Motion {
                 time,
                 translation: base.translation + offset,
                 rotation: Quat::from_rotation_y(phase) * base.rotation,
+                scale: base.scale,
             }
         })
         .collect();
@@ -145,26 +154,33 @@ mod tests {
     use super::*;
 
     fn key(time: f32, x: f32, turn: f32) -> Key {
-        Key { time, translation: Vec3::new(x, 0.0, 0.0), rotation: Quat::from_rotation_y(turn) }
+        Key { time, translation: Vec3::new(x, 0.0, 0.0), rotation: Quat::from_rotation_y(turn), scale: 1.0 }
     }
 
     #[test]
     fn keys_are_hit_exactly_and_interpolated_between_held_or_looped_beyond() {
         let once = Motion { keys: vec![key(1.0, 0.0, 0.0), key(3.0, 4.0, 1.0)], loop_seconds: None };
-        assert_eq!(once.at(1.0), (Vec3::ZERO, Quat::from_rotation_y(0.0)));
+        assert_eq!(once.at(1.0), once.keys[0].transform());
         assert_eq!(once.at(0.0), once.at(1.0), "held before the first key");
-        assert_eq!(
-            once.at(9.0),
-            (Vec3::new(4.0, 0.0, 0.0), Quat::from_rotation_y(1.0)),
-            "held after the last"
+        assert_eq!(once.at(9.0), once.keys[1].transform(), "held after the last");
+        let half = once.at(2.0);
+        assert!(
+            (half.translation.x - 2.0).abs() < 1e-6
+                && half.rotation.abs_diff_eq(Quat::from_rotation_y(0.5), 1e-6)
         );
-        let (t, r) = once.at(2.0);
-        assert!((t.x - 2.0).abs() < 1e-6 && r.abs_diff_eq(Quat::from_rotation_y(0.5), 1e-6));
+        let growing = Motion {
+            keys: vec![key(0.0, 0.0, 0.0), Key { scale: 3.0, ..key(2.0, 0.0, 0.0) }],
+            loop_seconds: None,
+        };
+        assert_eq!(growing.at(0.5).scale, 1.5, "scale interpolated linearly");
         // Looping over 4 s: from the last key (3 s) back to the first one period later (5 s).
         let looped = Motion { loop_seconds: Some(4.0), ..once.clone() };
         assert_eq!(looped.at(5.0), looped.at(1.0));
-        assert!((looped.at(4.0).0.x - 2.0).abs() < 1e-6, "half-way from the last key back to the first");
-        assert!((looped.at(3.5).0.x - 3.0).abs() < 1e-6);
+        assert!(
+            (looped.at(4.0).translation.x - 2.0).abs() < 1e-6,
+            "half-way from the last key back to the first"
+        );
+        assert!((looped.at(3.5).translation.x - 3.0).abs() < 1e-6);
         assert_eq!(looped.duration(), 4.0);
         assert_eq!(once.duration(), 3.0);
     }
@@ -181,6 +197,8 @@ mod tests {
         assert!(bad(vec![key(0.0, f32::INFINITY, 0.0)], None).contains("translation"));
         let skewed = Key { rotation: Quat::from_xyzw(0.0, 0.0, 0.0, 2.0), ..key(0.0, 0.0, 0.0) };
         assert!(bad(vec![skewed], None).contains("not a unit quaternion"));
+        let flat = Key { scale: 0.0, ..key(0.0, 0.0, 0.0) };
+        assert!(bad(vec![flat], None).contains("keyframe 0: scale 0"));
         assert!(bad(vec![key(0.0, 0.0, 0.0), key(2.0, 0.0, 0.0)], Some(1.0)).contains("loop_seconds 1"));
     }
 

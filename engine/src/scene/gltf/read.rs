@@ -1,36 +1,76 @@
-//! glTF 2.0 scenes (`--scene FILE.gltf` or `FILE.glb`), read through the `gltf` crate.
+//! Reading glTF 2.0 (`--scene FILE.gltf` or `FILE.glb`).
 //!
 //! What is read:
 //! - the default scene (else the first); each root node with meshes in its subtree becomes one
 //!   rigid group: its transform (TRS or matrix, uniform scale) the group's, its descendants'
-//!   transforms baked into their meshes' vertices;
+//!   transforms baked into their meshes' vertices (meshes without one read as stored);
 //! - triangle primitives: positions, normals (computed where absent), indices (0, 1, 2, … where
 //!   absent); the material's baseColorFactor as albedo, times the mean of its baseColorTexture
 //!   (sRGB decoded) where it has one, with a note: Kage shades each mesh with one diffuse colour;
-//! - the first perspective camera (without one, a view of the whole scene, with a note);
+//! - the first perspective camera, or the one named (without one, a view of the whole scene,
+//!   with a note);
 //! - KHR_lights_punctual point and spot lights (colour × intensity, read as Kage's radiant
 //!   intensity; a spot's full cone is twice its outer cone angle);
-//! - animations' translation and rotation channels on root nodes: the groups' keyframes (linear;
-//!   step and cubic-spline sampled into linear keys, see `linear_track`).
+//! - animations' translation, rotation and (uniform) scale channels on root nodes: the groups'
+//!   keyframes (linear; step and cubic-spline sampled into linear keys, see `linear_track`),
+//!   played once unless Kage's extras give a loop.
 //!
 //! What is refused, by name: skins and morph targets (a rigid group cannot follow them), other
-//! primitive modes, animation channels on nodes inside a group, orthographic cameras, non-uniform scale on a root node, data out of its buffer.
-//! What is not used (directional lights, scale channels, extensions, textures other than the
-//! base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
+//! primitive modes, animation channels on nodes inside a group, orthographic cameras, non-uniform
+//! scale on a root node or in its scale channel, data out of its buffer.
+//! What is not used (directional lights, morph weight channels, extensions, textures other than
+//! the base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
 //! sky of radiance 1 (a note says so; `--env` or a scene file gives another).
-use super::motion::{Key, Motion};
-use super::{Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
+use super::super::motion::{Key, Motion};
+use super::super::{Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
+use super::Extras;
 use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
 use gltf::animation::{Interpolation, Property};
 use std::path::Path;
 
-/// Reads the glTF file at `path`; every error names the file, and the element at fault.
+/// What a glTF file gives a scene: its groups, lights and camera (if it has one).
+pub struct Parts {
+    pub groups: Vec<Group>,
+    pub lights: Vec<Light>,
+    pub camera: Option<Camera>,
+}
+
+/// Reads the glTF file at `path` as a whole scene; every error names the file, and the element
+/// at fault.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let Parts { groups, lights, camera } = parts(path, None)?;
+    let file = path.display();
+    let camera = match camera {
+        Some(camera) => camera,
+        None => {
+            eprintln!("kage: note: {file} has no camera: viewing the whole scene from the front");
+            overview(&groups)
+        }
+    };
+    eprintln!("kage: note: {file} has no environment: lit by a constant sky of radiance 1 (give one with --env or a scene file)");
+    let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let scene = Scene {
+        name,
+        groups,
+        environment: EnvMap::constant([1.0; 3]),
+        lights,
+        camera,
+        walkthrough: Vec::new(),
+        probes: Vec::new(),
+        exposure: 1.0,
+    };
+    scene.validate().map_err(|e| e.attributed_to(path))?;
+    Ok(scene)
+}
+
+/// Reads the groups, lights and camera of the glTF file at `path`: the camera named `camera`
+/// (a camera's or its node's name), else the first one.
+pub fn parts(path: &Path, camera: Option<&str>) -> Result<Parts, SceneError> {
     // The gltf crate (1.4) panics on some malformed files inside its own checks (an index of
     // 2^32 - 1, a channel's unchecked target): contained here, such a file is an error like
     // any other (Rust's panic message is printed before it).
-    std::panic::catch_unwind(|| read(path)).unwrap_or_else(|payload| {
+    std::panic::catch_unwind(|| read(path, camera)).unwrap_or_else(|payload| {
         let text = payload
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
@@ -43,7 +83,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     })
 }
 
-fn read(path: &Path) -> Result<Scene, SceneError> {
+fn read(path: &Path, wanted_camera: Option<&str>) -> Result<Parts, SceneError> {
     let fail = |problem: String| SceneError::in_file(path, problem);
     let (document, buffers, images) =
         gltf::import(path).map_err(|e| fail(format!("not a glTF 2.0 file Kage can read: {e}")))?;
@@ -66,6 +106,7 @@ fn read(path: &Path) -> Result<Scene, SceneError> {
 
     let mut groups = Vec::new();
     let mut camera = None;
+    let mut camera_names = Vec::new();
     let mut lights = Vec::new();
     let mut root_of_group = Vec::new();
     // glTF's nodes form trees: a node met twice (its own ancestor, or two parents) is refused.
@@ -94,16 +135,25 @@ fn read(path: &Path) -> Result<Scene, SceneError> {
                     );
                 }
             }
-            if let (None, Some(c)) = (&camera, node.camera()) {
-                camera = Some(camera_of(&c, world).map_err(|e| fail(format!("camera {}: {e}", c.index())))?);
+            if let Some(c) = node.camera() {
+                let names = [c.name(), node.name()];
+                camera_names.extend(names.iter().flatten().map(|n| format!("\"{n}\"")));
+                let wanted = wanted_camera.is_none_or(|w| names.contains(&Some(w)));
+                if camera.is_none() && wanted {
+                    let read = camera_of(&c, &node, world)
+                        .map_err(|e| fail(format!("camera {}: {e}", c.index())))?;
+                    camera = Some(read);
+                }
             }
             if let Some(light) = node.light() {
-                match light_of(&light, world) {
-                    Some(l) => lights.push(l),
+                match light_of(&light, &node, world) {
+                    Some(l) => lights.push(l.map_err(|e| fail(format!("light {}: {e}", light.index())))?),
                     None => unused.push(format!("directional light {}", light.index())),
                 }
             }
-            for child in node.children() {
+            // Pushed last to first: the meshes come in the file's order (depth first).
+            let children: Vec<_> = node.children().collect();
+            for child in children.into_iter().rev() {
                 let local = Mat4::from_cols_array_2d(&child.transform().matrix());
                 stack.push((child, relative * local));
             }
@@ -111,7 +161,13 @@ fn read(path: &Path) -> Result<Scene, SceneError> {
         if meshes.is_empty() {
             continue;
         }
-        let (scale, rotation, translation) = root_matrix.to_scale_rotation_translation();
+        // Read from the TRS as written where it is one (no round trip through a matrix).
+        let (scale, rotation, translation) = match root.transform() {
+            gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+                (Vec3::from(scale), Quat::from_array(rotation), Vec3::from(translation))
+            }
+            gltf::scene::Transform::Matrix { .. } => root_matrix.to_scale_rotation_translation(),
+        };
         if (scale.max_element() - scale.min_element()).abs() > 1e-4 * scale.max_element().abs() {
             return Err(fail(format!(
                 "node {}: scale {scale} is not uniform (a group scales uniformly)",
@@ -126,35 +182,19 @@ fn read(path: &Path) -> Result<Scene, SceneError> {
     if groups.is_empty() {
         return Err(fail("its scene has no meshes".into()));
     }
+    if let (Some(wanted), None) = (wanted_camera, &camera) {
+        let names = if camera_names.is_empty() { "none".to_string() } else { camera_names.join(", ") };
+        return Err(fail(format!(
+            "it has no camera named \"{wanted}\" (its cameras and their nodes: {names})"
+        )));
+    }
     motions(&document, &buffers, &root_of_group, &mut groups, &mut unused).map_err(fail)?;
-
-    let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let file = path.display();
-    let camera = match camera {
-        Some(camera) => camera,
-        None => {
-            eprintln!("kage: note: {file} has no camera: viewing the whole scene from the front");
-            overview(&groups)
-        }
-    };
-    eprintln!("kage: note: {file} has no environment: lit by a constant sky of radiance 1 (give one with --env or a scene file)");
     if !unused.is_empty() {
         unused.sort();
         unused.dedup();
-        eprintln!("kage: note: {file}: not used by Kage: {}", unused.join(", "));
+        eprintln!("kage: note: {}: not used by Kage: {}", path.display(), unused.join(", "));
     }
-    let scene = Scene {
-        name,
-        groups,
-        environment: EnvMap::constant([1.0; 3]),
-        lights,
-        camera,
-        walkthrough: Vec::new(),
-        probes: Vec::new(),
-        exposure: 1.0,
-    };
-    scene.validate().map_err(|e| e.attributed_to(path))?;
-    Ok(scene)
+    Ok(Parts { groups, lights, camera })
 }
 
 /// One triangle primitive as a mesh, its vertices placed by `relative` (within its group).
@@ -183,15 +223,20 @@ fn primitive_mesh(
         }
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-    let positions: Vec<[f32; 3]> = reader
-        .read_positions()
-        .ok_or("positions missing, or beyond their buffer")?
-        .map(|p| relative.transform_point3(Vec3::from(p)).to_array())
-        .collect();
-    let normal_matrix = glam::Mat3::from_mat4(relative).inverse().transpose();
-    let normals = reader
-        .read_normals()
-        .map(|n| n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero().to_array()).collect());
+    let positions = reader.read_positions().ok_or("positions missing, or beyond their buffer")?;
+    let normals = reader.read_normals();
+    // A mesh on a group's root node (or a child without a transform) is read as stored, bit for
+    // bit; one further down has its place within the group baked in.
+    let (positions, normals): (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>) = if relative == Mat4::IDENTITY {
+        (positions.collect(), normals.map(Iterator::collect))
+    } else {
+        let normal_matrix = glam::Mat3::from_mat4(relative).inverse().transpose();
+        (
+            positions.map(|p| relative.transform_point3(Vec3::from(p)).to_array()).collect(),
+            normals
+                .map(|n| n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero().to_array()).collect()),
+        )
+    };
     let mut indices: Vec<u32> = match reader.read_indices() {
         Some(indices) => indices.into_u32().collect(),
         None if primitive.get(&gltf::Semantic::Positions).is_some_and(|a| a.count() == positions.len()) => {
@@ -225,8 +270,8 @@ fn primitive_mesh(
     {
         unused.push("normal, occlusion and emissive textures".into());
     }
-    let name =
-        format!("{}.{p}", mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string));
+    let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+    let name = if mesh.primitives().len() == 1 { mesh_name } else { format!("{mesh_name}.{p}") };
     Mesh::new(name, positions, normals, indices, albedo.map(|c| c.clamp(0.0, 1.0))).map_err(|e| e.to_string())
 }
 
@@ -245,40 +290,81 @@ fn mean_colour(image: &gltf::image::Data) -> Option<[f32; 3]> {
     Some(sum.map(|c| c / count))
 }
 
-fn camera_of(camera: &gltf::Camera, world: Mat4) -> Result<Camera, String> {
+/// A perspective camera on `node` (placed by `world`); Kage's own look-at where its extras hold
+/// one that agrees (a target and up vector glTF has no place for).
+fn camera_of(camera: &gltf::Camera, node: &gltf::Node, world: Mat4) -> Result<Camera, String> {
     let gltf::camera::Projection::Perspective(perspective) = camera.projection() else {
         return Err("orthographic: Kage renders perspective views".into());
     };
     let position = world.transform_point3(Vec3::ZERO);
     let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
     let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-    Camera::from_arrays(
+    let read = Camera::from_arrays(
         position.to_array(),
         (position + forward).to_array(),
         up.to_array(),
         perspective.yfov().to_degrees(),
     )
-    .map_err(|e| e.to_string())
+    .map_err(|e| e.to_string())?;
+    let exact = Extras::of(node.extras())
+        .camera
+        .and_then(|c| Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg).ok());
+    Ok(exact.filter(|exact| agrees(&camera_frame(exact), &camera_frame(&read))).unwrap_or(read))
 }
 
-/// A point or spot light; `None` for a directional one.
-fn light_of(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Option<Light> {
+/// A camera's position, viewing direction, up direction (square to it) and field of view.
+fn camera_frame(camera: &Camera) -> [f32; 10] {
+    let forward = (camera.target - camera.position).normalize();
+    let up = forward.cross(camera.up).cross(forward).normalize();
+    let [a, b, c] = camera.position.to_array();
+    let ([d, e, f], [g, h, i]) = (forward.to_array(), up.to_array());
+    [a, b, c, d, e, f, g, h, i, camera.fov_y_deg.to_radians()]
+}
+
+/// Whether Kage's values and the glTF ones read beside them are the same up to f32 rounding
+/// in glTF's form (a quaternion, radians, colour × intensity): 1e-5 relative to their size.
+fn agrees(exact: &[f32], read: &[f32]) -> bool {
+    exact.iter().zip(read).all(|(a, b)| (a - b).abs() <= 1e-5 * a.abs().max(b.abs()).max(1.0))
+}
+
+/// A point or spot light on `node` (placed by `world`), Kage's own where its extras hold one
+/// that agrees; `None` for a directional one.
+fn light_of(
+    light: &gltf::khr_lights_punctual::Light,
+    node: &gltf::Node,
+    world: Mat4,
+) -> Option<Result<Light, String>> {
     let position = world.transform_point3(Vec3::ZERO);
     let intensity = light.color().map(|c| c * light.intensity());
-    match light.kind() {
-        gltf::khr_lights_punctual::Kind::Point => Some(Light::Point { position, intensity }),
-        gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => Some(Light::Spot {
+    let read = match light.kind() {
+        gltf::khr_lights_punctual::Kind::Point => Light::Point { position, intensity },
+        gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => Light::Spot {
             position,
             direction: world.transform_vector3(Vec3::NEG_Z),
             fov_deg: 2.0 * outer_cone_angle.to_degrees(),
             intensity,
-        }),
-        gltf::khr_lights_punctual::Kind::Directional => None,
-    }
+        },
+        gltf::khr_lights_punctual::Kind::Directional => return None,
+    };
+    let read = match read.validated() {
+        Ok(read) => read,
+        Err(e) => return Some(Err(e.to_string())),
+    };
+    let exact = Extras::of(node.extras()).light.and_then(|desc| super::super::load::light(desc).ok());
+    let numbers = |light: &Light| match *light {
+        Light::Point { position, intensity } => [position.to_array(), intensity, [0.0; 3], [0.0; 3]].concat(),
+        Light::Spot { position, direction, fov_deg, intensity } => {
+            [position.to_array(), intensity, direction.to_array(), [fov_deg.to_radians(), 1.0, 1.0]].concat()
+        }
+    };
+    let same_kind = |exact: &Light| std::mem::discriminant(exact) == std::mem::discriminant(&read);
+    Some(Ok(exact
+        .filter(|exact| same_kind(exact) && agrees(&numbers(exact), &numbers(&read)))
+        .unwrap_or(read)))
 }
 
 /// A camera that sees every group: from the front (+Z), above their box's centre.
-fn overview(groups: &[Group]) -> Camera {
+pub fn overview(groups: &[Group]) -> Camera {
     let (lo, hi) = groups
         .iter()
         .flat_map(|g| {
@@ -306,10 +392,12 @@ fn motions(
     groups: &mut [Group],
     unused: &mut Vec<String>,
 ) -> Result<(), String> {
-    // Per group: the times and values of its translation and rotation channels.
+    // Per group: the times and values of its translation, rotation and scale channels.
     type Track<T> = Option<(Vec<f32>, Vec<T>)>;
-    let mut tracks: Vec<(Track<Vec3>, Track<Quat>)> = vec![(None, None); groups.len()];
+    let mut tracks: Vec<(Track<Vec3>, Track<Quat>, Track<f32>)> = vec![(None, None, None); groups.len()];
+    let mut loops: Vec<Option<f32>> = vec![None; groups.len()];
     for animation in document.animations() {
+        let loop_seconds = Extras::of(animation.extras()).loop_seconds;
         for (c, channel) in animation.channels().enumerate() {
             let at = |problem: String| format!("animation {} channel {c}: {problem}", animation.index());
             // The crate leaves a channel's target unchecked (and panics on reading a bad one).
@@ -322,8 +410,8 @@ fn motions(
             }
             let node = channel.target().node();
             let property = channel.target().property();
-            if property == Property::Scale || property == Property::MorphTargetWeights {
-                unused.push(format!("{property:?} channels"));
+            if property == Property::MorphTargetWeights {
+                unused.push("morph target weight channels".into());
                 continue;
             }
             let Some(g) = root_of_group.iter().position(|&r| r == node.index()) else {
@@ -332,6 +420,7 @@ fn motions(
                     node.index()
                 )));
             };
+            loops[g] = loops[g].or(loop_seconds);
             let interpolation = channel.sampler().interpolation();
             let reader = channel.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let times: Vec<f32> =
@@ -346,22 +435,34 @@ fn motions(
                     let track = linear_track(&times, &values, interpolation, Vec4::normalize).map_err(at)?;
                     tracks[g].1 = Some((track.0, track.1.into_iter().map(Quat::from_vec4).collect()));
                 }
-                _ => unreachable!("scale and weights are skipped above"),
+                ReadOutputs::Scales(values) => {
+                    let values: Vec<Vec3> = values.map(Vec3::from).collect();
+                    let track = linear_track(&times, &values, interpolation, |v| v).map_err(at)?;
+                    let uniform =
+                        |v: &Vec3| (v.max_element() - v.min_element()).abs() <= 1e-4 * v.max_element().abs();
+                    if let Some(v) = track.1.iter().find(|v| !uniform(v)) {
+                        return Err(at(format!("scale {v} is not uniform (a group scales uniformly)")));
+                    }
+                    tracks[g].2 = Some((track.0, track.1.iter().map(|v| v.x).collect()));
+                }
+                ReadOutputs::MorphTargetWeights(_) => unreachable!("weights are skipped above"),
             }
         }
     }
-    for (group, (translations, rotations)) in groups.iter_mut().zip(tracks) {
-        if translations.is_none() && rotations.is_none() {
+    for ((group, (translations, rotations, scales)), loop_seconds) in groups.iter_mut().zip(tracks).zip(loops)
+    {
+        let track_times = [
+            translations.as_ref().map(|t| &t.0),
+            rotations.as_ref().map(|t| &t.0),
+            scales.as_ref().map(|t| &t.0),
+        ];
+        if track_times.iter().all(Option::is_none) {
             continue;
         }
-        let mut times: Vec<f32> = [&translations.as_ref().map(|t| &t.0), &rotations.as_ref().map(|t| &t.0)]
-            .into_iter()
-            .flatten()
-            .flat_map(|t| t.iter().copied())
-            .collect();
+        let mut times: Vec<f32> = track_times.into_iter().flatten().flat_map(|t| t.iter().copied()).collect();
         times.sort_by(f32::total_cmp);
         times.dedup();
-        let keys = times
+        let mut keys: Vec<Key> = times
             .iter()
             .map(|&time| Key {
                 time,
@@ -371,9 +472,24 @@ fn motions(
                 rotation: rotations
                     .as_ref()
                     .map_or(group.transform.rotation, |(t, v)| sample(t, v, time, Quat::slerp)),
+                scale: scales
+                    .as_ref()
+                    .map_or(group.transform.scale, |(t, v)| sample(t, v, time, |a, b, s| a + (b - a) * s)),
             })
             .collect();
-        let motion = Motion { keys, loop_seconds: None };
+        // A looping motion's last key at its loop length, where it repeats the first key at 0
+        // (as Kage writes it, for players that loop over the animation's length), is the first.
+        let (first, last) = (keys[0], keys[keys.len() - 1]);
+        let closing = |p: f32| {
+            keys.len() > 1 && first.time == 0.0 && last.time == p && {
+                let (a, b) = (Key { time: 0.0, ..last }, first);
+                a == b
+            }
+        };
+        if loop_seconds.is_some_and(closing) {
+            keys.pop();
+        }
+        let motion = Motion { keys, loop_seconds };
         motion.validate().map_err(|e| format!("group \"{}\": {e}", group.name))?;
         group.motion = Some(motion);
     }
@@ -449,12 +565,13 @@ where
     Ok((out_times, out_values))
 }
 
-/// A channel's value at `time`: interpolated between its keys, held beyond them.
+/// A channel's value at `time`: its key's exactly at a key's time, interpolated between keys,
+/// held beyond them.
 fn sample<T: Copy>(times: &[f32], values: &[T], time: f32, mix: impl Fn(T, T, f32) -> T) -> T {
     let k = times.partition_point(|&t| t <= time);
     match k {
         0 => values[0],
-        k if k == times.len() => values[k - 1],
+        k if k == times.len() || times[k - 1] == time => values[k - 1],
         k => {
             let s = (time - times[k - 1]) / (times[k] - times[k - 1]);
             mix(values[k - 1], values[k], s)
