@@ -308,3 +308,49 @@ fn the_default_scene_as_gltf_renders_the_same_pixels_with_every_technique() {
         assert!(a.iter().any(|p| p[0] > 0.0), "{kind:?} rendered black");
     }
 }
+
+/// The default scene written by Blender (see tests/assets/gltf/blender-teapot/README.md) reads
+/// as the built-in one: its groups' triangles and extent, its camera from the node alone (Blender
+/// drops Kage's extras), and the hop as Blender resampled it at 24 frames per second, each key
+/// the built-in motion's pose at that instant.
+#[test]
+fn the_default_scene_written_by_blender_reads_as_the_builtin_one() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/blender-teapot/teapot.glb");
+    let (blender, builtin) = (Scene::load(&path).unwrap(), Scene::builtin("teapot").unwrap());
+    let names: Vec<&str> = blender.groups.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, ["teapot", "floor"]);
+    let extent = |group: &kage::scene::Group| {
+        let m = group.transform.matrix();
+        let points = group
+            .meshes
+            .iter()
+            .flat_map(|mesh| mesh.positions.iter().map(|p| m.transform_point3(Vec3::from(*p))));
+        points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+    };
+    for (a, b) in blender.groups.iter().zip(&builtin.groups) {
+        assert_eq!(a.meshes[0].triangle_count(), b.meshes[0].triangle_count(), "{}", a.name);
+        let ((a_lo, a_hi), (b_lo, b_hi)) = (extent(a), extent(b));
+        assert!(close(a_lo, b_lo) && close(a_hi, b_hi), "{}: {a_lo} {a_hi} against {b_lo} {b_hi}", a.name);
+    }
+    let (camera, expected) = (blender.camera, builtin.camera);
+    assert!(close(camera.position, expected.position));
+    let direction = |c: &kage::scene::Camera| (c.target - c.position).normalize();
+    assert!(direction(&camera).dot(direction(&expected)) > 1.0 - 1e-6);
+    assert!((camera.fov_y_deg - expected.fov_y_deg).abs() < 1e-4);
+    let motion = blender.groups[0].motion.as_ref().unwrap();
+    assert_eq!((motion.keys.len(), motion.loop_seconds), (25, None));
+    for key in &motion.keys {
+        let hop = builtin.groups[0].pose_at(key.time);
+        assert!(
+            close(key.translation, hop.translation),
+            "at {} s: {} against {}",
+            key.time,
+            key.translation,
+            hop.translation
+        );
+        assert!(
+            key.rotation.abs_diff_eq(hop.rotation, 1e-5) || key.rotation.abs_diff_eq(-hop.rotation, 1e-5)
+        );
+        assert!((key.scale - hop.scale).abs() < 1e-6);
+    }
+}
