@@ -106,7 +106,7 @@ fn hostile_gltf_is_refused_naming_the_file_and_the_element() {
         (
             "child-moves",
             &|g| g["animations"][0]["channels"][1]["target"]["node"] = 1.into(),
-            "moves node 1 inside a group",
+            "moves node 1, which is no group",
         ),
         ("skin", &|g| g["skins"] = serde_json::json!([{"joints": [1]}]), "skin 0"),
         ("stretched", &|g| g["nodes"][0]["scale"] = serde_json::json!([1, 2, 1]), "node 0: scale"),
@@ -245,7 +245,7 @@ fn a_scene_file_takes_its_geometry_from_gltf() {
     let lone = dir.join("lone.json");
     std::fs::write(&lone, r#"{"gltf_camera": "camera", "environment": {"constant": [1, 1, 1]}, "camera": {"position": [0, 0, 1], "target": [0, 0, 0], "fov_y_deg": 40}}"#).unwrap();
     let message = Scene::load(&lone).unwrap_err().to_string();
-    assert!(message.contains("\"gltf_camera\" without a \"gltf\" file"), "{message}");
+    assert!(message.contains("\"gltf_camera\" or \"gltf_groups\" without a \"gltf\" file"), "{message}");
 }
 
 /// Kage's own look-at in a camera node's extras is taken while it agrees with the node; once
@@ -352,5 +352,57 @@ fn the_default_scene_written_by_blender_reads_as_the_builtin_one() {
             key.rotation.abs_diff_eq(hop.rotation, 1e-5) || key.rotation.abs_diff_eq(-hop.rotation, 1e-5)
         );
         assert!((key.scale - hop.scale).abs() < 1e-6);
+    }
+}
+
+/// `gltf_groups` makes a node inside a root a group of its own: the box's child "cube" is then
+/// placed by its parents (its vertices as stored), and its keys, written in its parent's frame,
+/// become world poses; naming a node the file lacks, or moving a node that is no group, is an
+/// error.
+#[test]
+fn gltf_groups_split_a_node_out_of_its_root() {
+    let dir = scratch_dir("gltf-groups");
+    let mut gltf: Value = serde_json::from_str(&std::fs::read_to_string(asset()).unwrap()).unwrap();
+    // The animation moves the child instead of the box.
+    for channel in gltf["animations"][0]["channels"].as_array_mut().unwrap() {
+        channel["target"]["node"] = 1.into();
+    }
+    std::fs::write(dir.join("child-moves.gltf"), gltf.to_string()).unwrap();
+    std::fs::copy(asset(), dir.join("two-groups.gltf")).unwrap();
+    // The box with a mesh of its own, moving, and the cube inside it.
+    let mut boxed: Value = serde_json::from_str(&std::fs::read_to_string(asset()).unwrap()).unwrap();
+    boxed["nodes"][0]["mesh"] = 0.into();
+    std::fs::write(dir.join("boxed.gltf"), boxed.to_string()).unwrap();
+    let scene_file = |gltf: &str, groups: &str| {
+        let path = dir.join(format!("{}-{}.json", gltf, groups.len()));
+        let json = format!(
+            r#"{{"gltf": "{gltf}.gltf", "gltf_groups": [{groups}], "environment": {{"constant": [1, 1, 1]}}}}"#
+        );
+        std::fs::write(&path, json).unwrap();
+        Scene::load(&path)
+    };
+    let scene = scene_file("child-moves", r#""cube""#).unwrap();
+    let names: Vec<&str> = scene.groups.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, ["floor", "cube"], "the box holds no mesh of its own: no group");
+    let cube = &scene.groups[1];
+    // The box (at (0, 0.5, 0), scale 0.5) places the cube's (0.2, 0, 0) offset.
+    assert!(
+        close(cube.transform.translation, Vec3::new(0.1, 0.5, 0.0))
+            && (cube.transform.scale - 0.5).abs() < 1e-6
+    );
+    assert!(cube.meshes[0].positions.iter().flatten().all(|c| c.abs() == 0.5), "vertices as stored");
+    // The key (1, 0.5, 0) in the box's frame: (0, 0.5, 0) + 0.5 × (1, 0.5, 0).
+    assert!(
+        close(cube.pose_at(1.0).translation, Vec3::new(0.5, 0.75, 0.0)),
+        "{}",
+        cube.pose_at(1.0).translation
+    );
+    for (file, groups, expected) in [
+        ("two-groups", r#""cube""#, "animation 0 channel 0: it moves node 0, which is no group"),
+        ("two-groups", r#""nobody""#, "gltf_groups: it has no node named \"nobody\""),
+        ("boxed", r#""cube""#, "group \"cube\" sits inside group \"box\", which moves"),
+    ] {
+        let message = scene_file(file, groups).unwrap_err().to_string();
+        assert!(message.contains(expected), "{message}");
     }
 }

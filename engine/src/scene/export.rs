@@ -53,6 +53,7 @@ pub fn export(scene: &Scene, dir: &Path, format: SceneFormat) -> Result<(), Scen
         name: Some(scene.name.clone()),
         gltf: None,
         gltf_camera: None,
+        gltf_groups: Vec::new(),
         camera: None,
         environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
         groups: Vec::new(),

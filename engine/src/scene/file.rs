@@ -36,7 +36,8 @@
 //!   scene takes ([`super::gltf`]), `groups` then left out; the file adds what glTF has no
 //!   place for (the environment, probes, walkthrough, exposure). Its `camera`, where given,
 //!   replaces the glTF one; `gltf_camera` names the glTF camera to take (a camera's or its
-//!   node's name) instead of the first; its `lights` are added to the glTF ones.
+//!   node's name) instead of the first; `gltf_groups` names nodes that are groups of their own
+//!   (besides the root nodes); its `lights` are added to the glTF ones.
 //! - `camera` is required unless a glTF file gives one.
 //! - Relative paths are relative to the folder of the scene file.
 use serde::{Deserialize, Serialize};
@@ -50,6 +51,8 @@ pub struct SceneFile {
     pub gltf: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gltf_camera: Option<String>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gltf_groups: Vec<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera: Option<CameraDesc>,
     pub environment: EnvironmentDesc,

@@ -33,19 +33,23 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .collect::<Result<Vec<_>, _>>()?;
     super::animation::check_walkthrough(&walkthrough)?;
     let environment = environment(&file.environment, folder)?;
-    let (mut groups, mut lights, gltf_camera) = match (&file.gltf, &file.gltf_camera) {
-        (Some(gltf), wanted) => {
+    let gltf_options = file.gltf_camera.is_some() || !file.gltf_groups.is_empty();
+    let (mut groups, mut lights, gltf_camera) = match (&file.gltf, gltf_options) {
+        (Some(gltf), _) => {
             if !file.groups.is_empty() {
                 return Err(SceneError::invalid(
                     "it gives both \"gltf\" and \"groups\": the groups come from one or the other",
                 ));
             }
-            let parts = super::gltf::parts(&folder.join(gltf), wanted.as_deref())?;
+            let parts =
+                super::gltf::parts(&folder.join(gltf), file.gltf_camera.as_deref(), &file.gltf_groups)?;
             (parts.groups, parts.lights, parts.camera)
         }
-        (None, Some(_)) => return Err(SceneError::invalid("\"gltf_camera\" without a \"gltf\" file")),
-        (None, None) if file.groups.is_empty() => return Err(SceneError::invalid("it has no groups")),
-        (None, None) => (Vec::new(), Vec::new(), None),
+        (None, true) => {
+            return Err(SceneError::invalid("\"gltf_camera\" or \"gltf_groups\" without a \"gltf\" file"))
+        }
+        (None, false) if file.groups.is_empty() => return Err(SceneError::invalid("it has no groups")),
+        (None, false) => (Vec::new(), Vec::new(), None),
     };
     let camera = match (camera, gltf_camera) {
         (Some(camera), _) | (None, Some(camera)) => camera,

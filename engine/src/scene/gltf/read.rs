@@ -3,7 +3,9 @@
 //! What is read:
 //! - the default scene (else the first); each root node with meshes in its subtree becomes one
 //!   rigid group: its transform (TRS or matrix, uniform scale) the group's, its descendants'
-//!   transforms baked into their meshes' vertices (meshes without one read as stored);
+//!   transforms baked into their meshes' vertices (meshes without one read as stored); a node
+//!   the caller names (a scene file's `gltf_groups`) is a group of its own with its subtree,
+//!   placed in the world by its parents;
 //! - triangle primitives: positions, normals (computed where absent), indices (0, 1, 2, … where
 //!   absent); the material's baseColorFactor as albedo, times the mean of its baseColorTexture
 //!   (sRGB decoded) where it has one, with a note: Kage shades each mesh with one diffuse colour;
@@ -11,13 +13,14 @@
 //!   with a note);
 //! - KHR_lights_punctual point and spot lights (colour × intensity, read as Kage's radiant
 //!   intensity; a spot's full cone is twice its outer cone angle);
-//! - animations' translation, rotation and (uniform) scale channels on root nodes: the groups'
+//! - animations' translation, rotation and (uniform) scale channels on group nodes: the groups'
 //!   keyframes (linear; step and cubic-spline sampled into linear keys, see `linear_track`),
 //!   played once unless Kage's extras give a loop.
 //!
 //! What is refused, by name: skins and morph targets (a rigid group cannot follow them), other
-//! primitive modes, animation channels on nodes inside a group, orthographic cameras, non-uniform
-//! scale on a root node or in its scale channel, data out of its buffer.
+//! primitive modes, animation channels on nodes inside a group, a group inside a moving one,
+//! orthographic cameras, non-uniform scale on a group node or in its scale channel, data out of
+//! its buffer.
 //! What is not used (directional lights, morph weight channels, extensions, textures other than
 //! the base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
 //! sky of radiance 1 (a note says so; `--env` or a scene file gives another).
@@ -39,7 +42,7 @@ pub struct Parts {
 /// Reads the glTF file at `path` as a whole scene; every error names the file, and the element
 /// at fault.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let Parts { groups, lights, camera } = parts(path, None)?;
+    let Parts { groups, lights, camera } = parts(path, None, &[])?;
     let file = path.display();
     let camera = match camera {
         Some(camera) => camera,
@@ -65,12 +68,13 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// Reads the groups, lights and camera of the glTF file at `path`: the camera named `camera`
-/// (a camera's or its node's name), else the first one.
-pub fn parts(path: &Path, camera: Option<&str>) -> Result<Parts, SceneError> {
+/// (a camera's or its node's name), else the first one; the nodes named in `groups` are groups
+/// of their own (with their subtrees but for listed nodes in them), besides the roots.
+pub fn parts(path: &Path, camera: Option<&str>, groups: &[String]) -> Result<Parts, SceneError> {
     // The gltf crate (1.4) panics on some malformed files inside its own checks (an index of
     // 2^32 - 1, a channel's unchecked target): contained here, such a file is an error like
     // any other (Rust's panic message is printed before it).
-    std::panic::catch_unwind(|| read(path, camera)).unwrap_or_else(|payload| {
+    std::panic::catch_unwind(|| read(path, camera, groups)).unwrap_or_else(|payload| {
         let text = payload
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
@@ -83,7 +87,16 @@ pub fn parts(path: &Path, camera: Option<&str>) -> Result<Parts, SceneError> {
     })
 }
 
-fn read(path: &Path, wanted_camera: Option<&str>) -> Result<Parts, SceneError> {
+/// A node that is a group: its index, its parent's world matrix (identity for a root), its TRS
+/// in its parent, and the group node above it (none for a root).
+struct GroupNode {
+    node: usize,
+    parent_world: Mat4,
+    local: Transform,
+    parent_group: Option<usize>,
+}
+
+fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Result<Parts, SceneError> {
     let fail = |problem: String| SceneError::in_file(path, problem);
     let (document, buffers, images) =
         gltf::import(path).map_err(|e| fail(format!("not a glTF 2.0 file Kage can read: {e}")))?;
@@ -104,22 +117,39 @@ fn read(path: &Path, wanted_camera: Option<&str>) -> Result<Parts, SceneError> {
         .or_else(|| document.scenes().next())
         .ok_or_else(|| fail("it holds no scene".into()))?;
 
+    // The nodes that are groups besides the scene's roots: those the caller names.
+    let mut listed = vec![false; document.nodes().len()];
+    for name in group_names {
+        let mut named = document.nodes().filter(|n| n.name() == Some(name.as_str()));
+        match (named.next(), named.next()) {
+            (Some(node), None) => listed[node.index()] = true,
+            (None, _) => return Err(fail(format!("gltf_groups: it has no node named \"{name}\""))),
+            (Some(_), Some(_)) => {
+                return Err(fail(format!("gltf_groups: several of its nodes are named \"{name}\"")))
+            }
+        }
+    }
+
     let mut groups = Vec::new();
     let mut camera = None;
     let mut camera_names = Vec::new();
     let mut lights = Vec::new();
-    let mut root_of_group = Vec::new();
+    let mut group_nodes: Vec<GroupNode> = Vec::new();
     // glTF's nodes form trees: a node met twice (its own ancestor, or two parents) is refused.
     let mut seen = vec![false; document.nodes().len()];
-    for root in scene.nodes() {
-        let root_matrix = Mat4::from_cols_array_2d(&root.transform().matrix());
+    // Group nodes to walk, with their parent's world matrix and the group node above them: the
+    // scene's roots, then each listed node met on the way.
+    let mut queue: std::collections::VecDeque<_> =
+        scene.nodes().map(|root| (root, Mat4::IDENTITY, None)).collect();
+    while let Some((top, parent_world, parent_group)) = queue.pop_front() {
+        let top_matrix = parent_world * Mat4::from_cols_array_2d(&top.transform().matrix());
         let mut meshes = Vec::new();
-        let mut stack = vec![(root.clone(), Mat4::IDENTITY)];
+        let mut stack = vec![(top.clone(), Mat4::IDENTITY)];
         while let Some((node, relative)) = stack.pop() {
             if std::mem::replace(&mut seen[node.index()], true) {
                 return Err(fail(format!("node {} is met twice: nodes must form trees", node.index())));
             }
-            let world = root_matrix * relative;
+            let world = top_matrix * relative;
             if let Some(mesh) = node.mesh() {
                 for (p, primitive) in mesh.primitives().enumerate() {
                     let at = |problem: String| {
@@ -151,33 +181,55 @@ fn read(path: &Path, wanted_camera: Option<&str>) -> Result<Parts, SceneError> {
                     None => unused.push(format!("directional light {}", light.index())),
                 }
             }
-            // Pushed last to first: the meshes come in the file's order (depth first).
+            // Pushed last to first: the meshes come in the file's order (depth first). A listed
+            // child is a group of its own, walked after this one.
             let children: Vec<_> = node.children().collect();
             for child in children.into_iter().rev() {
-                let local = Mat4::from_cols_array_2d(&child.transform().matrix());
-                stack.push((child, relative * local));
+                if listed[child.index()] {
+                    queue.push_back((child, world, Some(top.index())));
+                } else {
+                    let local = Mat4::from_cols_array_2d(&child.transform().matrix());
+                    stack.push((child, relative * local));
+                }
             }
         }
         if meshes.is_empty() {
             continue;
         }
+        let uniform = |scale: Vec3| {
+            if (scale.max_element() - scale.min_element()).abs() > 1e-4 * scale.max_element().abs() {
+                return Err(fail(format!(
+                    "node {}: scale {scale} is not uniform (a group scales uniformly)",
+                    top.index()
+                )));
+            }
+            Ok(scale.x)
+        };
         // Read from the TRS as written where it is one (no round trip through a matrix).
-        let (scale, rotation, translation) = match root.transform() {
+        let (scale, rotation, translation) = match top.transform() {
             gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
                 (Vec3::from(scale), Quat::from_array(rotation), Vec3::from(translation))
             }
-            gltf::scene::Transform::Matrix { .. } => root_matrix.to_scale_rotation_translation(),
+            gltf::scene::Transform::Matrix { matrix } => {
+                Mat4::from_cols_array_2d(&matrix).to_scale_rotation_translation()
+            }
         };
-        if (scale.max_element() - scale.min_element()).abs() > 1e-4 * scale.max_element().abs() {
-            return Err(fail(format!(
-                "node {}: scale {scale} is not uniform (a group scales uniformly)",
-                root.index()
-            )));
-        }
-        let name = root.name().map_or_else(|| format!("node {}", root.index()), str::to_string);
-        let transform = Transform { translation, rotation, scale: scale.x };
+        let local = Transform { translation, rotation, scale: uniform(scale)? };
+        let transform = if parent_world == Mat4::IDENTITY {
+            local
+        } else {
+            let (scale, rotation, translation) = top_matrix.to_scale_rotation_translation();
+            Transform { translation, rotation, scale: uniform(scale)? }
+        };
+        let name = top.name().map_or_else(|| format!("node {}", top.index()), str::to_string);
         groups.push(Group { name, meshes, transform, motion: None });
-        root_of_group.push(root.index());
+        group_nodes.push(GroupNode { node: top.index(), parent_world, local, parent_group });
+    }
+    if let Some(name) = group_names
+        .iter()
+        .find(|name| document.nodes().any(|n| n.name() == Some(name.as_str()) && !seen[n.index()]))
+    {
+        return Err(fail(format!("gltf_groups: node \"{name}\" is not in its scene")));
     }
     if groups.is_empty() {
         return Err(fail("its scene has no meshes".into()));
@@ -188,7 +240,17 @@ fn read(path: &Path, wanted_camera: Option<&str>) -> Result<Parts, SceneError> {
             "it has no camera named \"{wanted}\" (its cameras and their nodes: {names})"
         )));
     }
-    motions(&document, &buffers, &root_of_group, &mut groups, &mut unused).map_err(fail)?;
+    motions(&document, &buffers, &group_nodes, &mut groups, &mut unused).map_err(fail)?;
+    // A group inside a moving group would be left behind: Kage's groups move on their own.
+    for (group, node) in groups.iter().zip(&group_nodes) {
+        let above = node.parent_group.and_then(|p| group_nodes.iter().position(|g| g.node == p));
+        if let Some(moving) = above.map(|a| &groups[a]).filter(|g| g.motion.is_some()) {
+            return Err(fail(format!(
+                "gltf_groups: group \"{}\" sits inside group \"{}\", which moves: Kage moves each group on its own",
+                group.name, moving.name
+            )));
+        }
+    }
     if !unused.is_empty() {
         unused.sort();
         unused.dedup();
@@ -388,7 +450,7 @@ pub fn overview(groups: &[Group]) -> Camera {
 fn motions(
     document: &gltf::Document,
     buffers: &[gltf::buffer::Data],
-    root_of_group: &[usize],
+    group_nodes: &[GroupNode],
     groups: &mut [Group],
     unused: &mut Vec<String>,
 ) -> Result<(), String> {
@@ -414,9 +476,10 @@ fn motions(
                 unused.push("morph target weight channels".into());
                 continue;
             }
-            let Some(g) = root_of_group.iter().position(|&r| r == node.index()) else {
+            let Some(g) = group_nodes.iter().position(|g| g.node == node.index()) else {
                 return Err(at(format!(
-                    "it moves node {} inside a group: Kage moves whole groups (root nodes)",
+                    "it moves node {}, which is no group: Kage moves whole groups (root nodes with \
+                     meshes, or nodes a scene file's gltf_groups names)",
                     node.index()
                 )));
             };
@@ -449,8 +512,9 @@ fn motions(
             }
         }
     }
-    for ((group, (translations, rotations, scales)), loop_seconds) in groups.iter_mut().zip(tracks).zip(loops)
-    {
+    let channels = groups.iter_mut().zip(group_nodes).zip(tracks).zip(loops);
+    for (((group, group_node), (translations, rotations, scales)), loop_seconds) in channels {
+        let local = group_node.local;
         let track_times = [
             translations.as_ref().map(|t| &t.0),
             rotations.as_ref().map(|t| &t.0),
@@ -464,19 +528,23 @@ fn motions(
         times.dedup();
         let mut keys: Vec<Key> = times
             .iter()
-            .map(|&time| Key {
-                time,
-                translation: translations
-                    .as_ref()
-                    .map_or(group.transform.translation, |(t, v)| sample(t, v, time, Vec3::lerp)),
-                rotation: rotations
-                    .as_ref()
-                    .map_or(group.transform.rotation, |(t, v)| sample(t, v, time, Quat::slerp)),
-                scale: scales
-                    .as_ref()
-                    .map_or(group.transform.scale, |(t, v)| sample(t, v, time, |a, b, s| a + (b - a) * s)),
+            .map(|&time| {
+                let key = Key {
+                    time,
+                    translation: translations
+                        .as_ref()
+                        .map_or(local.translation, |(t, v)| sample(t, v, time, Vec3::lerp)),
+                    rotation: rotations
+                        .as_ref()
+                        .map_or(local.rotation, |(t, v)| sample(t, v, time, Quat::slerp)),
+                    scale: scales
+                        .as_ref()
+                        .map_or(local.scale, |(t, v)| sample(t, v, time, |a, b, s| a + (b - a) * s)),
+                };
+                in_world(key, group_node.parent_world)
             })
-            .collect();
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("group \"{}\": {e}", group.name))?;
         // A looping motion's last key at its loop length, where it repeats the first key at 0
         // (as Kage writes it, for players that loop over the animation's length), is the first.
         let (first, last) = (keys[0], keys[keys.len() - 1]);
@@ -494,6 +562,20 @@ fn motions(
         group.motion = Some(motion);
     }
     Ok(())
+}
+
+/// A key of a node's TRS in its parent as the group's pose in the world: the same for a root; a
+/// listed node's placed by its parent's world matrix (still uniformly scaled).
+fn in_world(key: Key, parent_world: Mat4) -> Result<Key, String> {
+    if parent_world == Mat4::IDENTITY {
+        return Ok(key);
+    }
+    let local = Mat4::from_scale_rotation_translation(Vec3::splat(key.scale), key.rotation, key.translation);
+    let (scale, rotation, translation) = (parent_world * local).to_scale_rotation_translation();
+    if (scale.max_element() - scale.min_element()).abs() > 1e-4 * scale.max_element().abs() {
+        return Err(format!("at {} s its node's scale in the world, {scale}, is not uniform", key.time));
+    }
+    Ok(Key { time: key.time, translation, rotation, scale: scale.x })
 }
 
 /// Sub-steps per key interval of a cubic-spline channel, sampled into linear keys: the spline's
