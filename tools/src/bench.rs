@@ -1,11 +1,11 @@
 //! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU; `kage bench
 //! probes` (in bench_probes.rs): how fast probe sets are tetrahedralized and looked up; `kage bench
 //! asm` (in bench_asm/): shadow-map techniques measured over a camera walkthrough.
+use crate::progress::Bar;
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Subcommand};
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use kage::layouts::CastRay;
 use kage::raycast::{offset_ray_origin, GpuBvh, GpuRays, Query, RayCaster, SceneBvh};
 use kage::scene::Scene;
@@ -89,12 +89,8 @@ fn rays(args: &RaysArgs) -> Result<()> {
     ];
     let queries = [("closest hit", Query::ClosestHit), ("any hit", Query::Occluded)];
 
-    let bar = ProgressBar::new((sets.len() * queries.len()) as u64 * (args.runs as u64 + 1)).with_style(
-        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} casts, {elapsed} elapsed, {eta} left")
-            .expect("static template"),
-    );
-    bar.set_draw_target(ProgressDrawTarget::hidden());
-    bar.set_message("casting");
+    let bar = Bar::new((sets.len() * queries.len()) as u64 * (args.runs as u64 + 1), "casts");
+    bar.message("casting");
     let count = (side * side) as f64;
     let mut rates = Vec::new();
     for (query_name, query) in queries {
@@ -106,10 +102,7 @@ fn rays(args: &RaysArgs) -> Result<()> {
                 if run > 0 {
                     ms.push(gpu_ms);
                 }
-                bar.inc(1);
-                if start.elapsed().as_secs_f32() > 1.0 && bar.is_hidden() {
-                    bar.set_draw_target(ProgressDrawTarget::stderr());
-                }
+                bar.advance(1);
             }
             ms.sort_by(f64::total_cmp);
             let median = ms[ms.len() / 2];
@@ -117,7 +110,7 @@ fn rays(args: &RaysArgs) -> Result<()> {
         }
         rates.push((query_name, row));
     }
-    bar.finish_and_clear();
+    drop(bar);
 
     println!("{} rays per cast ({side}x{side} camera image; as many random surface rays), median of {} runs, GPU time, {}", side * side, args.runs, ctx.info().name);
     println!(

@@ -1,10 +1,10 @@
 //! `kage reference`: the ray-traced ground truth, rendered progressively in batches with a
 //! progress bar and a running estimate of the noise left; or, with `--irradiance`, E(p, n) at
 //! listed points.
+use crate::progress::Bar;
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use kage::files;
 use kage::reference::{
     IrradianceFile, IrradianceReference, LightMode, PointsFile, ReferenceOptions, ReferenceRenderer,
@@ -234,14 +234,8 @@ fn progressive(
     time_budget: Option<f64>,
     item: &str,
 ) -> Result<Statistics> {
-    let bar = ProgressBar::new(u64::from(spp)).with_style(
-        ProgressStyle::with_template(&format!(
-            "{{msg}} [{{bar:30}}] {{pos}}/{{len}} samples per {item}, {{elapsed}} elapsed, {{eta}} left"
-        ))
-        .expect("static template"),
-    );
-    bar.set_draw_target(ProgressDrawTarget::hidden());
-    bar.set_message("sampling");
+    let bar = Bar::new(u64::from(spp), &format!("samples per {item}"));
+    bar.message("sampling");
     let start = Instant::now();
     let budget = time_budget.map(Duration::from_secs_f64);
     let mut batch = 1u32;
@@ -264,18 +258,15 @@ fn progressive(
         let seconds = batch_start.elapsed().as_secs_f64().max(1e-6);
         let next = (BATCH_TARGET.as_secs_f64() / seconds * f64::from(size)) as u32;
         batch = next.clamp(1, size.saturating_mul(4));
-        bar.set_position(u64::from(reference.samples()));
+        bar.at(u64::from(reference.samples()), u64::from(spp));
         if reference.samples() >= 2 && last_noise.elapsed() >= NOISE_INTERVAL {
             if let Some(noise) = reference.statistics()?.relative_standard_error() {
-                bar.set_message(format!("relative standard error {noise:.2e}"));
+                bar.message(format!("relative standard error {noise:.2e}"));
             }
             last_noise = Instant::now();
         }
-        if start.elapsed().as_secs_f32() >= 1.0 {
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-        }
     }
-    bar.finish_and_clear();
+    drop(bar);
     if reference.samples() < spp {
         eprintln!(
             "kage: note: the time budget ran out after {} of {spp} samples per {item}",

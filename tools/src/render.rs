@@ -1,9 +1,9 @@
 //! `kage render`: renders frames offscreen, writes the last one, and reports pass timings.
+use crate::progress::Bar;
 use crate::transfer_source::{Origin, PrtArgs};
 use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use kage::pass::TimingTable;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
@@ -250,11 +250,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
-    let bar = ProgressBar::new(u64::from(args.warmup) + u64::from(args.frames)).with_style(
-        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
-            .expect("static template"),
-    );
-    bar.set_message("rendering");
+    let bar = Bar::new(u64::from(args.warmup) + u64::from(args.frames), "frames");
+    bar.message("rendering");
     let start = Instant::now();
     let mut table = TimingTable::default();
     let mut trace = crate::trace::Trace::default();
@@ -275,12 +272,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let passes = renderer.render()?;
         let frame_end = start.elapsed();
         let after = calibrate()?;
-        bar.inc(1);
-        if start.elapsed().as_secs_f32() < 1.0 {
-            bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-        } else {
-            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-        }
+        bar.advance(1);
         let Some(frame) = frame else { continue };
         if let (Some(before), Some(after)) = (before, after) {
             let origin = *trace_origin_ns.get_or_insert(before.host_ns as f64);
@@ -306,7 +298,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         table.add_frame(&passes);
         dropped = dropped.max(renderer.stats().dropped_layers);
     }
-    bar.finish_and_clear();
+    drop(bar);
     if let Some(stats) = renderer.stats().asm {
         println!(
             "asm: {} tiles resident, {:.2} of {:.2} MB, deepest level {}, {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",

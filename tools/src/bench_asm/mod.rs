@@ -12,10 +12,10 @@ mod frames;
 mod references;
 pub mod report;
 
+use crate::progress::Bar;
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use kage::frame::MAX_SIZE;
 use kage::imageio::RgbaF32Image;
 use kage::reference::{shadow_flips, shadow_mismatch, SHADOW_THRESHOLD};
@@ -26,7 +26,6 @@ use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::TechniqueDesc;
 use report::{FrameRow, Series};
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// What the benchmark compares unless told: the conventional maps and ASM budgets.
 pub const DEFAULT_CONFIGS: [&str; 6] =
@@ -294,23 +293,18 @@ fn walk(
     references: &mut references::References,
     args: &AsmBenchArgs,
 ) -> Result<(Vec<Series>, Vec<FrameRow>)> {
-    let bar = ProgressBar::new(plan.len() as u64).with_style(
-        ProgressStyle::with_template("{msg:24} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, {eta} left")
-            .expect("static template"),
-    );
-    bar.set_draw_target(ProgressDrawTarget::hidden());
-    let start = Instant::now();
+    let bar = Bar::new(plan.len() as u64, "frames");
     let n = renderers.len();
     let mut series: Vec<Series> = (0..n).map(|_| Series::default()).collect();
     let mut rows = Vec::new();
     // The last frame's reference and renders, for the flips.
     let mut previous: Option<(RgbaF32Image, Vec<RgbaF32Image>)> = None;
     for (i, frame) in plan.iter().enumerate() {
-        bar.set_message(format!("frame {i}: reference"));
+        bar.message(format!("frame {i}: reference"));
         let truth = references.get(&frame.camera)?;
         let motion = (i > 0).then(|| frames::motion_px(&plan[i - 1].camera, &frame.camera, args.size));
         let slow = motion.is_some_and(|m| m > 0.0 && m <= args.slow_px);
-        bar.set_message(format!("frame {i}: rendering"));
+        bar.message(format!("frame {i}: rendering"));
         let mut timings = vec![Vec::new(); n];
         for k in 0..n {
             let c = (i + k) % n;
@@ -344,12 +338,9 @@ fn walk(
             rows.push(row);
         }
         previous = Some((truth, images));
-        bar.inc(1);
-        if start.elapsed().as_secs_f32() > 1.0 && bar.is_hidden() {
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-        }
+        bar.advance(1);
     }
-    bar.finish_and_clear();
+    drop(bar);
     Ok((series, rows))
 }
 

@@ -8,11 +8,11 @@ mod converged;
 pub(crate) mod pick;
 mod probes;
 
+use crate::progress::Bar;
 use crate::transfer_source::PrtArgs;
 use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use kage::backend::Context;
 use kage::pass::TimingTable;
 use kage::prt::{PrtParams, TransferSet};
@@ -317,10 +317,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
 
     let timed = if args.frames > 0 { 1 } else { 0 };
     let steps = envs.len() * (args.poses.len() + settings.len() * (args.poses.len() + timed));
-    let bar = ProgressBar::new(steps as u64).with_style(
-        ProgressStyle::with_template("{msg:40} [{bar:30}] {pos}/{len}, {elapsed} elapsed, {eta} left")
-            .expect("static template"),
-    );
+    let bar = Bar::new(steps as u64, "steps");
     let mut rows = Vec::new();
     for (env_name, map) in &envs {
         let mut lit = scene.clone();
@@ -329,9 +326,9 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             .poses
             .iter()
             .map(|&t| {
-                bar.set_message(format!("{env_name}: reference at t = {t}"));
+                bar.message(format!("{env_name}: reference at t = {t}"));
                 let mut progress = |spp: u32, noise: f64| {
-                    bar.set_message(format!(
+                    bar.message(format!(
                         "{env_name}: reference at t = {t}, {spp} spp, noise {:.2} %",
                         100.0 * noise
                     ))
@@ -345,7 +342,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
                     &reference_dir,
                     &mut progress,
                 );
-                bar.inc(1);
+                bar.advance(1);
                 if let Ok(r) = &reference {
                     let noise = 100.0 * r.noise;
                     bar.suspend(|| {
@@ -356,7 +353,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             })
             .collect::<Result<_>>()?;
         for &setting in &settings {
-            bar.set_message(format!("{env_name}: {}", setting.name()));
+            bar.message(format!("{env_name}: {}", setting.name()));
             let transfer = transfer_of(setting);
             let before = ctx.allocated_bytes();
             let mut renderer = Renderer::new(
@@ -376,7 +373,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
                 renderer.set_time(t)?;
                 renderer.render()?;
                 errors.push(compare(&renderer.image()?, &reference.image)?.relative_rmse);
-                bar.inc(1);
+                bar.advance(1);
             }
             drop(renderer);
             let frame_ms = if args.frames > 0 {
@@ -387,7 +384,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
                     transfer: transfer.clone(),
                 };
                 let ms = frame_time(&ctx, &lit, &options, args.frames)?;
-                bar.inc(1);
+                bar.advance(1);
                 Some(ms)
             } else {
                 None
@@ -405,7 +402,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             rows.push(row);
         }
     }
-    bar.finish_and_clear();
+    drop(bar);
 
     let path = args.out.join("sweep.csv");
     std::fs::write(&path, csv(&scene.name, &args.poses, &rows))
