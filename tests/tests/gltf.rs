@@ -76,7 +76,12 @@ fn error_of(name: &str, edit: impl Fn(&mut Value)) -> String {
 #[test]
 fn hostile_gltf_is_refused_naming_the_file_and_the_element() {
     type Edit<'a> = &'a dyn Fn(&mut Value);
-    let cases: [(&str, Edit, &str); 10] = [
+    let cases: [(&str, Edit, &str); 11] = [
+        (
+            "missing-buffer",
+            &|g| g["buffers"][0]["uri"] = "missing.bin".into(),
+            "buffer 0's file \"missing.bin\" cannot be read",
+        ),
         ("cycle", &|g| g["nodes"][0]["children"] = serde_json::json!([0]), "node 0 is met twice"),
         (
             "lines",

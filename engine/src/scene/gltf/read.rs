@@ -98,8 +98,12 @@ struct GroupNode {
 
 fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Result<Parts, SceneError> {
     let fail = |problem: String| SceneError::in_file(path, problem);
-    let (document, buffers, images) =
-        gltf::import(path).map_err(|e| fail(format!("not a glTF 2.0 file Kage can read: {e}")))?;
+    let (document, buffers, images) = gltf::import(path).map_err(|e| {
+        fail(match missing_file(path) {
+            Some(what) => format!("{what} cannot be read: {e}"),
+            None => format!("not a glTF 2.0 file Kage can read: {e}"),
+        })
+    })?;
     let mut unused: Vec<String> = document
         .extensions_used()
         .filter(|e| *e != "KHR_lights_punctual")
@@ -257,6 +261,24 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
         eprintln!("kage: note: {}: not used by Kage: {}", path.display(), unused.join(", "));
     }
     Ok(Parts { groups, lights, camera })
+}
+
+/// The first buffer or image of the file at `path` whose own file (a relative path beside it)
+/// is not there, named: what a failed import that reads no further is most likely about.
+fn missing_file(path: &Path) -> Option<String> {
+    let document = gltf::Gltf::open(path).ok()?.document;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let absent = |uri: &str| !uri.starts_with("data:") && !folder.join(uri).is_file();
+    let buffers = document.buffers().filter_map(|b| match b.source() {
+        gltf::buffer::Source::Uri(uri) => Some((format!("buffer {}", b.index()), uri)),
+        gltf::buffer::Source::Bin => None,
+    });
+    let images = document.images().filter_map(|i| match i.source() {
+        gltf::image::Source::Uri { uri, .. } => Some((format!("image {}", i.index()), uri)),
+        gltf::image::Source::View { .. } => None,
+    });
+    let (what, uri) = buffers.chain(images).find(|(_, uri)| absent(uri))?;
+    Some(format!("{what}'s file \"{uri}\""))
 }
 
 /// One triangle primitive as a mesh, its vertices placed by `relative` (within its group).
