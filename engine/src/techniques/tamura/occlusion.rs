@@ -279,7 +279,7 @@ impl Occlusion {
                     name: "occlusion.temp",
                     size: u64::from(layer_count)
                         * u64::from(resolution * resolution)
-                        * size_of::<[f32; 4]>() as u64,
+                        * size_of::<[u16; 4]>() as u64, // four half floats per texel
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::GpuOnly,
                 },
