@@ -86,7 +86,7 @@ pub fn write_glb(scene: &Scene) -> Vec<u8> {
     let (mut nodes, mut meshes, mut materials, mut animations) = (vec![], vec![], vec![], vec![]);
     let mut roots = Vec::new();
     for group in &scene.groups {
-        let mesh_nodes: Vec<usize> = group
+        let mesh_indices: Vec<usize> = group
             .meshes
             .iter()
             .map(|mesh| {
@@ -109,14 +109,15 @@ pub fn write_glb(scene: &Scene) -> Vec<u8> {
             "rotation": t.rotation.to_array(),
             "scale": vec![t.scale; 3],
         });
-        // One mesh sits on the group's node; several on children of it without a transform.
-        if let [mesh] = mesh_nodes[..] {
+        // One mesh sits on the group's node; several on children of it without a transform (a
+        // group without meshes, which scenes made in code may hold, is a bare node).
+        if let [mesh] = mesh_indices[..] {
             root["mesh"] = mesh.into();
-        } else {
+        } else if !mesh_indices.is_empty() {
             let children: Vec<usize> = group
                 .meshes
                 .iter()
-                .zip(&mesh_nodes)
+                .zip(&mesh_indices)
                 .map(|(mesh, &index)| {
                     nodes.push(json!({"name": mesh.name, "mesh": index}));
                     nodes.len() - 1
