@@ -43,12 +43,6 @@ pub fn export(scene: &Scene, dir: &Path, format: SceneFormat) -> Result<(), Scen
     std::fs::create_dir_all(dir)
         .map_err(|e| SceneError::in_file(dir, format!("cannot create folder: {e}")))?;
     scene.environment.write_exr(&output(dir, ENVIRONMENT_FILE)?)?;
-    let camera = |c: &Camera| CameraDesc {
-        position: c.position.to_array(),
-        target: c.target.to_array(),
-        up: c.up.to_array(),
-        fov_y_deg: c.fov_y_deg,
-    };
     let mut file = SceneFile {
         name: Some(scene.name.clone()),
         gltf: None,
@@ -127,6 +121,15 @@ fn groups(scene: &Scene, dir: &Path) -> Result<Vec<GroupDesc>, SceneError> {
         });
     }
     Ok(groups)
+}
+
+pub(super) fn camera(c: &Camera) -> CameraDesc {
+    CameraDesc {
+        position: c.position.to_array(),
+        target: c.target.to_array(),
+        up: c.up.to_array(),
+        fov_y_deg: c.fov_y_deg,
+    }
 }
 
 pub(super) fn light(light: &Light) -> LightDesc {

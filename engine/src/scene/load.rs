@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
 
-use super::file::{EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, SceneFile};
+use super::file::{CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, SceneFile};
 use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, SceneProbe, Transform};
 use crate::files;
 
@@ -20,16 +20,39 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     build(file, name, folder).map_err(|e| e.attributed_to(path))
 }
 
+/// A glTF file read alone: as a scene file that names it, lit by a constant sky of radiance 1
+/// (a note says so).
+pub fn gltf_alone(path: &Path) -> Result<Scene, SceneError> {
+    eprintln!(
+        "kage: note: {} has no environment: lit by a constant sky of radiance 1 (give one with --env or a scene file)",
+        path.display()
+    );
+    let file = SceneFile {
+        name: None,
+        gltf: Some(path.file_name().unwrap_or_default().to_string_lossy().into_owned()),
+        gltf_camera: None,
+        gltf_groups: Vec::new(),
+        camera: None,
+        environment: EnvironmentDesc { image: None, constant: Some([1.0; 3]), intensity: 1.0 },
+        groups: Vec::new(),
+        lights: Vec::new(),
+        walkthrough: Vec::new(),
+        probes: Vec::new(),
+        exposure: 1.0,
+    };
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    build(file, name, folder).map_err(|e| e.attributed_to(path))
+}
+
 /// Assembles a scene from its description; `folder` anchors the relative paths in it.
 fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
-    let camera_of =
-        |c: &super::file::CameraDesc| Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg);
-    let camera = file.camera.as_ref().map(camera_of).transpose()?;
+    let own_camera = file.camera.as_ref().map(camera).transpose()?;
     let walkthrough = file
         .walkthrough
         .iter()
         .enumerate()
-        .map(|(at, c)| camera_of(c).map_err(|e| e.within(&format!("walkthrough camera {at}"))))
+        .map(|(at, c)| camera(c).map_err(|e| e.within(&format!("walkthrough camera {at}"))))
         .collect::<Result<Vec<_>, _>>()?;
     super::animation::check_walkthrough(&walkthrough)?;
     let environment = environment(&file.environment, folder)?;
@@ -51,9 +74,12 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         (None, false) if file.groups.is_empty() => return Err(SceneError::invalid("it has no groups")),
         (None, false) => (Vec::new(), Vec::new(), None),
     };
-    let camera = match (camera, gltf_camera) {
+    let camera = match (own_camera, gltf_camera) {
         (Some(camera), _) | (None, Some(camera)) => camera,
-        (None, None) if file.gltf.is_some() => super::gltf::overview(&groups),
+        (None, None) if file.gltf.is_some() => {
+            eprintln!("kage: note: the glTF file has no camera: viewing the whole scene from the front");
+            super::gltf::overview(&groups)
+        }
         (None, None) => return Err(SceneError::invalid("it has no \"camera\"")),
     };
     let listed: Vec<Group> = file
@@ -171,6 +197,10 @@ fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
         mesh.name = name;
     }
     Ok(mesh)
+}
+
+pub(super) fn camera(desc: &CameraDesc) -> Result<Camera, SceneError> {
+    Camera::from_arrays(desc.position, desc.target, desc.up, desc.fov_y_deg)
 }
 
 pub(super) fn light(desc: LightDesc) -> Result<Light, SceneError> {

@@ -115,7 +115,7 @@ impl Scene {
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         match extension.as_deref() {
-            Some("gltf" | "glb") => gltf::load(path),
+            Some("gltf" | "glb") => load::gltf_alone(path),
             _ => load::load(path),
         }
     }

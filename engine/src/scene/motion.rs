@@ -19,6 +19,11 @@ pub struct Key {
 }
 
 impl Key {
+    /// The key at `time` holding `pose`.
+    pub fn posed(time: f32, pose: Transform) -> Key {
+        Key { time, translation: pose.translation, rotation: pose.rotation, scale: pose.scale }
+    }
+
     fn transform(&self) -> Transform {
         Transform { translation: self.translation, rotation: self.rotation, scale: self.scale }
     }

@@ -1,4 +1,4 @@
-//! glTF 2.0 scenes: read ([`load`], [`parts`]) and written ([`write_glb`]) through the `gltf` crate.
+//! glTF 2.0 scenes: read ([`parts`]) and written ([`write_glb`]) through the `gltf` crate.
 //!
 //! Kage's scene and glTF's map onto each other as follows (both ways):
 //! - a group is a root node: its TRS the group's transform, its meshes on it (one) or on
@@ -18,7 +18,7 @@
 mod read;
 mod write;
 
-pub use read::{load, overview, parts, Parts};
+pub use read::{overview, parts, Parts};
 pub use write::write_glb;
 
 use super::file::{CameraDesc, LightDesc};

@@ -25,7 +25,7 @@
 //! the base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
 //! sky of radiance 1 (a note says so; `--env` or a scene file gives another).
 use super::super::motion::{Key, Motion};
-use super::super::{Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, Transform};
+use super::super::{Camera, Group, Light, Mesh, SceneError, Transform};
 use super::Extras;
 use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
@@ -37,34 +37,6 @@ pub struct Parts {
     pub groups: Vec<Group>,
     pub lights: Vec<Light>,
     pub camera: Option<Camera>,
-}
-
-/// Reads the glTF file at `path` as a whole scene; every error names the file, and the element
-/// at fault.
-pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let Parts { groups, lights, camera } = parts(path, None, &[])?;
-    let file = path.display();
-    let camera = match camera {
-        Some(camera) => camera,
-        None => {
-            eprintln!("kage: note: {file} has no camera: viewing the whole scene from the front");
-            overview(&groups)
-        }
-    };
-    eprintln!("kage: note: {file} has no environment: lit by a constant sky of radiance 1 (give one with --env or a scene file)");
-    let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let scene = Scene {
-        name,
-        groups,
-        environment: EnvMap::constant([1.0; 3]),
-        lights,
-        camera,
-        walkthrough: Vec::new(),
-        probes: Vec::new(),
-        exposure: 1.0,
-    };
-    scene.validate().map_err(|e| e.attributed_to(path))?;
-    Ok(scene)
 }
 
 /// Reads the groups, lights and camera of the glTF file at `path`: the camera named `camera`
@@ -201,13 +173,9 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
             continue;
         }
         let uniform = |scale: Vec3| {
-            if (scale.max_element() - scale.min_element()).abs() > 1e-4 * scale.max_element().abs() {
-                return Err(fail(format!(
-                    "node {}: scale {scale} is not uniform (a group scales uniformly)",
-                    top.index()
-                )));
-            }
-            Ok(scale.x)
+            uniform_scale(scale).ok_or_else(|| {
+                fail(format!("node {}: scale {scale} is not uniform (a group scales uniformly)", top.index()))
+            })
         };
         // Read from the TRS as written where it is one (no round trip through a matrix).
         let (scale, rotation, translation) = match top.transform() {
@@ -390,9 +358,7 @@ fn camera_of(camera: &gltf::Camera, node: &gltf::Node, world: Mat4) -> Result<Ca
         perspective.yfov().to_degrees(),
     )
     .map_err(|e| e.to_string())?;
-    let exact = Extras::of(node.extras())
-        .camera
-        .and_then(|c| Camera::from_arrays(c.position, c.target, c.up, c.fov_y_deg).ok());
+    let exact = Extras::of(node.extras()).camera.and_then(|c| super::super::load::camera(&c).ok());
     Ok(exact.filter(|exact| agrees(&camera_frame(exact), &camera_frame(&read))).unwrap_or(read))
 }
 
@@ -523,12 +489,11 @@ fn motions(
                 ReadOutputs::Scales(values) => {
                     let values: Vec<Vec3> = values.map(Vec3::from).collect();
                     let track = linear_track(&times, &values, interpolation, |v| v).map_err(at)?;
-                    let uniform =
-                        |v: &Vec3| (v.max_element() - v.min_element()).abs() <= 1e-4 * v.max_element().abs();
-                    if let Some(v) = track.1.iter().find(|v| !uniform(v)) {
-                        return Err(at(format!("scale {v} is not uniform (a group scales uniformly)")));
-                    }
-                    tracks[g].2 = Some((track.0, track.1.iter().map(|v| v.x).collect()));
+                    let scales = track.1.iter().map(|v| {
+                        uniform_scale(*v)
+                            .ok_or_else(|| at(format!("scale {v} is not uniform (a group scales uniformly)")))
+                    });
+                    tracks[g].2 = Some((track.0, scales.collect::<Result<_, _>>()?));
                 }
                 ReadOutputs::MorphTargetWeights(_) => unreachable!("weights are skipped above"),
             }
@@ -594,10 +559,16 @@ fn in_world(key: Key, parent_world: Mat4) -> Result<Key, String> {
     }
     let local = Mat4::from_scale_rotation_translation(Vec3::splat(key.scale), key.rotation, key.translation);
     let (scale, rotation, translation) = (parent_world * local).to_scale_rotation_translation();
-    if (scale.max_element() - scale.min_element()).abs() > 1e-4 * scale.max_element().abs() {
-        return Err(format!("at {} s its node's scale in the world, {scale}, is not uniform", key.time));
-    }
-    Ok(Key { time: key.time, translation, rotation, scale: scale.x })
+    let scale = uniform_scale(scale)
+        .ok_or_else(|| format!("at {} s its node's scale in the world, {scale}, is not uniform", key.time))?;
+    Ok(Key { time: key.time, translation, rotation, scale })
+}
+
+/// A scale's one factor where it is uniform (the same along every axis to 1e-4 of it): Kage's
+/// groups scale uniformly.
+fn uniform_scale(scale: Vec3) -> Option<f32> {
+    let spread = (scale.max_element() - scale.min_element()).abs();
+    (spread <= 1e-4 * scale.max_element().abs()).then_some(scale.x)
 }
 
 /// Sub-steps per key interval of a cubic-spline channel, sampled into linear keys: the spline's

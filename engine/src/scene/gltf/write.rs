@@ -1,7 +1,6 @@
 //! Writing a scene's groups, lights, camera and motion as binary glTF (.glb), in the mapping
 //! the module documents; [`super::parts`] reads them back identical.
 use super::super::camera::{FAR, NEAR};
-use super::super::file::CameraDesc;
 use super::super::motion::{Key, Motion};
 use super::super::{Camera, Group, Light, Mesh, Scene};
 use super::{Extras, KageExtras};
@@ -195,10 +194,10 @@ fn animation_json(b: &mut Builder, group: &Group, motion: &Motion, node: usize) 
     let mut keys: Vec<Key> = motion.keys.clone();
     if let Some(period) = motion.loop_seconds {
         if keys[0].time > 0.0 {
-            keys.insert(0, key_at(motion, 0.0));
+            keys.insert(0, Key::posed(0.0, motion.at(0.0)));
         }
         if keys[keys.len() - 1].time < period {
-            keys.push(key_at(motion, period));
+            keys.push(Key::posed(period, motion.at(period)));
         }
     }
     let times: Vec<f32> = keys.iter().map(|k| k.time).collect();
@@ -222,23 +221,12 @@ fn animation_json(b: &mut Builder, group: &Group, motion: &Motion, node: usize) 
     animation
 }
 
-/// The motion's pose at `time` as a key.
-fn key_at(motion: &Motion, time: f32) -> Key {
-    let pose = motion.at(time);
-    Key { time, translation: pose.translation, rotation: pose.rotation, scale: pose.scale }
-}
-
 /// The camera's node: its position and orientation (glTF cameras look down their node's −Z
 /// with +Y up), and Kage's look-at in the extras.
 fn camera_node(camera: &Camera) -> Value {
     let view = Mat3::from_mat4(camera.view());
     let rotation = Quat::from_mat3(&view.transpose()).normalize();
-    let desc = CameraDesc {
-        position: camera.position.to_array(),
-        target: camera.target.to_array(),
-        up: camera.up.to_array(),
-        fov_y_deg: camera.fov_y_deg,
-    };
+    let desc = super::super::export::camera(camera);
     json!({
         "name": "camera",
         "camera": 0,
