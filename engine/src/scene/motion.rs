@@ -24,7 +24,8 @@ impl Key {
         Key { time, translation: pose.translation, rotation: pose.rotation, scale: pose.scale }
     }
 
-    fn transform(&self) -> Transform {
+    /// The pose it holds.
+    pub fn transform(&self) -> Transform {
         Transform { translation: self.translation, rotation: self.rotation, scale: self.scale }
     }
 }

@@ -1,11 +1,14 @@
 //! Reading glTF 2.0 (`--scene FILE.gltf` or `FILE.glb`).
 //!
 //! What is read:
-//! - the default scene (else the first); each root node with meshes in its subtree becomes one
-//!   rigid group: its transform (TRS or matrix, uniform scale) the group's, its descendants'
-//!   transforms baked into their meshes' vertices (meshes without one read as stored); a node
-//!   the caller names (a scene file's `gltf_groups`) is a group of its own with its subtree,
-//!   placed in the world by its parents;
+//! - the default scene (else the first). Its groups follow from what moves: each root node with
+//!   meshes in its subtree is one rigid group (its transform, TRS or matrix with uniform scale,
+//!   the group's; its descendants' transforms baked into their meshes' vertices, meshes without
+//!   one read as stored), and so is every node an animation moves, wherever it sits, and every
+//!   node a scene file's `gltf_groups` names: such a node is a group of its own with its subtree,
+//!   placed in the world by its parents at every instant (a moving node inside a moving one
+//!   composes both motions). Nodes without a name are named `node<index>` (`node3`), which
+//!   `gltf_groups` takes too;
 //! - triangle primitives: positions, normals (computed where absent), indices (0, 1, 2, … where
 //!   absent); the material's baseColorFactor as albedo, times the mean of its baseColorTexture
 //!   (sRGB decoded) where it has one, with a note: Kage shades each mesh with one diffuse colour;
@@ -13,13 +16,15 @@
 //!   with a note);
 //! - KHR_lights_punctual point and spot lights (colour × intensity, read as Kage's radiant
 //!   intensity; a spot's full cone is twice its outer cone angle);
-//! - animations' translation, rotation and (uniform) scale channels on group nodes: the groups'
-//!   keyframes (linear; step and cubic-spline sampled into linear keys, see `linear_track`),
-//!   played once unless Kage's extras give a loop.
+//! - animations' translation, rotation and scale channels: each group's keyframes, its node's
+//!   channels composed with its ancestors' (linear; step and cubic-spline sampled into linear
+//!   keys, see `linear_track`; where an ancestor moves, 8 keys per interval, see [`motions`]),
+//!   played once unless Kage's extras give a loop. The animation of a node that moves no mesh (a
+//!   camera, a light, an empty node) is listed as unused.
 //!
-//! What is refused, by name: skins and morph targets (a rigid group cannot follow them), other
-//! primitive modes, animation channels on nodes inside a group, a group inside a moving one,
-//! orthographic cameras, non-uniform scale on a group node or in its scale channel, data out of
+//! What is refused, by name: skins and morph targets (a rigid group cannot follow them: an error
+//! naming the skin or primitive, not the rest pose), other primitive modes, orthographic
+//! cameras, a group whose scale in the world is not uniform (at rest or at a key), data out of
 //! its buffer.
 //! What is not used (directional lights, morph weight channels, extensions, textures other than
 //! the base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
@@ -59,13 +64,29 @@ pub fn parts(path: &Path, camera: Option<&str>, groups: &[String]) -> Result<Par
     })
 }
 
-/// A node that is a group: its index, its parent's world matrix (identity for a root), its TRS
-/// in its parent, and the group node above it (none for a root).
+/// A node that is a group: its index and its ancestors, root first (none for a root).
 struct GroupNode {
     node: usize,
-    parent_world: Mat4,
-    local: Transform,
-    parent_group: Option<usize>,
+    ancestors: Vec<usize>,
+}
+
+/// Whether any of the file's animations moves each node (a translation, rotation or scale
+/// channel on it), read from the JSON so that a bad target is left for [`motions`] to name.
+fn animated_nodes(document: &gltf::Document) -> Vec<bool> {
+    use gltf::json::validation::Checked;
+    let mut animated = vec![false; document.nodes().len()];
+    for channel in document.as_json().animations.iter().flat_map(|a| &a.channels) {
+        let moves = matches!(channel.target.path, Checked::Valid(p) if p != gltf::json::animation::Property::MorphTargetWeights);
+        if let Some(node) = animated.get_mut(channel.target.node.value()).filter(|_| moves) {
+            *node = true;
+        }
+    }
+    animated
+}
+
+/// A node's name, or `node<index>` for a node without one (the name `gltf_groups` takes too).
+fn node_name(node: &gltf::Node) -> String {
+    node.name().map_or_else(|| format!("node{}", node.index()), str::to_string)
 }
 
 fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Result<Parts, SceneError> {
@@ -93,10 +114,11 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
         .or_else(|| document.scenes().next())
         .ok_or_else(|| fail("it holds no scene".into()))?;
 
-    // The nodes that are groups besides the scene's roots: those the caller names.
-    let mut listed = vec![false; document.nodes().len()];
+    // The nodes that are groups besides the scene's roots: those that move, and those the
+    // caller names.
+    let mut listed = animated_nodes(&document);
     for name in group_names {
-        let mut named = document.nodes().filter(|n| n.name() == Some(name.as_str()));
+        let mut named = document.nodes().filter(|n| node_name(n) == *name);
         match (named.next(), named.next()) {
             (Some(node), None) => listed[node.index()] = true,
             (None, _) => return Err(fail(format!("gltf_groups: it has no node named \"{name}\""))),
@@ -113,11 +135,12 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
     let mut group_nodes: Vec<GroupNode> = Vec::new();
     // glTF's nodes form trees: a node met twice (its own ancestor, or two parents) is refused.
     let mut seen = vec![false; document.nodes().len()];
-    // Group nodes to walk, with their parent's world matrix and the group node above them: the
-    // scene's roots, then each listed node met on the way.
-    let mut queue: std::collections::VecDeque<_> =
-        scene.nodes().map(|root| (root, Mat4::IDENTITY, None)).collect();
-    while let Some((top, parent_world, parent_group)) = queue.pop_front() {
+    // Each node's parent on the walk: a group node's ancestors follow it up.
+    let mut parent = vec![None; document.nodes().len()];
+    // Group nodes to walk, with their parent's world matrix at rest: the scene's roots, then
+    // each listed node met on the way.
+    let mut queue: std::collections::VecDeque<_> = scene.nodes().map(|root| (root, Mat4::IDENTITY)).collect();
+    while let Some((top, parent_world)) = queue.pop_front() {
         let top_matrix = parent_world * Mat4::from_cols_array_2d(&top.transform().matrix());
         let mut meshes = Vec::new();
         let mut stack = vec![(top.clone(), Mat4::IDENTITY)];
@@ -161,8 +184,9 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
             // child is a group of its own, walked after this one.
             let children: Vec<_> = node.children().collect();
             for child in children.into_iter().rev() {
+                parent[child.index()] = Some(node.index());
                 if listed[child.index()] {
-                    queue.push_back((child, world, Some(top.index())));
+                    queue.push_back((child, world));
                 } else {
                     let local = Mat4::from_cols_array_2d(&child.transform().matrix());
                     stack.push((child, relative * local));
@@ -178,28 +202,19 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
             })
         };
         // Read from the TRS as written where it is one (no round trip through a matrix).
-        let (scale, rotation, translation) = match top.transform() {
-            gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
-                (Vec3::from(scale), Quat::from_array(rotation), Vec3::from(translation))
-            }
-            gltf::scene::Transform::Matrix { matrix } => {
-                Mat4::from_cols_array_2d(&matrix).to_scale_rotation_translation()
-            }
-        };
-        let local = Transform { translation, rotation, scale: uniform(scale)? };
+        let (scale, rotation, translation) = rest_pose(&top);
         let transform = if parent_world == Mat4::IDENTITY {
-            local
+            Transform { translation, rotation, scale: uniform(scale)? }
         } else {
             let (scale, rotation, translation) = top_matrix.to_scale_rotation_translation();
             Transform { translation, rotation, scale: uniform(scale)? }
         };
-        let name = top.name().map_or_else(|| format!("node {}", top.index()), str::to_string);
-        groups.push(Group { name, meshes, transform, motion: None });
-        group_nodes.push(GroupNode { node: top.index(), parent_world, local, parent_group });
+        groups.push(Group { name: node_name(&top), meshes, transform, motion: None });
+        let ancestors = std::iter::successors(parent[top.index()], |&a| parent[a]).collect::<Vec<_>>();
+        group_nodes.push(GroupNode { node: top.index(), ancestors: ancestors.into_iter().rev().collect() });
     }
-    if let Some(name) = group_names
-        .iter()
-        .find(|name| document.nodes().any(|n| n.name() == Some(name.as_str()) && !seen[n.index()]))
+    if let Some(name) =
+        group_names.iter().find(|name| document.nodes().any(|n| node_name(&n) == **name && !seen[n.index()]))
     {
         return Err(fail(format!("gltf_groups: node \"{name}\" is not in its scene")));
     }
@@ -213,16 +228,6 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
         )));
     }
     motions(&document, &buffers, &group_nodes, &mut groups, &mut unused).map_err(fail)?;
-    // A group inside a moving group would be left behind: Kage's groups move on their own.
-    for (group, node) in groups.iter().zip(&group_nodes) {
-        let above = node.parent_group.and_then(|p| group_nodes.iter().position(|g| g.node == p));
-        if let Some(moving) = above.map(|a| &groups[a]).filter(|g| g.motion.is_some()) {
-            return Err(fail(format!(
-                "gltf_groups: group \"{}\" sits inside group \"{}\", which moves: Kage moves each group on its own",
-                group.name, moving.name
-            )));
-        }
-    }
     if !unused.is_empty() {
         unused.sort();
         unused.dedup();
@@ -413,15 +418,23 @@ fn light_of(
         .unwrap_or(read)))
 }
 
-/// A camera that sees every group: from the front (+Z), above their box's centre.
+/// A camera that sees every group wherever its motion takes it (its box at rest and at each of
+/// its keys): from the front (+Z), above their box's centre.
 pub fn overview(groups: &[Group]) -> Camera {
     let (lo, hi) = groups
         .iter()
         .flat_map(|g| {
-            let m = g.transform.matrix();
-            g.meshes
-                .iter()
-                .flat_map(move |mesh| mesh.positions.iter().map(move |p| m.transform_point3(Vec3::from(*p))))
+            let points = g.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
+            let (lo, hi) =
+                points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
+            let corners = (0..8)
+                .map(move |c| Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo));
+            let keys = g.motion.iter().flat_map(|m| m.keys.iter().map(|k| k.transform()));
+            let poses: Vec<Mat4> = std::iter::once(g.transform).chain(keys).map(|t| t.matrix()).collect();
+            let corners: Vec<Vec3> = if lo.cmple(hi).all() { corners.collect() } else { Vec::new() };
+            poses
+                .into_iter()
+                .flat_map(move |m| corners.clone().into_iter().map(move |c| m.transform_point3(c)))
         })
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
     let centre = 0.5 * (lo + hi);
@@ -434,7 +447,45 @@ pub fn overview(groups: &[Group]) -> Camera {
     }
 }
 
-/// The animations' channels on the groups' root nodes as the groups' keyframes.
+/// A channel's keys: their times and values.
+type Track<T> = Option<(Vec<f32>, Vec<T>)>;
+
+/// What the animations do to one node: its translation, rotation and scale channels (each
+/// sampled into linear keys) and the loop Kage's extras give their animation.
+#[derive(Clone, Default)]
+struct NodeTracks {
+    translation: Track<Vec3>,
+    rotation: Track<Quat>,
+    scale: Track<Vec3>,
+    loop_seconds: Option<f32>,
+}
+
+impl NodeTracks {
+    fn moves(&self) -> bool {
+        self.translation.is_some() || self.rotation.is_some() || self.scale.is_some()
+    }
+
+    fn times(&self) -> impl Iterator<Item = f32> + '_ {
+        let times = [self.translation.as_ref().map(|t| &t.0), self.rotation.as_ref().map(|t| &t.0)];
+        times.into_iter().chain([self.scale.as_ref().map(|t| &t.0)]).flatten().flatten().copied()
+    }
+
+    /// The node's scale, rotation and translation in its parent at `time`: its channels'
+    /// values, its rest pose `rest` where it has none.
+    fn at(&self, time: f32, rest: (Vec3, Quat, Vec3)) -> (Vec3, Quat, Vec3) {
+        (
+            self.scale.as_ref().map_or(rest.0, |(t, v)| sample(t, v, time, Vec3::lerp)),
+            self.rotation.as_ref().map_or(rest.1, |(t, v)| sample(t, v, time, Quat::slerp)),
+            self.translation.as_ref().map_or(rest.2, |(t, v)| sample(t, v, time, Vec3::lerp)),
+        )
+    }
+}
+
+/// The animations' channels as the groups' keyframes. A group's pose at every instant is its
+/// node's animated TRS placed by its ancestors' at that instant (hierarchical animation
+/// composed): keys at every key time of the node and of its ancestors, with `SPLINE_STEPS`
+/// keys per interval where an ancestor moves (a parent's turn carries its child along an arc,
+/// which linear keys follow only in steps).
 fn motions(
     document: &gltf::Document,
     buffers: &[gltf::buffer::Data],
@@ -442,10 +493,7 @@ fn motions(
     groups: &mut [Group],
     unused: &mut Vec<String>,
 ) -> Result<(), String> {
-    // Per group: the times and values of its translation, rotation and scale channels.
-    type Track<T> = Option<(Vec<f32>, Vec<T>)>;
-    let mut tracks: Vec<(Track<Vec3>, Track<Quat>, Track<f32>)> = vec![(None, None, None); groups.len()];
-    let mut loops: Vec<Option<f32>> = vec![None; groups.len()];
+    let mut tracks = vec![NodeTracks::default(); document.nodes().len()];
     for animation in document.animations() {
         let loop_seconds = Extras::of(animation.extras()).loop_seconds;
         for (c, channel) in animation.channels().enumerate() {
@@ -458,20 +506,12 @@ fn motions(
             if raw.node.value() >= document.nodes().len() {
                 return Err(at(format!("its target node {} does not exist", raw.node.value())));
             }
-            let node = channel.target().node();
-            let property = channel.target().property();
-            if property == Property::MorphTargetWeights {
+            if channel.target().property() == Property::MorphTargetWeights {
                 unused.push("morph target weight channels".into());
                 continue;
             }
-            let Some(g) = group_nodes.iter().position(|g| g.node == node.index()) else {
-                return Err(at(format!(
-                    "it moves node {}, which is no group: Kage moves whole groups (root nodes with \
-                     meshes, or nodes a scene file's gltf_groups names)",
-                    node.index()
-                )));
-            };
-            loops[g] = loops[g].or(loop_seconds);
+            let node = &mut tracks[channel.target().node().index()];
+            node.loop_seconds = node.loop_seconds.or(loop_seconds);
             let interpolation = channel.sampler().interpolation();
             let reader = channel.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let times: Vec<f32> =
@@ -479,59 +519,68 @@ fn motions(
             match reader.read_outputs().ok_or_else(|| at("values beyond their buffer".into()))? {
                 ReadOutputs::Translations(values) => {
                     let values: Vec<Vec3> = values.map(Vec3::from).collect();
-                    tracks[g].0 = Some(linear_track(&times, &values, interpolation, |v| v).map_err(at)?);
+                    node.translation = Some(linear_track(&times, &values, interpolation, |v| v).map_err(at)?);
                 }
                 ReadOutputs::Rotations(values) => {
                     let values: Vec<Vec4> = values.into_f32().map(Vec4::from_array).collect();
                     let track = linear_track(&times, &values, interpolation, Vec4::normalize).map_err(at)?;
-                    tracks[g].1 = Some((track.0, track.1.into_iter().map(Quat::from_vec4).collect()));
+                    node.rotation = Some((track.0, track.1.into_iter().map(Quat::from_vec4).collect()));
                 }
                 ReadOutputs::Scales(values) => {
                     let values: Vec<Vec3> = values.map(Vec3::from).collect();
-                    let track = linear_track(&times, &values, interpolation, |v| v).map_err(at)?;
-                    let scales = track.1.iter().map(|v| {
-                        uniform_scale(*v)
-                            .ok_or_else(|| at(format!("scale {v} is not uniform (a group scales uniformly)")))
-                    });
-                    tracks[g].2 = Some((track.0, scales.collect::<Result<_, _>>()?));
+                    node.scale = Some(linear_track(&times, &values, interpolation, |v| v).map_err(at)?);
                 }
                 ReadOutputs::MorphTargetWeights(_) => unreachable!("weights are skipped above"),
             }
         }
     }
-    let channels = groups.iter_mut().zip(group_nodes).zip(tracks).zip(loops);
-    for (((group, group_node), (translations, rotations, scales)), loop_seconds) in channels {
-        let local = group_node.local;
-        let track_times = [
-            translations.as_ref().map(|t| &t.0),
-            rotations.as_ref().map(|t| &t.0),
-            scales.as_ref().map(|t| &t.0),
-        ];
-        if track_times.iter().all(Option::is_none) {
+    // Moving nodes that move no group (a camera, a light, an empty node): their motion is lost.
+    let mut used = vec![false; tracks.len()];
+    for group_node in group_nodes {
+        used[group_node.node] = true;
+        group_node.ancestors.iter().for_each(|&a| used[a] = true);
+    }
+    for (n, _) in tracks.iter().enumerate().filter(|(n, t)| t.moves() && !used[*n]) {
+        unused.push(format!("the animation of node {n}, which moves no mesh"));
+    }
+    let rest: Vec<(Vec3, Quat, Vec3)> = document.nodes().map(|node| rest_pose(&node)).collect();
+    let matrices: Vec<Mat4> =
+        document.nodes().map(|n| Mat4::from_cols_array_2d(&n.transform().matrix())).collect();
+    for (group, group_node) in groups.iter_mut().zip(group_nodes) {
+        let chain = || group_node.ancestors.iter().chain([&group_node.node]).map(|&n| (n, &tracks[n]));
+        if !chain().any(|(_, t)| t.moves()) {
             continue;
         }
-        let mut times: Vec<f32> = track_times.into_iter().flatten().flat_map(|t| t.iter().copied()).collect();
+        let mut times: Vec<f32> = chain().flat_map(|(_, t)| t.times()).collect();
         times.sort_by(f32::total_cmp);
         times.dedup();
-        let mut keys: Vec<Key> = times
+        if group_node.ancestors.iter().any(|&a| tracks[a].moves()) {
+            let steps = times.windows(2).flat_map(|w| {
+                (1..SPLINE_STEPS).map(move |j| w[0] + (w[1] - w[0]) * j as f32 / SPLINE_STEPS as f32)
+            });
+            times = times.iter().copied().chain(steps.collect::<Vec<_>>()).collect();
+            times.sort_by(f32::total_cmp);
+        }
+        let keys = times
             .iter()
             .map(|&time| {
-                let key = Key {
-                    time,
-                    translation: translations
-                        .as_ref()
-                        .map_or(local.translation, |(t, v)| sample(t, v, time, Vec3::lerp)),
-                    rotation: rotations
-                        .as_ref()
-                        .map_or(local.rotation, |(t, v)| sample(t, v, time, Quat::slerp)),
-                    scale: scales
-                        .as_ref()
-                        .map_or(local.scale, |(t, v)| sample(t, v, time, |a, b, s| a + (b - a) * s)),
-                };
-                in_world(key, group_node.parent_world)
+                // Static ancestors by their matrices as written, moving ones at this instant.
+                let parent_world = group_node.ancestors.iter().fold(Mat4::IDENTITY, |world, &a| {
+                    let local = if tracks[a].moves() {
+                        let (scale, rotation, translation) = tracks[a].at(time, rest[a]);
+                        Mat4::from_scale_rotation_translation(scale, rotation, translation)
+                    } else {
+                        matrices[a]
+                    };
+                    world * local
+                });
+                let (scale, rotation, translation) = tracks[group_node.node].at(time, rest[group_node.node]);
+                in_world(time, scale, rotation, translation, parent_world)
             })
-            .collect::<Result<_, _>>()
+            .collect::<Result<Vec<_>, _>>()
             .map_err(|e| format!("group \"{}\": {e}", group.name))?;
+        let loop_seconds = chain().rev().find_map(|(_, t)| t.loop_seconds);
+        let mut keys = keys;
         // A looping motion's last key at its loop length, where it repeats the first key at 0
         // (as Kage writes it, for players that loop over the animation's length), is the first.
         let (first, last) = (keys[0], keys[keys.len() - 1]);
@@ -551,17 +600,37 @@ fn motions(
     Ok(())
 }
 
-/// A key of a node's TRS in its parent as the group's pose in the world: the same for a root; a
-/// listed node's placed by its parent's world matrix (still uniformly scaled).
-fn in_world(key: Key, parent_world: Mat4) -> Result<Key, String> {
-    if parent_world == Mat4::IDENTITY {
-        return Ok(key);
+/// A node's scale, rotation and translation at rest: its TRS as written, or its matrix's.
+fn rest_pose(node: &gltf::Node) -> (Vec3, Quat, Vec3) {
+    match node.transform() {
+        gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+            (Vec3::from(scale), Quat::from_array(rotation), Vec3::from(translation))
+        }
+        gltf::scene::Transform::Matrix { matrix } => {
+            Mat4::from_cols_array_2d(&matrix).to_scale_rotation_translation()
+        }
     }
-    let local = Mat4::from_scale_rotation_translation(Vec3::splat(key.scale), key.rotation, key.translation);
-    let (scale, rotation, translation) = (parent_world * local).to_scale_rotation_translation();
-    let scale = uniform_scale(scale)
-        .ok_or_else(|| format!("at {} s its node's scale in the world, {scale}, is not uniform", key.time))?;
-    Ok(Key { time: key.time, translation, rotation, scale })
+}
+
+/// A node's TRS in its parent at `time` as the group's key in the world: the TRS itself for a
+/// root (read as written), else placed by its parent's world matrix; uniformly scaled either way.
+fn in_world(
+    time: f32,
+    scale: Vec3,
+    rotation: Quat,
+    translation: Vec3,
+    parent_world: Mat4,
+) -> Result<Key, String> {
+    let (scale, rotation, translation) = if parent_world == Mat4::IDENTITY {
+        (scale, rotation, translation)
+    } else {
+        (parent_world * Mat4::from_scale_rotation_translation(scale, rotation, translation))
+            .to_scale_rotation_translation()
+    };
+    let scale = uniform_scale(scale).ok_or_else(|| {
+        format!("at {time} s its scale in the world, {scale}, is not uniform (a group scales uniformly)")
+    })?;
+    Ok(Key { time, translation, rotation, scale })
 }
 
 /// A scale's one factor where it is uniform (the same along every axis to 1e-4 of it): Kage's
