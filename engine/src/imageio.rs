@@ -181,6 +181,27 @@ pub fn tonemap_srgb8(rgb: [f32; 3], exposure: f32) -> [u8; 3] {
     })
 }
 
+/// The mid-grey a picture's log-average luminance is exposed to by [`auto_exposure`]
+/// (Reinhard et al. 2002's "key" of a normal scene).
+pub const AUTO_EXPOSURE_KEY: f32 = 0.18;
+
+/// An exposure that makes any picture readable, whatever its units (a light of 54,351 cd and a
+/// sky of radiance 1 alike): [`AUTO_EXPOSURE_KEY`] over the image's log-average luminance
+/// exp(mean ln(10⁻⁴ + L)), L the Rec. 709 luminance of each finite pixel (the 10⁻⁴ keeps
+/// black pixels from sending the mean to −∞). A black image gets 1.
+pub fn auto_exposure(image: &RgbaF32Image) -> f32 {
+    const DELTA: f64 = 1e-4;
+    let luminances = image.pixels.iter().map(|&[r, g, b, _]| 0.2126 * r + 0.7152 * g + 0.0722 * b);
+    let (sum, count) = luminances
+        .filter(|l| l.is_finite() && *l >= 0.0)
+        .fold((0.0f64, 0usize), |(sum, n), l| (sum + (DELTA + f64::from(l)).ln(), n + 1));
+    let average = if count == 0 { DELTA } else { (sum / count as f64).exp() };
+    if average <= 2.0 * DELTA {
+        return 1.0;
+    }
+    (f64::from(AUTO_EXPOSURE_KEY) / average) as f32
+}
+
 /// Narkowicz's rational fit of the ACES RRT + ODT, clamped to [0, 1]. It is monotonic on
 /// [0, ∞) and overshoots 1 (towards 2.51/2.43), hence the output clamp. It reaches 1 at
 /// x ≈ 7.24, so capping the input at 100 changes no result but keeps x² from overflowing to
@@ -212,6 +233,23 @@ pub fn srgb_eotf(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A uniform picture of luminance L is exposed to the key: 0.18 / (L + 10⁻⁴); one 1000×
+    /// brighter takes a 1000× smaller exposure (units do not matter); black keeps 1, and NaN or
+    /// negative pixels are left out of the average.
+    #[test]
+    fn auto_exposure_brings_the_log_average_to_the_key() {
+        let uniform = |value: f32, extra: Vec<[f32; 4]>| {
+            let mut pixels = vec![[value; 4]; 64];
+            pixels.extend(extra);
+            RgbaF32Image { width: pixels.len() as u32, height: 1, pixels }
+        };
+        let dim = auto_exposure(&uniform(0.5, Vec::new()));
+        assert!((dim - AUTO_EXPOSURE_KEY / 0.5001).abs() < 1e-5, "{dim}");
+        let bright = auto_exposure(&uniform(500.0, vec![[f32::NAN; 4], [-1.0; 4]]));
+        assert!((dim / bright / 1000.0 - 1.0).abs() < 1e-3, "{dim} {bright}");
+        assert_eq!(auto_exposure(&uniform(0.0, Vec::new())), 1.0);
+    }
 
     fn scratch(name: &str) -> PathBuf {
         crate::files::scratch_path("imageio", name)

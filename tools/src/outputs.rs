@@ -7,19 +7,45 @@ use std::path::Path;
 /// How bright a PNG output is: the radiance is multiplied by it before tonemapping.
 #[derive(Args)]
 pub struct Exposure {
-    /// Exposure multiplier applied before tonemapping (PNG only; default: the scene's
-    /// `exposure`, 1 for most scenes, 4 for probe-room)
+    /// Exposure multiplier applied before tonemapping (PNG only), or `auto`: 0.18 over the
+    /// picture's log-average luminance, readable whatever the light's units (default: the
+    /// scene's `exposure`, 1 for most scenes, 4 for probe-room)
     #[arg(long)]
-    exposure: Option<f32>,
+    exposure: Option<String>,
+}
+
+/// What `--exposure` asked for.
+#[derive(Clone, Copy, Debug)]
+pub enum ExposureRule {
+    Fixed(f32),
+    Auto,
 }
 
 impl Exposure {
-    /// The multiplier given, once checked to be a positive number, else `scene`'s.
-    pub fn checked(&self, scene: &kage::scene::Scene) -> Result<f32> {
-        match self.exposure {
-            Some(e) if !(e.is_finite() && e > 0.0) => bail!("--exposure must be a positive number, got {e}"),
-            Some(e) => Ok(e),
-            None => Ok(scene.exposure),
+    /// The rule given, once checked (`auto` or a positive number), else `scene`'s exposure.
+    pub fn checked(&self, scene: &kage::scene::Scene) -> Result<ExposureRule> {
+        match self.exposure.as_deref() {
+            None => Ok(ExposureRule::Fixed(scene.exposure)),
+            Some("auto") => Ok(ExposureRule::Auto),
+            Some(text) => match text.parse::<f32>() {
+                Ok(e) if e.is_finite() && e > 0.0 => Ok(ExposureRule::Fixed(e)),
+                _ => bail!("--exposure must be a positive number or auto, got {text}"),
+            },
+        }
+    }
+}
+
+impl ExposureRule {
+    /// The multiplier for `image`: the fixed one, or [`kage::imageio::auto_exposure`]'s (said
+    /// in a note, so that the next run can fix it).
+    pub fn for_image(self, image: &kage::imageio::RgbaF32Image) -> f32 {
+        match self {
+            ExposureRule::Fixed(e) => e,
+            ExposureRule::Auto => {
+                let exposure = kage::imageio::auto_exposure(image);
+                eprintln!("kage: note: --exposure auto: {exposure:.4}");
+                exposure
+            }
         }
     }
 }

@@ -135,7 +135,7 @@ fn run_image(
     args: &ReferenceArgs,
     ctx: &std::sync::Arc<kage::backend::Context>,
     scene: &Scene,
-    exposure: f32,
+    exposure: crate::outputs::ExposureRule,
 ) -> Result<()> {
     let light = match args.light {
         LightArg::Env => LightMode::Environment,
@@ -163,7 +163,7 @@ fn run_image(
         progressive(&mut renderer, args.spp, args.time_budget, "pixel")?
     };
     let image = renderer.to_image(&statistics);
-    kage::imageio::write(&args.out, &image, exposure)?;
+    kage::imageio::write(&args.out, &image, exposure.for_image(&image))?;
     println!(
         "wrote {} ({}x{}, scene {}, {} light, {} spp, {:.1} s, {})",
         args.out.display(),

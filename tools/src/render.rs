@@ -318,7 +318,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let image = renderer.image()?;
-    kage::imageio::write(&args.out, &image, exposure)?;
+    kage::imageio::write(&args.out, &image, exposure.for_image(&image))?;
     println!("wrote {} ({}x{}, scene {})", args.out.display(), args.width, args.height, scene.name);
 
     let rows = table.rows();

@@ -1166,3 +1166,42 @@ fn scene_export_as_gltf_renders_and_plays_its_motion() {
     assert!(start != render(&glb, &["--time", "0.125"], "hop").0, "the teapot hopped");
     render(&glb, &["--animate", "--frames", "3"], "animated");
 }
+
+/// `--exposure auto` gives a readable picture whatever the light's scale: the teapot under its
+/// sky and under the same sky 1000× brighter (as a file in candela would be) come out with
+/// their mean sRGB value within a few levels of each other, where the fixed default leaves the
+/// bright one white.
+#[test]
+fn auto_exposure_reads_any_scale_of_light() {
+    let dir = scratch_dir("cli-exposure");
+    let mean_level = |png: &std::path::Path| {
+        let image = image::open(png).unwrap().to_rgb8();
+        image.as_raw().iter().map(|&b| f64::from(b)).sum::<f64>() / image.as_raw().len() as f64
+    };
+    let render = |scale: &str, exposure: &[&str]| {
+        let scene = dir.join(format!("sky-{scale}.json"));
+        std::fs::write(
+            &scene,
+            format!(
+                r#"{{"camera": {{"position": [0, 1, 3], "target": [0, 0.3, 0], "fov_y_deg": 45}},
+                    "environment": {{"constant": [1, 1, 1], "intensity": {scale}}},
+                    "groups": [{{"name": "ball", "meshes": [{{"sphere": {{"radius": 0.5, "segments": 16}}, "albedo": [0.5, 0.5, 0.5]}}]}}]}}"#
+            ),
+        )
+        .unwrap();
+        let png = dir.join(format!("sky-{scale}-{}.png", exposure.len()));
+        let args =
+            [&["render", "--scene", scene.to_str().unwrap(), "--technique", "unshadowed"][..], exposure]
+                .concat();
+        let args = [&args[..], &["--width", "16", "--height", "16", "--out", png.to_str().unwrap()]].concat();
+        let out = kage(&args);
+        assert!(out.status.success(), "{}", text(&out));
+        (mean_level(&png), text(&out))
+    };
+    let (dim, note) = render("1", &["--exposure", "auto"]);
+    assert!(note.contains("--exposure auto: "), "{note}");
+    let (bright, _) = render("1000", &["--exposure", "auto"]);
+    let (white, _) = render("1000", &[]);
+    assert!((dim - bright).abs() < 3.0 && dim > 60.0 && dim < 200.0, "{dim} {bright}");
+    assert!(white > 250.0, "{white}");
+}
