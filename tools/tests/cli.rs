@@ -1166,3 +1166,45 @@ fn scene_export_as_gltf_renders_and_plays_its_motion() {
     assert!(start != render(&glb, &["--time", "0.125"], "hop").0, "the teapot hopped");
     render(&glb, &["--animate", "--frames", "3"], "animated");
 }
+
+/// A scene file around the Khronos Box with a floor added, under `name`, seen from `camera`
+/// (JSON), with `extra` fields; no environment.
+fn box_on_floor(dir: &std::path::Path, file: &str, name: &str, camera: &str, extra: &str) -> String {
+    let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
+    let json = format!(
+        r#"{{"name": {}, "gltf": {}, "camera": {camera}, "groups": [{{"name": "floor", "translation": [0, -0.5, 0], "meshes": [{{"plane": {{"size": [3, 3], "vertices": [5, 5]}}, "albedo": [0.6, 0.6, 0.6]}}]}}]{extra}}}"#,
+        serde_json::to_string(name).unwrap(),
+        serde_json::to_string(gltf).unwrap()
+    );
+    let path = dir.join(file);
+    std::fs::write(&path, json).unwrap();
+    path.to_str().unwrap().to_owned()
+}
+
+/// The note that a scene has no environment (a glTF file alone, a scene file without one) is
+/// printed when the default sky lights it, and not when `--env` replaces it.
+#[test]
+fn the_default_sky_note_is_printed_only_when_the_default_stays() {
+    let dir = scratch_dir("cli-default-sky");
+    let camera = r#"{"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
+    let composed = box_on_floor(&dir, "composed.json", "composed", camera, "");
+    let given = box_on_floor(
+        &dir,
+        "given.json",
+        "given",
+        camera,
+        r#", "environment": {"constant": [0.5, 0.5, 0.5]}"#,
+    );
+    let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
+    let map = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/sun/sun2-45-sky.exr");
+    let render = |scene: &str, extra: &[&str]| {
+        let out = dir.join("out.exr");
+        let args = ["render", "--scene", scene, "--technique", "unshadowed", "--width", "8", "--height", "8"];
+        let run = kage(&[&args[..], &["--out", out.to_str().unwrap()], extra].concat());
+        assert!(run.status.success(), "{}", text(&run));
+        text(&run).contains("has no environment: lit by a constant sky of radiance 1")
+    };
+    assert!(render(gltf, &[]) && render(&composed, &[]), "the note where the default sky lights the scene");
+    assert!(!render(gltf, &["--env", map]) && !render(&composed, &["--env", map]), "no note under --env");
+    assert!(!render(&given, &[]), "no note where the file gives an environment");
+}
