@@ -1181,6 +1181,42 @@ fn box_on_floor(dir: &std::path::Path, file: &str, name: &str, camera: &str, ext
     path.to_str().unwrap().to_owned()
 }
 
+/// The PRT cache is keyed by the geometry, not the scene: two scene files around the same
+/// geometry, with other names (one of 300 characters, longer than a file name may be) and
+/// cameras, make one cache file, which the second precomputation and a render of either read.
+#[test]
+fn scene_files_around_the_same_geometry_share_one_cache_file() {
+    let dir = scratch_dir("cli-prt-shared");
+    let cache = dir.join("cache");
+    let cache_arg = cache.to_str().unwrap();
+    let near = r#"{"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
+    let far = r#"{"position": [2, 3, 5], "target": [0, 0, 0], "fov_y_deg": 30}"#;
+    let first = box_on_floor(&dir, "first.json", "box on a floor", near, "");
+    let long_name = "a scene with a long name ".repeat(12);
+    assert_eq!(long_name.len(), 300);
+    let second = box_on_floor(&dir, "second.json", &long_name, far, "");
+    let precompute = |scene: &str| {
+        let run = kage(&["precompute", "--scene", scene, "--rays", "16", "--cache", cache_arg, "--validate"]);
+        assert!(run.status.success(), "{}", text(&run));
+        text(&run)
+    };
+    let made = precompute(&first);
+    assert!(made.contains("cache: wrote"), "{made}");
+    let hit = precompute(&second);
+    assert!(hit.contains("is valid, nothing to compute"), "{hit}");
+    let files: Vec<String> =
+        std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into()).collect();
+    assert!(files.len() == 1 && files[0].starts_with("prt-") && files[0].ends_with(".kageprt"), "{files:?}");
+    let out = dir.join("second.png");
+    let args =
+        ["render", "--scene", &second, "--technique", "sloan-self", "--rays", "16", "--cache", cache_arg];
+    let render =
+        kage(&[&args[..], &["--width", "16", "--height", "16", "--out", out.to_str().unwrap()]].concat());
+    assert!(render.status.success(), "{}", text(&render));
+    assert!(text(&render).contains("transfer: from"), "the shared file is read: {}", text(&render));
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 1);
+}
+
 /// The note that a scene has no environment (a glTF file alone, a scene file without one) is
 /// printed when the default sky lights it, and not when `--env` replaces it.
 #[test]
