@@ -3,11 +3,14 @@
 //! file and the element, a file written by another tool, scene files that take their geometry
 //! from glTF, and Kage's own glTF export rendering the same pixels as the scene it came from.
 use glam::{Quat, Vec3};
+use kage::prt::{transfer, PrtParams};
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{Light, Scene, SceneFormat, SCENE_FILE};
+use kage::techniques::description::TechniqueDesc;
 use kage_tests::{every_technique, scratch_dir, Validated};
 use serde_json::Value;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 fn asset() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/two-groups.gltf")
@@ -69,7 +72,9 @@ fn error_of(name: &str, edit: impl Fn(&mut Value)) -> String {
     let path = scratch_dir("gltf").join(format!("{name}.gltf"));
     std::fs::write(&path, gltf.to_string()).unwrap();
     let message = Scene::load(&path).unwrap_err().to_string();
-    assert!(message.contains(&format!("{name}.gltf")), "{message}: names no file");
+    // Once: the file read alone is both the scene and the glTF file at fault.
+    let named = message.matches(path.to_str().unwrap()).count();
+    assert_eq!(named, 1, "{message}: names the file {named} times, not once");
     message
 }
 
@@ -196,7 +201,7 @@ fn step_sampling_holds_each_value_until_the_next_key() {
 
 /// A scene file that takes its groups, lights and camera from a glTF file and adds what glTF has
 /// no place for; its own camera replaces the glTF one, `gltf_camera` picks one by name, its
-/// lights are added; mixing in groups, or naming a camera the file lacks, is an error.
+/// lights are added; naming a camera the file lacks is an error.
 #[test]
 fn a_scene_file_takes_its_geometry_from_gltf() {
     let dir = scratch_dir("gltf-scene-file");
@@ -227,18 +232,11 @@ fn a_scene_file_takes_its_geometry_from_gltf() {
 
     let named = Scene::load(&write("named.json", r#", "gltf_camera": "camera""#)).unwrap();
     assert_eq!(named.camera, from_gltf.camera, "the camera's node is named \"camera\"");
-    for (file, extra, expected) in [
-        (
-            "missing.json",
-            r#", "gltf_camera": "nobody""#,
-            "no camera named \"nobody\" (its cameras and their nodes: \"camera\")",
-        ),
-        (
-            "both.json",
-            r#", "groups": [{"name": "g", "meshes": [{"sphere": {"radius": 1, "segments": 8}, "albedo": [1, 1, 1]}]}]"#,
-            "both \"gltf\" and \"groups\"",
-        ),
-    ] {
+    for (file, extra, expected) in [(
+        "missing.json",
+        r#", "gltf_camera": "nobody""#,
+        "no camera named \"nobody\" (its cameras and their nodes: \"camera\")",
+    )] {
         let message = Scene::load(&write(file, extra)).unwrap_err().to_string();
         assert!(message.contains(file) && message.contains(expected), "{message}");
     }
@@ -246,6 +244,118 @@ fn a_scene_file_takes_its_geometry_from_gltf() {
     std::fs::write(&lone, r#"{"gltf_camera": "camera", "environment": {"constant": [1, 1, 1]}, "camera": {"position": [0, 0, 1], "target": [0, 0, 0], "fov_y_deg": 40}}"#).unwrap();
     let message = Scene::load(&lone).unwrap_err().to_string();
     assert!(message.contains("\"gltf_camera\" or \"gltf_groups\" without a \"gltf\" file"), "{message}");
+}
+
+/// The Khronos sample Box.
+fn khronos_box() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box/Box.gltf")
+}
+
+/// A scene file naming Box.gltf and adding `extra` (JSON fields after a comma).
+fn box_scene_file(dir: &std::path::Path, name: &str, extra: &str) -> PathBuf {
+    let path = dir.join(name);
+    let gltf = serde_json::to_string(khronos_box().to_str().unwrap()).unwrap();
+    std::fs::write(&path, format!(r#"{{"gltf": {gltf}{extra}}}"#)).unwrap();
+    path
+}
+
+const FLOOR: &str = r#""groups": [{"name": "floor", "translation": [0, -0.5, 0],
+    "meshes": [{"plane": {"size": [3, 3], "vertices": [9, 9]}, "albedo": [0.6, 0.6, 0.6]}]}]"#;
+
+/// A scene file adds a floor (a plane group) under a glTF model and gives no environment: the
+/// glTF's group first, then the floor; lit by the default sky, as the glTF file alone is. It
+/// renders under validation, unshadowed and with Sloan's PRT of the whole scene, whose shadow
+/// of the box on the floor (and of the floor on the box) only darkens: under a constant sky the
+/// unoccluded transfer is the unshadowed one.
+#[test]
+fn a_scene_file_adds_a_floor_under_a_gltf_model_and_renders() {
+    let dir = scratch_dir("gltf-floor");
+    let camera = r#""camera": {"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
+    let file = box_scene_file(&dir, "box-on-floor.json", &format!(", {camera}, {FLOOR}"));
+    let loaded = Scene::read(&file).unwrap();
+    assert!(loaded.default_environment, "no environment given");
+    let scene = loaded.scene;
+    let alone = Scene::read(&khronos_box()).unwrap();
+    assert!(alone.default_environment);
+    let names: Vec<&str> = scene.groups.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, ["node 0", "floor"], "the glTF's group, then the listed one");
+    assert_eq!(scene.groups[0], alone.scene.groups[0]);
+    assert_eq!(scene.groups[1].meshes[0].vertex_count(), 81);
+    assert_eq!(scene.groups[1].transform.translation, Vec3::new(0.0, -0.5, 0.0));
+    assert_eq!(scene.environment, alone.scene.environment);
+    assert!(scene.environment.pixels().iter().all(|p| *p == [kage::scene::DEFAULT_SKY; 3]));
+
+    let ctx = Validated::new();
+    let render = |technique: TechniqueDesc| {
+        let transfer = technique.precomputation().map(|params| {
+            Arc::new(transfer::precompute(&ctx, &scene, params, &mut kage::progress::silent).unwrap())
+        });
+        let options = RenderOptions { width: 32, height: 32, technique, transfer };
+        let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
+        renderer.render().unwrap();
+        renderer.image().unwrap().pixels
+    };
+    let unshadowed = render(TechniqueDesc::Unshadowed);
+    let prt = PrtParams { bands: 3, rays: 16, ..PrtParams::DEFAULT };
+    let shadowed = render(TechniqueDesc::SloanScene { prt });
+    let luminance = |p: &[f32; 4]| p[0] + p[1] + p[2];
+    assert!(unshadowed.iter().chain(&shadowed).all(|p| p.iter().all(|c| c.is_finite())));
+    let lit = unshadowed.iter().filter(|p| luminance(p) > 0.0).count();
+    assert!(lit > unshadowed.len() / 4, "the box and floor fill the view: {lit} lit pixels");
+    let darker = unshadowed.iter().zip(&shadowed).filter(|(u, s)| luminance(s) < 0.9 * luminance(u)).count();
+    let brighter =
+        unshadowed.iter().zip(&shadowed).filter(|(u, s)| luminance(s) > 1.05 * luminance(u)).count();
+    assert!(darker > 10 && brighter == 0, "{darker} pixels shadowed, {brighter} brighter");
+}
+
+/// A scene file that composes a glTF model with groups of its own still refuses bad values,
+/// naming the scene file and the place; a glTF error names each file once.
+#[test]
+fn a_composed_scene_file_refuses_bad_values_by_name() {
+    let dir = scratch_dir("gltf-floor-bad");
+    let camera = r#""camera": {"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
+    let cases = [
+        (
+            "scale.json",
+            format!(
+                ", {camera}, {}",
+                FLOOR.replace("\"name\": \"floor\"", "\"name\": \"floor\", \"scale\": 0")
+            ),
+            "group 0 (\"floor\"): scale must be finite and greater than zero",
+        ),
+        (
+            "env.json",
+            format!(
+                ", {camera}, {FLOOR}, \"environment\": {{\"image\": \"sky.exr\", \"constant\": [1, 1, 1]}}"
+            ),
+            "environment needs exactly one of",
+        ),
+        (
+            "negative.json",
+            format!(", {FLOOR}, \"environment\": {{\"constant\": [1, -1, 1]}}"),
+            "must be finite and >= 0",
+        ),
+        (
+            "no-meshes.json",
+            format!(", {camera}, \"groups\": [{{\"name\": \"floor\", \"meshes\": []}}]"),
+            "group 0 (\"floor\"): it has no meshes",
+        ),
+    ];
+    for (name, extra, expected) in cases {
+        let path = box_scene_file(&dir, name, &extra);
+        let message = Scene::load(&path).unwrap_err().to_string();
+        assert!(message.contains(expected), "{name}: {message}");
+        assert_eq!(message.matches(path.to_str().unwrap()).count(), 1, "{message}");
+    }
+    // A glTF file that is not there, behind a scene file: the scene file and the glTF file,
+    // each named once.
+    let missing = dir.join("missing.json");
+    std::fs::write(&missing, format!(r#"{{"gltf": "nowhere.gltf", {camera}, {FLOOR}}}"#)).unwrap();
+    let message = Scene::load(&missing).unwrap_err().to_string();
+    let gltf = dir.join("nowhere.gltf");
+    for file in [missing.to_str().unwrap(), gltf.to_str().unwrap()] {
+        assert_eq!(message.matches(file).count(), 1, "{file} in {message}");
+    }
 }
 
 /// Kage's own look-at in a camera node's extras is taken while it agrees with the node; once

@@ -231,7 +231,7 @@ fn cache_round_trips_and_detects_every_kind_of_stale_file() {
     let params = PrtParams { bands: 3, rays: 32, ..PrtParams::DEFAULT };
     let set = transfer::precompute(&ctx, &scene, params, &mut kage::progress::silent).unwrap();
     let key = CacheKey::new(&scene, params);
-    let path = dir.join(key.file_name(&scene.name));
+    let path = dir.join(key.file_name());
     assert_eq!(cache::load(&path, &key), Err(Stale::Missing));
     let bytes = cache::save(&path, &set, &key).unwrap();
     assert_eq!(std::fs::metadata(&path).unwrap().len(), bytes);

@@ -453,3 +453,30 @@ fn keyframes_in_a_scene_file_move_their_group_and_bad_ones_are_named() {
         assert!(message.contains("group 0") || message.contains("unknown field"), "{message}");
     }
 }
+
+/// `environment` is optional: a scene file without one is lit by the default sky (the same as a
+/// glTF file alone gets) and says so; one with it, a built-in scene and an export (which always
+/// writes the environment) do not, and the export reads back as the same scene.
+#[test]
+fn a_scene_file_without_environment_is_lit_by_the_default_sky() {
+    let dir = temp_dir("no-environment");
+    let sphere = r#"{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}"#;
+    let bare = write(
+        &dir,
+        "bare.json",
+        &format!(r#"{{{CAMERA}, "groups": [{{"name": "g", "meshes": [{sphere}]}}]}}"#),
+    );
+    let loaded = Scene::read(&bare).unwrap();
+    assert!(loaded.default_environment);
+    let sky = kage::scene::EnvMap::constant([kage::scene::DEFAULT_SKY; 3]);
+    assert_eq!(loaded.scene.environment, sky);
+    let given = write(&dir, "given.json", &scene_json("", sphere, ""));
+    let given = Scene::read_arg(given.to_str().unwrap()).unwrap();
+    assert!(!given.default_environment && given.scene.environment == sky, "given, if equal");
+    assert!(!Scene::read_arg("teapot").unwrap().default_environment);
+    let out = dir.join("exported");
+    loaded.scene.export(&out, kage::scene::SceneFormat::Json).unwrap();
+    let back = Scene::read(&out.join(kage::scene::SCENE_FILE)).unwrap();
+    assert!(!back.default_environment);
+    assert_eq!(back.scene, loaded.scene);
+}

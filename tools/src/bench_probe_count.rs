@@ -175,7 +175,7 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         args.points, args.normals, args.test_region.describe(), args.spp, args.cube_size, params.capture.light, ctx.info().name
     );
     for name in &args.scenes {
-        let scene = Scene::from_arg(name)?;
+        let scene = crate::read_scene(name, false)?;
         let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {name}"))?;
         println!(
             "\nscene {}: {} test points; reference noise {:.4}, capture-at-the-point floor {:.4}; reference {:.1} s; capture {:.1} ms per probe",

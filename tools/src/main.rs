@@ -76,7 +76,7 @@ pub struct SceneArgs {
 
 impl SceneArgs {
     pub fn load(&self) -> Result<kage::scene::Scene> {
-        let mut scene = kage::scene::Scene::from_arg(&self.scene)?;
+        let mut scene = read_scene(&self.scene, self.env.is_some())?;
         if let Some(k) = self.keyframe {
             let Some(camera) = scene.walkthrough.get(k) else {
                 bail!(
@@ -94,6 +94,22 @@ impl SceneArgs {
         report_clamped(&scene.environment);
         Ok(scene)
     }
+}
+
+/// The scene a `--scene` argument names ([`kage::scene::Scene::from_arg`]), with a note when its
+/// file gives no environment, so that it is lit by the default sky, unless the command lights it
+/// with maps of its own (`env_replaced`: `--env`). The loader leaves the note to its caller,
+/// which alone knows whether the default stays.
+pub fn read_scene(arg: &str, env_replaced: bool) -> Result<kage::scene::Scene> {
+    let loaded = kage::scene::Scene::read_arg(arg)?;
+    if loaded.default_environment && !env_replaced {
+        eprintln!(
+            "kage: note: {arg} has no environment: lit by a constant sky of radiance {} (give one with \
+             --env or \"environment\" in a scene file)",
+            kage::scene::DEFAULT_SKY
+        );
+    }
+    Ok(loaded.scene)
 }
 
 /// Says so when loading an environment map changed it (negative texels clamped to 0).

@@ -5,7 +5,6 @@ use clap::{Args, Subcommand};
 use glam::DVec3;
 use kage::files;
 use kage::frame::GpuScene;
-use kage::scene::Scene;
 use kage::techniques::probes::{
     positions_file, CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker,
 };
@@ -86,7 +85,7 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
 }
 
 fn place(args: &PlaceArgs) -> Result<()> {
-    let scene = Scene::from_arg(&args.scene)?;
+    let scene = crate::read_scene(&args.scene, false)?;
     let placement = crate::render::probe_placement(&args.probes, &scene)?;
     if !matches!(placement, ProbePlacement::Auto { .. }) {
         anyhow::bail!("--probes {}: expected auto, auto:TOL or auto:TOL:NX,NY,NZ", args.probes);

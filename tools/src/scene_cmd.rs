@@ -1,7 +1,7 @@
 //! `kage scene ...`: scene utilities.
 use anyhow::{Context as _, Result};
 use clap::Subcommand;
-use kage::scene::{Scene, SceneFormat};
+use kage::scene::SceneFormat;
 use std::path::PathBuf;
 
 #[derive(Subcommand)]
@@ -24,7 +24,7 @@ pub enum SceneCommand {
 pub fn run(command: &SceneCommand) -> Result<()> {
     match command {
         SceneCommand::Export { scene, out, format } => {
-            let loaded = Scene::from_arg(scene)?;
+            let loaded = crate::read_scene(scene, false)?;
             loaded.export(out, *format).with_context(|| format!("exporting scene {scene}"))?;
             println!("wrote {}", out.join(kage::scene::SCENE_FILE).display());
             if *format == SceneFormat::Gltf {

@@ -54,7 +54,7 @@ impl PrtArgs {
             )?,
         };
         let key = cache::CacheKey::new(scene, params);
-        let path = dir.join(key.file_name(&scene.name));
+        let path = dir.join(key.file_name());
         if self.force {
             eprintln!("cache: rebuilding {} (--force)", path.display());
         } else {

@@ -103,7 +103,9 @@ pub struct kage_scene_desc {
 
 /// Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb; see the README), or the name of a built-in
 /// scene ("teapot", the default scene; an unknown name's error lists the others). A path that
-/// exists or ends in ".json" is a file.
+/// exists or ends in ".json" is a file. A file that gives no environment (a glTF file alone, a
+/// scene file without "environment") is lit by a constant sky of radiance 1; nothing is printed,
+/// so a host that takes such files tells its users (or gives the scene file an environment).
 ///
 /// On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
 /// on failure it is set to NULL, and a bad or missing file is `KAGE_RESULT_FILE`, with the file

@@ -369,7 +369,7 @@ pub unsafe extern "C" fn kage_precompute_with(
         let Some(params) = desc.precomputation() else { return Ok(()) };
         let params = params.validated()?;
         let key = cache::CacheKey::new(&scene.scene, params);
-        let path = cache_dir.map(|dir| dir.join(key.file_name(&scene.scene.name)));
+        let path = cache_dir.map(|dir| dir.join(key.file_name()));
         if let Some(set) = path.as_ref().and_then(|p| cache::load(p, &key).ok()) {
             scene.transfer = Some(Arc::new(set));
             return Ok(());

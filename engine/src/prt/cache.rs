@@ -1,6 +1,7 @@
-//! The on-disk cache of a scene's [`TransferSet`]: one versioned binary file per scene and
-//! parameter set, checked field by field on load so that a stale or damaged file is reported
-//! with its reason and rebuilt, never used.
+//! The on-disk cache of a scene's [`TransferSet`]: one versioned binary file per geometry and
+//! parameter set ([`CacheKey::file_name`]: scenes that share their geometry share the file),
+//! checked field by field on load so that a stale or damaged file is reported with its reason
+//! and rebuilt, never used.
 //!
 //! # File format (little-endian)
 //! | offset | size | field |
@@ -133,22 +134,19 @@ impl CacheKey {
         HEADER_BYTES + MESH_ENTRY_BYTES * self.layout.len() + 4 * self.params.coeffs() * vertices
     }
 
-    /// `<scene name>-<16 hex digits>.kageprt`: the digits hash the geometry, the parameters and
-    /// the format version, so scenes that share a name and runs with other parameters each keep
-    /// their own file.
-    pub fn file_name(&self, scene_name: &str) -> String {
+    /// `prt-<16 hex digits>.kageprt`: the digits hash what the transfer depends on and nothing
+    /// else, [`CacheKey::geometry`] (the geometry hash, with the group transforms under the whole
+    /// scene's visibility), the parameters and the format version. Never the scene's name or
+    /// file: scene files around the same geometry (another camera, another name) share one file,
+    /// and the name's length is fixed.
+    pub fn file_name(&self) -> String {
         let mut h = Fnv64::new();
         h.write(&self.geometry.to_le_bytes());
         h.write(&self.params.bands.to_le_bytes());
         h.write(&self.params.rays.to_le_bytes());
         h.write(&visibility_code(self.params.visibility).to_le_bytes());
         h.write(&FORMAT_VERSION.to_le_bytes());
-        let name: String = scene_name
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
-            .collect();
-        let name = if name.is_empty() { "scene" } else { &name };
-        format!("{name}-{:016x}.{EXTENSION}", h.finish())
+        format!("prt-{:016x}.{EXTENSION}", h.finish())
     }
 }
 
@@ -435,15 +433,19 @@ mod tests {
     }
 
     #[test]
-    fn file_names_are_safe_and_keyed() {
-        let key = |bands| CacheKey {
-            params: PrtParams { bands, rays: 64, ..PrtParams::DEFAULT },
-            geometry: 7,
+    fn file_names_are_keyed_by_what_the_transfer_depends_on() {
+        let key = |geometry, bands, visibility| CacheKey {
+            params: PrtParams { bands, rays: 64, visibility },
+            geometry,
             layout: Vec::new(),
         };
-        let name = key(3).file_name("../my scene");
-        assert!(name.starts_with("___my_scene-") && name.ends_with(".kageprt"), "{name}");
-        assert_ne!(name, key(4).file_name("../my scene"));
-        assert!(key(3).file_name("").starts_with("scene-"));
+        let name = key(7, 3, Visibility::Group).file_name();
+        assert!(name.starts_with("prt-") && name.ends_with(".kageprt") && name.len() == 28, "{name}");
+        assert_eq!(name, key(7, 3, Visibility::Group).file_name());
+        for other in
+            [key(8, 3, Visibility::Group), key(7, 4, Visibility::Group), key(7, 3, Visibility::Scene)]
+        {
+            assert_ne!(name, other.file_name());
+        }
     }
 }

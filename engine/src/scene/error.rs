@@ -27,11 +27,12 @@ impl SceneError {
         SceneError { file: None, problem: format!("{place}: {self}") }
     }
 
-    /// Names `file` as the file at fault, keeping any file already named in the message.
+    /// Names `file` as the file at fault, keeping any other file already named in the message
+    /// (the same file is named once: a glTF file read alone is both the scene and the file).
     pub(crate) fn attributed_to(self, file: &Path) -> SceneError {
-        let problem = match self.file {
-            Some(_) => self.to_string(),
-            None => self.problem,
+        let problem = match &self.file {
+            Some(named) if named != file => self.to_string(),
+            _ => self.problem,
         };
         SceneError { file: Some(file.to_path_buf()), problem }
     }

@@ -49,7 +49,12 @@ pub fn export(scene: &Scene, dir: &Path, format: SceneFormat) -> Result<(), Scen
         gltf_camera: None,
         gltf_groups: Vec::new(),
         camera: None,
-        environment: EnvironmentDesc { image: Some(ENVIRONMENT_FILE.into()), constant: None, intensity: 1.0 },
+        // Always written, the default sky too: the folder reads back as the same scene.
+        environment: Some(EnvironmentDesc {
+            image: Some(ENVIRONMENT_FILE.into()),
+            constant: None,
+            intensity: 1.0,
+        }),
         groups: Vec::new(),
         lights: Vec::new(),
         walkthrough: scene.walkthrough.iter().map(camera).collect(),

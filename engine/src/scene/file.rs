@@ -15,7 +15,9 @@
 //! ```
 //!
 //! - `environment` is exactly one of `image` (a path to .exr or .hdr), `constant` (an RGB
-//!   radiance); `intensity` (default 1) scales it.
+//!   radiance); `intensity` (default 1) scales it. Optional: without one the scene is lit by a
+//!   constant sky of radiance [`super::DEFAULT_SKY`], as a glTF file read alone is
+//!   ([`super::Loaded::default_environment`] says so).
 //! - A group's rotation is `rotation_deg`, Euler angles in degrees with R = Rz · Ry · Rx (X
 //!   applied first), or `rotation_quat` [x, y, z, w]; `translation`, rotation and `scale`
 //!   (uniform, > 0) are optional.
@@ -33,8 +35,9 @@
 //! - `exposure` (optional, > 0, default 1): what a PNG of the scene is multiplied by before
 //!   tonemapping when the command names no `--exposure`.
 //! - `gltf` (optional): a glTF 2.0 file (.gltf or .glb) whose groups, lights and camera the
-//!   scene takes ([`super::gltf`]), `groups` then left out; the file adds what glTF has no
-//!   place for (the environment, probes, walkthrough, exposure). Its `camera`, where given,
+//!   scene takes ([`super::gltf`]); the file adds what glTF has no place for (the environment,
+//!   probes, walkthrough, exposure) and may add geometry: its `groups` come after the glTF's
+//!   (a floor under a model, say). Its `camera`, where given,
 //!   replaces the glTF one; `gltf_camera` names the glTF camera to take (a camera's or its
 //!   node's name) instead of the first; `gltf_groups` names nodes that are groups of their own
 //!   (besides the root nodes); its `lights` are added to the glTF ones.
@@ -55,7 +58,8 @@ pub struct SceneFile {
     pub gltf_groups: Vec<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera: Option<CameraDesc>,
-    pub environment: EnvironmentDesc,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<EnvironmentDesc>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groups: Vec<GroupDesc>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -9,7 +9,22 @@ use super::file::{CameraDesc, EnvironmentDesc, GroupDesc, LightDesc, MeshDesc, S
 use super::{obj, shapes, Camera, EnvMap, Group, Light, Mesh, Scene, SceneError, SceneProbe, Transform};
 use crate::files;
 
-pub fn load(path: &Path) -> Result<Scene, SceneError> {
+/// The radiance of the constant sky that lights a scene whose file gives no environment (a glTF
+/// file read alone, a scene file without `environment`): the one place this default is set.
+pub const DEFAULT_SKY: f32 = 1.0;
+
+/// A scene read from a file, and what the file left to the default. Only the caller knows
+/// whether it replaces the default (the command line's `--env`), so the loader prints no note
+/// about it: the caller tells the user, or documents it (the C ABI's `kage_scene_load`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Loaded {
+    pub scene: Scene,
+    /// The file gave no environment: the scene is lit by a constant sky of radiance
+    /// [`DEFAULT_SKY`].
+    pub default_environment: bool,
+}
+
+pub fn load(path: &Path) -> Result<Loaded, SceneError> {
     let bytes = files::read(path, files::JSON).map_err(|e| SceneError::in_file(path, e.to_string()))?;
     let json = files::without_bom(&bytes);
     let file: SceneFile = serde_json::from_slice(json)
@@ -20,20 +35,16 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     build(file, name, folder).map_err(|e| e.attributed_to(path))
 }
 
-/// A glTF file read alone: as a scene file that names it, lit by a constant sky of radiance 1
-/// (a note says so).
-pub fn gltf_alone(path: &Path) -> Result<Scene, SceneError> {
-    eprintln!(
-        "kage: note: {} has no environment: lit by a constant sky of radiance 1 (give one with --env or a scene file)",
-        path.display()
-    );
+/// A glTF file read alone: as a scene file that names it and gives nothing else (so it is lit by
+/// the default sky).
+pub fn gltf_alone(path: &Path) -> Result<Loaded, SceneError> {
     let file = SceneFile {
         name: None,
         gltf: Some(path.file_name().unwrap_or_default().to_string_lossy().into_owned()),
         gltf_camera: None,
         gltf_groups: Vec::new(),
         camera: None,
-        environment: EnvironmentDesc { image: None, constant: Some([1.0; 3]), intensity: 1.0 },
+        environment: None,
         groups: Vec::new(),
         lights: Vec::new(),
         walkthrough: Vec::new(),
@@ -45,8 +56,9 @@ pub fn gltf_alone(path: &Path) -> Result<Scene, SceneError> {
     build(file, name, folder).map_err(|e| e.attributed_to(path))
 }
 
-/// Assembles a scene from its description; `folder` anchors the relative paths in it.
-fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
+/// Assembles a scene from its description; `folder` anchors the relative paths in it. With a
+/// glTF file, its groups come first and the listed ones after them.
+fn build(file: SceneFile, name: String, folder: &Path) -> Result<Loaded, SceneError> {
     let own_camera = file.camera.as_ref().map(camera).transpose()?;
     let walkthrough = file
         .walkthrough
@@ -55,15 +67,13 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         .map(|(at, c)| camera(c).map_err(|e| e.within(&format!("walkthrough camera {at}"))))
         .collect::<Result<Vec<_>, _>>()?;
     super::animation::check_walkthrough(&walkthrough)?;
-    let environment = environment(&file.environment, folder)?;
+    let environment = match &file.environment {
+        Some(desc) => environment(desc, folder)?,
+        None => EnvMap::constant([DEFAULT_SKY; 3]),
+    };
     let gltf_options = file.gltf_camera.is_some() || !file.gltf_groups.is_empty();
     let (mut groups, mut lights, gltf_camera) = match (&file.gltf, gltf_options) {
         (Some(gltf), _) => {
-            if !file.groups.is_empty() {
-                return Err(SceneError::invalid(
-                    "it gives both \"gltf\" and \"groups\": the groups come from one or the other",
-                ));
-            }
             let parts =
                 super::gltf::parts(&folder.join(gltf), file.gltf_camera.as_deref(), &file.gltf_groups)?;
             (parts.groups, parts.lights, parts.camera)
@@ -73,14 +83,6 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         }
         (None, false) if file.groups.is_empty() => return Err(SceneError::invalid("it has no groups")),
         (None, false) => (Vec::new(), Vec::new(), None),
-    };
-    let camera = match (own_camera, gltf_camera) {
-        (Some(camera), _) | (None, Some(camera)) => camera,
-        (None, None) if file.gltf.is_some() => {
-            eprintln!("kage: note: the glTF file has no camera: viewing the whole scene from the front");
-            super::gltf::overview(&groups)
-        }
-        (None, None) => return Err(SceneError::invalid("it has no \"camera\"")),
     };
     let listed: Vec<Group> = file
         .groups
@@ -92,6 +94,14 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         })
         .collect::<Result<_, _>>()?;
     groups.extend(listed);
+    let camera = match (own_camera, gltf_camera) {
+        (Some(camera), _) | (None, Some(camera)) => camera,
+        (None, None) if file.gltf.is_some() => {
+            eprintln!("kage: note: the glTF file has no camera: viewing the whole scene from the front");
+            super::gltf::overview(&groups)
+        }
+        (None, None) => return Err(SceneError::invalid("it has no \"camera\"")),
+    };
     let listed: Vec<Light> = file
         .lights
         .into_iter()
@@ -116,7 +126,7 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
     // The rules every scene meets however it was made (its extent among them), checked here
     // too so that a file's fault is named with the file, not found when a renderer is made.
     scene.validate()?;
-    Ok(scene)
+    Ok(Loaded { scene, default_environment: file.environment.is_none() })
 }
 
 fn environment(desc: &EnvironmentDesc, folder: &Path) -> Result<EnvMap, SceneError> {

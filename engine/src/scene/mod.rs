@@ -47,6 +47,7 @@ pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use error::SceneError;
 pub use export::{SceneFormat, ENVIRONMENT_FILE, GLTF_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
+pub use load::{Loaded, DEFAULT_SKY};
 pub use mesh::Mesh;
 pub use motion::Motion;
 pub use obj::{load_obj, parse_obj, write_obj};
@@ -111,8 +112,15 @@ pub fn check_extent(translation: Vec3, scale: f32, object_reach: f32) -> Result<
 
 impl Scene {
     /// Reads a scene file: JSON (relative paths inside it are relative to its folder), or glTF
-    /// 2.0 by its extension, .gltf or .glb ([`gltf`]).
+    /// 2.0 by its extension, .gltf or .glb ([`gltf`]). A file that gives no environment (a glTF
+    /// file alone, a scene file without one) is lit by a constant sky of radiance
+    /// [`DEFAULT_SKY`]; [`Scene::read`] says when.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Scene::read(path).map(|loaded| loaded.scene)
+    }
+
+    /// [`Scene::load`], saying whether the scene's environment is the default sky.
+    pub fn read(path: &Path) -> Result<Loaded, SceneError> {
         let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         match extension.as_deref() {
             Some("gltf" | "glb") => load::gltf_alone(path),
@@ -131,13 +139,20 @@ impl Scene {
     /// and any other existing path is a file that cannot be read (a folder without
     /// [`SCENE_FILE`], a device, a FIFO): an error naming it, not "no built-in scene".
     pub fn from_arg(arg: &str) -> Result<Scene, SceneError> {
+        Scene::read_arg(arg).map(|loaded| loaded.scene)
+    }
+
+    /// [`Scene::from_arg`], saying whether the scene's environment is the default sky (a
+    /// built-in scene's never is).
+    pub fn read_arg(arg: &str) -> Result<Loaded, SceneError> {
+        let builtin = |name| Scene::builtin(name).map(|scene| Loaded { scene, default_environment: false });
         let path = Path::new(arg);
         if path.join(SCENE_FILE).is_file() {
-            Scene::load(&path.join(SCENE_FILE))
+            Scene::read(&path.join(SCENE_FILE))
         } else if path.is_file() || [".json", ".gltf", ".glb"].iter().any(|e| arg.ends_with(e)) {
-            Scene::load(path)
+            Scene::read(path)
         } else if BUILTIN.contains(&arg) {
-            Scene::builtin(arg)
+            builtin(arg)
         } else if path.is_dir() {
             Err(SceneError::in_file(
                 path,
@@ -148,9 +163,9 @@ impl Scene {
                 ),
             ))
         } else if path.symlink_metadata().is_ok() {
-            Scene::load(path)
+            Scene::read(path)
         } else {
-            Scene::builtin(arg)
+            builtin(arg)
         }
     }
 

@@ -276,7 +276,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
 
 fn run_prt(args: &SweepArgs) -> Result<()> {
     let settings = chosen(&args.only)?;
-    let scene = Scene::from_arg(args.scene.as_deref().unwrap_or("teapot"))?;
+    let scene = crate::read_scene(args.scene.as_deref().unwrap_or("teapot"), !args.envs.is_empty())?;
     if scene.groups.is_empty() {
         bail!("scene {} has no groups to move", scene.name);
     }

@@ -11,7 +11,6 @@ use crate::bench_probe_count::{measure, Params, TestRegion, DEFAULT_GRIDS, DEFAU
 use crate::sweep::chart::Axes;
 use crate::sweep::pick::Point;
 use anyhow::{bail, Context as _, Result};
-use kage::scene::Scene;
 use kage::sh::ShRgb9;
 use kage::techniques::probes::CaptureSettings;
 use kage::techniques::probes::CapturedLight;
@@ -35,7 +34,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     if !args.only.is_empty() {
         bail!("--only: the probe sweep measures every grid level and tolerance together (the automatic placement starts from the finest grid)");
     }
-    let scene = Scene::from_arg(args.scene.as_deref().unwrap_or("probe-room"))?;
+    let scene = crate::read_scene(args.scene.as_deref().unwrap_or("probe-room"), false)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let ctx = args.gpu.context()?;
     let cache = args.out.join("reference-cache");
