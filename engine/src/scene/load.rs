@@ -33,7 +33,7 @@ pub fn gltf_alone(path: &Path) -> Result<Scene, SceneError> {
         gltf_camera: None,
         gltf_groups: Vec::new(),
         camera: None,
-        environment: EnvironmentDesc { image: None, constant: Some([1.0; 3]), intensity: 1.0 },
+        environment: lone_sky(),
         groups: Vec::new(),
         lights: Vec::new(),
         walkthrough: Vec::new(),
@@ -45,8 +45,65 @@ pub fn gltf_alone(path: &Path) -> Result<Scene, SceneError> {
     build(file, name, folder).map_err(|e| e.attributed_to(path))
 }
 
+/// The albedo of an OBJ file read alone ([`obj_alone`]): OBJ materials are not read.
+pub const LONE_OBJ_ALBEDO: [f32; 3] = [0.8; 3];
+
+/// What a model file read alone is lit by (glTF and OBJ have no environment): a constant sky
+/// of radiance 1.
+fn lone_sky() -> EnvironmentDesc {
+    EnvironmentDesc { image: None, constant: Some([1.0; 3]), intensity: 1.0 }
+}
+
+/// An OBJ file read alone: as a scene file holding one group of it at rest, albedo
+/// [`LONE_OBJ_ALBEDO`], lit as a glTF file read alone ([`gltf_alone`]), viewed whole from the
+/// front ([`super::gltf::overview`]); no ground, lights or probes are added. A note says so.
+pub fn obj_alone(path: &Path) -> Result<Scene, SceneError> {
+    let file_name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+    let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let mesh =
+        MeshDesc { name: None, obj: Some(file_name), plane: None, sphere: None, albedo: LONE_OBJ_ALBEDO };
+    let group = GroupDesc {
+        name: name.clone(),
+        translation: [0.0; 3],
+        rotation_deg: None,
+        rotation_quat: None,
+        scale: 1.0,
+        meshes: vec![mesh],
+        keyframes: Vec::new(),
+        loop_seconds: None,
+    };
+    let file = SceneFile {
+        name: None,
+        gltf: None,
+        gltf_camera: None,
+        gltf_groups: Vec::new(),
+        camera: None,
+        environment: lone_sky(),
+        groups: vec![group],
+        lights: Vec::new(),
+        walkthrough: Vec::new(),
+        probes: Vec::new(),
+        exposure: 1.0,
+    };
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let scene = assemble(file, name, folder, true).map_err(|e| e.attributed_to(path))?;
+    eprintln!(
+        "kage: note: {} read alone: one group at rest, albedo {}, lit by a constant sky of radiance 1, \
+         viewed whole from the front, no ground (give more with --env or a scene file)",
+        path.display(),
+        LONE_OBJ_ALBEDO[0]
+    );
+    Ok(scene)
+}
+
 /// Assembles a scene from its description; `folder` anchors the relative paths in it.
 fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneError> {
+    assemble(file, name, folder, false)
+}
+
+/// [`build`], and with `view_whole` a description without a camera (a model file read alone)
+/// is viewed whole from the front instead of refused.
+fn assemble(file: SceneFile, name: String, folder: &Path, view_whole: bool) -> Result<Scene, SceneError> {
     let own_camera = file.camera.as_ref().map(camera).transpose()?;
     let walkthrough = file
         .walkthrough
@@ -75,11 +132,12 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         (None, false) => (Vec::new(), Vec::new(), None),
     };
     let camera = match (own_camera, gltf_camera) {
-        (Some(camera), _) | (None, Some(camera)) => camera,
+        (Some(camera), _) | (None, Some(camera)) => Some(camera),
         (None, None) if file.gltf.is_some() => {
             eprintln!("kage: note: the glTF file has no camera: viewing the whole scene from the front");
-            super::gltf::overview(&groups)
+            Some(super::gltf::overview(&groups))
         }
+        (None, None) if view_whole => None,
         (None, None) => return Err(SceneError::invalid("it has no \"camera\"")),
     };
     let listed: Vec<Group> = file
@@ -92,6 +150,8 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Scene, SceneErr
         })
         .collect::<Result<_, _>>()?;
     groups.extend(listed);
+    // `view_whole` without a camera: the whole scene, now that its groups are read.
+    let camera = camera.unwrap_or_else(|| super::gltf::overview(&groups));
     let listed: Vec<Light> = file
         .lights
         .into_iter()
