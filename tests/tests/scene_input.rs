@@ -453,3 +453,105 @@ fn keyframes_in_a_scene_file_move_their_group_and_bad_ones_are_named() {
         assert!(message.contains("group 0") || message.contains("unknown field"), "{message}");
     }
 }
+
+/// The vendored scanned bunny (tests/assets/bunny/): 1,839 vertices with normals, vertex 1's
+/// `vn 0 0 0`.
+fn bunny_obj() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny/bunny.obj")
+}
+
+/// The area-weighted normal of the triangles around the vertex at `at` (what a repaired normal
+/// must be), and the normals of the other vertices of those triangles.
+fn around(mesh: &kage::scene::Mesh, at: usize) -> (Vec3, Vec<Vec3>) {
+    let mut sum = Vec3::ZERO;
+    let mut neighbours = Vec::new();
+    for tri in mesh.indices.chunks_exact(3).filter(|t| t.contains(&(at as u32))) {
+        let [a, b, c] = [0, 1, 2].map(|k| Vec3::from(mesh.positions[tri[k] as usize]));
+        sum += (b - a).cross(c - a);
+        neighbours
+            .extend(tri.iter().filter(|&&i| i as usize != at).map(|&i| Vec3::from(mesh.normals[i as usize])));
+    }
+    (sum.normalize(), neighbours)
+}
+
+/// An OBJ given straight to `--scene` is a scene: the mesh at rest in one group, albedo 0.8,
+/// the constant sky of radiance 1, the whole model in view, no ground; the bunny's zero normal
+/// is recomputed from its faces and the file's other normals kept.
+#[test]
+fn a_scanned_obj_with_a_zero_normal_loads_alone_repaired() {
+    let path = bunny_obj();
+    let scene = Scene::from_arg(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.name, "bunny");
+    assert_eq!(scene.groups.len(), 1, "no ground is added");
+    let group = &scene.groups[0];
+    assert!(group.motion.is_none() && group.transform == kage::scene::Transform::default());
+    assert_eq!(group.meshes.len(), 1);
+    let mesh = &group.meshes[0];
+    assert_eq!(mesh.vertex_count(), 1839);
+    assert_eq!(mesh.albedo, kage::scene::LONE_OBJ_ALBEDO);
+    assert_eq!(mesh.albedo, [0.8; 3]);
+    assert_eq!(scene.environment, kage::scene::EnvMap::constant([1.0; 3]));
+    assert!(scene.lights.is_empty() && scene.walkthrough.is_empty() && scene.probes.is_empty());
+    assert_eq!(scene.camera, kage::scene::gltf::overview(&scene.groups));
+    // Every vertex is in front of the camera and inside its view.
+    let view_projection = scene.camera.projection(1.0) * scene.camera.view();
+    for p in &mesh.positions {
+        let clip = view_projection * Vec3::from(*p).extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        assert!(clip.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{p:?} is out of view");
+    }
+
+    let at = mesh.positions.iter().position(|p| *p == [1.301895, 0.122622, 2.550061]).unwrap();
+    let repaired = Vec3::from(mesh.normals[at]);
+    assert!((repaired.length() - 1.0).abs() < 1e-6, "{repaired}");
+    let (faces, neighbours) = around(mesh, at);
+    assert!(repaired.dot(faces) > 1.0 - 1e-5, "{repaired} is not its faces' normal {faces}");
+    assert!(neighbours.len() >= 4);
+    for n in neighbours {
+        assert!(repaired.dot(n) > 0.8, "{repaired} is far from its neighbour's normal {n}");
+    }
+    // The file's other normals are its own (6 decimals), not recomputed ones.
+    let second = mesh.positions.iter().position(|p| *p == [1.045326, 0.139058, 2.835156]).unwrap();
+    let given = Vec3::new(-0.043332, -0.999055, -0.003240);
+    assert!(Vec3::from(mesh.normals[second]).distance(given.normalize()) < 1e-6);
+
+    // The extension in any case; the same scene through Scene::load.
+    let dir = temp_dir("obj-alone");
+    let upper = dir.join("BUNNY.OBJ");
+    std::fs::copy(&path, &upper).unwrap();
+    let loud = Scene::load(&upper).unwrap();
+    assert_eq!(loud.groups[0].meshes[0].normals, mesh.normals);
+}
+
+/// A NaN or infinite normal in an OBJ is repaired like a zero one.
+#[test]
+fn non_finite_obj_normals_are_repaired() {
+    let dir = temp_dir("obj-nan-normal");
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 0 -1\nv 1 0 -1\nvn nan 0 1\nvn 0 1 0\nvn 0 inf 0\nvn 0 1 0\n\
+               f 1//1 2//2 3//3\nf 2//2 4//4 3//3\n";
+    let path = write(&dir, "nan-normal.obj", obj);
+    let scene = Scene::from_arg(path.to_str().unwrap()).unwrap();
+    let normals = &scene.groups[0].meshes[0].normals;
+    assert_eq!(normals, &vec![[0.0, 1.0, 0.0]; 4]);
+}
+
+/// An OBJ read alone that cannot be read is an error naming it, never JSON's or a built-in
+/// scene's.
+#[test]
+fn bad_obj_files_alone_are_errors_naming_them() {
+    let dir = temp_dir("obj-alone-bad");
+    let cases = [
+        ("malformed.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n", "malformed"),
+        ("range.Obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of"),
+        ("empty.obj", "", "no triangles"),
+    ];
+    for (file, contents, problem) in cases {
+        let path = write(&dir, file, contents);
+        let message = Scene::from_arg(path.to_str().unwrap()).unwrap_err().to_string();
+        assert!(message.contains(file) && message.contains(problem), "{message}");
+        assert!(!message.contains("JSON"), "{message}");
+    }
+    let missing = dir.join("absent.OBJ");
+    let message = Scene::from_arg(missing.to_str().unwrap()).unwrap_err().to_string();
+    assert!(message.contains("absent.OBJ") && message.contains("cannot read"), "{message}");
+}
