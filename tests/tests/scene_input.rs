@@ -555,3 +555,65 @@ fn bad_obj_files_alone_are_errors_naming_them() {
     let message = Scene::from_arg(missing.to_str().unwrap()).unwrap_err().to_string();
     assert!(message.contains("absent.OBJ") && message.contains("cannot read"), "{message}");
 }
+
+/// The C ABI reads a lone OBJ as `--scene` does (a bad one is `KAGE_RESULT_FILE`), and repairs
+/// a NaN or zero normal in the host's arrays instead of refusing the scene.
+#[test]
+fn the_c_abi_loads_a_lone_obj_and_repairs_normals() {
+    use kage::capi::{self, kage_result};
+    use std::ptr::{null, null_mut};
+    let path = std::ffi::CString::new(bunny_obj().to_str().unwrap()).unwrap();
+    let mut scene = null_mut();
+    // SAFETY: a NUL-terminated path and a writable out-handle.
+    assert_eq!(unsafe { capi::scene::kage_scene_load(path.as_ptr(), &mut scene) }, kage_result::Ok);
+    let mut count = 0;
+    // SAFETY: a live handle and a writable count.
+    assert_eq!(unsafe { capi::scene::kage_scene_group_count(scene, &mut count) }, kage_result::Ok);
+    assert_eq!(count, 1);
+    assert_eq!(capi::scene::kage_scene_destroy(scene), kage_result::Ok);
+
+    let dir = temp_dir("capi-obj");
+    let bad = write(&dir, "bad.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n");
+    let bad = std::ffi::CString::new(bad.to_str().unwrap()).unwrap();
+    // SAFETY: as above.
+    assert_eq!(unsafe { capi::scene::kage_scene_load(bad.as_ptr(), &mut scene) }, kage_result::File);
+    assert!(scene.is_null());
+
+    let positions = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0f32];
+    let normals = [f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0f32];
+    let indices = [0, 1, 2u32];
+    let mesh = capi::scene::kage_mesh_desc {
+        positions: positions.as_ptr(),
+        normals: normals.as_ptr(),
+        vertex_count: 3,
+        indices: indices.as_ptr(),
+        index_count: 3,
+        albedo: [0.5; 3],
+    };
+    let group = capi::scene::kage_group_desc {
+        name: null(),
+        transform: capi::scene::kage_transform {
+            translation: [0.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            scale: 1.0,
+        },
+        meshes: &mesh,
+        mesh_count: 1,
+    };
+    let sky = [1.0f32; 3 * 8 * 4];
+    let desc = capi::scene::kage_scene_desc {
+        size: std::mem::size_of::<capi::scene::kage_scene_desc>() as u32,
+        groups: &group,
+        group_count: 1,
+        environment: capi::scene::kage_environment_desc { pixels: sky.as_ptr(), width: 8, height: 4 },
+        camera: capi::scene::kage_camera_desc {
+            position: [0.0, 1.0, 2.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 60.0,
+        },
+    };
+    // SAFETY: the desc's arrays hold the counts it states and outlive the call.
+    assert_eq!(unsafe { capi::scene::kage_scene_create(&desc, &mut scene) }, kage_result::Ok);
+    assert_eq!(capi::scene::kage_scene_destroy(scene), kage_result::Ok);
+}
