@@ -776,7 +776,9 @@ typedef struct {
    */
   const float *positions;
   /**
-   * 3 floats per vertex, or NULL: then area-weighted vertex normals are computed.
+   * 3 floats per vertex, or NULL: then area-weighted vertex normals are computed. A zero or
+   * non-finite normal is not refused: that vertex's normal is computed as if NULL (+Y where
+   * its triangles are all degenerate), with a note on stderr naming the mesh and the count.
    */
   const float *normals;
   uint32_t vertex_count;
@@ -1086,11 +1088,14 @@ kage_result kage_renderer_timings(const kage_renderer *renderer,
 kage_result kage_last_error_message(char *buffer, size_t capacity, size_t *length);
 
 /**
- * Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb; see the README), or the name of a built-in
- * scene ("teapot", the default scene; an unknown name's error lists the others). A path that
- * exists or ends in ".json" is a file. A file that gives no environment (a glTF file alone, a
- * scene file without "environment") is lit by a constant sky of radiance 1; nothing is printed,
- * so a host that takes such files tells its users (or gives the scene file an environment).
+ * Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb or a Wavefront .obj read
+ * alone; see the README), or the name of a built-in scene ("teapot", the default scene; an
+ * unknown name's error lists the others). A path that exists or ends in ".json", ".gltf",
+ * ".glb" or ".obj" (any case) is a file. A .gltf/.glb or .obj file read alone is lit by a
+ * constant sky of radiance 1 and, without a camera of its own, viewed whole from the front; an
+ * OBJ is one group at rest with albedo 0.8 in each channel and no ground added (a note on
+ * stderr says so). Zero or non-finite normals in a file are recomputed from its triangles,
+ * with a note.
  *
  * On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
  * on failure it is set to NULL, and a bad or missing file is `KAGE_RESULT_FILE`, with the file
@@ -1099,16 +1104,16 @@ kage_result kage_last_error_message(char *buffer, size_t capacity, size_t *lengt
  * # Safety
  * `path` must be NULL or a NUL-terminated UTF-8 string; `scene` NULL or writable.
  */
-kage_result kage_scene_load(const char *path,
-                            kage_scene **scene);
+kage_result kage_scene_load(const char *path, kage_scene **scene);
 
 /**
  * Builds a scene from the host's arrays. Everything is copied during the call: the host may
  * free or reuse its arrays as soon as it returns.
  *
  * Bad data is `KAGE_RESULT_INVALID_VALUE` naming the group and mesh: no groups or meshes,
- * NaN or infinite values, indices out of range or not a multiple of 3, albedo outside [0, 1],
- * a map that is not 2:1, a degenerate camera or transform. A NULL array with a non-zero count
+ * NaN or infinite values (but a zero or non-finite normal is recomputed: see
+ * `kage_mesh_desc`), indices out of range or not a multiple of 3, albedo outside [0, 1], a map
+ * that is not 2:1, a degenerate camera or transform. A NULL array with a non-zero count
  * is `KAGE_RESULT_NULL_ARGUMENT`.
  *
  * On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;

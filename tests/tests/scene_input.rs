@@ -480,3 +480,167 @@ fn a_scene_file_without_environment_is_lit_by_the_default_sky() {
     assert!(!back.default_environment);
     assert_eq!(back.scene, loaded.scene);
 }
+
+/// The vendored scanned bunny (tests/assets/bunny/): 1,839 vertices with normals, vertex 1's
+/// `vn 0 0 0`.
+fn bunny_obj() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny/bunny.obj")
+}
+
+/// The area-weighted normal of the triangles around the vertex at `at` (what a repaired normal
+/// must be), and the normals of the other vertices of those triangles.
+fn around(mesh: &kage::scene::Mesh, at: usize) -> (Vec3, Vec<Vec3>) {
+    let mut sum = Vec3::ZERO;
+    let mut neighbours = Vec::new();
+    for tri in mesh.indices.chunks_exact(3).filter(|t| t.contains(&(at as u32))) {
+        let [a, b, c] = [0, 1, 2].map(|k| Vec3::from(mesh.positions[tri[k] as usize]));
+        sum += (b - a).cross(c - a);
+        neighbours
+            .extend(tri.iter().filter(|&&i| i as usize != at).map(|&i| Vec3::from(mesh.normals[i as usize])));
+    }
+    (sum.normalize(), neighbours)
+}
+
+/// An OBJ given straight to `--scene` is a scene: the mesh at rest in one group, albedo 0.8,
+/// the constant sky of radiance 1, the whole model in view, no ground; the bunny's zero normal
+/// is recomputed from its faces and the file's other normals kept.
+#[test]
+fn a_scanned_obj_with_a_zero_normal_loads_alone_repaired() {
+    let path = bunny_obj();
+    let scene = Scene::from_arg(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.name, "bunny");
+    assert_eq!(scene.groups.len(), 1, "no ground is added");
+    let group = &scene.groups[0];
+    assert!(group.motion.is_none() && group.transform == kage::scene::Transform::default());
+    assert_eq!(group.meshes.len(), 1);
+    let mesh = &group.meshes[0];
+    assert_eq!(mesh.vertex_count(), 1839);
+    assert_eq!(mesh.albedo, kage::scene::LONE_OBJ_ALBEDO);
+    assert_eq!(mesh.albedo, [0.8; 3]);
+    assert_eq!(scene.environment, kage::scene::EnvMap::constant([1.0; 3]));
+    assert!(scene.lights.is_empty() && scene.walkthrough.is_empty() && scene.probes.is_empty());
+    assert_eq!(scene.camera, kage::scene::gltf::overview(&scene.groups));
+    // Every vertex is in front of the camera and inside its view.
+    let view_projection = scene.camera.projection(1.0) * scene.camera.view();
+    for p in &mesh.positions {
+        let clip = view_projection * Vec3::from(*p).extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        assert!(clip.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{p:?} is out of view");
+    }
+
+    let at = mesh.positions.iter().position(|p| *p == [1.301895, 0.122622, 2.550061]).unwrap();
+    let repaired = Vec3::from(mesh.normals[at]);
+    assert!((repaired.length() - 1.0).abs() < 1e-6, "{repaired}");
+    let (faces, neighbours) = around(mesh, at);
+    assert!(repaired.dot(faces) > 1.0 - 1e-5, "{repaired} is not its faces' normal {faces}");
+    assert!(neighbours.len() >= 4);
+    for n in neighbours {
+        assert!(repaired.dot(n) > 0.8, "{repaired} is far from its neighbour's normal {n}");
+    }
+    // The file's other normals are its own (6 decimals), not recomputed ones.
+    let second = mesh.positions.iter().position(|p| *p == [1.045326, 0.139058, 2.835156]).unwrap();
+    let given = Vec3::new(-0.043332, -0.999055, -0.003240);
+    assert!(Vec3::from(mesh.normals[second]).distance(given.normalize()) < 1e-6);
+
+    // The extension in any case; the same scene through Scene::load.
+    let dir = temp_dir("obj-alone");
+    let upper = dir.join("BUNNY.OBJ");
+    std::fs::copy(&path, &upper).unwrap();
+    let loud = Scene::load(&upper).unwrap();
+    assert_eq!(loud.groups[0].meshes[0].normals, mesh.normals);
+}
+
+/// A NaN or infinite normal in an OBJ is repaired like a zero one.
+#[test]
+fn non_finite_obj_normals_are_repaired() {
+    let dir = temp_dir("obj-nan-normal");
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 0 -1\nv 1 0 -1\nvn nan 0 1\nvn 0 1 0\nvn 0 inf 0\nvn 0 1 0\n\
+               f 1//1 2//2 3//3\nf 2//2 4//4 3//3\n";
+    let path = write(&dir, "nan-normal.obj", obj);
+    let scene = Scene::from_arg(path.to_str().unwrap()).unwrap();
+    let normals = &scene.groups[0].meshes[0].normals;
+    assert_eq!(normals, &vec![[0.0, 1.0, 0.0]; 4]);
+}
+
+/// An OBJ read alone that cannot be read is an error naming it, never JSON's or a built-in
+/// scene's.
+#[test]
+fn bad_obj_files_alone_are_errors_naming_them() {
+    let dir = temp_dir("obj-alone-bad");
+    let cases = [
+        ("malformed.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n", "malformed"),
+        ("range.Obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of"),
+        ("empty.obj", "", "no triangles"),
+    ];
+    for (file, contents, problem) in cases {
+        let path = write(&dir, file, contents);
+        let message = Scene::from_arg(path.to_str().unwrap()).unwrap_err().to_string();
+        assert!(message.contains(file) && message.contains(problem), "{message}");
+        assert!(!message.contains("JSON"), "{message}");
+    }
+    let missing = dir.join("absent.OBJ");
+    let message = Scene::from_arg(missing.to_str().unwrap()).unwrap_err().to_string();
+    assert!(message.contains("absent.OBJ") && message.contains("cannot read"), "{message}");
+}
+
+/// The C ABI reads a lone OBJ as `--scene` does (a bad one is `KAGE_RESULT_FILE`), and repairs
+/// a NaN or zero normal in the host's arrays instead of refusing the scene.
+#[test]
+fn the_c_abi_loads_a_lone_obj_and_repairs_normals() {
+    use kage::capi::{self, kage_result};
+    use std::ptr::{null, null_mut};
+    let path = std::ffi::CString::new(bunny_obj().to_str().unwrap()).unwrap();
+    let mut scene = null_mut();
+    // SAFETY: a NUL-terminated path and a writable out-handle.
+    assert_eq!(unsafe { capi::scene::kage_scene_load(path.as_ptr(), &mut scene) }, kage_result::Ok);
+    let mut count = 0;
+    // SAFETY: a live handle and a writable count.
+    assert_eq!(unsafe { capi::scene::kage_scene_group_count(scene, &mut count) }, kage_result::Ok);
+    assert_eq!(count, 1);
+    assert_eq!(capi::scene::kage_scene_destroy(scene), kage_result::Ok);
+
+    let dir = temp_dir("capi-obj");
+    let bad = write(&dir, "bad.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n");
+    let bad = std::ffi::CString::new(bad.to_str().unwrap()).unwrap();
+    // SAFETY: as above.
+    assert_eq!(unsafe { capi::scene::kage_scene_load(bad.as_ptr(), &mut scene) }, kage_result::File);
+    assert!(scene.is_null());
+
+    let positions = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0f32];
+    let normals = [f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0f32];
+    let indices = [0, 1, 2u32];
+    let mesh = capi::scene::kage_mesh_desc {
+        positions: positions.as_ptr(),
+        normals: normals.as_ptr(),
+        vertex_count: 3,
+        indices: indices.as_ptr(),
+        index_count: 3,
+        albedo: [0.5; 3],
+    };
+    let group = capi::scene::kage_group_desc {
+        name: null(),
+        transform: capi::scene::kage_transform {
+            translation: [0.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            scale: 1.0,
+        },
+        meshes: &mesh,
+        mesh_count: 1,
+    };
+    let sky = [1.0f32; 3 * 8 * 4];
+    let desc = capi::scene::kage_scene_desc {
+        size: std::mem::size_of::<capi::scene::kage_scene_desc>() as u32,
+        groups: &group,
+        group_count: 1,
+        environment: capi::scene::kage_environment_desc { pixels: sky.as_ptr(), width: 8, height: 4 },
+        camera: capi::scene::kage_camera_desc {
+            position: [0.0, 1.0, 2.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 60.0,
+        },
+    };
+    // SAFETY: the desc's arrays hold the counts it states and outlive the call.
+    assert_eq!(unsafe { capi::scene::kage_scene_create(&desc, &mut scene) }, kage_result::Ok);
+    assert_eq!(capi::scene::kage_scene_destroy(scene), kage_result::Ok);
+}

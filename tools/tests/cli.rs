@@ -1282,3 +1282,43 @@ fn the_default_sky_note_is_printed_only_when_the_default_stays() {
     assert!(!render(gltf, &["--env", map]) && !render(&composed, &["--env", map]), "no note under --env");
     assert!(!render(&given, &[]), "no note where the file gives an environment");
 }
+
+/// `kage render --scene bunny.obj`: the scanned bunny with its `vn 0 0 0`, read alone, renders
+/// under the constant sky with notes for the defaults and the repaired normal; the default
+/// camera has it in the middle of the picture. A bad OBJ is an error naming it.
+#[test]
+fn an_obj_alone_renders_with_its_zero_normal_repaired() {
+    let dir = scratch_dir("cli-obj-alone");
+    let bunny = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/assets/bunny/bunny.obj");
+    let image = dir.join("bunny.exr");
+    let args = ["render", "--validate", "--scene", bunny.to_str().unwrap(), "--technique", "unshadowed"];
+    let size = ["--width", "32", "--height", "32", "--frames", "1", "--out", image.to_str().unwrap()];
+    let run = kage(&[&args[..], &size[..]].concat());
+    let output = text(&run);
+    assert!(run.status.success(), "{output}");
+    assert!(output.contains("kage: note: mesh \"bunny\": 1 normal(s) were zero or not finite"), "{output}");
+    assert!(
+        output.contains("read alone") && output.contains("albedo 0.8") && output.contains("no ground"),
+        "{output}"
+    );
+    let picture = kage::imageio::read_exr(&image).unwrap();
+    assert_eq!((picture.width, picture.height), (32, 32));
+    let luminance = |x: usize, y: usize| {
+        let [r, g, b, _] = picture.pixels[y * 32 + x];
+        (r + g + b) / 3.0
+    };
+    // The sky of radiance 1 in the corner; the bunny (albedo 0.8, lit by at most that sky) in
+    // the middle.
+    assert!((luminance(0, 0) - 1.0).abs() < 0.02, "corner {}", luminance(0, 0));
+    assert!(luminance(16, 16) < 0.85, "middle {}", luminance(16, 16));
+
+    let bad = dir.join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let run = kage(&["render", "--scene", bad.to_str().unwrap(), "--width", "32", "--height", "32"]);
+    let output = text(&run);
+    assert!(
+        !run.status.success() && output.contains("bad.obj") && output.contains("malformed OBJ"),
+        "{output}"
+    );
+    assert!(!output.contains("panicked") && !output.contains("JSON"), "{output}");
+}

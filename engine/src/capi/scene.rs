@@ -43,7 +43,9 @@ impl kage_transform {
 pub struct kage_mesh_desc {
     /// 3 floats (x, y, z) per vertex.
     pub positions: *const f32,
-    /// 3 floats per vertex, or NULL: then area-weighted vertex normals are computed.
+    /// 3 floats per vertex, or NULL: then area-weighted vertex normals are computed. A zero or
+    /// non-finite normal is not refused: that vertex's normal is computed as if NULL (+Y where
+    /// its triangles are all degenerate), with a note on stderr naming the mesh and the count.
     pub normals: *const f32,
     pub vertex_count: u32,
     /// 3 per triangle, counter-clockwise seen from the side the normals point to.
@@ -101,11 +103,16 @@ pub struct kage_scene_desc {
     pub camera: kage_camera_desc,
 }
 
-/// Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb; see the README), or the name of a built-in
-/// scene ("teapot", the default scene; an unknown name's error lists the others). A path that
-/// exists or ends in ".json" is a file. A file that gives no environment (a glTF file alone, a
-/// scene file without "environment") is lit by a constant sky of radiance 1; nothing is printed,
-/// so a host that takes such files tells its users (or gives the scene file an environment).
+/// Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb or a Wavefront .obj read
+/// alone; see the README), or the name of a built-in scene ("teapot", the default scene; an
+/// unknown name's error lists the others). A path that exists or ends in ".json", ".gltf",
+/// ".glb" or ".obj" (any case) is a file. A file that gives no environment (a .gltf/.glb or
+/// .obj read alone, a scene file without "environment") is lit by a constant sky of radiance 1,
+/// and nothing says so, so a host that takes such files tells its users (or gives the scene
+/// file an environment). A model file read alone without a camera of its own is viewed whole
+/// from the front; an OBJ is one group at rest with albedo 0.8 in each channel and no ground
+/// added. Zero or non-finite normals in a file are recomputed from its triangles, with a note
+/// on stderr.
 ///
 /// On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
 /// on failure it is set to NULL, and a bad or missing file is `KAGE_RESULT_FILE`, with the file
@@ -130,8 +137,9 @@ pub unsafe extern "C" fn kage_scene_load(path: *const c_char, scene: *mut *mut k
 /// free or reuse its arrays as soon as it returns.
 ///
 /// Bad data is `KAGE_RESULT_INVALID_VALUE` naming the group and mesh: no groups or meshes,
-/// NaN or infinite values, indices out of range or not a multiple of 3, albedo outside [0, 1],
-/// a map that is not 2:1, a degenerate camera or transform. A NULL array with a non-zero count
+/// NaN or infinite values (but a zero or non-finite normal is recomputed: see
+/// `kage_mesh_desc`), indices out of range or not a multiple of 3, albedo outside [0, 1], a map
+/// that is not 2:1, a degenerate camera or transform. A NULL array with a non-zero count
 /// is `KAGE_RESULT_NULL_ARGUMENT`.
 ///
 /// On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;

@@ -56,9 +56,60 @@ pub fn gltf_alone(path: &Path) -> Result<Loaded, SceneError> {
     build(file, name, folder).map_err(|e| e.attributed_to(path))
 }
 
+/// The albedo of an OBJ file read alone ([`obj_alone`]): OBJ materials are not read.
+pub const LONE_OBJ_ALBEDO: [f32; 3] = [0.8; 3];
+
+/// An OBJ file read alone: as a scene file holding one group of it at rest, albedo
+/// [`LONE_OBJ_ALBEDO`], lit as a glTF file read alone ([`gltf_alone`]), viewed whole from the
+/// front ([`super::gltf::overview`]); no ground, lights or probes are added. A note says so.
+pub fn obj_alone(path: &Path) -> Result<Loaded, SceneError> {
+    let file_name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+    let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let mesh =
+        MeshDesc { name: None, obj: Some(file_name), plane: None, sphere: None, albedo: LONE_OBJ_ALBEDO };
+    let group = GroupDesc {
+        name: name.clone(),
+        translation: [0.0; 3],
+        rotation_deg: None,
+        rotation_quat: None,
+        scale: 1.0,
+        meshes: vec![mesh],
+        keyframes: Vec::new(),
+        loop_seconds: None,
+    };
+    let file = SceneFile {
+        name: None,
+        gltf: None,
+        gltf_camera: None,
+        gltf_groups: Vec::new(),
+        camera: None,
+        environment: None,
+        groups: vec![group],
+        lights: Vec::new(),
+        walkthrough: Vec::new(),
+        probes: Vec::new(),
+        exposure: 1.0,
+    };
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let loaded = assemble(file, name, folder, true).map_err(|e| e.attributed_to(path))?;
+    eprintln!(
+        "kage: note: {} read alone: one group at rest, albedo {}, viewed whole from the front, no \
+         ground (a scene file gives more)",
+        path.display(),
+        LONE_OBJ_ALBEDO[0]
+    );
+    Ok(loaded)
+}
+
 /// Assembles a scene from its description; `folder` anchors the relative paths in it. With a
 /// glTF file, its groups come first and the listed ones after them.
 fn build(file: SceneFile, name: String, folder: &Path) -> Result<Loaded, SceneError> {
+    assemble(file, name, folder, false)
+}
+
+/// [`build`], and with `view_whole` a description without a camera (a model file read alone)
+/// is viewed whole from the front instead of refused.
+fn assemble(file: SceneFile, name: String, folder: &Path, view_whole: bool) -> Result<Loaded, SceneError> {
     let own_camera = file.camera.as_ref().map(camera).transpose()?;
     let walkthrough = file
         .walkthrough
@@ -100,6 +151,7 @@ fn build(file: SceneFile, name: String, folder: &Path) -> Result<Loaded, SceneEr
             eprintln!("kage: note: the glTF file has no camera: viewing the whole scene from the front");
             super::gltf::overview(&groups)
         }
+        (None, None) if view_whole => super::gltf::overview(&groups),
         (None, None) => return Err(SceneError::invalid("it has no \"camera\"")),
     };
     let listed: Vec<Light> = file

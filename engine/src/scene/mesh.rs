@@ -24,6 +24,14 @@ impl Mesh {
     /// Validates the data and brings it into the canonical vertex order. Without `normals` (or
     /// with normals that do not match the positions one to one), area-weighted vertex normals
     /// are computed.
+    ///
+    /// Given normals are kept (normalized) where they are finite and non-zero. A zero or
+    /// non-finite one (scanned meshes carry a few: the Stanford bunny users bring has a
+    /// `vn 0 0 0`) is repaired rather than refused: that vertex gets the area-weighted normal of
+    /// its faces, and a note on stderr names the mesh and how many were repaired. Where that
+    /// normal is zero too (the vertex's faces are all degenerate, or their normals cancel) it
+    /// gets +Y, like any computed normal there: a unit vector as good as another, and never NaN.
+    /// [`Mesh::new_reporting`] does the same without the note.
     pub fn new(
         name: impl Into<String>,
         positions: Vec<[f32; 3]>,
@@ -31,14 +39,35 @@ impl Mesh {
         indices: Vec<u32>,
         albedo: [f32; 3],
     ) -> Result<Mesh, SceneError> {
+        let (mesh, repaired) = Mesh::new_reporting(name, positions, normals, indices, albedo)?;
+        if repaired > 0 {
+            eprintln!(
+                "kage: note: mesh \"{}\": {repaired} normal(s) were zero or not finite; recomputed from the faces around them",
+                mesh.name
+            );
+        }
+        Ok(mesh)
+    }
+
+    /// [`Mesh::new`] without its note: the mesh and how many of the given normals were zero or
+    /// not finite and were recomputed from the faces (0 without given normals).
+    pub fn new_reporting(
+        name: impl Into<String>,
+        positions: Vec<[f32; 3]>,
+        normals: Option<Vec<[f32; 3]>>,
+        indices: Vec<u32>,
+        albedo: [f32; 3],
+    ) -> Result<(Mesh, usize), SceneError> {
         let name = name.into();
         check_geometry(&name, &positions, &indices, albedo)?;
-        let normals = match normals {
-            Some(normals) if normals.len() == positions.len() => unit_normals(&name, normals)?,
-            _ => area_weighted_normals(&positions, &indices),
+        let (normals, repaired) = match normals {
+            Some(normals) if normals.len() == positions.len() => {
+                repaired_normals(normals, &positions, &indices)
+            }
+            _ => (area_weighted_normals(&positions, &indices), 0),
         };
         let (positions, normals, indices) = in_first_use_order(positions, normals, indices);
-        Ok(Mesh { name, positions, normals, indices, albedo })
+        Ok((Mesh { name, positions, normals, indices, albedo }, repaired))
     }
 
     /// Checks what [`Mesh::new`] guarantees, for a mesh whose public fields were filled or
@@ -119,16 +148,33 @@ fn checked_normal(name: &str, at: usize, n: [f32; 3]) -> Result<Vec3, SceneError
     Ok(v)
 }
 
-fn unit_normals(name: &str, normals: Vec<[f32; 3]>) -> Result<Vec<[f32; 3]>, SceneError> {
-    normals
+/// The given normals, normalized, with each zero or non-finite one replaced by the vertex's
+/// area-weighted normal; and how many were replaced.
+fn repaired_normals(
+    normals: Vec<[f32; 3]>,
+    positions: &[[f32; 3]],
+    indices: &[u32],
+) -> (Vec<[f32; 3]>, usize) {
+    let unit = |n: [f32; 3]| {
+        let v = Vec3::from(n);
+        // Scaled to its largest component first, so that no finite non-zero normal over- or
+        // underflows on the way to unit length.
+        let largest = v.abs().max_element();
+        (v.is_finite() && largest > 0.0).then(|| (v / largest).normalize())
+    };
+    let repaired = normals.iter().filter(|n| unit(**n).is_none()).count();
+    let computed = (repaired > 0).then(|| area_weighted_normals(positions, indices));
+    let normals = normals
         .into_iter()
         .enumerate()
-        .map(|(at, n)| {
-            let v = checked_normal(name, at, n)?;
+        .map(|(at, n)| match unit(n) {
             // Already-unit normals stay bit-identical (see `Mesh`'s round-trip promise).
-            Ok(if v.is_normalized() { n } else { v.normalize().to_array() })
+            Some(_) if Vec3::from(n).is_normalized() => n,
+            Some(v) => v.to_array(),
+            None => computed.as_ref().map_or([0.0, 1.0, 0.0], |c| c[at]),
         })
-        .collect()
+        .collect();
+    (normals, repaired)
 }
 
 /// Sums each triangle's unnormalized face normal (length = twice its area) into its vertices.
@@ -201,7 +247,68 @@ mod tests {
         assert!(err(tri(), vec![0, 1, 3], [0.5; 3]).contains("out of range"));
         assert!(err(vec![[0.0, f32::NAN, 0.0]; 3], vec![0, 1, 2], [0.5; 3]).contains("NaN"));
         assert!(err(tri(), vec![0, 1, 2], [1.5, 0.5, 0.5]).contains("albedo"));
-        let zero_normal = Mesh::new("m", tri(), Some(vec![[0.0; 3]; 3]), vec![0, 1, 2], [0.5; 3]);
-        assert!(zero_normal.unwrap_err().to_string().contains("normal"));
+    }
+
+    /// A zero, NaN or infinite given normal is recomputed from the vertex's faces (area-weighted)
+    /// and counted; the good ones are kept, unit ones bit for bit, others normalized.
+    #[test]
+    fn zero_and_non_finite_normals_are_recomputed_from_the_faces() {
+        // Two triangles folded along the edge 0-1: vertex 0's faces face +Y and +Z.
+        let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 2.0, 0.0]];
+        let indices = vec![0, 1, 2, 0, 1, 3];
+        let given = vec![[0.0; 3], [f32::NAN, 0.0, 1.0], [0.0, 3.0, 0.0], [0.6, 0.0, 0.8]];
+        let (mesh, repaired) =
+            Mesh::new_reporting("m", positions.clone(), Some(given), indices.clone(), [0.5; 3]).unwrap();
+        assert_eq!(repaired, 2);
+        let computed = area_weighted_normals(&positions, &indices);
+        assert_eq!(mesh.normals, vec![computed[0], computed[1], [0.0, 1.0, 0.0], [0.6, 0.0, 0.8]]);
+        // Areas 0.5 (+Y) and 1 (+Z): the repaired normal leans to the larger face.
+        let expected = Vec3::new(0.0, 1.0, 2.0).normalize();
+        assert!(Vec3::from(mesh.normals[0]).distance(expected) < 1e-6, "{:?}", mesh.normals[0]);
+        mesh.validate().unwrap();
+
+        let infinite = vec![[f32::INFINITY, 0.0, 0.0]; 4];
+        let (_, repaired) = Mesh::new_reporting("m", positions, Some(infinite), indices, [0.5; 3]).unwrap();
+        assert_eq!(repaired, 4);
+    }
+
+    /// Tiny and huge finite normals are directions like any other: normalized, not repaired.
+    #[test]
+    fn extreme_finite_normals_are_normalized() {
+        let tri = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]];
+        let given = vec![[0.0, 1e-30, 0.0], [0.0, 3e38, 3e38], [1e-45, 0.0, 0.0]];
+        let (mesh, repaired) = Mesh::new_reporting("m", tri, Some(given), vec![0, 1, 2], [0.5; 3]).unwrap();
+        assert_eq!(repaired, 0);
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        assert_eq!(mesh.normals[0], [0.0, 1.0, 0.0]);
+        assert!(Vec3::from(mesh.normals[1]).distance(Vec3::new(0.0, h, h)) < 1e-6);
+        assert_eq!(mesh.normals[2], [1.0, 0.0, 0.0]);
+    }
+
+    /// A bad normal at a vertex whose faces are all degenerate has no face normal to take: it
+    /// gets +Y, as a computed normal there does.
+    #[test]
+    fn a_bad_normal_among_degenerate_faces_gets_plus_y() {
+        let (mesh, repaired) = Mesh::new_reporting(
+            "m",
+            vec![[1.0, 2.0, 3.0]; 3],
+            Some(vec![[0.0; 3]; 3]),
+            vec![0, 1, 2],
+            [0.5; 3],
+        )
+        .unwrap();
+        assert_eq!(repaired, 3);
+        assert_eq!(mesh.normals, vec![[0.0, 1.0, 0.0]; 3]);
+    }
+
+    /// Hand-filled meshes are checked, not repaired: `validate` still refuses a zero normal.
+    #[test]
+    fn validate_refuses_a_zero_normal() {
+        let mut mesh =
+            Mesh::new("m", vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]], None, vec![0, 1, 2], [0.5; 3])
+                .unwrap();
+        mesh.normals[1] = [0.0; 3];
+        let error = mesh.validate().unwrap_err().to_string();
+        assert!(error.contains("normal 1") && error.contains("non-zero"), "{error}");
     }
 }

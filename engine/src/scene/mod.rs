@@ -13,7 +13,9 @@
 //!   (j + ½) / height). See [`envmap`] for the details and [`direction_to_uv`] for the code.
 //! - The camera's projection targets Vulkan clip space (depth 0..1) with +Y world up in the image.
 //!
-//! Scenes come from JSON files ([`file`](mod@file) documents the schema), from the built-in set
+//! Scenes come from JSON files ([`file`](mod@file) documents the schema), from a glTF 2.0 or
+//! OBJ file read alone ([`Scene::load`]: a constant sky of radiance 1, the whole model in view,
+//! an OBJ at albedo [`LONE_OBJ_ALBEDO`] with no ground added), from the built-in set
 //! ([`BUILTIN`]), or from code. Every loading error is a [`SceneError`] naming the file and the
 //! problem.
 use glam::Vec3;
@@ -47,6 +49,7 @@ pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use error::SceneError;
 pub use export::{SceneFormat, ENVIRONMENT_FILE, GLTF_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
+pub use load::LONE_OBJ_ALBEDO;
 pub use load::{Loaded, DEFAULT_SKY};
 pub use mesh::Mesh;
 pub use motion::Motion;
@@ -60,6 +63,10 @@ pub use sun_map::SunMap;
 /// at 1e6 a 4096² map's texel is still finer than the scene's extent over 1e3.
 pub const MAX_EXTENT: f32 = 1e6;
 pub use transform::Transform;
+
+/// What a `--scene` argument ending in one of these (any case) names: a scene file, even
+/// where there is none to read (the error names the file, not a missing built-in scene).
+const SCENE_EXTENSIONS: [&str; 4] = [".json", ".gltf", ".glb", ".obj"];
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -111,10 +118,11 @@ pub fn check_extent(translation: Vec3, scale: f32, object_reach: f32) -> Result<
 }
 
 impl Scene {
-    /// Reads a scene file: JSON (relative paths inside it are relative to its folder), or glTF
-    /// 2.0 by its extension, .gltf or .glb ([`gltf`]). A file that gives no environment (a glTF
-    /// file alone, a scene file without one) is lit by a constant sky of radiance
-    /// [`DEFAULT_SKY`]; [`Scene::read`] says when.
+    /// Reads a scene file: JSON (relative paths inside it are relative to its folder), or by
+    /// its extension (any case) glTF 2.0, .gltf or .glb ([`gltf`]), or a Wavefront .obj. A model
+    /// file read alone is lit by a constant sky of radiance 1 and, without a camera of its own,
+    /// viewed whole from the front; an OBJ is one group at rest of albedo
+    /// [`LONE_OBJ_ALBEDO`], with no ground added. A note on stderr says so; [`Scene::read`] says whether the sky is the default.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         Scene::read(path).map(|loaded| loaded.scene)
     }
@@ -124,6 +132,7 @@ impl Scene {
         let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         match extension.as_deref() {
             Some("gltf" | "glb") => load::gltf_alone(path),
+            Some("obj") => load::obj_alone(path),
             _ => load::load(path),
         }
     }
@@ -133,8 +142,8 @@ impl Scene {
         builtin::builtin(name)
     }
 
-    /// What a `--scene` argument means: an existing file or a name ending in `.json` is a scene
-    /// file, a folder holding [`SCENE_FILE`] (as [`Scene::export`] writes it) that file, then a
+    /// What a `--scene` argument means: an existing file or a name ending in `.json`, `.gltf`,
+    /// `.glb` or `.obj` (any case) is a scene file ([`Scene::load`]), a folder holding [`SCENE_FILE`] (as [`Scene::export`] writes it) that file, then a
     /// built-in name is that scene (so a folder named like a built-in scene does not hide it),
     /// and any other existing path is a file that cannot be read (a folder without
     /// [`SCENE_FILE`], a device, a FIFO): an error naming it, not "no built-in scene".
@@ -149,7 +158,7 @@ impl Scene {
         let path = Path::new(arg);
         if path.join(SCENE_FILE).is_file() {
             Scene::read(&path.join(SCENE_FILE))
-        } else if path.is_file() || [".json", ".gltf", ".glb"].iter().any(|e| arg.ends_with(e)) {
+        } else if path.is_file() || SCENE_EXTENSIONS.iter().any(|e| arg.to_ascii_lowercase().ends_with(e)) {
             Scene::read(path)
         } else if BUILTIN.contains(&arg) {
             builtin(arg)
