@@ -449,3 +449,66 @@ pub fn capture_at(
     let groups = ProbeGroups::of(scene);
     positions.iter().map(|p| capture.capture(gpu, |g| groups.is_static(g), p.as_vec3())).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::motion::Key;
+    use crate::scene::{shapes, Camera, EnvMap, Group, Motion, Transform};
+
+    fn group(name: &str, at: Vec3, moves: bool) -> Group {
+        let mesh = shapes::boxes(name, &[([-0.5; 3], [0.5; 3])], [0.5; 3]).unwrap();
+        let transform = Transform { translation: at, ..Transform::default() };
+        let motion = moves.then(|| Motion { keys: vec![Key::posed(0.0, transform)], loop_seconds: None });
+        Group { name: name.into(), meshes: vec![mesh], transform, motion }
+    }
+
+    fn scene(groups: Vec<Group>) -> Scene {
+        Scene {
+            name: "boxes".into(),
+            groups,
+            environment: EnvMap::constant([1.0; 3]),
+            lights: vec![],
+            walkthrough: vec![],
+            probes: vec![],
+            exposure: 1.0,
+            camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        }
+    }
+
+    #[test]
+    fn the_moving_groups_are_those_with_keyframes_wherever_they_are() {
+        let groups = vec![group("floor", Vec3::ZERO, false), group("ball", Vec3::X * 9.0, true)];
+        let moving = ProbeGroups::of(&scene(groups.clone()));
+        assert_eq!((moving.moving(), moving.fallback()), (&[1][..], false));
+        assert!(moving.is_static(0) && moving.is_moving(1));
+        let mut three = groups.clone();
+        three.push(group("cart", Vec3::Y * 9.0, true));
+        assert_eq!(ProbeGroups::of(&scene(three)).moving(), [1, 2]);
+        // Without keyframes the first group moves.
+        let still = vec![group("ball", Vec3::X * 9.0, false), group("floor", Vec3::ZERO, false)];
+        let fallback = ProbeGroups::of(&scene(still));
+        assert_eq!((fallback.moving(), fallback.fallback()), (&[0][..], true));
+        assert!(ProbeGroups::of(&scene(vec![])).moving().is_empty());
+    }
+
+    #[test]
+    fn the_probes_span_the_static_groups_alone_whatever_their_order() {
+        // The moving ball far away leaves the grid over the floor's unit box either way.
+        for groups in [
+            vec![group("floor", Vec3::ZERO, false), group("ball", Vec3::X * 9.0, true)],
+            vec![group("ball", Vec3::X * 9.0, true), group("floor", Vec3::ZERO, false)],
+        ] {
+            let lattice = grid_lattice(&scene(groups), [2; 3]).unwrap();
+            let (lo, hi) = bounds(lattice.positions().iter().map(|p| p.as_vec3())).unwrap();
+            assert!(
+                lo.abs_diff_eq(Vec3::splat(-0.25), 1e-6) && hi.abs_diff_eq(Vec3::splat(0.25), 1e-6),
+                "{lo} {hi}"
+            );
+        }
+        // Every group moving leaves none to place probes in, and the message says which move.
+        let all = scene(vec![group("ball", Vec3::ZERO, true), group("cart", Vec3::X, true)]);
+        let error = ProbeSettings::default().positions(&all).unwrap_err().to_string();
+        assert!(error.contains("no static group") && error.contains("group 1 (\"cart\")"), "{error}");
+    }
+}
