@@ -3,12 +3,13 @@
 //! irradiance from the probes, E(n) = nᵀMn (Ramamoorthi & Hanrahan 2001) with M from the SH
 //! interpolated at that group's centre by its own walker, which starts where its last frame's
 //! lookup ended (one lookup per moving group per frame, on the host; with trilinear
-//! interpolation, from the grid cell instead), into its own `ProbeLight` uniform buffer, bound
-//! for its draws; negative irradiance is clamped; times albedo / π. The static groups keep their own lighting
-//! in the same frame and depth buffer: the unshadowed technique's (environment SH, no shadows)
-//! or Sloan's PRT (self-shadowed among the static groups: walls shade each other). The probes
-//! are captured once, when the technique is built, with the environment unrotated: turning the
-//! environment afterwards turns the static groups' light, not the probes'.
+//! interpolation, from the grid cell instead), written to its own `ProbeLight` uniform buffer
+//! and bound for its draws; negative irradiance is clamped; times albedo / π. The static groups
+//! keep their own lighting in the same frame and depth buffer: the unshadowed technique's
+//! (environment SH, no shadows) or Sloan's PRT (self-shadowed among the static groups: walls
+//! shade each other). The probes are captured once, when the technique is built, with the
+//! environment unrotated: turning the environment afterwards turns the static groups' light,
+//! not the probes'.
 use super::set::{bounds, ProbeGroups, ProbeSet, ProbeSettings, StaticLighting};
 use super::Walker;
 use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, Depth, GraphicsPipeline, MemoryLocation};
