@@ -154,7 +154,9 @@ enum kage_technique
   KAGE_TECHNIQUE_SHADOW_MAP = 5,
   /**
    * Morishige 2014: light probes captured as SH when the renderer is made light the scene's
-   * first group (the moving one); the other groups are lit as the probe statics say.
+   * moving groups (those with keyframes, each at its own place; a scene without any moves its
+   * first group, with a note); the other groups are captured by the probes and lit as the
+   * probe statics say.
    */
   KAGE_TECHNIQUE_PROBES = 4,
   /**
@@ -281,7 +283,7 @@ typedef uint32_t kage_probe_interpolation;
 #endif // __cplusplus
 
 /**
- * How the static groups are lit in the frame the probes light the moving group in.
+ * How the static groups are lit in the frame the probes light the moving groups in.
  */
 enum kage_static_lighting
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L

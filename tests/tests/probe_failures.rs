@@ -18,7 +18,8 @@ fn sun_map() -> EnvMap {
     EnvMap::from_pixels(w, h, pixels).unwrap()
 }
 
-/// A small sphere (the moving group) over a floor, under the sun.
+/// A small sphere over a floor, under the sun. No group has keyframes, so the first, the sphere,
+/// is the moving one the probes light (`ProbeGroups`' fallback).
 fn sun_scene() -> Scene {
     let group = |name: &str, mesh, y: f32| Group {
         name: name.into(),

@@ -1,15 +1,18 @@
-//! Light probes in use: the probes technique renders, and probe-interpolated irradiance in
-//! probe-room checked against the ray-cast ground truth with a bound derived per point.
+//! Light probes in use: the probes technique renders, the moving groups (those with keyframes,
+//! wherever they are in the scene) each lit by their own lookup, and probe-interpolated
+//! irradiance in probe-room checked against the ray-cast ground truth with a bound derived per
+//! point.
 use glam::{Mat4, Vec3};
 use kage::frame::GpuScene;
 use kage::reference::irradiance::Point;
 use kage::reference::{surface_radiance, IrradianceReference};
 use kage::renderer::{RenderOptions, Renderer};
-use kage::scene::{Light, Scene};
+use kage::scene::motion::Key;
+use kage::scene::{shapes, Camera, EnvMap, Group, Light, Motion, Scene, Transform};
 use kage::techniques::description::TechniqueDesc;
 use kage::techniques::probes::{
-    is_static, CaptureSettings, CapturedLight, ProbeCapture, ProbePlacement, ProbeSet, ProbeSettings, Walker,
-    MOVING_GROUP, RADIANCE_SEED,
+    CaptureSettings, CapturedLight, ProbeCapture, ProbeGroups, ProbePlacement, ProbeSet, ProbeSettings,
+    Walker, RADIANCE_SEED,
 };
 use kage_tests::Validated;
 
@@ -40,10 +43,11 @@ fn the_moving_bunny_takes_the_walls_colours_from_the_probes() {
     let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
     // Two frames, the first with the bunny near the green wall: the second frame's walk starts
     // from the first's tetrahedron.
-    let rest = scene.groups[MOVING_GROUP].transform.matrix();
-    renderer.set_group_transform(MOVING_GROUP, Mat4::from_translation(Vec3::X) * rest).unwrap();
+    let bunny = ProbeGroups::of(&scene).moving()[0];
+    let rest = scene.groups[bunny].transform.matrix();
+    renderer.set_group_transform(bunny, Mat4::from_translation(Vec3::X) * rest).unwrap();
     renderer.render().unwrap();
-    renderer.set_group_transform(MOVING_GROUP, rest).unwrap();
+    renderer.set_group_transform(bunny, rest).unwrap();
     renderer.render().unwrap();
     let image = renderer.image().unwrap();
     let at = |x: u32, y: u32| image.pixels[(y * image.width + x) as usize];
@@ -114,7 +118,10 @@ fn interpolated_irradiance_matches_the_ray_cast_reference_within_its_derived_bou
     let mut scene = Scene::builtin("probe-room").unwrap();
     // The probes leave the moving bunny out; so does the reference, with the bunny moved under
     // the floor.
-    scene.groups[MOVING_GROUP].transform.translation = Vec3::new(0.0, -50.0, 0.0);
+    let groups = ProbeGroups::of(&scene);
+    for &g in groups.moving() {
+        scene.groups[g].transform.translation = Vec3::new(0.0, -50.0, 0.0);
+    }
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
     // Sky only: the light paths the reference integrates (environment, full visibility).
     let settings = ProbeSettings {
@@ -140,7 +147,7 @@ fn interpolated_irradiance_matches_the_ray_cast_reference_within_its_derived_bou
         let location = walker.locate(&set.mesh, p.as_dvec3()).unwrap();
         assert!(!location.extrapolated, "{p} is outside the probes' hull");
         let interpolated = set.interpolate(&mut walker, p).unwrap().irradiance(n);
-        let direct_sh = capture.capture(&gpu, is_static, p).unwrap();
+        let direct_sh = capture.capture(&gpu, |g| groups.is_static(g), p).unwrap();
         let direct = direct_sh.irradiance(n);
         for k in 0..3 {
             let exact = statistics.mean[i][k];
@@ -189,9 +196,12 @@ fn interpolated_irradiance_matches_the_ray_cast_reference_within_its_derived_bou
 fn captured_scene_light_matches_the_reference_with_bounces() {
     let ctx = Validated::new();
     let mut scene = Scene::builtin("probe-room").unwrap();
-    // No moving group: the reference's scene is then exactly the probes' static one, so both
+    // No moving meshes: the reference's scene is then exactly the probes' static one, so both
     // compute the walls' radiance from the same vertices with the same seed.
-    scene.groups[MOVING_GROUP].meshes.clear();
+    let groups = ProbeGroups::of(&scene);
+    for &g in groups.moving() {
+        scene.groups[g].meshes.clear();
+    }
     scene.lights.push(Light::Point { position: Vec3::new(1.2, 2.2, -1.0), intensity: [0.02, 0.015, 0.01] });
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
     let capture = CaptureSettings {
@@ -216,7 +226,7 @@ fn captured_scene_light_matches_the_reference_with_bounces() {
     let mut probe = ProbeCapture::new(&ctx, &scene, capture).unwrap();
     for (i, point) in points.iter().enumerate() {
         let (p, n) = (Vec3::from(point.position), Vec3::from(point.normal).normalize());
-        let sh = probe.capture(&gpu, is_static, p).unwrap();
+        let sh = probe.capture(&gpu, |g| groups.is_static(g), p).unwrap();
         let e = sh.irradiance(n);
         for k in 0..3 {
             let exact = statistics.mean[i][k];
@@ -240,4 +250,177 @@ fn captured_scene_light_matches_the_reference_with_bounces() {
             assert!(exact - direct[i][k] > 0.05 * exact, "point {i} channel {k}: no bounce light");
         }
     }
+}
+
+/// Open sky to the right (x > 0), a roof over the left (x < 0): a card there sees much less sky.
+fn shelter() -> Group {
+    let boxes = [([-2.5, -0.1, -1.5], [2.5, 0.0, 1.5]), ([-2.5, 1.2, -1.5], [0.0, 1.3, 1.5])];
+    let mesh = shapes::boxes("shelter", &boxes, [0.5; 3]).unwrap();
+    Group { name: "shelter".into(), meshes: vec![mesh], transform: Transform::default(), motion: None }
+}
+
+/// Where a card is in the open and under the roof, between the probes.
+const BRIGHT: Vec3 = Vec3::new(1.2, 0.5, 0.05);
+const DARK: Vec3 = Vec3::new(-1.2, 0.5, 0.05);
+const CARD_ALBEDO: [f32; 3] = [0.8, 0.7, 0.6];
+
+/// A small cube at `at` (its centre), with keyframes holding it there when `moves`.
+fn card(name: &str, at: Vec3, moves: bool) -> Group {
+    let mesh = shapes::boxes(name, &[([-0.3; 3], [0.3; 3])], CARD_ALBEDO).unwrap();
+    let transform = Transform { translation: at, ..Transform::default() };
+    let motion = moves.then(|| Motion { keys: vec![Key::posed(0.0, transform)], loop_seconds: None });
+    Group { name: name.into(), meshes: vec![mesh], transform, motion }
+}
+
+fn shelter_scene(groups: Vec<Group>) -> Scene {
+    Scene {
+        name: "shelter".into(),
+        groups,
+        environment: EnvMap::constant([1.0; 3]),
+        lights: vec![],
+        walkthrough: vec![],
+        probes: vec![],
+        exposure: 1.0,
+        camera: Camera {
+            position: Vec3::new(0.0, 0.6, 4.5),
+            target: Vec3::new(0.0, 0.6, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 50.0,
+        },
+    }
+}
+
+/// 2 × 2 × 2 probes over the shelter's box (x = ±1.25, y = 0.25 and 0.95, z = ±0.75), sky only.
+fn shelter_probes() -> ProbeSettings {
+    ProbeSettings {
+        placement: ProbePlacement::Grid([2, 2, 2]),
+        capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
+        ..Default::default()
+    }
+}
+
+const SIZE: u32 = 32;
+
+fn renderer(ctx: &Validated, scene: &Scene, technique: TechniqueDesc) -> Renderer {
+    let options = RenderOptions { width: SIZE, height: SIZE, technique, transfer: None };
+    Renderer::new(ctx, scene, &options).unwrap()
+}
+
+fn probes_technique() -> TechniqueDesc {
+    TechniqueDesc::Probes { probes: shelter_probes(), prt: kage::prt::PrtParams::DEFAULT }
+}
+
+fn frame(renderer: &mut Renderer) -> Vec<[f32; 4]> {
+    renderer.render().unwrap();
+    renderer.image().unwrap().pixels
+}
+
+/// The radiance the probes give a card face of normal `n` with its centre at `at`, computed
+/// as probe_scene.frag does: albedo / π · max((n, 1)ᵀ M (n, 1), 0), M from the SH that `set`
+/// interpolates there.
+fn predicted(set: &ProbeSet, at: Vec3, n: Vec3) -> [f32; 3] {
+    let matrices = set.interpolate(&mut Walker::default(), at).unwrap().irradiance_matrix();
+    let v = n.extend(1.0);
+    std::array::from_fn(|k| CARD_ALBEDO[k] / std::f32::consts::PI * v.dot(matrices[k] * v).max(0.0))
+}
+
+/// The faces of a card the camera sees (front, and the side towards the camera's axis).
+const FACES: [Vec3; 3] = [Vec3::Z, Vec3::X, Vec3::NEG_X];
+
+/// Checks the pixels of `probes` that differ from the unshadowed render `unshadowed` (the
+/// probe-lit cards': the shelter is lit alike by both) against the probes' prediction for the
+/// card at `left` (image columns left of the middle) or at `right`: each is one of the visible
+/// faces' radiance, and the front face's is seen. Returns the front face's prediction at each.
+fn check_cards(
+    set: &ProbeSet,
+    probes: &[[f32; 4]],
+    unshadowed: &[[f32; 4]],
+    left: Option<Vec3>,
+    right: Option<Vec3>,
+) -> [Option<[f32; 3]>; 2] {
+    let faces = |at: Vec3| FACES.map(|n| predicted(set, at, n));
+    let sides = [left.map(faces), right.map(faces)];
+    let near = |p: [f32; 4], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() <= 1e-4 * q[k] + 1e-6);
+    let (mut front, mut statics) = ([0; 2], 0);
+    for (i, (p, u)) in probes.iter().zip(unshadowed).enumerate() {
+        if p == u {
+            statics += 1;
+            continue;
+        }
+        let side = usize::from(i as u32 % SIZE >= SIZE / 2);
+        let Some(expected) = sides[side] else {
+            panic!("pixel {i}: {p:?} differs from {u:?} where no card is")
+        };
+        let face = expected.iter().position(|&q| near(*p, q));
+        let face =
+            face.unwrap_or_else(|| panic!("pixel {i}: {p:?} is none of the card's faces {expected:?}"));
+        front[side] += usize::from(face == 0);
+    }
+    // The shelter is lit by the probe statics' own technique (unshadowed): most of the image.
+    assert!(statics > (SIZE * SIZE / 2) as usize, "only {statics} pixels are lit as the static groups");
+    for side in 0..2 {
+        if sides[side].is_some() {
+            assert!(front[side] >= 4, "{} front pixels of the card on side {side}", front[side]);
+        }
+    }
+    [sides[0].map(|f| f[0]), sides[1].map(|f| f[0])]
+}
+
+/// The static shelter first and the keyframed card second (as Blender writes nodes in creation
+/// order): the card, not the shelter, is lit by the probes, its shade follows the probes as it
+/// moves from the open to under the roof, and the shelter keeps its own lighting.
+#[test]
+fn a_moving_group_after_the_static_one_takes_the_probes_light_where_it_goes() {
+    let ctx = Validated::new();
+    let scene = shelter_scene(vec![shelter(), card("card", BRIGHT, true)]);
+    assert_eq!(ProbeGroups::of(&scene).moving(), [1]);
+    let gpu = GpuScene::new(&ctx, &scene).unwrap();
+    let set = ProbeSet::capture(&ctx, &scene, &gpu, &shelter_probes(), &mut kage::progress::silent).unwrap();
+    let mut unshadowed = renderer(&ctx, &scene, TechniqueDesc::Unshadowed);
+    let mut probes = renderer(&ctx, &scene, probes_technique());
+
+    let [_, bright] = check_cards(&set, &frame(&mut probes), &frame(&mut unshadowed), None, Some(BRIGHT));
+    let dark_pose = Mat4::from_translation(DARK);
+    probes.set_group_transform(1, dark_pose).unwrap();
+    unshadowed.set_group_transform(1, dark_pose).unwrap();
+    let [dark, _] = check_cards(&set, &frame(&mut probes), &frame(&mut unshadowed), Some(DARK), None);
+    let (bright, dark) = (bright.unwrap(), dark.unwrap());
+    eprintln!("front face in the open {bright:?}, under the roof {dark:?}");
+    // The roof hides the sky above the card: the probes there say it is darker.
+    assert!((0..3).all(|k| dark[k] < 0.8 * bright[k]), "open {bright:?}, under the roof {dark:?}");
+}
+
+/// The groups' order changes no pixel: the static shelter lit the same, the keyframed card lit
+/// by the probes the same, whether the card comes first or second; and a scene without any
+/// keyframes lights its first group from the probes (the fallback), here the same card.
+#[test]
+fn the_groups_order_changes_no_pixel_and_without_keyframes_the_first_group_moves() {
+    let ctx = Validated::new();
+    let render = |groups| frame(&mut renderer(&ctx, &shelter_scene(groups), probes_technique()));
+    let card_first = render(vec![card("card", BRIGHT, true), shelter()]);
+    let card_second = render(vec![shelter(), card("card", BRIGHT, true)]);
+    let no_keyframes = render(vec![card("card", BRIGHT, false), shelter()]);
+    assert!(card_first == card_second, "the groups' order changed the image");
+    assert!(card_first == no_keyframes, "without keyframes the first group is not the probe-lit one");
+    let scene = shelter_scene(vec![card("card", BRIGHT, false), shelter()]);
+    let groups = ProbeGroups::of(&scene);
+    assert!(groups.fallback() && groups.moving() == [0]);
+    let unshadowed = frame(&mut renderer(&ctx, &scene, TechniqueDesc::Unshadowed));
+    assert!(card_first != unshadowed, "the card is lit by the probes");
+}
+
+/// Two keyframed cards, one in the open and one under the roof, in one frame: each looks up its
+/// own light at its own centre.
+#[test]
+fn two_moving_groups_each_take_the_light_at_their_own_place() {
+    let ctx = Validated::new();
+    let scene = shelter_scene(vec![shelter(), card("open", BRIGHT, true), card("roofed", DARK, true)]);
+    assert_eq!(ProbeGroups::of(&scene).moving(), [1, 2]);
+    let gpu = GpuScene::new(&ctx, &scene).unwrap();
+    let set = ProbeSet::capture(&ctx, &scene, &gpu, &shelter_probes(), &mut kage::progress::silent).unwrap();
+    let probes = frame(&mut renderer(&ctx, &scene, probes_technique()));
+    let unshadowed = frame(&mut renderer(&ctx, &scene, TechniqueDesc::Unshadowed));
+    let [dark, bright] = check_cards(&set, &probes, &unshadowed, Some(DARK), Some(BRIGHT));
+    let (bright, dark) = (bright.unwrap(), dark.unwrap());
+    assert!((0..3).all(|k| dark[k] < 0.8 * bright[k]), "open {bright:?}, under the roof {dark:?}");
 }

@@ -3,9 +3,9 @@
 //! for automatic placement with tetrahedral interpolation (Morishige 2014).
 //!
 //! Test points: random points in the moving group's bounding box at random times of its
-//! motion (`--animate`: its keyframes), those inside a solid dropped, each with random normals.
-//! Truth: the reference's irradiance E(p, n) (the moving group moved far away, as the probes
-//! leave it out), cached. Error: the RMS of |E_probes − E| over points, normals and channels
+//! motion (`--animate`: its keyframes; the first of the moving groups, see `ProbeGroups`), those
+//! inside a solid dropped, each with random normals. Truth: the reference's irradiance E(p, n)
+//! (every moving group moved far away, as the probes leave them out), cached. Error: the RMS of |E_probes − E| over points, normals and channels
 //! divided by the RMS of E (a relative error that dark normals cannot blow up).
 //!
 //! Captures are shared: the grid levels are captured once each, and automatic placement's
@@ -27,8 +27,8 @@ use kage::reference::IrradianceReference;
 use kage::scene::Scene;
 use kage::sh::ShRgb9;
 use kage::techniques::probes::{
-    bounds, capture_at, grid_lattice, CaptureSettings, Lattice, ProbeSet, Solids, Walker, MAX_GRID,
-    MOVING_GROUP,
+    bounds, capture_at, grid_lattice, CaptureSettings, Lattice, ProbeGroups, ProbeSet, Solids, Walker,
+    MAX_GRID,
 };
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -42,8 +42,8 @@ pub const DEFAULT_TOLERANCES: [f32; 6] = [0.5, 0.35, 0.25, 0.1, 0.05, 0.025];
 
 #[derive(Args)]
 pub struct ProbeCountArgs {
-    /// Built-in scene names or scene files, each with a moving group 0 (`--scenes` is the old
-    /// name).
+    /// Built-in scene names or scene files, each with a moving group (a group with keyframes;
+    /// the test points follow the first of them; `--scenes` is the old name).
     #[arg(long = "scene", alias = "scenes", value_delimiter = ',', default_values_t = ["probe-room".to_string(), "atrium".to_string()])]
     scenes: Vec<String>,
     /// Grid levels: probes along the static box's longest side (the others in proportion, at
@@ -342,7 +342,7 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
     let points = test_points(scene, &solids, params, static_box)?;
     let (truth, noise, reference_seconds) = reference(ctx, scene, &points, params)?;
 
-    // The probes leave the moving group out of their captures; it stays where it is.
+    // The probes leave the moving groups out of their captures; they stay where they are.
     let gpu = GpuScene::new(ctx, scene)?;
     let rms_truth = (truth.iter().flatten().map(|&e| e * e).sum::<f64>() / (3 * truth.len()) as f64).sqrt();
     let error = |set: &ProbeSet| -> Result<f64> {
@@ -355,7 +355,7 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         Ok((sum / (3 * truth.len()) as f64).sqrt() / rms_truth)
     };
 
-    let path = path_bounds(&scene.groups[MOVING_GROUP], static_box)
+    let path = path_bounds(&scene.groups[moving_group(scene)?], static_box)
         .filter(|(lo, hi)| (*hi - *lo).min_element() > 0.0)
         .context("the moving group's path has no volume inside the static box")?;
 
@@ -441,6 +441,15 @@ fn squared_error(sh: &ShRgb9, point: &Point, exact: &[f64; 3]) -> f64 {
     (0..3).map(|k| (f64::from(e[k].max(0.0)) - exact[k]).powi(2)).sum()
 }
 
+/// The moving group whose path the test points follow: the first of the probes' moving groups
+/// ([`ProbeGroups`]: those with keyframes, or the first group in a scene without any).
+fn moving_group(scene: &Scene) -> Result<usize> {
+    match ProbeGroups::of(scene).moving().first() {
+        Some(&g) => Ok(g),
+        None => bail!("scene {} has no moving group to take a path from", scene.name),
+    }
+}
+
 /// `normals` points per position, each with random normals: random positions outside solids,
 /// in the moving group's bounding box at random times of its motion (`TestRegion::Path`) or in
 /// the static box (`TestRegion::Box`).
@@ -451,9 +460,7 @@ fn test_points(
     static_box: (Vec3, Vec3),
 ) -> Result<Vec<Point>> {
     let (positions, normals) = (params.points, params.normals);
-    let Some(group) = scene.groups.get(MOVING_GROUP) else {
-        bail!("scene {} has no moving group (group {MOVING_GROUP}) to take a path from", scene.name)
-    };
+    let group = &scene.groups[moving_group(scene)?];
     let corners = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
     let Some((lo, hi)) = bounds(corners) else {
         bail!("the moving group of scene {} has no vertices", scene.name)
@@ -518,7 +525,9 @@ fn reference(
         Some(c) => c.irradiance,
         None => {
             let mut away = scene.clone();
-            away.groups[MOVING_GROUP].transform.translation += Vec3::new(0.0, -1e4, 0.0);
+            for &g in ProbeGroups::of(scene).moving() {
+                away.groups[g].transform.translation += Vec3::new(0.0, -1e4, 0.0);
+            }
             let mut reference = IrradianceReference::new(ctx, &away, points, 11)?;
             let batch = 512;
             let mut left = params.spp;

@@ -65,7 +65,7 @@ pub struct RenderArgs {
     /// How the light between probes is found: `trilinear` needs a `grid:` placement.
     #[arg(long, value_enum, default_value_t = ProbeInterpolation::Tetrahedral)]
     probe_interpolation: ProbeInterpolation,
-    /// How the probes technique lights the static groups beside the probe-lit moving group.
+    /// How the probes technique lights the static groups beside the probe-lit moving ones.
     #[arg(long, value_enum, default_value_t = StaticLighting::Unshadowed)]
     probe_statics: StaticLighting,
     /// Texels per side of a probe's cube-map face, 8 to 256.

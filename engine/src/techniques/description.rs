@@ -52,7 +52,9 @@ pub enum TechniqueKind {
     #[cfg_attr(feature = "clap", value(name = "shadowmap"))]
     ShadowMap = 5,
     /// Morishige 2014: light probes captured as SH when the renderer is made light the scene's
-    /// first group (the moving one); the other groups are lit as the probe statics say.
+    /// moving groups (those with keyframes, each at its own place; a scene without any moves its
+    /// first group, with a note); the other groups are captured by the probes and lit as the
+    /// probe statics say.
     Probes = 4,
     /// Adaptive shadow maps (Fernando et al. 2001) for the scene's one point or spot light: a
     /// quadtree of tiles in a page pool of a memory budget, refined where the eye sees shadow

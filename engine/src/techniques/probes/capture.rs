@@ -22,7 +22,7 @@
 //! more than [`MAX_BACK_FACES`] of the directions do. A probe in open space sees no back face;
 //! one just behind a single-sided wall sees its back over about half the sphere.
 use super::dering::Dering;
-use super::set::is_static;
+use super::set::ProbeGroups;
 use crate::backend::{
     vk, Binding, BindingKind, Buffer, BufferDesc, Context, Depth, DepthTest, Edge, GraphicsPipeline, Image,
     ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
@@ -197,8 +197,9 @@ pub struct ProbeCapture {
 }
 
 impl ProbeCapture {
-    /// Uploads `scene`'s environment and computes the radiance of its static groups ([`is_static`])
-    /// once, lit by everything static (the moving group casts no shadow on them).
+    /// Uploads `scene`'s environment and computes the radiance of its static groups
+    /// ([`ProbeGroups::is_static`]) once, lit by everything static (the moving groups cast no
+    /// shadow on them).
     pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: CaptureSettings) -> Result<ProbeCapture> {
         let settings = settings.validated()?;
         let side = settings.cube_size;
@@ -254,8 +255,9 @@ impl ProbeCapture {
     }
 
     /// The SH of the radiance arriving at `position`: the meshes of `scene` whose group
-    /// `is_static` accepts, and the environment (not rotated) behind them. A mesh of the
-    /// module's moving group that `is_static` accepts has no radiance and is drawn black.
+    /// `is_static` accepts, and the environment (not rotated) behind them. A mesh of one of the
+    /// scene's moving groups ([`ProbeGroups`]) that `is_static` accepts has no radiance and is
+    /// drawn black.
     pub fn capture(
         &mut self,
         scene: &GpuScene,
@@ -393,12 +395,13 @@ impl ProbeCapture {
     }
 }
 
-/// A copy of `scene` without the meshes of its moving group (the group stays, empty, so that
-/// group indices do not change).
+/// A copy of `scene` without the meshes of its moving groups (each stays, empty, so that group
+/// indices do not change).
 fn static_scene(scene: &Scene) -> Scene {
+    let groups = ProbeGroups::of(scene);
     let mut statics = scene.clone();
     for (g, group) in statics.groups.iter_mut().enumerate() {
-        if !is_static(g) {
+        if groups.is_moving(g) {
             group.meshes.clear();
         }
     }

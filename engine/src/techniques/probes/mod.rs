@@ -1,8 +1,10 @@
 //! Light probes (Morishige 2014).
 //!
 //! Capture ([`ProbeCapture`]): a cube map of the scene at each probe projected to SH on the GPU;
-//! [`ProbeSet`]: placement, capture and interpolation; [`technique`]: the moving group lit by
-//! the probes. The geometry:
+//! [`ProbeSet`]: placement, capture and interpolation; [`ProbeGroups`]: which groups move (those
+//! with keyframes, wherever they are in the scene; a scene without any moves its first group)
+//! and which are static (captured by the probes, lit by their own technique); [`technique`]:
+//! each moving group lit by the probes with its own lookup. The geometry:
 //!
 //! Automatic placement ([`ProbePlacement::Auto`]) captures a dense set of candidates, keeps
 //! those the others cannot reproduce ([`reduce`]), moves each kept one to the nearby candidate
@@ -51,8 +53,8 @@ pub use lookup::{Location, Walker};
 pub use reduce::reduce;
 pub use relocate::relocate;
 pub use set::{
-    bounds, capture_at, grid_lattice, is_static, ProbeCounts, ProbeInterpolation, ProbePlacement, ProbeSet,
-    ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID, MOVING_GROUP,
+    bounds, capture_at, grid_lattice, ProbeCounts, ProbeGroups, ProbeInterpolation, ProbePlacement, ProbeSet,
+    ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID,
 };
 pub use solids::{Hit, Solids};
 pub use tetmesh::{Across, TetMesh};

@@ -17,13 +17,59 @@ use crate::sh::ShRgb9;
 use glam::{DVec3, Vec3};
 use std::sync::Arc;
 
-/// The group that moves and takes its light from the probes: the first, the one
-/// `kage render --animate` moves. Every other group is static: captured by the probes and lit
-/// by its own technique.
-pub const MOVING_GROUP: usize = 0;
+/// Which groups of a scene move and take their light from the probes, and which are static:
+/// captured by the probes and lit by their own technique ([`StaticLighting`]).
+///
+/// The moving groups are those with a motion ([`crate::scene::Group::motion`]: keyframes),
+/// wherever they stand in the scene's list: Blender writes its nodes in creation order, so the
+/// animated object may well come after the ground. Each one looks its light up on its own
+/// (its own centre, its own interpolated SH).
+///
+/// A scene where no group has a motion (one built from a C host's arrays, which moves its groups
+/// with `kage_renderer_set_group_transform`, or a scene file without keyframes) falls back to
+/// its first group alone as the moving one, the rule before keyframes existed;
+/// [`ProbeGroups::fallback`] says so, and the technique prints a note. Every built-in scene's
+/// first group has a motion (the hop), so for them both rules agree.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ProbeGroups {
+    /// The moving groups' indices, increasing.
+    moving: Vec<usize>,
+    fallback: bool,
+}
 
-pub fn is_static(group: usize) -> bool {
-    group != MOVING_GROUP
+impl ProbeGroups {
+    pub fn of(scene: &Scene) -> ProbeGroups {
+        let moving: Vec<usize> =
+            (0..scene.groups.len()).filter(|&g| scene.groups[g].motion.is_some()).collect();
+        if moving.is_empty() && !scene.groups.is_empty() {
+            return ProbeGroups { moving: vec![0], fallback: true };
+        }
+        ProbeGroups { moving, fallback: false }
+    }
+
+    /// The moving groups' indices, in the scene's order.
+    pub fn moving(&self) -> &[usize] {
+        &self.moving
+    }
+
+    pub fn is_moving(&self, group: usize) -> bool {
+        self.moving.binary_search(&group).is_ok()
+    }
+
+    pub fn is_static(&self, group: usize) -> bool {
+        !self.is_moving(group)
+    }
+
+    /// No group has a motion: the first is the moving one (see [`ProbeGroups`]).
+    pub fn fallback(&self) -> bool {
+        self.fallback
+    }
+
+    /// The moving groups named for a message: `group 0 ("bunny"), group 2 ("ball")`.
+    pub fn describe(&self, scene: &Scene) -> String {
+        let name = |g: usize| format!("group {g} (\"{}\")", scene.groups[g].name);
+        self.moving.iter().map(|&g| name(g)).collect::<Vec<_>>().join(", ")
+    }
 }
 
 /// Most probes along each axis of a grid: 64³ captures would take hours on lavapipe.
@@ -73,7 +119,7 @@ impl Default for ProbePlacement {
     }
 }
 
-/// How the static groups are lit in the frame the probes light the moving group in.
+/// How the static groups are lit in the frame the probes light the moving groups in.
 #[repr(u32)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
@@ -154,8 +200,8 @@ impl ProbeSettings {
 
 /// The cell centres of a `counts` grid over the static groups' bounding box. Along an axis
 /// where that box is flat (a floor alone) every probe would lie in one plane, which no
-/// tetrahedron spans: there the grid spans the whole scene's box instead, the moving group as
-/// the scene places it included.
+/// tetrahedron spans: there the grid spans the whole scene's box instead, the moving groups as
+/// the scene places them included.
 pub fn grid_lattice(scene: &Scene, counts: [u32; 3]) -> Result<Lattice> {
     let (mut lo, mut hi) = static_bounds_of(scene)?;
     let (all_lo, all_hi) = world_bounds(scene, |_| true).unwrap_or((lo, hi));
@@ -172,17 +218,19 @@ pub fn grid_lattice(scene: &Scene, counts: [u32; 3]) -> Result<Lattice> {
 const FLAT: f32 = 1e-3;
 
 fn static_bounds_of(scene: &Scene) -> Result<(Vec3, Vec3)> {
-    static_bounds(scene).ok_or_else(|| {
+    let groups = ProbeGroups::of(scene);
+    world_bounds(scene, |g| groups.is_static(g)).ok_or_else(|| {
+        let why = if groups.fallback() {
+            ": no group has keyframes, so the first one is the moving one"
+        } else {
+            ""
+        };
         Error::InvalidArgument(format!(
-            "scene \"{}\" has no static group to place probes in (group {MOVING_GROUP} moves)",
-            scene.name
+            "scene \"{}\" has no static group to place probes in (moving: {}{why})",
+            scene.name,
+            groups.describe(scene)
         ))
     })
-}
-
-/// The world bounding box of the static groups' vertices.
-fn static_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
-    world_bounds(scene, is_static)
 }
 
 /// The world bounding box of the vertices of the groups `keep` takes (by index).
@@ -256,12 +304,13 @@ impl ProbeSet {
         }
         let candidates = positions.len();
         let cancelled = || Error::Cancelled("the light probes' capture");
+        let groups = ProbeGroups::of(scene);
         let mut sh: Vec<ShRgb9> = Vec::with_capacity(candidates);
         for p in &positions {
             if !progress(sh.len(), candidates + 1) {
                 return Err(cancelled());
             }
-            sh.push(capture.capture(gpu, is_static, p.as_vec3())?);
+            sh.push(capture.capture(gpu, |g| groups.is_static(g), p.as_vec3())?);
         }
         if !progress(candidates, candidates + 1) {
             return Err(cancelled());
@@ -397,5 +446,69 @@ pub fn capture_at(
     positions: &[DVec3],
 ) -> Result<Vec<ShRgb9>> {
     let mut capture = ProbeCapture::new(ctx, scene, settings)?;
-    positions.iter().map(|p| capture.capture(gpu, is_static, p.as_vec3())).collect()
+    let groups = ProbeGroups::of(scene);
+    positions.iter().map(|p| capture.capture(gpu, |g| groups.is_static(g), p.as_vec3())).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::motion::Key;
+    use crate::scene::{shapes, Camera, EnvMap, Group, Motion, Transform};
+
+    fn group(name: &str, at: Vec3, moves: bool) -> Group {
+        let mesh = shapes::boxes(name, &[([-0.5; 3], [0.5; 3])], [0.5; 3]).unwrap();
+        let transform = Transform { translation: at, ..Transform::default() };
+        let motion = moves.then(|| Motion { keys: vec![Key::posed(0.0, transform)], loop_seconds: None });
+        Group { name: name.into(), meshes: vec![mesh], transform, motion }
+    }
+
+    fn scene(groups: Vec<Group>) -> Scene {
+        Scene {
+            name: "boxes".into(),
+            groups,
+            environment: EnvMap::constant([1.0; 3]),
+            lights: vec![],
+            walkthrough: vec![],
+            probes: vec![],
+            exposure: 1.0,
+            camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        }
+    }
+
+    #[test]
+    fn the_moving_groups_are_those_with_keyframes_wherever_they_are() {
+        let groups = vec![group("floor", Vec3::ZERO, false), group("ball", Vec3::X * 9.0, true)];
+        let moving = ProbeGroups::of(&scene(groups.clone()));
+        assert_eq!((moving.moving(), moving.fallback()), (&[1][..], false));
+        assert!(moving.is_static(0) && moving.is_moving(1));
+        let mut three = groups.clone();
+        three.push(group("cart", Vec3::Y * 9.0, true));
+        assert_eq!(ProbeGroups::of(&scene(three)).moving(), [1, 2]);
+        // Without keyframes the first group moves.
+        let still = vec![group("ball", Vec3::X * 9.0, false), group("floor", Vec3::ZERO, false)];
+        let fallback = ProbeGroups::of(&scene(still));
+        assert_eq!((fallback.moving(), fallback.fallback()), (&[0][..], true));
+        assert!(ProbeGroups::of(&scene(vec![])).moving().is_empty());
+    }
+
+    #[test]
+    fn the_probes_span_the_static_groups_alone_whatever_their_order() {
+        // The moving ball far away leaves the grid over the floor's unit box either way.
+        for groups in [
+            vec![group("floor", Vec3::ZERO, false), group("ball", Vec3::X * 9.0, true)],
+            vec![group("ball", Vec3::X * 9.0, true), group("floor", Vec3::ZERO, false)],
+        ] {
+            let lattice = grid_lattice(&scene(groups), [2; 3]).unwrap();
+            let (lo, hi) = bounds(lattice.positions().iter().map(|p| p.as_vec3())).unwrap();
+            assert!(
+                lo.abs_diff_eq(Vec3::splat(-0.25), 1e-6) && hi.abs_diff_eq(Vec3::splat(0.25), 1e-6),
+                "{lo} {hi}"
+            );
+        }
+        // Every group moving leaves none to place probes in, and the message says which move.
+        let all = scene(vec![group("ball", Vec3::ZERO, true), group("cart", Vec3::X, true)]);
+        let error = ProbeSettings::default().positions(&all).unwrap_err().to_string();
+        assert!(error.contains("no static group") && error.contains("group 1 (\"cart\")"), "{error}");
+    }
 }

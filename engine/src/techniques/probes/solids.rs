@@ -2,7 +2,7 @@
 //! there see only the inside of a wall or column, and are dropped. Triangles are tested one by
 //! one (Möller & Trumbore 1997): a few thousand triangles and a few hundred points take
 //! milliseconds, and no GPU round trip.
-use super::set::is_static;
+use super::set::ProbeGroups;
 use crate::scene::Scene;
 use glam::Vec3;
 
@@ -33,12 +33,14 @@ pub(super) fn directions() -> [Vec3; 14] {
 }
 
 impl Solids {
+    /// The triangles of the static groups ([`ProbeGroups::is_static`]).
     pub fn of_static(scene: &Scene) -> Solids {
+        let groups = ProbeGroups::of(scene);
         let triangles = scene
             .groups
             .iter()
             .enumerate()
-            .filter(|(g, _)| is_static(*g))
+            .filter(|(g, _)| groups.is_static(*g))
             .flat_map(|(_, group)| {
                 let m = group.transform.matrix();
                 group.meshes.iter().flat_map(move |mesh| {
@@ -86,20 +88,23 @@ impl Solids {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{shapes, Camera, EnvMap, Group, Transform};
+    use crate::scene::motion::Key;
+    use crate::scene::{shapes, Camera, EnvMap, Group, Motion, Transform};
 
+    /// A column and, after it in the scene, a box that moves (a motion holding its rest pose).
     fn scene() -> Scene {
         let column = shapes::boxes("column", &[([0.0, 0.0, 0.0], [1.0, 3.0, 1.0])], [0.5; 3]).unwrap();
         let moving = shapes::boxes("mover", &[([5.0, 0.0, 5.0], [6.0, 1.0, 6.0])], [0.5; 3]).unwrap();
-        let group = |name: &str, mesh| Group {
+        let group = |name: &str, mesh, motion| Group {
             name: name.into(),
             meshes: vec![mesh],
             transform: Transform::default(),
-            motion: None,
+            motion,
         };
+        let held = Motion { keys: vec![Key::posed(0.0, Transform::default())], loop_seconds: None };
         Scene {
             name: "column".into(),
-            groups: vec![group("mover", moving), group("column", column)],
+            groups: vec![group("column", column, None), group("mover", moving, Some(held))],
             environment: EnvMap::constant([1.0; 3]),
             lights: vec![],
             walkthrough: vec![],
@@ -114,7 +119,7 @@ mod tests {
         let solids = Solids::of_static(&scene());
         assert!(solids.contains(Vec3::new(0.5, 1.5, 0.5)));
         assert!(!solids.contains(Vec3::new(1.5, 1.5, 0.5)));
-        // The moving group is no solid.
+        // The moving group (the second: the one with a motion) is no solid.
         assert!(!solids.contains(Vec3::new(5.5, 0.5, 5.5)));
         let hit = solids.first_hit(Vec3::new(-1.0, 1.0, 0.5), Vec3::X).unwrap();
         assert!((hit.distance - 1.0).abs() < 1e-6 && !hit.back, "{hit:?}");

@@ -1,13 +1,16 @@
-//! The light-probe technique: the moving group ([`MOVING_GROUP`]) takes its irradiance from
-//! the probes, E(n) = nᵀMn (Ramamoorthi & Hanrahan 2001) with M from the SH interpolated at the
-//! group's centre by a walker that starts where the last frame's lookup ended (one lookup per
-//! object per frame, on the host; with trilinear interpolation, from the grid cell instead);
-//! negative irradiance is clamped; times albedo / π. The static groups keep their own lighting
-//! in the same frame and depth buffer: the unshadowed technique's (environment SH, no shadows)
-//! or Sloan's PRT (self-shadowed among the static groups: walls shade each other). The probes
-//! are captured once, when the technique is built, with the environment unrotated: turning the
-//! environment afterwards turns the static groups' light, not the probes'.
-use super::set::{bounds, is_static, ProbeSet, ProbeSettings, StaticLighting, MOVING_GROUP};
+//! The light-probe technique: each moving group (those with keyframes, whatever their place in
+//! the scene; a scene without any moves its first group: see [`ProbeGroups`]) takes its
+//! irradiance from the probes, E(n) = nᵀMn (Ramamoorthi & Hanrahan 2001) with M from the SH
+//! interpolated at that group's centre by its own walker, which starts where its last frame's
+//! lookup ended (one lookup per moving group per frame, on the host; with trilinear
+//! interpolation, from the grid cell instead), written to its own `ProbeLight` uniform buffer
+//! and bound for its draws; negative irradiance is clamped; times albedo / π. The static groups
+//! keep their own lighting in the same frame and depth buffer: the unshadowed technique's
+//! (environment SH, no shadows) or Sloan's PRT (self-shadowed among the static groups: walls
+//! shade each other). The probes are captured once, when the technique is built, with the
+//! environment unrotated: turning the environment afterwards turns the static groups' light,
+//! not the probes'.
+use super::set::{bounds, ProbeGroups, ProbeSet, ProbeSettings, StaticLighting};
 use super::Walker;
 use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, Depth, GraphicsPipeline, MemoryLocation};
 use crate::error::{Error, Result};
@@ -35,16 +38,24 @@ enum Statics {
     Sloan(Box<PrtTechnique>),
 }
 
+/// A moving group and its own probe lookup.
+struct Lit {
+    group: usize,
+    /// The group's centre in its object space (its bounding box's), where it looks up its light;
+    /// `None` when it has no vertices (nothing to light).
+    centre: Option<Vec3>,
+    walker: Walker,
+    /// Its `ProbeLight`.
+    light: Buffer,
+}
+
 pub struct ProbeTechnique {
     statics: Statics,
     pipeline: GraphicsPipeline,
     set: ProbeSet,
-    /// The moving group's centre in its object space (its bounding box's), where it looks up
-    /// its light; `None` when the scene has no such group.
-    centre: Option<Vec3>,
-    walker: Walker,
-    /// `ProbeLight` of the moving group.
-    light: Buffer,
+    groups: ProbeGroups,
+    /// One per moving group, in the scene's order.
+    lit: Vec<Lit>,
 }
 
 impl ProbeTechnique {
@@ -58,10 +69,12 @@ impl ProbeTechnique {
         transfer: Option<&TransferSet>,
         progress: &mut Progress,
     ) -> Result<ProbeTechnique> {
+        let groups = ProbeGroups::of(scene);
         let statics = match (settings.statics, transfer) {
             (StaticLighting::Unshadowed, _) => Statics::Unshadowed(Unshadowed::new(ctx)?),
             (StaticLighting::Sloan, Some(transfer)) => {
-                let prt = sloan::new(ctx, scene, gpu, transfer)?.for_groups(is_static);
+                let drawn = (0..scene.groups.len()).map(|g| groups.is_static(g)).collect();
+                let prt = sloan::new(ctx, scene, gpu, transfer)?.for_groups(drawn);
                 Statics::Sloan(Box::new(prt))
             }
             (StaticLighting::Sloan, None) => {
@@ -70,25 +83,39 @@ impl ProbeTechnique {
                 ))
             }
         };
-        let centre = scene.groups.get(MOVING_GROUP).and_then(|group| {
-            let points = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
-            bounds(points).map(|(lo, hi)| (lo + hi) * 0.5)
-        });
+        let set = ProbeSet::capture(ctx, scene, gpu, settings, progress)?;
+        if groups.fallback() {
+            eprintln!(
+                "kage: note: no group of scene \"{}\" has keyframes: its first group, {}, is the moving one the probes light",
+                scene.name,
+                groups.describe(scene)
+            );
+        }
+        let lit = groups
+            .moving()
+            .iter()
+            .map(|&group| {
+                let meshes = &scene.groups[group].meshes;
+                let points = meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
+                let light = Buffer::new(
+                    ctx,
+                    &BufferDesc {
+                        name: &format!("{}.probe_light", scene.groups[group].name),
+                        size: size_of::<ProbeLight>() as u64,
+                        usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                        location: MemoryLocation::CpuToGpu,
+                    },
+                )?;
+                let centre = bounds(points).map(|(lo, hi)| (lo + hi) * 0.5);
+                Ok(Lit { group, centre, walker: Walker::default(), light })
+            })
+            .collect::<Result<_>>()?;
         Ok(ProbeTechnique {
             statics,
             pipeline: lighting_pipeline(ctx, "scene_probes", spirv::PROBE_SCENE_FRAG)?,
-            set: ProbeSet::capture(ctx, scene, gpu, settings, progress)?,
-            centre,
-            walker: Walker::default(),
-            light: Buffer::new(
-                ctx,
-                &BufferDesc {
-                    name: "probe_light",
-                    size: size_of::<ProbeLight>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
-                },
-            )?,
+            set,
+            groups,
+            lit,
         })
     }
 }
@@ -98,12 +125,15 @@ impl Technique for ProbeTechnique {
         if let Statics::Sloan(prt) = &mut self.statics {
             prt.update(state)?;
         }
-        let (Some(centre), Some(transform)) = (self.centre, state.transforms.get(MOVING_GROUP)) else {
-            return Ok(());
-        };
-        let sh = self.set.interpolate(&mut self.walker, transform.transform_point3(centre))?;
-        let [red, green, blue] = sh.irradiance_matrix().map(|m| m.to_cols_array_2d());
-        self.light.write(0, bytes_of(&ProbeLight { red, green, blue }))
+        for lit in &mut self.lit {
+            let (Some(centre), Some(transform)) = (lit.centre, state.transforms.get(lit.group)) else {
+                continue;
+            };
+            let sh = self.set.interpolate(&mut lit.walker, transform.transform_point3(centre))?;
+            let [red, green, blue] = sh.irradiance_matrix().map(|m| m.to_cols_array_2d());
+            lit.light.write(0, bytes_of(&ProbeLight { red, green, blue }))?;
+        }
+        Ok(())
     }
 
     fn persistent(&self) -> &'static [Resource] {
@@ -127,13 +157,20 @@ impl Technique for ProbeTechnique {
                 None,
                 Some(Depth::Clear((&targets.depth).into())),
             );
+            let groups = &self.groups;
             match &self.statics {
-                Statics::Unshadowed(unshadowed) => unshadowed
-                    .draw(ctx, cmd, uniforms, env_sh, scene, |m| is_static(m.group).then_some(m.albedo)),
+                Statics::Unshadowed(unshadowed) => unshadowed.draw(ctx, cmd, uniforms, env_sh, scene, |m| {
+                    groups.is_static(m.group).then_some(m.albedo)
+                }),
                 Statics::Sloan(prt) => prt.record_draws(ctx, cmd, uniforms, scene),
             }
-            self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(&self.light)]);
-            draw_lit_meshes(ctx, cmd, &self.pipeline, scene, |m| (!is_static(m.group)).then_some(m.albedo));
+            // Each moving group with its own light.
+            for lit in self.lit.iter().filter(|lit| lit.centre.is_some()) {
+                self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(&lit.light)]);
+                draw_lit_meshes(ctx, cmd, &self.pipeline, scene, |m| {
+                    (m.group == lit.group).then_some(m.albedo)
+                });
+            }
             ctx.end_rendering(cmd);
         }));
         passes

@@ -147,7 +147,7 @@ impl SelfShadow {
 
     /// Marks the groups `drawn` keeps whose orientation relative to the light changed, and
     /// rotates the environment's SH into their frames: g(ω) = L_map(R_envᵀ R_group ω).
-    pub fn update(&mut self, transforms: &[Mat4], env: Mat3, drawn: fn(usize) -> bool) -> Result<()> {
+    pub fn update(&mut self, transforms: &[Mat4], env: Mat3, drawn: impl Fn(usize) -> bool) -> Result<()> {
         for (g, transform) in transforms.iter().enumerate() {
             if !drawn(g) {
                 self.dirty[g] = false;

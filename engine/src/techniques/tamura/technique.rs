@@ -140,8 +140,9 @@ impl OcclusionSettings {
 }
 
 pub struct PrtTechnique {
-    /// The groups it lights (all, unless another technique lights some: see `for_groups`).
-    drawn: fn(usize) -> bool,
+    /// The groups it lights, by index: all (`None`) unless another technique lights some (see
+    /// `for_groups`).
+    drawn: Option<Vec<bool>>,
     self_shadow: SelfShadow,
     occlusion: Occlusion,
     dominant: DominantMaps,
@@ -190,7 +191,7 @@ impl PrtTechnique {
         let region_vec4 = regions.regions.len().div_ceil(4).max(1) as u32;
         let basis_vec4 = (bands * bands).div_ceil(4) as u32;
         Ok(PrtTechnique {
-            drawn: |_| true,
+            drawn: None,
             self_shadow: SelfShadow::new(ctx, gpu, transfer, env)?,
             occlusion: Occlusion::new(ctx, regions, &split.lights, bands, bounds.clone(), sheets, &settings)?,
             dominant: DominantMaps::new(ctx, split.lights, bounds, settings.light_map_size)?,
@@ -254,7 +255,8 @@ impl Technique for PrtTechnique {
 
     fn update(&mut self, state: &FrameState) -> Result<()> {
         let env = env_rotation(state.env_rotation);
-        self.self_shadow.update(state.transforms, env, self.drawn)?;
+        let drawn = &self.drawn;
+        self.self_shadow.update(state.transforms, env, |g| draws(drawn, g))?;
         self.dominant.update(state.transforms, env)?;
         self.occlusion.update(state.transforms, env)
     }
@@ -290,11 +292,16 @@ impl Technique for PrtTechnique {
     }
 }
 
+/// Whether a [`PrtTechnique`] whose `drawn` is `drawn` lights group `group`.
+fn draws(drawn: &Option<Vec<bool>>, group: usize) -> bool {
+    drawn.as_ref().is_none_or(|drawn| drawn.get(group).copied().unwrap_or(false))
+}
+
 impl PrtTechnique {
-    /// The technique lighting only the groups `drawn` keeps (their self-shadow texels are the
-    /// only ones kept up to date).
-    pub fn for_groups(self, drawn: fn(usize) -> bool) -> PrtTechnique {
-        PrtTechnique { drawn, ..self }
+    /// The technique lighting only the groups `drawn` keeps, by index (a group beyond its end is
+    /// not drawn); their self-shadow texels are the only ones kept up to date.
+    pub fn for_groups(self, drawn: Vec<bool>) -> PrtTechnique {
+        PrtTechnique { drawn: Some(drawn), ..self }
     }
 
     /// The passes before the scene's: the self-shadow texels of the groups that turned, and
@@ -327,7 +334,7 @@ impl PrtTechnique {
             ],
         );
         let q = occlusion.region_count() as u32;
-        for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| (self.drawn)(m.group)) {
+        for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| draws(&self.drawn, m.group)) {
             let (first_layer, layer_count) = occlusion.ranges[mesh.group];
             let model = scene.transforms[mesh.group];
             // Groups scale uniformly (scene::Transform).
