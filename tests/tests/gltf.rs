@@ -278,7 +278,7 @@ fn a_scene_file_adds_a_floor_under_a_gltf_model_and_renders() {
     let alone = Scene::read(&khronos_box()).unwrap();
     assert!(alone.default_environment);
     let names: Vec<&str> = scene.groups.iter().map(|g| g.name.as_str()).collect();
-    assert_eq!(names, ["node 0", "floor"], "the glTF's group, then the listed one");
+    assert_eq!(names, ["node0", "floor"], "the glTF's group, then the listed one");
     assert_eq!(scene.groups[0], alone.scene.groups[0]);
     assert_eq!(scene.groups[1].meshes[0].vertex_count(), 81);
     assert_eq!(scene.groups[1].transform.translation, Vec3::new(0.0, -0.5, 0.0));
