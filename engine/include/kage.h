@@ -1093,11 +1093,13 @@ kage_result kage_last_error_message(char *buffer, size_t capacity, size_t *lengt
  * Loads a scene: a path to a scene file (JSON, or glTF 2.0 .gltf/.glb or a Wavefront .obj read
  * alone; see the README), or the name of a built-in scene ("teapot", the default scene; an
  * unknown name's error lists the others). A path that exists or ends in ".json", ".gltf",
- * ".glb" or ".obj" (any case) is a file. A .gltf/.glb or .obj file read alone is lit by a
- * constant sky of radiance 1 and, without a camera of its own, viewed whole from the front; an
- * OBJ is one group at rest with albedo 0.8 in each channel and no ground added (a note on
- * stderr says so). Zero or non-finite normals in a file are recomputed from its triangles,
- * with a note.
+ * ".glb" or ".obj" (any case) is a file. A file that gives no environment (a .gltf/.glb or
+ * .obj read alone, a scene file without "environment") is lit by a constant sky of radiance 1,
+ * and nothing says so, so a host that takes such files tells its users (or gives the scene
+ * file an environment). A model file read alone without a camera of its own is viewed whole
+ * from the front; an OBJ is one group at rest with albedo 0.8 in each channel and no ground
+ * added. Zero or non-finite normals in a file are recomputed from its triangles, with a note
+ * on stderr.
  *
  * On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
  * on failure it is set to NULL, and a bad or missing file is `KAGE_RESULT_FILE`, with the file
