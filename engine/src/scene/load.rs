@@ -56,7 +56,7 @@ pub fn gltf_alone(path: &Path) -> Result<Loaded, SceneError> {
     build(file, name, folder).map_err(|e| e.attributed_to(path))
 }
 
-/// The albedo of an OBJ file read alone ([`obj_alone`]): OBJ materials are not read.
+/// The albedo of an OBJ file read alone (given straight to [`super::Scene::read`]): OBJ materials are not read.
 pub const LONE_OBJ_ALBEDO: [f32; 3] = [0.8; 3];
 
 /// An OBJ file read alone: as a scene file holding one group of it at rest, albedo
