@@ -1034,8 +1034,8 @@ kage_result kage_renderer_render(kage_renderer *renderer);
  * Copies the last frame into `pixels`, row 0 at the top, rows tightly packed, in `format` (a
  * `kage_pixel_format` value). `size` is the buffer's size in bytes and must be at least
  * width × height × bytes per pixel, else `KAGE_RESULT_BUFFER_TOO_SMALL`. `exposure` (> 0)
- * scales radiance before tonemapping `KAGE_PIXEL_FORMAT_RGBA8_SRGB`; the linear format ignores
- * it. Before the first `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
+ * scales radiance before tonemapping `KAGE_PIXEL_FORMAT_RGBA8_SRGB` (`kage_renderer_auto_exposure`
+ * gives one for any units of light); the linear format ignores it. Before the first `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
  *
  * # Safety
  * `pixels` NULL or `size`
@@ -1046,6 +1046,18 @@ kage_result kage_renderer_read_pixels(const kage_renderer *renderer,
                                       float exposure,
                                       uint8_t *pixels,
                                       size_t size);
+
+/**
+ * Writes to `*exposure` the exposure that makes the last frame readable whatever its units
+ * (what `kage render --exposure auto` uses): 0.18 over the log-average Rec. 709 luminance of
+ * its linear pixels, exp(mean ln(10⁻⁴ + L)); 1 for a black frame. Pass it to
+ * `kage_renderer_read_pixels`. Before the first `kage_renderer_render`:
+ * `KAGE_RESULT_INVALID_VALUE`.
+ *
+ * # Safety
+ * `exposure` NULL or writable.
+ */
+kage_result kage_renderer_auto_exposure(const kage_renderer *renderer, float *exposure);
 
 /**
  * Writes the last frame's device time in milliseconds to `*milliseconds`: from its first

@@ -341,6 +341,10 @@ static void check_bad_arguments(kage_context *context) {
     EXPECT(kage_renderer_frame_time(renderer, NULL), KAGE_RESULT_NULL_ARGUMENT);
     EXPECT(kage_renderer_frame_time(NULL, &frame_ms), KAGE_RESULT_NULL_ARGUMENT);
   }
+  {
+    float exposure = 0.0f;
+    EXPECT(kage_renderer_auto_exposure(renderer, &exposure), KAGE_RESULT_INVALID_VALUE); /* no frame yet */
+  }
   EXPECT(kage_renderer_render(NULL), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_render((kage_renderer *)scene), KAGE_RESULT_INVALID_HANDLE);
   CHECK(kage_renderer_render(renderer));
@@ -368,6 +372,23 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA32F_LINEAR, 1.0f, pixels, 8 * 8 * 16 - 1),
          KAGE_RESULT_BUFFER_TOO_SMALL);
   CHECK(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA32F_LINEAR, 1.0f, pixels, sizeof pixels));
+  /* The auto exposure brings the frame's log-average luminance to 0.18, as documented. */
+  {
+    float exposure = 0.0f;
+    EXPECT(kage_renderer_auto_exposure(NULL, &exposure), KAGE_RESULT_NULL_ARGUMENT);
+    EXPECT(kage_renderer_auto_exposure(renderer, NULL), KAGE_RESULT_NULL_ARGUMENT);
+    CHECK(kage_renderer_auto_exposure(renderer, &exposure));
+    const float *linear = (const float *)pixels;
+    double log_sum = 0.0;
+    for (unsigned i = 0; i < 8 * 8; i++) {
+      const float *p = &linear[4 * i];
+      log_sum += log(1e-4 + 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+    }
+    double average = exp(log_sum / (8 * 8));
+    REQUIRE(fabs(exposure * average - 0.18) < 1e-4);
+    static uint8_t exposed[8 * 8 * 4];
+    CHECK(kage_renderer_read_pixels(renderer, KAGE_PIXEL_FORMAT_RGBA8_SRGB, exposure, exposed, sizeof exposed));
+  }
   EXPECT(kage_renderer_timings(NULL, &timing, 1, &passes), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_timings(renderer, &timing, 1, NULL), KAGE_RESULT_NULL_ARGUMENT);
   EXPECT(kage_renderer_timings(renderer, NULL, 1, &passes), KAGE_RESULT_NULL_ARGUMENT);

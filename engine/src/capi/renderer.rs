@@ -5,7 +5,7 @@ use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::{kage_camera_desc, kage_scene, kage_transform};
 use super::technique::{kage_progress_fn, kage_technique_desc};
-use crate::imageio::tonemap_srgb8;
+use crate::imageio::{auto_exposure, tonemap_srgb8};
 use crate::pass::PassTiming;
 use crate::renderer::{RenderOptions, Renderer};
 use crate::scene::Light;
@@ -307,8 +307,8 @@ pub extern "C" fn kage_renderer_render(renderer: *mut kage_renderer) -> kage_res
 /// Copies the last frame into `pixels`, row 0 at the top, rows tightly packed, in `format` (a
 /// `kage_pixel_format` value). `size` is the buffer's size in bytes and must be at least
 /// width × height × bytes per pixel, else `KAGE_RESULT_BUFFER_TOO_SMALL`. `exposure` (> 0)
-/// scales radiance before tonemapping `KAGE_PIXEL_FORMAT_RGBA8_SRGB`; the linear format ignores
-/// it. Before the first `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
+/// scales radiance before tonemapping `KAGE_PIXEL_FORMAT_RGBA8_SRGB` (`kage_renderer_auto_exposure`
+/// gives one for any units of light); the linear format ignores it. Before the first `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
 ///
 /// # Safety
 /// `pixels` NULL or `size`
@@ -359,6 +359,31 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
         }
         // SAFETY: the caller promises `size` >= bytes.len() writable bytes at `pixels`.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), pixels, bytes.len()) };
+        Ok(())
+    })
+}
+
+/// Writes to `*exposure` the exposure that makes the last frame readable whatever its units
+/// (what `kage render --exposure auto` uses): 0.18 over the log-average Rec. 709 luminance of
+/// its linear pixels, exp(mean ln(10⁻⁴ + L)); 1 for a black frame. Pass it to
+/// `kage_renderer_read_pixels`. Before the first `kage_renderer_render`:
+/// `KAGE_RESULT_INVALID_VALUE`.
+///
+/// # Safety
+/// `exposure` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_auto_exposure(
+    renderer: *const kage_renderer,
+    exposure: *mut f32,
+) -> kage_result {
+    boundary(|| {
+        let r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or writable.
+        let exposure = unsafe { args::out(exposure, "exposure") }?;
+        if r.timings.is_none() {
+            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
+        }
+        *exposure = auto_exposure(&r.renderer.image()?);
         Ok(())
     })
 }
