@@ -1204,135 +1204,135 @@ fn auto_exposure_reads_any_scale_of_light() {
     let (white, _) = render("1000", &[]);
     assert!((dim - bright).abs() < 3.0 && dim > 60.0 && dim < 200.0, "{dim} {bright}");
     assert!(white > 250.0, "{white}");
+}
 
-    /// A scene file around the Khronos Box with a floor added, under `name`, seen from `camera`
-    /// (JSON), with `extra` fields; no environment.
-    fn box_on_floor(dir: &std::path::Path, file: &str, name: &str, camera: &str, extra: &str) -> String {
-        let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
-        let json = format!(
-            r#"{{"name": {}, "gltf": {}, "camera": {camera}, "groups": [{{"name": "floor", "translation": [0, -0.5, 0], "meshes": [{{"plane": {{"size": [3, 3], "vertices": [5, 5]}}, "albedo": [0.6, 0.6, 0.6]}}]}}]{extra}}}"#,
-            serde_json::to_string(name).unwrap(),
-            serde_json::to_string(gltf).unwrap()
-        );
-        let path = dir.join(file);
-        std::fs::write(&path, json).unwrap();
-        path.to_str().unwrap().to_owned()
-    }
+/// A scene file around the Khronos Box with a floor added, under `name`, seen from `camera`
+/// (JSON), with `extra` fields; no environment.
+fn box_on_floor(dir: &std::path::Path, file: &str, name: &str, camera: &str, extra: &str) -> String {
+    let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
+    let json = format!(
+        r#"{{"name": {}, "gltf": {}, "camera": {camera}, "groups": [{{"name": "floor", "translation": [0, -0.5, 0], "meshes": [{{"plane": {{"size": [3, 3], "vertices": [5, 5]}}, "albedo": [0.6, 0.6, 0.6]}}]}}]{extra}}}"#,
+        serde_json::to_string(name).unwrap(),
+        serde_json::to_string(gltf).unwrap()
+    );
+    let path = dir.join(file);
+    std::fs::write(&path, json).unwrap();
+    path.to_str().unwrap().to_owned()
+}
 
-    /// The PRT cache is keyed by the geometry, not the scene: two scene files around the same
-    /// geometry, with other names (one of 300 characters, longer than a file name may be) and
-    /// cameras, make one cache file, which the second precomputation and a render of either read.
-    #[test]
-    fn scene_files_around_the_same_geometry_share_one_cache_file() {
-        let dir = scratch_dir("cli-prt-shared");
-        let cache = dir.join("cache");
-        let cache_arg = cache.to_str().unwrap();
-        let near = r#"{"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
-        let far = r#"{"position": [2, 3, 5], "target": [0, 0, 0], "fov_y_deg": 30}"#;
-        let first = box_on_floor(&dir, "first.json", "box on a floor", near, "");
-        let long_name = "a scene with a long name ".repeat(12);
-        assert_eq!(long_name.len(), 300);
-        let second = box_on_floor(&dir, "second.json", &long_name, far, "");
-        let precompute = |scene: &str| {
-            let run =
-                kage(&["precompute", "--scene", scene, "--rays", "16", "--cache", cache_arg, "--validate"]);
-            assert!(run.status.success(), "{}", text(&run));
-            text(&run)
-        };
-        let made = precompute(&first);
-        assert!(made.contains("cache: wrote"), "{made}");
-        let hit = precompute(&second);
-        assert!(hit.contains("is valid, nothing to compute"), "{hit}");
-        let files: Vec<String> = std::fs::read_dir(&cache)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into())
-            .collect();
-        assert!(
-            files.len() == 1 && files[0].starts_with("prt-") && files[0].ends_with(".kageprt"),
-            "{files:?}"
-        );
-        let out = dir.join("second.png");
+/// The PRT cache is keyed by the geometry, not the scene: two scene files around the same
+/// geometry, with other names (one of 300 characters, longer than a file name may be) and
+/// cameras, make one cache file, which the second precomputation and a render of either read.
+#[test]
+fn scene_files_around_the_same_geometry_share_one_cache_file() {
+    let dir = scratch_dir("cli-prt-shared");
+    let cache = dir.join("cache");
+    let cache_arg = cache.to_str().unwrap();
+    let near = r#"{"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
+    let far = r#"{"position": [2, 3, 5], "target": [0, 0, 0], "fov_y_deg": 30}"#;
+    let first = box_on_floor(&dir, "first.json", "box on a floor", near, "");
+    let long_name = "a scene with a long name ".repeat(12);
+    assert_eq!(long_name.len(), 300);
+    let second = box_on_floor(&dir, "second.json", &long_name, far, "");
+    let precompute = |scene: &str| {
+        let run =
+            kage(&["precompute", "--scene", scene, "--rays", "16", "--cache", cache_arg, "--validate"]);
+        assert!(run.status.success(), "{}", text(&run));
+        text(&run)
+    };
+    let made = precompute(&first);
+    assert!(made.contains("cache: wrote"), "{made}");
+    let hit = precompute(&second);
+    assert!(hit.contains("is valid, nothing to compute"), "{hit}");
+    let files: Vec<String> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    assert!(
+        files.len() == 1 && files[0].starts_with("prt-") && files[0].ends_with(".kageprt"),
+        "{files:?}"
+    );
+    let out = dir.join("second.png");
+    let args =
+        ["render", "--scene", &second, "--technique", "sloan-self", "--rays", "16", "--cache", cache_arg];
+    let render =
+        kage(&[&args[..], &["--width", "16", "--height", "16", "--out", out.to_str().unwrap()]].concat());
+    assert!(render.status.success(), "{}", text(&render));
+    assert!(text(&render).contains("transfer: from"), "the shared file is read: {}", text(&render));
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 1);
+}
+
+/// The note that a scene has no environment (a glTF file alone, a scene file without one) is
+/// printed when the default sky lights it, and not when `--env` replaces it.
+#[test]
+fn the_default_sky_note_is_printed_only_when_the_default_stays() {
+    let dir = scratch_dir("cli-default-sky");
+    let camera = r#"{"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
+    let composed = box_on_floor(&dir, "composed.json", "composed", camera, "");
+    let given = box_on_floor(
+        &dir,
+        "given.json",
+        "given",
+        camera,
+        r#", "environment": {"constant": [0.5, 0.5, 0.5]}"#,
+    );
+    let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
+    let map = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/sun/sun2-45-sky.exr");
+    let render = |scene: &str, extra: &[&str]| {
+        let out = dir.join("out.exr");
         let args =
-            ["render", "--scene", &second, "--technique", "sloan-self", "--rays", "16", "--cache", cache_arg];
-        let render =
-            kage(&[&args[..], &["--width", "16", "--height", "16", "--out", out.to_str().unwrap()]].concat());
-        assert!(render.status.success(), "{}", text(&render));
-        assert!(text(&render).contains("transfer: from"), "the shared file is read: {}", text(&render));
-        assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 1);
-    }
+            ["render", "--scene", scene, "--technique", "unshadowed", "--width", "8", "--height", "8"];
+        let run = kage(&[&args[..], &["--out", out.to_str().unwrap()], extra].concat());
+        assert!(run.status.success(), "{}", text(&run));
+        text(&run).contains("has no environment: lit by a constant sky of radiance 1")
+    };
+    assert!(
+        render(gltf, &[]) && render(&composed, &[]),
+        "the note where the default sky lights the scene"
+    );
+    assert!(!render(gltf, &["--env", map]) && !render(&composed, &["--env", map]), "no note under --env");
+    assert!(!render(&given, &[]), "no note where the file gives an environment");
+}
 
-    /// The note that a scene has no environment (a glTF file alone, a scene file without one) is
-    /// printed when the default sky lights it, and not when `--env` replaces it.
-    #[test]
-    fn the_default_sky_note_is_printed_only_when_the_default_stays() {
-        let dir = scratch_dir("cli-default-sky");
-        let camera = r#"{"position": [0, 1.5, 3], "target": [0, -0.3, 0], "fov_y_deg": 45}"#;
-        let composed = box_on_floor(&dir, "composed.json", "composed", camera, "");
-        let given = box_on_floor(
-            &dir,
-            "given.json",
-            "given",
-            camera,
-            r#", "environment": {"constant": [0.5, 0.5, 0.5]}"#,
-        );
-        let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
-        let map = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/sun/sun2-45-sky.exr");
-        let render = |scene: &str, extra: &[&str]| {
-            let out = dir.join("out.exr");
-            let args =
-                ["render", "--scene", scene, "--technique", "unshadowed", "--width", "8", "--height", "8"];
-            let run = kage(&[&args[..], &["--out", out.to_str().unwrap()], extra].concat());
-            assert!(run.status.success(), "{}", text(&run));
-            text(&run).contains("has no environment: lit by a constant sky of radiance 1")
-        };
-        assert!(
-            render(gltf, &[]) && render(&composed, &[]),
-            "the note where the default sky lights the scene"
-        );
-        assert!(!render(gltf, &["--env", map]) && !render(&composed, &["--env", map]), "no note under --env");
-        assert!(!render(&given, &[]), "no note where the file gives an environment");
-    }
+/// `kage render --scene bunny.obj`: the scanned bunny with its `vn 0 0 0`, read alone, renders
+/// under the constant sky with notes for the defaults and the repaired normal; the default
+/// camera has it in the middle of the picture. A bad OBJ is an error naming it.
+#[test]
+fn an_obj_alone_renders_with_its_zero_normal_repaired() {
+    let dir = scratch_dir("cli-obj-alone");
+    let bunny = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/assets/bunny/bunny.obj");
+    let image = dir.join("bunny.exr");
+    let args = ["render", "--validate", "--scene", bunny.to_str().unwrap(), "--technique", "unshadowed"];
+    let size = ["--width", "32", "--height", "32", "--frames", "1", "--out", image.to_str().unwrap()];
+    let run = kage(&[&args[..], &size[..]].concat());
+    let output = text(&run);
+    assert!(run.status.success(), "{output}");
+    assert!(
+        output.contains("kage: note: mesh \"bunny\": 1 normal(s) were zero or not finite"),
+        "{output}"
+    );
+    assert!(
+        output.contains("read alone") && output.contains("albedo 0.8") && output.contains("no ground"),
+        "{output}"
+    );
+    let picture = kage::imageio::read_exr(&image).unwrap();
+    assert_eq!((picture.width, picture.height), (32, 32));
+    let luminance = |x: usize, y: usize| {
+        let [r, g, b, _] = picture.pixels[y * 32 + x];
+        (r + g + b) / 3.0
+    };
+    // The sky of radiance 1 in the corner; the bunny (albedo 0.8, lit by at most that sky) in
+    // the middle.
+    assert!((luminance(0, 0) - 1.0).abs() < 0.02, "corner {}", luminance(0, 0));
+    assert!(luminance(16, 16) < 0.85, "middle {}", luminance(16, 16));
 
-    /// `kage render --scene bunny.obj`: the scanned bunny with its `vn 0 0 0`, read alone, renders
-    /// under the constant sky with notes for the defaults and the repaired normal; the default
-    /// camera has it in the middle of the picture. A bad OBJ is an error naming it.
-    #[test]
-    fn an_obj_alone_renders_with_its_zero_normal_repaired() {
-        let dir = scratch_dir("cli-obj-alone");
-        let bunny = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/assets/bunny/bunny.obj");
-        let image = dir.join("bunny.exr");
-        let args = ["render", "--validate", "--scene", bunny.to_str().unwrap(), "--technique", "unshadowed"];
-        let size = ["--width", "32", "--height", "32", "--frames", "1", "--out", image.to_str().unwrap()];
-        let run = kage(&[&args[..], &size[..]].concat());
-        let output = text(&run);
-        assert!(run.status.success(), "{output}");
-        assert!(
-            output.contains("kage: note: mesh \"bunny\": 1 normal(s) were zero or not finite"),
-            "{output}"
-        );
-        assert!(
-            output.contains("read alone") && output.contains("albedo 0.8") && output.contains("no ground"),
-            "{output}"
-        );
-        let picture = kage::imageio::read_exr(&image).unwrap();
-        assert_eq!((picture.width, picture.height), (32, 32));
-        let luminance = |x: usize, y: usize| {
-            let [r, g, b, _] = picture.pixels[y * 32 + x];
-            (r + g + b) / 3.0
-        };
-        // The sky of radiance 1 in the corner; the bunny (albedo 0.8, lit by at most that sky) in
-        // the middle.
-        assert!((luminance(0, 0) - 1.0).abs() < 0.02, "corner {}", luminance(0, 0));
-        assert!(luminance(16, 16) < 0.85, "middle {}", luminance(16, 16));
-
-        let bad = dir.join("bad.obj");
-        std::fs::write(&bad, "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-        let run = kage(&["render", "--scene", bad.to_str().unwrap(), "--width", "32", "--height", "32"]);
-        let output = text(&run);
-        assert!(
-            !run.status.success() && output.contains("bad.obj") && output.contains("malformed OBJ"),
-            "{output}"
-        );
-        assert!(!output.contains("panicked") && !output.contains("JSON"), "{output}");
-    }
+    let bad = dir.join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let run = kage(&["render", "--scene", bad.to_str().unwrap(), "--width", "32", "--height", "32"]);
+    let output = text(&run);
+    assert!(
+        !run.status.success() && output.contains("bad.obj") && output.contains("malformed OBJ"),
+        "{output}"
+    );
+    assert!(!output.contains("panicked") && !output.contains("JSON"), "{output}");
 }
