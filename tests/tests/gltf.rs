@@ -45,6 +45,7 @@ fn groups_transforms_albedo_camera_lights_and_animation_are_read() {
     let forward = (camera.target - camera.position).normalize();
     assert!((forward.y + 0.3f32.sin()).abs() < 1e-5, "{forward}");
     assert!((camera.fov_y_deg - 0.7f32.to_degrees()).abs() < 1e-4);
+    // The file's 3415 and 6147 cd are 5 and 9 W/sr at 683 lm/W.
     match scene.lights[..] {
         [Light::Point { position, intensity }, Light::Spot { position: at, direction, fov_deg, intensity: spot }] =>
         {

@@ -64,8 +64,9 @@ gltf = {
     "asset": {"version": "2.0", "generator": "kage tests/assets/gltf/make.py"},
     "extensionsUsed": ["KHR_lights_punctual"],
     "extensions": {"KHR_lights_punctual": {"lights": [
-        {"type": "point", "color": [1, 1, 1], "intensity": 5},
-        {"type": "spot", "color": [1, 0.5, 0.5], "intensity": 9, "spot": {"outerConeAngle": 0.5}},
+        # Candela: 683 lm/W times the 5 and 9 W/sr Kage reads.
+        {"type": "point", "color": [1, 1, 1], "intensity": 5 * 683},
+        {"type": "spot", "color": [1, 0.5, 0.5], "intensity": 9 * 683, "spot": {"outerConeAngle": 0.5}},
     ]}},
     "scene": 0,
     "scenes": [{"nodes": [0, 2, 3, 4, 5]}],

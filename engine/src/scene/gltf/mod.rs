@@ -8,8 +8,9 @@
 //! - a group's motion is one animation named after the group, with linear translation, rotation
 //!   and scale channels;
 //! - the camera is a perspective camera on its own root node, point and spot lights are
-//!   KHR_lights_punctual lights on their own root nodes (colour × intensity = Kage's radiant
-//!   intensity, a spot's full cone twice its outer cone angle, its edge hard).
+//!   KHR_lights_punctual lights on their own root nodes (colour × intensity in candela, over
+//!   [`LUMENS_PER_WATT`], = Kage's radiant intensity in W/sr; a spot's full cone twice its outer
+//!   cone angle, its edge hard).
 //!
 //! Where glTF's form loses what Kage holds (a camera's look-at target and up vector, rounding in
 //! a light's colour and cone, a motion's loop), Kage writes its own values in the node's or
@@ -23,6 +24,12 @@ pub use write::write_glb;
 
 use super::file::{CameraDesc, LightDesc};
 use serde::{Deserialize, Serialize};
+
+/// The luminous efficacy that turns KHR_lights_punctual's candela (lm/sr) into Kage's radiant
+/// intensity (W/sr): 683 lm/W, the definition of the candela at 555 nm, as Blender's exporter
+/// uses it (a Blender point light of P watts is written as P × 683 / 4π cd, read back as the
+/// P / 4π W/sr it radiates).
+pub const LUMENS_PER_WATT: f32 = 683.0;
 
 /// `extras` of a node or animation that Kage wrote: `{"kage": {...}}`.
 #[derive(Debug, Default, Serialize, Deserialize)]

@@ -14,7 +14,7 @@
 //!   (sRGB decoded) where it has one, with a note: Kage shades each mesh with one diffuse colour;
 //! - the first perspective camera, or the one named (without one, a view of the whole scene,
 //!   with a note);
-//! - KHR_lights_punctual point and spot lights (colour × intensity, read as Kage's radiant
+//! - KHR_lights_punctual point and spot lights (colour × candela over 683 lm/W, Kage's radiant
 //!   intensity; a spot's full cone is twice its outer cone angle);
 //! - animations' translation, rotation and scale channels: each group's keyframes, its node's
 //!   channels composed with its ancestors' (linear; step and cubic-spline sampled into linear
@@ -390,7 +390,8 @@ fn light_of(
     world: Mat4,
 ) -> Option<Result<Light, String>> {
     let position = world.transform_point3(Vec3::ZERO);
-    let intensity = light.color().map(|c| c * light.intensity());
+    let watts_per_sr = light.intensity() / super::LUMENS_PER_WATT;
+    let intensity = light.color().map(|c| c * watts_per_sr);
     let read = match light.kind() {
         gltf::khr_lights_punctual::Kind::Point => Light::Point { position, intensity },
         gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => Light::Spot {

@@ -237,7 +237,7 @@ fn camera_node(camera: &Camera) -> Value {
 }
 
 /// A light's node and its KHR_lights_punctual entry (index `index`): colour the intensity over
-/// its largest channel, intensity that channel; a spot turned from −Z to its direction with a
+/// its largest channel, intensity that channel in candela; a spot turned from −Z to its direction with a
 /// hard edge (inner cone just inside the outer one).
 fn light_json(light: &Light, index: usize) -> (Value, Value) {
     let (position, intensity) = match *light {
@@ -253,7 +253,7 @@ fn light_json(light: &Light, index: usize) -> (Value, Value) {
         "extensions": {"KHR_lights_punctual": {"light": index}},
         "extras": extras(KageExtras { light: Some(super::super::export::light(light)), ..Default::default() }),
     });
-    let mut entry = json!({"name": format!("light {index}"), "color": colour, "intensity": peak});
+    let mut entry = json!({"name": format!("light {index}"), "color": colour, "intensity": peak * super::LUMENS_PER_WATT});
     match *light {
         Light::Point { .. } => entry["type"] = "point".into(),
         Light::Spot { direction, fov_deg, .. } => {
