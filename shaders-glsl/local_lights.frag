@@ -3,6 +3,7 @@
 // k's map, reconstructed between texel centres and kept hard (shadow_footprint_texel: the
 // reference's shadows are hard). Points outside the map (a point
 // light's map covers only its field of view) are lit.
+#define KAGE_ALBEDO_MAP_BINDING 3
 #include "local_lights_shading.glsl"
 
 layout(set = 0, binding = 2) uniform sampler2DArray shadow_maps;

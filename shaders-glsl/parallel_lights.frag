@@ -4,6 +4,8 @@
 // V_i is one depth comparison (no PCF): the banding of binary maps is what this baseline shows.
 #include "layouts.glsl"
 #include "sh.glsl"
+#define KAGE_ALBEDO_MAP_BINDING 3
+#include "albedo_map.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform Lights { ParallelLight lights[KAGE_MAX_PARALLEL_LIGHTS]; };
@@ -11,6 +13,7 @@ layout(set = 0, binding = 2) uniform sampler2DArray shadow_maps;
 layout(push_constant) uniform Push { ParallelDrawPush draw; };
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
+layout(location = 2) in vec2 texcoord;
 layout(location = 0) out vec4 color;
 
 void main() {
@@ -35,5 +38,5 @@ void main() {
             sum += lights[i].energy.rgb * c;
         }
     }
-    color = vec4(draw.albedo.rgb / KAGE_PI * sum, 1.0);
+    color = vec4(draw.albedo.rgb * albedo_texel(texcoord) / KAGE_PI * sum, 1.0);
 }

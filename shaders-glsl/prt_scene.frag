@@ -9,6 +9,8 @@
 #include "occlusion.glsl"
 #include "sh.glsl"
 #include "envmap.glsl"
+#define KAGE_ALBEDO_MAP_BINDING 10
+#include "albedo_map.glsl"
 
 layout(set = 0, binding = 3, std140) uniform Energy { vec4 region_energy[KAGE_MAX_REGIONS]; };
 layout(set = 0, binding = 4) uniform sampler2DArray occlusion;
@@ -32,8 +34,9 @@ layout(constant_id = 4) const bool PIXEL_COSINE = false;
 layout(location = 0) in vec3 self_term;
 layout(location = 1) in vec3 world_position;
 layout(location = 2) in vec3 world_normal;
-layout(location = 3) flat in uvec4 candidates[KAGE_LAYER_UVEC4];
-layout(location = 3 + KAGE_LAYER_UVEC4) in vec4 region_transfer[REGION_VEC4];
+layout(location = 3) in vec2 texcoord;
+layout(location = 4) flat in uvec4 candidates[KAGE_LAYER_UVEC4];
+layout(location = 4 + KAGE_LAYER_UVEC4) in vec4 region_transfer[REGION_VEC4];
 layout(location = 0) out vec4 color;
 
 // The adaptive penumbra (beyond the paper): a box as wide as sqrt(Omega_i) times this pixel's
@@ -124,5 +127,5 @@ void main() {
     }
     vec3 radiance = max(self_shadowed - draw.albedo.rgb * blocked, vec3(0.0))
         + draw.albedo.rgb / KAGE_PI * max(dominant_light - dominant_blocked, vec3(0.0));
-    color = vec4(radiance, 1.0);
+    color = vec4(radiance * albedo_texel(texcoord), 1.0);
 }

@@ -31,17 +31,19 @@ layout(constant_id = 4) const bool PIXEL_COSINE = false;
 
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
-layout(location = 2) in vec4 transfer[KAGE_TRANSFER_VEC4];
+layout(location = 2) in vec2 uv;
+layout(location = 3) in vec4 transfer[KAGE_TRANSFER_VEC4];
 
 // L_s, or with PIXEL_COSINE albedo / pi E(n) - L_s; less, or more, what occluder sheets hide
 // (albedo B_i T_i of the regions they take away whole).
 layout(location = 0) out vec3 self_term;
 layout(location = 1) out vec3 world_position;
 layout(location = 2) out vec3 world_normal;
+layout(location = 3) out vec2 texcoord;
 // Bit k: the receiver's occlusion layer k may hold a shadow somewhere on a triangle this vertex
 // provokes (prt_scene.frag's candidates).
-layout(location = 3) flat out uvec4 candidates[KAGE_LAYER_UVEC4];
-layout(location = 3 + KAGE_LAYER_UVEC4) out vec4 region_transfer[REGION_VEC4];
+layout(location = 4) flat out uvec4 candidates[KAGE_LAYER_UVEC4];
+layout(location = 4 + KAGE_LAYER_UVEC4) out vec4 region_transfer[REGION_VEC4];
 // The same operations as depth_prepass.vert's, which lays the depth down first.
 precise gl_Position;
 
@@ -69,6 +71,7 @@ void main() {
     }
     // Uniform scale only: the model matrix's upper 3x3 keeps normals perpendicular.
     world_normal = mat3(draw.model) * normal;
+    texcoord = uv;
     if (PIXEL_COSINE) {
         vec3 unshadowed = max(sh9_irradiance(sh.c, env_world_to_map(normalize(world_normal), frame.env_params.y)), vec3(0.0));
         self_term = draw.albedo.rgb / KAGE_PI * unshadowed - self_term;

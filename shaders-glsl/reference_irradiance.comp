@@ -42,7 +42,8 @@ vec3 surface_irradiance_sample(vec3 position, vec3 n, inout Rng rng) {
     uvec4 ids = triangle_vertices[hit.triangle];
     vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
     vec3 l = w.x * radiance[ids.x].rgb + w.y * radiance[ids.y].rgb + w.z * radiance[ids.z].rgb;
-    return l * REFERENCE_PI;
+    // The vertices' radiance holds the mesh's albedo; its albedo map multiplies it at the hit.
+    return l * bvh_hit_texel(hit) * REFERENCE_PI;
 }
 
 void main() {

@@ -213,7 +213,7 @@ fn aces_narkowicz(x: f32) -> f32 {
 }
 
 /// The exact piecewise sRGB encoding (IEC 61966-2-1), not the 1/2.2 power approximation.
-fn srgb_oetf(x: f32) -> f32 {
+pub fn srgb_oetf(x: f32) -> f32 {
     if x <= 0.0031308 {
         12.92 * x
     } else {

@@ -18,6 +18,10 @@ layout(set = 0, binding = 3, std430) readonly buffer BvhTriangles { BvhTriangle 
 layout(set = 0, binding = 4, std430) readonly buffer BvhAttributes {
     BvhTriangleAttributes bvh_attributes[];
 };
+// The scene's albedo maps (entry 0 unused: a triangle without a map) and their texels, RGBA8
+// sRGB packed little-endian, row after row from the top.
+layout(set = 0, binding = 5, std430) readonly buffer BvhAlbedoMaps { BvhAlbedoMap bvh_albedo_maps[]; };
+layout(set = 0, binding = 6, std430) readonly buffer BvhAlbedoTexels { BvhTexel bvh_albedo_texels[]; };
 
 // instance == KAGE_NO_HIT on a miss; triangle indexes the BVH triangle buffer; barycentric holds
 // the weights of the triangle's v1 and v2 (v0's is 1 - x - y).
@@ -223,8 +227,53 @@ bool bvh_occluded_object_space(uint instance, vec3 origin, vec3 dir, float tmax)
     return bvh_traverse_blas(instance, origin, dir, true, hit);
 }
 
+// Texel coordinate i (any integer) of a side of n texels, wrapped as `wrap` says.
+int bvh_wrap_texel(int i, int n, uint wrap) {
+    if (wrap == KAGE_WRAP_CLAMP) return clamp(i, 0, n - 1);
+    int period = wrap == KAGE_WRAP_MIRROR ? 2 * n : n;
+    int j = ((i % period) + period) % period;
+    return j < n ? j : period - 1 - j;
+}
+
+// Linear colour of texel (x, y) of albedo map `map`, wrapped.
+vec3 bvh_albedo_texel_at(BvhAlbedoMap map, int x, int y) {
+    int w = int(map.info.y), h = int(map.info.z);
+    x = bvh_wrap_texel(x, w, map.info.w & 3u);
+    y = bvh_wrap_texel(y, h, (map.info.w >> 2) & 3u);
+    vec3 srgb = unpackUnorm4x8(bvh_albedo_texels[map.info.x + uint(y * w + x)].rgba).rgb;
+    // The exact sRGB decoding (IEC 61966-2-1), as the rasterizer's R8G8B8A8_SRGB images do.
+    return mix(srgb / 12.92, pow((srgb + 0.055) / 1.055, vec3(2.4)), greaterThan(srgb, vec3(0.04045)));
+}
+
+// Albedo map `index` at texture coordinate uv: level 0, bilinear in linear colour (or nearest,
+// as its sampler magnifies), wrapped as its sampler wraps; white without a map. The
+// rasterizer's mipmaps average the same texels over a pixel's footprint, as the reference's
+// samples spread over each pixel do.
+vec3 bvh_albedo_texel(uint index, vec2 uv) {
+    if (index == 0u) return vec3(1.0);
+    BvhAlbedoMap map = bvh_albedo_maps[index];
+    vec2 f = uv * vec2(map.info.yz) - 0.5;
+    if ((map.info.w & 16u) == 0u) {
+        vec2 c = floor(f + 0.5);
+        return bvh_albedo_texel_at(map, int(c.x), int(c.y));
+    }
+    vec2 c = floor(f), t = f - c;
+    int x = int(c.x), y = int(c.y);
+    return mix(mix(bvh_albedo_texel_at(map, x, y), bvh_albedo_texel_at(map, x + 1, y), t.x),
+               mix(bvh_albedo_texel_at(map, x, y + 1), bvh_albedo_texel_at(map, x + 1, y + 1), t.x), t.y);
+}
+
+// What the albedo map of the triangle hit multiplies its albedo by at the hit (1 without one).
+vec3 bvh_hit_texel(RayHit hit) {
+    BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+    vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
+    vec2 uv = w.x * a.uv01.xy + w.y * a.uv01.zw + w.z * a.uv2.xy;
+    return bvh_albedo_texel(floatBitsToUint(a.albedo.a), uv);
+}
+
 // The world-space surface at a hit. Both normals face against ray_dir; the shading normal flips
-// together with the geometric one, as the rasterizer's gl_FrontFacing does.
+// together with the geometric one, as the rasterizer's gl_FrontFacing does. Its albedo is the
+// mesh's times its albedo map's texel there.
 SurfacePoint bvh_surface(RayHit hit, vec3 ray_dir) {
     BvhTriangle v = bvh_triangles[hit.triangle];
     BvhTriangleAttributes a = bvh_attributes[hit.triangle];
@@ -236,7 +285,7 @@ SurfacePoint bvh_surface(RayHit hit, vec3 ray_dir) {
     vec3 ng = normalize(rotate * cross(v.v1.xyz - v.v0.xyz, v.v2.xyz - v.v0.xyz));
     vec3 ns = normalize(rotate * (w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz));
     float facing = dot(ng, ray_dir) > 0.0 ? -1.0 : 1.0;
-    return SurfacePoint((to_world * vec4(p, 1.0)).xyz, facing * ng, facing * ns, a.albedo.rgb);
+    return SurfacePoint((to_world * vec4(p, 1.0)).xyz, facing * ng, facing * ns, a.albedo.rgb * bvh_hit_texel(hit));
 }
 
 // Moves p off its surface along n (to the side the new ray leaves on), by a few ulps of p's

@@ -19,7 +19,11 @@
 
 // Storage buffers that bvh.glsl declares at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1; a shader
 // that includes it numbers its own bindings from here.
-#define KAGE_BVH_BINDINGS 5
+#define KAGE_BVH_BINDINGS 7
+// How an albedo map reads beyond [0, 1] (BvhAlbedoMap.info.w): repeat, mirrored repeat, clamp.
+#define KAGE_WRAP_REPEAT 0
+#define KAGE_WRAP_MIRROR 1
+#define KAGE_WRAP_CLAMP 2
 // RayHit.instance of a ray that hit nothing (0xffffffff).
 #define KAGE_NO_HIT 4294967295u
 // Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.

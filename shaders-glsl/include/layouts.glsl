@@ -62,7 +62,19 @@ struct BvhTriangleAttributes {
     vec4 n0; // xyz: unit object-space vertex normal of v0, w: unused
     vec4 n1;
     vec4 n2;
-    vec4 albedo; // rgb: diffuse albedo, a: unused
+    vec4 albedo; // rgb: diffuse albedo, a: floatBitsToUint = its albedo map in BvhAlbedoMaps (0: none)
+    vec4 uv01; // xy: albedo-map texture coordinate of v0, zw: of v1
+    vec4 uv2; // xy: of v2, zw: unused
+};
+
+// One texel of an albedo map: RGBA8 sRGB, R in the lowest byte.
+struct BvhTexel {
+    uint rgba;
+};
+
+// An albedo map as the ray tracer samples it (level 0, bvh.glsl's bvh_albedo_texel).
+struct BvhAlbedoMap {
+    uvec4 info; // x: first texel in BvhAlbedoTexels, y: width, z: height, w: bits 0-1 wrap in u, 2-3 wrap in v (KAGE_WRAP_*), bit 4 linear magnification
 };
 
 // A scene group placed in the world; instance index == group index.

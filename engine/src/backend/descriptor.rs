@@ -24,6 +24,7 @@ impl BindingKind {
 }
 
 /// A resource bound at record time, in binding order.
+#[derive(Clone, Copy)]
 pub enum Binding<'a> {
     Uniform(&'a Buffer),
     Storage(&'a Buffer),
@@ -32,7 +33,7 @@ pub enum Binding<'a> {
 }
 
 impl Binding<'_> {
-    fn kind(&self) -> BindingKind {
+    pub fn kind(&self) -> BindingKind {
         match self {
             Binding::Uniform(_) => BindingKind::UniformBuffer,
             Binding::Storage(_) => BindingKind::StorageBuffer,
@@ -67,6 +68,19 @@ pub fn push_descriptors(
     bindings: &[Binding],
 ) {
     debug_assert_eq!(expected, bindings.iter().map(Binding::kind).collect::<Vec<_>>().as_slice());
+    push_descriptors_from(ctx, cmd, bind_point, layout, 0, bindings);
+}
+
+/// Binds `bindings` to bindings `first`, `first + 1`, … of set 0 of `layout`, leaving the others
+/// as the last push left them (push descriptors update only what they write).
+pub fn push_descriptors_from(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    bind_point: vk::PipelineBindPoint,
+    layout: vk::PipelineLayout,
+    first: u32,
+    bindings: &[Binding],
+) {
     // A push with no writes is invalid (descriptorWriteCount must be at least 1): pipelines
     // without resources, such as the depth-only shadow pass, push nothing.
     if bindings.is_empty() {
@@ -102,7 +116,7 @@ pub fn push_descriptors(
         .enumerate()
         .map(|(i, b)| {
             let write = vk::WriteDescriptorSet::default()
-                .dst_binding(i as u32)
+                .dst_binding(first + i as u32)
                 .descriptor_type(b.kind().descriptor_type());
             match b {
                 Binding::Uniform(_) | Binding::Storage(_) => write.buffer_info(&buffer_infos[i]),

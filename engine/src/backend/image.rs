@@ -15,6 +15,8 @@ pub struct ImageDesc<'a> {
     pub width: u32,
     pub height: u32,
     pub layers: u32,
+    /// Mipmap levels, each half the one before (rounded down, at least 1): 1 for most images.
+    pub levels: u32,
     /// Viewed as a 2D array even with one layer (shaders declare `*2DArray`).
     pub array: bool,
     pub format: vk::Format,
@@ -30,7 +32,7 @@ impl<'a> ImageDesc<'a> {
         format: vk::Format,
         usage: vk::ImageUsageFlags,
     ) -> ImageDesc<'a> {
-        ImageDesc { name, width: size, height: size, layers, array: true, format, usage }
+        ImageDesc { name, width: size, height: size, layers, levels: 1, array: true, format, usage }
     }
 }
 
@@ -44,6 +46,7 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub layers: u32,
+    pub levels: u32,
     pub format: vk::Format,
     name: String,
 }
@@ -95,19 +98,23 @@ impl Image {
         if desc.width == 0
             || desc.height == 0
             || desc.layers == 0
+            || desc.levels == 0
+            || desc.levels > limits.max_mip_levels
             || desc.width > max.width
             || desc.height > max.height
             || desc.layers > limits.max_array_layers
         {
             return Err(Error::InvalidArgument(format!(
-                "image {} of {}x{}x{} is outside the device limits (1..={}x{}, {} layers)",
+                "image {} of {}x{}x{} with {} levels is outside the device limits (1..={}x{}, {} layers, {} levels)",
                 desc.name,
                 desc.width,
                 desc.height,
                 desc.layers,
+                desc.levels,
                 max.width,
                 max.height,
-                limits.max_array_layers
+                limits.max_array_layers,
+                limits.max_mip_levels
             )));
         }
         if let Some(texel) = texel_bytes(desc.format) {
@@ -127,7 +134,7 @@ impl Image {
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
             .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
-            .mip_levels(1)
+            .mip_levels(desc.levels)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -161,6 +168,7 @@ impl Image {
             width: desc.width,
             height: desc.height,
             layers: desc.layers,
+            levels: desc.levels,
             format: desc.format,
             name: desc.name.to_owned(),
         };
@@ -232,7 +240,7 @@ impl Image {
         vk::ImageSubresourceRange {
             aspect_mask: aspect_of(self.format),
             base_mip_level: 0,
-            level_count: 1,
+            level_count: self.levels,
             base_array_layer: 0,
             layer_count: self.layers,
         }
@@ -251,22 +259,44 @@ impl Image {
         self.layer_views.get(layer as usize).copied().unwrap_or(self.view)
     }
 
-    /// Bytes of the whole image in a tightly packed buffer.
+    /// Width and height of mipmap level `level`.
+    pub fn level_extent(&self, level: u32) -> (u32, u32) {
+        ((self.width >> level).max(1), (self.height >> level).max(1))
+    }
+
+    /// Bytes of the whole image in a tightly packed buffer: level after level, each layer after
+    /// layer.
     pub fn byte_size(&self) -> Result<u64> {
         let texel = texel_bytes(self.format)
             .ok_or_else(|| Error::Internal(format!("no host copies of {:?} ({})", self.format, self.name)))?;
-        Ok(texel * self.width as u64 * self.height as u64 * self.layers as u64)
+        let level = |l| {
+            let (w, h) = self.level_extent(l);
+            texel * w as u64 * h as u64 * self.layers as u64
+        };
+        Ok((0..self.levels).map(level).sum())
     }
 
-    pub(crate) fn copy_region(&self) -> vk::BufferImageCopy {
-        vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: aspect_of(self.format),
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: self.layers,
+    /// One copy per level between the image and a tightly packed buffer laid out as
+    /// [`Image::byte_size`] says.
+    pub(crate) fn copy_regions(&self) -> Vec<vk::BufferImageCopy> {
+        let texel = texel_bytes(self.format).unwrap_or(0);
+        let mut offset = 0;
+        (0..self.levels)
+            .map(|level| {
+                let (width, height) = self.level_extent(level);
+                let region = vk::BufferImageCopy::default()
+                    .buffer_offset(offset)
+                    .image_subresource(vk::ImageSubresourceLayers {
+                        aspect_mask: aspect_of(self.format),
+                        mip_level: level,
+                        base_array_layer: 0,
+                        layer_count: self.layers,
+                    })
+                    .image_extent(vk::Extent3D { width, height, depth: 1 });
+                offset += texel * width as u64 * height as u64 * self.layers as u64;
+                region
             })
-            .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 })
+            .collect()
     }
 
     /// Records a copy of the whole image into `buffer` (tightly packed, layer after layer).
@@ -275,7 +305,7 @@ impl Image {
         self.transition(cmd, vk::ImageLayout::GENERAL, src);
         // SAFETY: recording command buffer; the image was just moved to `src`.
         unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, src, buffer.raw, &[self.copy_region()])
+            self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, src, buffer.raw, &self.copy_regions())
         }
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
@@ -328,7 +358,7 @@ impl Image {
         );
     }
 
-    /// Fills the image from tightly packed texels through a staging buffer.
+    /// Fills the image (every level) from tightly packed texels through a staging buffer.
     pub fn upload(&self, data: &[u8]) -> Result<()> {
         let expected = self.byte_size()?;
         if data.len() as u64 != expected {
@@ -348,12 +378,12 @@ impl Image {
             },
         )?;
         staging.write(0, data)?;
-        let region = self.copy_region();
+        let regions = self.copy_regions();
         self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
             let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
             self.transition(cmd, vk::ImageLayout::GENERAL, dst);
             // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
-            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region]) }
+            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &regions) }
             self.transition(cmd, dst, vk::ImageLayout::GENERAL);
         })
     }
@@ -420,6 +450,8 @@ pub enum Edge {
     Repeat,
     /// The edge texel.
     Clamp,
+    /// Wrap around, every other repeat mirrored.
+    Mirror,
 }
 
 impl Edge {
@@ -427,23 +459,46 @@ impl Edge {
         match self {
             Edge::Repeat => vk::SamplerAddressMode::REPEAT,
             Edge::Clamp => vk::SamplerAddressMode::CLAMP_TO_EDGE,
+            Edge::Mirror => vk::SamplerAddressMode::MIRRORED_REPEAT,
         }
     }
 }
 
+/// How a sampler filters: magnified and minified texels (linear or nearest), mipmap levels
+/// (`Some(linear)` between them, `None` level 0 only), and its edges in u and v.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SamplerDesc {
+    pub magnify_linear: bool,
+    pub minify_linear: bool,
+    pub mipmaps: Option<bool>,
+    pub u: Edge,
+    pub v: Edge,
+}
+
 impl Sampler {
-    /// A sampler with linear or nearest filtering and the given behaviour beyond the edges in u
-    /// and v (w, layers of arrays, clamps).
+    /// A sampler with linear or nearest filtering of level 0 and the given behaviour beyond the
+    /// edges in u and v (w, layers of arrays, clamps).
     pub fn new(ctx: &Arc<Context>, name: &str, linear: bool, u: Edge, v: Edge) -> Result<Sampler> {
-        let filter = if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
+        let desc = SamplerDesc { magnify_linear: linear, minify_linear: linear, mipmaps: None, u, v };
+        Sampler::with_desc(ctx, name, &desc)
+    }
+
+    /// A sampler as `desc` says (w, layers of arrays, clamps).
+    pub fn with_desc(ctx: &Arc<Context>, name: &str, desc: &SamplerDesc) -> Result<Sampler> {
+        let filter = |linear| if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
+        let (mipmap_mode, max_lod) = match desc.mipmaps {
+            Some(true) => (vk::SamplerMipmapMode::LINEAR, vk::LOD_CLAMP_NONE),
+            Some(false) => (vk::SamplerMipmapMode::NEAREST, vk::LOD_CLAMP_NONE),
+            None => (vk::SamplerMipmapMode::NEAREST, 0.0),
+        };
         let info = vk::SamplerCreateInfo::default()
-            .mag_filter(filter)
-            .min_filter(filter)
-            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
-            .address_mode_u(u.mode())
-            .address_mode_v(v.mode())
+            .mag_filter(filter(desc.magnify_linear))
+            .min_filter(filter(desc.minify_linear))
+            .mipmap_mode(mipmap_mode)
+            .address_mode_u(desc.u.mode())
+            .address_mode_v(desc.v.mode())
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .max_lod(0.0);
+            .max_lod(max_lod);
         // SAFETY: valid device and create info.
         let raw = unsafe { ctx.device.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
         ctx.set_name(raw, name);

@@ -1,6 +1,6 @@
 //! Compute and graphics pipelines. Each owns its set layout (push descriptors, set 0) and
 //! pipeline layout, and records its own binds so passes stay short.
-use super::descriptor::{push_descriptors, set_layout_bindings};
+use super::descriptor::{push_descriptors, push_descriptors_from, set_layout_bindings};
 use super::{reflect, Binding, BindingKind, Context};
 use crate::error::{Error, Result};
 use ash::vk;
@@ -357,6 +357,21 @@ impl GraphicsPipeline {
             &self.layout.bindings,
             bindings,
         );
+    }
+
+    /// Binds `binding` at index `at` of the pipeline's bindings in place of what [`bind`] gave
+    /// it (a per-draw resource), keeping the others.
+    ///
+    /// [`bind`]: GraphicsPipeline::bind
+    pub fn rebind(&self, cmd: vk::CommandBuffer, at: u32, binding: Binding) {
+        debug_assert_eq!(self.layout.bindings.get(at as usize), Some(&binding.kind()));
+        let bind_point = vk::PipelineBindPoint::GRAPHICS;
+        push_descriptors_from(&self.ctx, cmd, bind_point, self.layout.pipeline, at, &[binding]);
+    }
+
+    /// How many resources the pipeline binds.
+    pub fn binding_count(&self) -> u32 {
+        self.layout.bindings.len() as u32
     }
 
     pub fn push(&self, cmd: vk::CommandBuffer, bytes: &[u8]) {

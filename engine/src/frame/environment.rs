@@ -31,6 +31,7 @@ impl GpuEnvironment {
                 width,
                 height,
                 layers: 1,
+                levels: 1,
                 array: false,
                 format: vk::Format::R32G32B32A32_SFLOAT,
                 usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,

@@ -1,23 +1,29 @@
 //! The scene's geometry on the GPU: one vertex and index buffer per mesh, one transform per
-//! group, and the vertex layouts the techniques' pipelines read it with.
-use crate::backend::{vk, Buffer, Context, VertexAttribute, VertexBuffer};
+//! group, the albedo maps, and the vertex layouts the techniques' pipelines read it with.
+use super::albedo_maps::GpuAlbedoMaps;
+use crate::backend::{vk, Binding, Buffer, Context, GraphicsPipeline, VertexAttribute, VertexBuffer};
 use crate::error::Result;
 use crate::scene::clusters::{clustered, Cluster};
 use crate::scene::Scene;
 use glam::Mat4;
 use std::sync::Arc;
 
-/// Vertex layout of `GpuScene` meshes: position then normal, 3 floats each.
-pub const VERTEX_STRIDE: u32 = 24;
-pub const MESH_ATTRIBUTES: [VertexAttribute; 2] = [
+/// Vertex layout of `GpuScene` meshes: position and normal, 3 floats each, then the albedo
+/// map's texture coordinate, 2 floats (0 without a map).
+pub const VERTEX_STRIDE: u32 = 32;
+pub const MESH_ATTRIBUTES: [VertexAttribute; 3] = [
     VertexAttribute { location: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
     VertexAttribute { location: 1, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
+    VertexAttribute { location: 2, format: vk::Format::R32G32_SFLOAT, offset: 24 },
 ];
 pub const MESH_VERTICES: VertexBuffer<'static> =
     VertexBuffer { stride: VERTEX_STRIDE, attributes: &MESH_ATTRIBUTES };
 /// The same buffers read by shaders that need positions only.
 pub const MESH_POSITIONS: VertexBuffer<'static> =
     VertexBuffer { stride: VERTEX_STRIDE, attributes: MESH_ATTRIBUTES.split_at(1).0 };
+/// Positions and texture coordinates, with the other attributes from other buffers.
+pub const MESH_POSITIONS_UVS: VertexBuffer<'static> =
+    VertexBuffer { stride: VERTEX_STRIDE, attributes: &[MESH_ATTRIBUTES[0], MESH_ATTRIBUTES[2]] };
 
 pub struct GpuMesh {
     /// `group.mesh`, for names and messages.
@@ -27,6 +33,8 @@ pub struct GpuMesh {
     pub index_count: u32,
     pub vertex_count: u32,
     pub albedo: [f32; 3],
+    /// Its albedo map in [`GpuScene::albedo_maps`] (0: none, a white texel).
+    pub albedo_map: usize,
     /// [`crate::scene::Mesh::longest_edge`], object units.
     pub longest_edge: f32,
     pub group: usize,
@@ -41,18 +49,22 @@ pub struct GpuMesh {
 pub struct GpuScene {
     pub meshes: Vec<GpuMesh>,
     pub transforms: Vec<Mat4>,
+    pub albedo_maps: GpuAlbedoMaps,
 }
 
 impl GpuScene {
     pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
+        let (albedo_maps, mut map_of_mesh) = GpuAlbedoMaps::new(ctx, scene)?;
+        let mut map_of_mesh = map_of_mesh.drain(..);
         let mut meshes = Vec::new();
         for (g, group) in scene.groups.iter().enumerate() {
             for (m, mesh) in group.meshes.iter().enumerate() {
-                let vertices: Vec<u8> = mesh
-                    .positions
-                    .iter()
-                    .zip(&mesh.normals)
-                    .flat_map(|(p, n)| [p[0], p[1], p[2], n[0], n[1], n[2]])
+                let uv = |v: usize| mesh.texturing.as_ref().map_or([0.0; 2], |t| t.uvs[v]);
+                let vertices: Vec<u8> = (0..mesh.positions.len())
+                    .flat_map(|v| {
+                        let (p, n, uv) = (mesh.positions[v], mesh.normals[v], uv(v));
+                        [p[0], p[1], p[2], n[0], n[1], n[2], uv[0], uv[1]]
+                    })
                     .flat_map(f32::to_ne_bytes)
                     .collect();
                 let (indices, clusters) = clustered(mesh);
@@ -76,12 +88,25 @@ impl GpuScene {
                     vertex_count: mesh.positions.len() as u32,
                     mesh: m,
                     albedo: mesh.albedo,
+                    albedo_map: map_of_mesh.next().unwrap_or(0),
                     longest_edge: mesh.longest_edge(),
                     group: g,
                     clusters,
                 });
             }
         }
-        Ok(GpuScene { meshes, transforms: scene.groups.iter().map(|g| g.transform.matrix()).collect() })
+        let transforms = scene.groups.iter().map(|g| g.transform.matrix()).collect();
+        Ok(GpuScene { meshes, transforms, albedo_maps })
+    }
+
+    /// `mesh`'s albedo map, for a lit pipeline's last binding.
+    pub fn albedo_map(&self, mesh: &GpuMesh) -> Binding<'_> {
+        self.albedo_maps.binding(mesh.albedo_map)
+    }
+
+    /// Binds `mesh`'s albedo map as the last binding of `pipeline`, a lit pipeline
+    /// ([`super::scene_pass::lit_bindings`]).
+    pub fn bind_albedo_map(&self, cmd: vk::CommandBuffer, pipeline: &GraphicsPipeline, mesh: &GpuMesh) {
+        pipeline.rebind(cmd, pipeline.binding_count() - 1, self.albedo_map(mesh));
     }
 }

@@ -2,6 +2,7 @@
 //! frame's targets, the environment map and its SH projection, the background pass, the scene
 //! and depth-prepass draws, shadow depth rendering, and the groups' bounds. A frame layer module
 //! imports the backend, the pass layer and the scene; never a technique.
+pub mod albedo_maps;
 pub mod background;
 pub mod bounds;
 pub mod environment;

@@ -1,6 +1,8 @@
 //! The pass most techniques end with: every mesh drawn once into the colour and depth targets
-//! by a pipeline that reads the mesh vertices (position, normal), with per-draw push constants.
-//! Shared by the unshadowed, parallel-lights, shadowmap and adaptive shadow map techniques.
+//! by a pipeline that reads the mesh vertices (position, normal, texture coordinate), with
+//! per-draw push constants and the mesh's albedo map as the pipeline's last binding (a lit
+//! pipeline, [`lit_bindings`]). Shared by the unshadowed, parallel-lights, shadowmap and
+//! adaptive shadow map techniques.
 //!
 //! The techniques with costly fragments (parallel lights, shadowmap, adaptive shadow maps, and
 //! Tamura's PRT technique) lay the depth down first in a depth-only prepass computing the scene
@@ -25,9 +27,16 @@ use std::sync::Arc;
 /// What a shadow-map technique's scene pass after a depth prepass reads.
 pub const PREPASS_SCENE_READS: [Resource; 4] = [FRAME_UNIFORMS, SHADOW_MAPS, COLOR, DEPTH];
 
-/// A scene pipeline named `name` from its two shaders, resources and push-constant size, drawing
-/// the meshes' positions and normals with the depth test `depth` (`Equal` after
-/// [`depth_prepass`]).
+/// A lit pipeline's bindings: `bindings`, then the mesh's albedo map, which its fragment shader
+/// declares through `albedo_map.glsl` at binding `bindings.len()` and which
+/// [`GpuScene::bind_albedo_map`] pushes per draw.
+pub fn lit_bindings(bindings: &[BindingKind]) -> Vec<BindingKind> {
+    [bindings, &[BindingKind::SampledImage]].concat()
+}
+
+/// A lit scene pipeline named `name` from its two shaders, resources (before the albedo map,
+/// [`lit_bindings`]) and push-constant size, drawing the meshes with the depth test `depth`
+/// (`Equal` after [`depth_prepass`]).
 pub fn scene_pipeline(
     ctx: &Arc<Context>,
     name: &str,
@@ -57,7 +66,7 @@ pub fn depth_prepass<'a, P: Pod>(
     Pass::new("depth_prepass", &[FRAME_UNIFORMS], &[DEPTH], move |cmd| {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear((&targets.depth).into())));
         pipeline.bind(cmd, &[Binding::Uniform(uniforms)]);
-        draw_meshes(ctx, cmd, scene, pipeline, &|m, t| Some(push(m, t)));
+        draw_meshes(ctx, cmd, scene, pipeline, false, &|m, t| Some(push(m, t)));
         ctx.end_rendering(cmd);
     })
 }
@@ -78,7 +87,7 @@ pub fn scene_pipeline_with(
             name,
             vertex_spirv: shaders.0,
             fragment_spirv: shaders.1,
-            bindings,
+            bindings: &lit_bindings(bindings),
             push_size: push_size as u32,
             vertex_buffers,
             topology: vk::PrimitiveTopology::TRIANGLE_LIST,
@@ -107,31 +116,45 @@ pub fn scene_pass<'a, P: Pod>(
         let depth =
             if pipeline.depth() == DepthTest::Equal { Depth::Keep(depth) } else { Depth::Clear(depth) };
         ctx.begin_rendering(cmd, Some((&targets.color).into()), None, Some(depth));
-        pipeline.bind(cmd, &bindings);
-        draw_meshes(ctx, cmd, scene, pipeline, &|m, t| Some(push(m, t)));
+        bind_lit(cmd, pipeline, scene, &bindings);
+        draw_meshes(ctx, cmd, scene, pipeline, true, &|m, t| Some(push(m, t)));
         ctx.end_rendering(cmd);
     })
 }
 
+/// Binds a lit pipeline with `bindings` and the first mesh's albedo map, which
+/// [`draw_meshes`] replaces per draw.
+pub fn bind_lit(cmd: vk::CommandBuffer, pipeline: &GraphicsPipeline, scene: &GpuScene, bindings: &[Binding]) {
+    let first = scene.albedo_maps.binding(scene.meshes.first().map_or(0, |m| m.albedo_map));
+    let all: Vec<Binding> = bindings.iter().cloned().chain([first]).collect();
+    pipeline.bind(cmd, &all);
+}
+
 /// Draws the meshes of `scene` with the push constants `push(mesh, its model matrix)` gives
-/// (`None` leaves a mesh out).
+/// (`None` leaves a mesh out); `lit`: with each mesh's albedo map (a lit pipeline bound with
+/// [`bind_lit`]).
 pub fn draw_meshes<P: Pod>(
     ctx: &Context,
     cmd: vk::CommandBuffer,
     scene: &GpuScene,
     pipeline: &GraphicsPipeline,
+    lit: bool,
     push: &impl Fn(&GpuMesh, &Mat4) -> Option<P>,
 ) {
     for mesh in &scene.meshes {
         if let Some(p) = push(mesh, &scene.transforms[mesh.group]) {
+            if lit {
+                scene.bind_albedo_map(cmd, pipeline, mesh);
+            }
             pipeline.push(cmd, bytes_of(&p));
             ctx.draw_indexed(cmd, &[&mesh.vertices], &mesh.indices, mesh.index_count);
         }
     }
 }
 
-/// A pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
-/// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1) and a `DrawPush`.
+/// A lit pipeline drawing `GpuScene` meshes with scene.vert and `fragment_spirv`, which reads
+/// `FrameUniforms` (binding 0), one uniform buffer of lighting (binding 1), the albedo map
+/// (binding 2) and a `DrawPush`.
 pub fn lighting_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) -> Result<GraphicsPipeline> {
     let bindings = [BindingKind::UniformBuffer, BindingKind::UniformBuffer];
     scene_pipeline(
@@ -144,8 +167,9 @@ pub fn lighting_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) 
     )
 }
 
-/// Draws, with a [`lighting_pipeline`] bound, the meshes of `scene` for which `albedo` gives an
-/// albedo (`None` leaves a mesh out), each with its group's transform.
+/// Draws, with a [`lighting_pipeline`] bound by [`bind_lit`], the meshes of `scene` for which
+/// `albedo` gives an albedo (`None` leaves a mesh out), each with its group's transform and
+/// albedo map.
 pub fn draw_lit_meshes(
     ctx: &Context,
     cmd: vk::CommandBuffer,
@@ -153,7 +177,7 @@ pub fn draw_lit_meshes(
     scene: &GpuScene,
     albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
 ) {
-    draw_meshes(ctx, cmd, scene, pipeline, &|mesh, model| {
+    draw_meshes(ctx, cmd, scene, pipeline, true, &|mesh, model| {
         let albedo = albedo(mesh)?;
         Some(DrawPush { model: model.to_cols_array_2d(), albedo: [albedo[0], albedo[1], albedo[2], 0.0] })
     });

@@ -36,6 +36,7 @@ impl Targets {
                 width,
                 height,
                 layers: 1,
+                levels: 1,
                 array: false,
                 format: COLOR_FORMAT,
                 usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
@@ -48,6 +49,7 @@ impl Targets {
                 width,
                 height,
                 layers: 1,
+                levels: 1,
                 array: false,
                 format: DEPTH_FORMAT,
                 // Sampled: the ASM refinement analysis reads the visible surfaces back.

@@ -17,6 +17,8 @@ pub struct GpuBvh {
     instances: Buffer,
     triangles: Buffer,
     attributes: Buffer,
+    albedo_maps: Buffer,
+    albedo_texels: Buffer,
 }
 
 impl GpuBvh {
@@ -30,6 +32,8 @@ impl GpuBvh {
             instances: upload(ctx, "bvh.instances", &bvh.instances)?,
             triangles: upload(ctx, "bvh.triangles", &bvh.triangles)?,
             attributes: upload(ctx, "bvh.attributes", &bvh.attributes)?,
+            albedo_maps: upload(ctx, "bvh.albedo_maps", &bvh.albedo_maps)?,
+            albedo_texels: upload(ctx, "bvh.albedo_texels", &bvh.albedo_texels)?,
         })
     }
 
@@ -63,6 +67,8 @@ impl GpuBvh {
             Binding::Storage(&self.instances),
             Binding::Storage(&self.triangles),
             Binding::Storage(&self.attributes),
+            Binding::Storage(&self.albedo_maps),
+            Binding::Storage(&self.albedo_texels),
         ]
     }
 

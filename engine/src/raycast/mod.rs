@@ -13,8 +13,9 @@
 //! 0. `BvhNode[]`, bottom-level nodes of every group, each group's tree contiguous from its root
 //!    (`BvhInstance.info.x`); 1. `BvhNode[]`, the top level, root at 0; 2. `BvhInstance[]`, per
 //!    group: both matrices, root node, first triangle, triangle count; 3. `BvhTriangle[]`,
-//!    object-space positions; 4. `BvhTriangleAttributes[]`: vertex normals and albedo at the
-//!    same index.
+//!    object-space positions; 4. `BvhTriangleAttributes[]`: vertex normals, albedo, albedo map
+//!    and texture coordinates at the same index; 5. `BvhAlbedoMap[]`, the albedo maps (entry 0
+//!    unused); 6. `u32[]`, their texels (RGBA8 sRGB), sampled at level 0 (`bvh_albedo_texel`).
 //!
 //! A node is 32 bytes: `lo = (min.xyz, index)`, `hi = (max.xyz, count)`, index and count as
 //! float bits. `count == 0`: interior node whose children are `index` and `index + 1`.

@@ -3,9 +3,13 @@
 use super::aabb::Aabb;
 use super::sah::{self, node_bounds};
 use crate::error::{Error, Result};
-use crate::layouts::{BvhInstance, BvhNode, BvhTriangle, BvhTriangleAttributes};
+use crate::layouts::{
+    constants, BvhAlbedoMap, BvhInstance, BvhNode, BvhTexel, BvhTriangle, BvhTriangleAttributes,
+};
+use crate::scene::albedo_map::{AlbedoMap, Wrap};
 use crate::scene::Scene;
 use glam::{Mat4, Vec3};
+use std::sync::Arc;
 
 /// Triangles per bottom-level leaf, at most; the SAH may stop earlier.
 const MAX_LEAF_TRIANGLES: usize = 4;
@@ -28,6 +32,9 @@ pub struct SceneBvh {
     pub(super) instances: Vec<BvhInstance>,
     pub(super) triangles: Vec<BvhTriangle>,
     pub(super) attributes: Vec<BvhTriangleAttributes>,
+    /// The meshes' albedo maps, entry 0 unused (no map), and their texels.
+    pub(super) albedo_maps: Vec<BvhAlbedoMap>,
+    pub(super) albedo_texels: Vec<BvhTexel>,
     origins: Vec<TriangleOrigin>,
 }
 
@@ -40,19 +47,35 @@ impl SceneBvh {
             instances: Vec::with_capacity(scene.groups.len()),
             triangles: Vec::with_capacity(scene.triangle_count()),
             attributes: Vec::with_capacity(scene.triangle_count()),
+            albedo_maps: vec![BvhAlbedoMap::default()],
+            albedo_texels: Vec::new(),
             origins: Vec::with_capacity(scene.triangle_count()),
         };
+        let mut maps_added: Vec<*const AlbedoMap> = Vec::new();
         for (g, group) in scene.groups.iter().enumerate() {
             let mut triangles = Vec::new();
             let mut attributes = Vec::new();
             let mut origins = Vec::new();
             for (m, mesh) in group.meshes.iter().enumerate() {
-                let albedo = Vec3::from(mesh.albedo).extend(0.0).to_array();
+                let map = match &mesh.texturing {
+                    Some(t) => bvh.albedo_map_index(&mut maps_added, &t.map)?,
+                    None => 0,
+                };
+                let albedo = [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], f32::from_bits(map)];
                 for (t, tri) in mesh.indices.chunks_exact(3).enumerate() {
                     let p = |k: usize| Vec3::from(mesh.positions[tri[k] as usize]).extend(0.0).to_array();
                     let n = |k: usize| Vec3::from(mesh.normals[tri[k] as usize]).extend(0.0).to_array();
+                    let uv = |k: usize| mesh.texturing.as_ref().map_or([0.0; 2], |t| t.uvs[tri[k] as usize]);
+                    let ([u0, v0], [u1, v1], [u2, v2]) = (uv(0), uv(1), uv(2));
                     triangles.push(BvhTriangle { v0: p(0), v1: p(1), v2: p(2) });
-                    attributes.push(BvhTriangleAttributes { n0: n(0), n1: n(1), n2: n(2), albedo });
+                    attributes.push(BvhTriangleAttributes {
+                        n0: n(0),
+                        n1: n(1),
+                        n2: n(2),
+                        albedo,
+                        uv01: [u0, v0, u1, v1],
+                        uv2: [u2, v2, 0.0, 0.0],
+                    });
                     origins.push(TriangleOrigin { group: g as u32, mesh: m as u32, triangle: t as u32 });
                 }
             }
@@ -102,18 +125,38 @@ impl SceneBvh {
         Ok(())
     }
 
+    /// The index of `map` in the albedo map buffer, added with its texels the first time.
+    fn albedo_map_index(&mut self, added: &mut Vec<*const AlbedoMap>, map: &Arc<AlbedoMap>) -> Result<u32> {
+        if let Some(at) = added.iter().position(|m| *m == Arc::as_ptr(map)) {
+            return Ok(at as u32 + 1);
+        }
+        let wrap = |w| match w {
+            Wrap::Repeat => constants::WRAP_REPEAT,
+            Wrap::MirroredRepeat => constants::WRAP_MIRROR,
+            Wrap::ClampToEdge => constants::WRAP_CLAMP,
+        };
+        let flags = wrap(map.wrap[0]) | wrap(map.wrap[1]) << 2 | u32::from(map.filter.magnify_linear) << 4;
+        let first = to_u32(self.albedo_texels.len(), "albedo map texels")?;
+        self.albedo_texels.extend(map.texels.iter().map(|t| BvhTexel { rgba: u32::from_le_bytes(*t) }));
+        self.albedo_maps.push(BvhAlbedoMap { info: [first, map.width, map.height, flags] });
+        added.push(Arc::as_ptr(map));
+        Ok(added.len() as u32)
+    }
+
     /// Nodes of both levels.
     pub fn node_count(&self) -> usize {
         self.blas_nodes.len() + self.tlas_nodes.len()
     }
 
-    /// Bytes of all five GPU buffers together.
+    /// Bytes of all its GPU buffers together.
     pub fn byte_size(&self) -> usize {
         size_of_val(self.blas_nodes.as_slice())
             + size_of_val(self.tlas_nodes.as_slice())
             + size_of_val(self.instances.as_slice())
             + size_of_val(self.triangles.as_slice())
             + size_of_val(self.attributes.as_slice())
+            + size_of_val(self.albedo_maps.as_slice())
+            + size_of_val(self.albedo_texels.as_slice())
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -220,8 +220,11 @@ fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
         .meshes
         .into_iter()
         .enumerate()
-        .map(|(at, m)| mesh(m, folder).map_err(|e| e.within(&format!("mesh {at}"))))
-        .collect::<Result<_, _>>()?;
+        .map(|(at, m)| meshes(m, folder).map_err(|e| e.within(&format!("mesh {at}"))))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     let keys = desc
         .keyframes
         .iter()
@@ -245,20 +248,25 @@ fn group(desc: GroupDesc, folder: &Path) -> Result<Group, SceneError> {
     Ok(Group { name: desc.name, meshes, transform, motion })
 }
 
-fn mesh(desc: MeshDesc, folder: &Path) -> Result<Mesh, SceneError> {
-    let mut mesh = match (desc.obj, desc.plane, desc.sphere) {
+/// The meshes of one mesh entry: one, or one per albedo map of an OBJ whose faces use several
+/// (named after the entry's `name`, with `.k` where there are several).
+fn meshes(desc: MeshDesc, folder: &Path) -> Result<Vec<Mesh>, SceneError> {
+    let mut meshes = match (desc.obj, desc.plane, desc.sphere) {
         (Some(obj), None, None) => {
             let path: PathBuf = folder.join(obj);
             obj::load_obj(&path, desc.albedo)?
         }
-        (None, Some(p), None) => shapes::plane("plane", p.size, p.vertices, desc.albedo)?,
-        (None, None, Some(s)) => shapes::sphere("sphere", s.radius, s.segments, desc.albedo)?,
+        (None, Some(p), None) => vec![shapes::plane("plane", p.size, p.vertices, desc.albedo)?],
+        (None, None, Some(s)) => vec![shapes::sphere("sphere", s.radius, s.segments, desc.albedo)?],
         _ => return Err(SceneError::invalid("a mesh needs exactly one of \"obj\", \"plane\" or \"sphere\"")),
     };
     if let Some(name) = desc.name {
-        mesh.name = name;
+        let several = meshes.len() > 1;
+        for (k, mesh) in meshes.iter_mut().enumerate() {
+            mesh.name = if several { format!("{name}.{k}") } else { name.clone() };
+        }
     }
-    Ok(mesh)
+    Ok(meshes)
 }
 
 pub(super) fn camera(desc: &CameraDesc) -> Result<Camera, SceneError> {

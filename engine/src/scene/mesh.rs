@@ -1,6 +1,7 @@
 //! Triangle meshes: validation, vertex normals, and the vertex order every mesh is kept in.
 use glam::Vec3;
 
+use super::albedo_map::Texturing;
 use super::SceneError;
 
 /// An indexed triangle mesh in object space with one diffuse albedo.
@@ -18,6 +19,9 @@ pub struct Mesh {
     pub indices: Vec<u32>,
     /// Diffuse reflectance per channel, in [0, 1].
     pub albedo: [f32; 3],
+    /// A texture the albedo is multiplied by per pixel, with a texture coordinate per
+    /// position; `None` for one albedo over the whole mesh.
+    pub texturing: Option<Texturing>,
 }
 
 impl Mesh {
@@ -39,14 +43,19 @@ impl Mesh {
         indices: Vec<u32>,
         albedo: [f32; 3],
     ) -> Result<Mesh, SceneError> {
-        let (mesh, repaired) = Mesh::new_reporting(name, positions, normals, indices, albedo)?;
-        if repaired > 0 {
-            eprintln!(
-                "kage: note: mesh \"{}\": {repaired} normal(s) were zero or not finite; recomputed from the faces around them",
-                mesh.name
-            );
-        }
-        Ok(mesh)
+        noted(Mesh::build(name.into(), positions, normals, indices, albedo, None)?)
+    }
+
+    /// [`Mesh::new`] with an albedo map and its texture coordinates (one per position, finite).
+    pub fn new_textured(
+        name: impl Into<String>,
+        positions: Vec<[f32; 3]>,
+        normals: Option<Vec<[f32; 3]>>,
+        indices: Vec<u32>,
+        albedo: [f32; 3],
+        texturing: Texturing,
+    ) -> Result<Mesh, SceneError> {
+        noted(Mesh::build(name.into(), positions, normals, indices, albedo, Some(texturing))?)
     }
 
     /// [`Mesh::new`] without its note: the mesh and how many of the given normals were zero or
@@ -58,16 +67,38 @@ impl Mesh {
         indices: Vec<u32>,
         albedo: [f32; 3],
     ) -> Result<(Mesh, usize), SceneError> {
-        let name = name.into();
+        Mesh::build(name.into(), positions, normals, indices, albedo, None)
+    }
+
+    fn build(
+        name: String,
+        positions: Vec<[f32; 3]>,
+        normals: Option<Vec<[f32; 3]>>,
+        indices: Vec<u32>,
+        albedo: [f32; 3],
+        texturing: Option<Texturing>,
+    ) -> Result<(Mesh, usize), SceneError> {
         check_geometry(&name, &positions, &indices, albedo)?;
+        if let Some(t) = &texturing {
+            check_uvs(&name, &t.uvs, positions.len())?;
+        }
         let (normals, repaired) = match normals {
             Some(normals) if normals.len() == positions.len() => {
                 repaired_normals(normals, &positions, &indices)
             }
             _ => (area_weighted_normals(&positions, &indices), 0),
         };
-        let (positions, normals, indices) = in_first_use_order(positions, normals, indices);
-        Ok((Mesh { name, positions, normals, indices, albedo }, repaired))
+        let order = first_use_order(positions.len(), &indices);
+        let texturing = texturing.map(|t| Texturing { uvs: reordered(&t.uvs, &order.0), ..t });
+        let mesh = Mesh {
+            name,
+            positions: reordered(&positions, &order.0),
+            normals: reordered(&normals, &order.0),
+            indices: order.1,
+            albedo,
+            texturing,
+        };
+        Ok((mesh, repaired))
     }
 
     /// Checks what [`Mesh::new`] guarantees, for a mesh whose public fields were filled or
@@ -83,7 +114,11 @@ impl Mesh {
                 self.positions.len()
             )));
         }
-        self.normals.iter().enumerate().try_for_each(|(at, n)| checked_normal(name, at, *n).map(|_| ()))
+        self.normals.iter().enumerate().try_for_each(|(at, n)| checked_normal(name, at, *n).map(|_| ()))?;
+        match &self.texturing {
+            Some(t) => check_uvs(name, &t.uvs, self.positions.len()),
+            None => Ok(()),
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -192,27 +227,55 @@ pub(crate) fn area_weighted_normals(positions: &[[f32; 3]], indices: &[u32]) -> 
     sums.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y).to_array()).collect()
 }
 
-fn in_first_use_order(
-    positions: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    indices: Vec<u32>,
-) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>) {
-    let mut new_index = vec![u32::MAX; positions.len()];
-    let mut ordered_positions = Vec::with_capacity(positions.len());
-    let mut ordered_normals = Vec::with_capacity(positions.len());
+/// The note [`Mesh::new`] prints where normals were repaired.
+fn noted((mesh, repaired): (Mesh, usize)) -> Result<Mesh, SceneError> {
+    if repaired > 0 {
+        eprintln!(
+            "kage: note: mesh \"{}\": {repaired} normal(s) were zero or not finite; recomputed from the faces around them",
+            mesh.name
+        );
+    }
+    Ok(mesh)
+}
+
+/// One finite texture coordinate per position.
+fn check_uvs(name: &str, uvs: &[[f32; 2]], positions: usize) -> Result<(), SceneError> {
+    if uvs.len() != positions {
+        return Err(SceneError::invalid(format!(
+            "mesh \"{name}\" has {} texture coordinates for {positions} positions",
+            uvs.len()
+        )));
+    }
+    match uvs.iter().position(|uv| !uv[0].is_finite() || !uv[1].is_finite()) {
+        Some(at) => Err(SceneError::invalid(format!(
+            "mesh \"{name}\": texture coordinate {at} is NaN or infinite: {:?}",
+            uvs[at]
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// The old index of each vertex in the order the triangles first use them (unused ones
+/// dropped), and the indices renumbered to that order.
+fn first_use_order(vertex_count: usize, indices: &[u32]) -> (Vec<u32>, Vec<u32>) {
+    let mut new_index = vec![u32::MAX; vertex_count];
+    let mut order = Vec::with_capacity(vertex_count);
     let indices = indices
-        .into_iter()
-        .map(|old| {
+        .iter()
+        .map(|&old| {
             let slot = &mut new_index[old as usize];
             if *slot == u32::MAX {
-                *slot = ordered_positions.len() as u32;
-                ordered_positions.push(positions[old as usize]);
-                ordered_normals.push(normals[old as usize]);
+                *slot = order.len() as u32;
+                order.push(old);
             }
             *slot
         })
         .collect();
-    (ordered_positions, ordered_normals, indices)
+    (order, indices)
+}
+
+fn reordered<T: Copy>(items: &[T], order: &[u32]) -> Vec<T> {
+    order.iter().map(|&old| items[old as usize]).collect()
 }
 
 #[cfg(test)]

@@ -1,8 +1,8 @@
 //! What a scene holds and how it is read and written.
 //!
-//! A [`Scene`] is rigid [`Group`]s of triangle [`Mesh`]es (one diffuse albedo each), one
-//! environment light ([`EnvMap`]), optional local [`Light`]s and a [`Camera`]. Nothing more until
-//! a technique needs it.
+//! A [`Scene`] is rigid [`Group`]s of triangle [`Mesh`]es (one diffuse albedo each, times an
+//! optional [`AlbedoMap`] per pixel), one environment light ([`EnvMap`]), optional local
+//! [`Light`]s and a [`Camera`]. Nothing more until a technique needs it.
 //!
 //! Conventions:
 //! - Right-handed, +Y up. Group transforms scale uniformly, then rotate, then translate; Euler
@@ -21,6 +21,7 @@
 use glam::Vec3;
 use std::path::Path;
 
+pub mod albedo_map;
 pub mod animation;
 mod asm_room;
 pub mod atrium;
@@ -43,6 +44,7 @@ pub mod shapes;
 mod sun_map;
 mod transform;
 
+pub use albedo_map::{AlbedoMap, Texturing};
 pub use builtin::BUILTIN;
 pub use camera::{Camera, FAR, NEAR};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};

@@ -2,7 +2,7 @@
 use super::Technique;
 use crate::backend::{vk, Binding, Buffer, Context, Depth, GraphicsPipeline};
 use crate::error::Result;
-use crate::frame::scene_pass::{draw_lit_meshes, lighting_pipeline};
+use crate::frame::scene_pass::{bind_lit, draw_lit_meshes, lighting_pipeline};
 use crate::frame::{FrameInputs, FrameState, COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
 use crate::frame::{GpuMesh, GpuScene};
 use crate::layouts::spirv;
@@ -54,7 +54,7 @@ impl Unshadowed {
         scene: &GpuScene,
         albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,
     ) {
-        self.scene.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(sh)]);
+        bind_lit(cmd, &self.scene, scene, &[Binding::Uniform(uniforms), Binding::Uniform(sh)]);
         draw_lit_meshes(ctx, cmd, &self.scene, scene, albedo);
     }
 }

@@ -4,7 +4,8 @@
 //! - a group is a root node: its TRS the group's transform, its meshes on it (one) or on
 //!   children without a transform (several); each Kage mesh one glTF mesh of one triangle
 //!   primitive with positions, normals, u32 indices and a material whose baseColorFactor is the
-//!   albedo (metallic 0, roughness 1: a diffuse surface in other viewers too);
+//!   albedo (metallic 0, roughness 1: a diffuse surface in other viewers too) and whose
+//!   baseColorTexture, read through TEXCOORD_0, is its albedo map (a PNG in the buffer);
 //! - a group's motion is one animation named after the group, with linear translation, rotation
 //!   and scale channels;
 //! - the camera is a perspective camera on its own root node, point and spot lights are
@@ -17,6 +18,7 @@
 //! animation's `extras` (`{"kage": {...}}`); the reader takes them only where they agree with the
 //! glTF values, so a file edited in another tool is read from what that tool wrote.
 mod read;
+mod texture;
 mod write;
 
 pub use read::{overview, parts, Parts};

@@ -10,8 +10,8 @@
 //!   composes both motions). Nodes without a name are named `node<index>` (`node3`), which
 //!   `gltf_groups` takes too;
 //! - triangle primitives: positions, normals (computed where absent), indices (0, 1, 2, … where
-//!   absent); the material's baseColorFactor as albedo, times the mean of its baseColorTexture
-//!   (sRGB decoded) where it has one, with a note: Kage shades each mesh with one diffuse colour;
+//!   absent); the material's baseColorFactor as albedo, and its baseColorTexture as the mesh's
+//!   albedo map (`texture`: its coordinate set, sampler and KHR_texture_transform);
 //! - the first perspective camera, or the one named (without one, a view of the whole scene,
 //!   with a note);
 //! - KHR_lights_punctual point and spot lights (colour × candela over 683 lm/W, Kage's radiant
@@ -27,7 +27,7 @@
 //! cameras, a group whose scale in the world is not uniform (at rest or at a key), data out of
 //! its buffer.
 //! What is not used (directional lights, morph weight channels, extensions, textures other than
-//! the base colour) is listed in one note. glTF has no environment: the scene is lit by a constant
+//! the base colour, alpha) is listed in one note. glTF has no environment: the scene is lit by a constant
 //! sky of radiance 1 (a note says so; `--env` or a scene file gives another).
 use super::super::motion::{Key, Motion};
 use super::super::{Camera, Group, Light, Mesh, SceneError, Transform};
@@ -99,7 +99,7 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
     })?;
     let mut unused: Vec<String> = document
         .extensions_used()
-        .filter(|e| *e != "KHR_lights_punctual")
+        .filter(|e| !["KHR_lights_punctual", "KHR_texture_transform"].contains(e))
         .map(|e| format!("extension {e}"))
         .collect();
     if let Some(skin) = document.skins().next() {
@@ -128,6 +128,7 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
         }
     }
 
+    let mut albedo_maps = super::texture::AlbedoMaps::new(&images);
     let mut groups = Vec::new();
     let mut camera = None;
     let mut camera_names = Vec::new();
@@ -159,7 +160,7 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
                         ))
                     };
                     meshes.push(
-                        primitive_mesh(&primitive, &mesh, p, relative, &buffers, &images, &mut unused)
+                        primitive_mesh(&primitive, &mesh, p, relative, &buffers, &mut albedo_maps, &mut unused)
                             .map_err(at)?,
                     );
                 }
@@ -261,7 +262,7 @@ fn primitive_mesh(
     p: usize,
     relative: Mat4,
     buffers: &[gltf::buffer::Data],
-    images: &[gltf::image::Data],
+    albedo_maps: &mut super::texture::AlbedoMaps,
     unused: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     if primitive.mode() != gltf::mesh::Mode::Triangles {
@@ -308,43 +309,30 @@ fn primitive_mesh(
     if relative.determinant() < 0.0 {
         indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
     }
-    let pbr = primitive.material().pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
-    let mut albedo = [r, g, b];
-    if let Some(info) = pbr.base_color_texture() {
-        let image = images.get(info.texture().source().index()).ok_or("its base colour image is missing")?;
-        let mean = mean_colour(image).ok_or("its base colour image has a format Kage cannot average")?;
-        albedo = [albedo[0] * mean[0], albedo[1] * mean[1], albedo[2] * mean[2]];
-        eprintln!(
-            "kage: note: mesh {} primitive {p}: its base colour texture is replaced by its mean colour (Kage shades a mesh with one albedo)",
-            mesh.index()
-        );
-    }
     let material = primitive.material();
+    let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
+    let albedo = [r, g, b].map(|c| c.clamp(0.0, 1.0));
+    let texturing = albedo_maps.texturing(
+        primitive,
+        |set| reader.read_tex_coords(set).map(|c| c.into_f32().collect()),
+        positions.len(),
+    )?;
     if material.normal_texture().is_some()
         || material.occlusion_texture().is_some()
         || material.emissive_texture().is_some()
     {
         unused.push("normal, occlusion and emissive textures".into());
     }
+    if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
+        unused.push("alpha (every surface is opaque)".into());
+    }
     let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
     let name = if mesh.primitives().len() == 1 { mesh_name } else { format!("{mesh_name}.{p}") };
-    Mesh::new(name, positions, normals, indices, albedo.map(|c| c.clamp(0.0, 1.0))).map_err(|e| e.to_string())
-}
-
-/// The mean linear colour of an 8-bit sRGB image (RGB or RGBA).
-fn mean_colour(image: &gltf::image::Data) -> Option<[f32; 3]> {
-    let channels = match image.format {
-        gltf::image::Format::R8G8B8 => 3,
-        gltf::image::Format::R8G8B8A8 => 4,
-        _ => return None,
-    };
-    let linear = |c: u8| crate::imageio::srgb_eotf(c as f32 / 255.0);
-    let texels = image.pixels.chunks_exact(channels);
-    let count = texels.len().max(1) as f32;
-    let sum =
-        texels.fold([0.0f32; 3], |s, t| [s[0] + linear(t[0]), s[1] + linear(t[1]), s[2] + linear(t[2])]);
-    Some(sum.map(|c| c / count))
+    match texturing {
+        Some(t) => Mesh::new_textured(name, positions, normals, indices, albedo, t),
+        None => Mesh::new(name, positions, normals, indices, albedo),
+    }
+    .map_err(|e| e.to_string())
 }
 
 /// A perspective camera on `node` (placed by `world`); Kage's own look-at where its extras hold

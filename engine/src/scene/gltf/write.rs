@@ -1,6 +1,7 @@
 //! Writing a scene's groups, lights, camera and motion as binary glTF (.glb), in the mapping
 //! the module documents; [`super::parts`] reads them back identical.
 use super::super::camera::{FAR, NEAR};
+use super::super::albedo_map::{AlbedoMap, Wrap};
 use super::super::motion::{Key, Motion};
 use super::super::{Camera, Group, Light, Mesh, Scene};
 use super::{Extras, KageExtras};
@@ -37,6 +38,11 @@ struct Builder {
     bin: Vec<u8>,
     views: Vec<Value>,
     accessors: Vec<Value>,
+    /// Each albedo map written (one image, sampler and texture each), by address.
+    maps: Vec<*const AlbedoMap>,
+    images: Vec<Value>,
+    samplers: Vec<Value>,
+    textures: Vec<Value>,
 }
 
 impl Builder {
@@ -77,6 +83,44 @@ impl Builder {
         self.accessors.push(accessor);
         self.accessors.len() - 1
     }
+
+    /// The texture of `map`, written as a PNG image in the buffer with its sampler the first
+    /// time.
+    fn texture(&mut self, map: &std::sync::Arc<AlbedoMap>) -> usize {
+        if let Some(at) = self.maps.iter().position(|m| *m == std::sync::Arc::as_ptr(map)) {
+            return at;
+        }
+        let offset = self.bin.len();
+        self.bin.extend(map.png());
+        self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": self.bin.len() - offset}));
+        // Each view starts 4-byte aligned, as accessors after it need.
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
+        let index = self.maps.len();
+        self.images.push(json!({"name": map.name, "mimeType": "image/png", "bufferView": self.views.len() - 1}));
+        let wrap = |w| match w {
+            Wrap::Repeat => 10497,
+            Wrap::MirroredRepeat => 33648,
+            Wrap::ClampToEdge => 33071,
+        };
+        let f = map.filter;
+        let min = match (f.minify_linear, f.mipmaps) {
+            (false, None) => 9728,
+            (true, None) => 9729,
+            (false, Some(false)) => 9984,
+            (true, Some(false)) => 9985,
+            (false, Some(true)) => 9986,
+            (true, Some(true)) => 9987,
+        };
+        self.samplers.push(json!({
+            "magFilter": if f.magnify_linear { 9729 } else { 9728 },
+            "minFilter": min,
+            "wrapS": wrap(map.wrap[0]),
+            "wrapT": wrap(map.wrap[1]),
+        }));
+        self.textures.push(json!({"source": index, "sampler": index}));
+        self.maps.push(std::sync::Arc::as_ptr(map));
+        index
+    }
 }
 
 /// The scene's groups, lights, camera and motion as a .glb file's bytes.
@@ -90,14 +134,19 @@ pub fn write_glb(scene: &Scene) -> Vec<u8> {
             .iter()
             .map(|mesh| {
                 meshes.push(mesh_json(&mut b, mesh, materials.len()));
-                materials.push(json!({
+                let mut material = json!({
                     "name": mesh.name,
                     "pbrMetallicRoughness": {
                         "baseColorFactor": [mesh.albedo[0], mesh.albedo[1], mesh.albedo[2], 1.0],
                         "metallicFactor": 0.0,
                         "roughnessFactor": 1.0,
                     },
-                }));
+                });
+                if let Some(texturing) = &mesh.texturing {
+                    let texture = b.texture(&texturing.map);
+                    material["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": texture});
+                }
+                materials.push(material);
                 meshes.len() - 1
             })
             .collect();
@@ -159,6 +208,11 @@ pub fn write_glb(scene: &Scene) -> Vec<u8> {
     if !animations.is_empty() {
         document["animations"] = animations.into();
     }
+    if !b.images.is_empty() {
+        document["images"] = b.images.into();
+        document["samplers"] = b.samplers.into();
+        document["textures"] = b.textures.into();
+    }
     if !lights.is_empty() {
         document["extensionsUsed"] = json!(["KHR_lights_punctual"]);
         document["extensions"] = json!({"KHR_lights_punctual": {"lights": lights}});
@@ -176,13 +230,14 @@ fn mesh_json(b: &mut Builder, mesh: &Mesh, material: usize) -> Value {
     let positions = b.accessor(mesh.positions.as_flattened(), 3, "VEC3", Some(ARRAY_BUFFER), true);
     let normals = b.accessor(mesh.normals.as_flattened(), 3, "VEC3", Some(ARRAY_BUFFER), false);
     let indices = b.accessor(&mesh.indices, 1, "SCALAR", Some(ELEMENT_ARRAY_BUFFER), false);
+    let mut attributes = json!({"POSITION": positions, "NORMAL": normals});
+    if let Some(texturing) = &mesh.texturing {
+        let uvs = b.accessor(texturing.uvs.as_flattened(), 2, "VEC2", Some(ARRAY_BUFFER), false);
+        attributes["TEXCOORD_0"] = uvs.into();
+    }
     json!({
         "name": mesh.name,
-        "primitives": [{
-            "attributes": {"POSITION": positions, "NORMAL": normals},
-            "indices": indices,
-            "material": material,
-        }],
+        "primitives": [{"attributes": attributes, "indices": indices, "material": material}],
     })
 }
 

@@ -30,8 +30,8 @@ use crate::backend::{
 use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
-use crate::frame::gpu_scene::MESH_POSITIONS;
-use crate::frame::scene_pass::scene_pipeline_with;
+use crate::frame::gpu_scene::MESH_POSITIONS_UVS;
+use crate::frame::scene_pass::{bind_lit, scene_pipeline_with};
 use crate::frame::sh_projection::{Mapping, ProjectionNames, ShProjection};
 use crate::frame::ENVIRONMENT;
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
@@ -207,7 +207,7 @@ impl ProbeCapture {
         let image = |name, format, usage| {
             Image::new(
                 ctx,
-                &ImageDesc { name, width: side, height: 6 * side, layers: 1, array: false, format, usage },
+                &ImageDesc { name, width: side, height: 6 * side, layers: 1, levels: 1, array: false, format, usage },
             )
         };
         let faces = (0..6)
@@ -243,7 +243,7 @@ impl ProbeCapture {
                 (spirv::PROBE_SURFACE_VERT, spirv::PROBE_SURFACE_FRAG),
                 &[BindingKind::UniformBuffer],
                 size_of::<DrawPush>(),
-                &[MESH_POSITIONS, RADIANCE_VERTICES],
+                &[MESH_POSITIONS_UVS, RADIANCE_VERTICES],
                 DepthTest::Less,
             )?,
             radiance: static_radiance(ctx, &statics, settings)?,
@@ -303,7 +303,7 @@ impl ProbeCapture {
                     ctx.begin_rendering(cmd, Some(cube.into()), None, Some(Depth::Clear(depth.into())));
                     for (f, uniforms) in faces.iter().enumerate() {
                         ctx.set_viewport(cmd, face_area(f as u32));
-                        surfaces.bind(cmd, &[Binding::Uniform(uniforms)]);
+                        bind_lit(cmd, surfaces, scene, &[Binding::Uniform(uniforms)]);
                         for mesh in scene.meshes.iter().filter(|m| is_static(m.group)) {
                             let Some(Some(r)) = radiance.get(mesh.group).and_then(|g| g.get(mesh.mesh))
                             else {
@@ -313,6 +313,7 @@ impl ProbeCapture {
                                 model: scene.transforms[mesh.group].to_cols_array_2d(),
                                 albedo: [0.0; 4],
                             };
+                            scene.bind_albedo_map(cmd, surfaces, mesh);
                             surfaces.push(cmd, bytes_of(&push));
                             ctx.draw_indexed(cmd, &[&mesh.vertices, r], &mesh.indices, mesh.index_count);
                         }

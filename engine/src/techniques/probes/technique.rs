@@ -14,7 +14,7 @@ use super::set::{bounds, ProbeGroups, ProbeSet, ProbeSettings, StaticLighting};
 use super::Walker;
 use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, Depth, GraphicsPipeline, MemoryLocation};
 use crate::error::{Error, Result};
-use crate::frame::scene_pass::{draw_lit_meshes, lighting_pipeline};
+use crate::frame::scene_pass::{bind_lit, draw_lit_meshes, lighting_pipeline};
 use crate::frame::GpuScene;
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
@@ -166,7 +166,7 @@ impl Technique for ProbeTechnique {
             }
             // Each moving group with its own light.
             for lit in self.lit.iter().filter(|lit| lit.centre.is_some()) {
-                self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Uniform(&lit.light)]);
+                bind_lit(cmd, &self.pipeline, scene, &[Binding::Uniform(uniforms), Binding::Uniform(&lit.light)]);
                 draw_lit_meshes(ctx, cmd, &self.pipeline, scene, |m| {
                     (m.group == lit.group).then_some(m.albedo)
                 });

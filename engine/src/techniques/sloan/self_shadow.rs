@@ -100,6 +100,7 @@ impl SelfShadow {
                 width: WIDTH,
                 height: next.div_ceil(WIDTH).max(1),
                 layers: 1,
+                levels: 1,
                 array: false,
                 format: vk::Format::R32G32B32A32_SFLOAT,
                 usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,

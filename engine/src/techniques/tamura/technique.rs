@@ -13,10 +13,10 @@ use crate::backend::{
 use crate::error::{Error, Result};
 use crate::frame::bounds::{env_rotation, group_bounds};
 use crate::frame::environment::GpuEnvironment;
-use crate::frame::gpu_scene::MESH_VERTICES;
+use crate::frame::gpu_scene::{MESH_ATTRIBUTES, MESH_VERTICES};
 use crate::frame::irradiance::gpu_irradiance;
 use crate::frame::regions::Regions;
-use crate::frame::scene_pass::{depth_prepass, depth_prepass_pipeline};
+use crate::frame::scene_pass::{bind_lit, depth_prepass, depth_prepass_pipeline, lit_bindings};
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::frame::{COLOR, DEPTH, FRAME_UNIFORMS};
@@ -184,7 +184,7 @@ impl PrtTechnique {
         for (c, rgb) in light_sh.c.iter_mut().zip(&env) {
             *c = [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 0.0];
         }
-        let transfer_attributes = transfer_vertex_buffer(2);
+        let transfer_attributes = transfer_vertex_buffer(MESH_ATTRIBUTES.len() as u32);
         let bounds = group_bounds(scene);
         let sheets = scene.groups.iter().map(Sheet::of).collect();
         // prt_scene.vert's pipeline constants: vec4s of region transfers and of SH coefficients.
@@ -201,7 +201,7 @@ impl PrtTechnique {
                     name: "scene_prt",
                     vertex_spirv: spirv::PRT_SCENE_VERT,
                     fragment_spirv: spirv::PRT_SCENE_FRAG,
-                    bindings: &[
+                    bindings: &lit_bindings(&[
                         BindingKind::UniformBuffer,
                         BindingKind::SampledImage,
                         BindingKind::StorageBuffer,
@@ -212,7 +212,7 @@ impl PrtTechnique {
                         BindingKind::SampledImage,
                         BindingKind::UniformBuffer,
                         BindingKind::SampledImage,
-                    ],
+                    ]),
                     push_size: size_of::<PrtDrawPush>() as u32,
                     vertex_buffers: &[
                         MESH_VERTICES,
@@ -318,8 +318,10 @@ impl PrtTechnique {
     pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, uniforms: &Buffer, scene: &GpuScene) {
         let (occlusion, self_shadow) = (&self.occlusion, &self.self_shadow);
         let [lights, shadow] = self.dominant.bindings();
-        self.scene_pipeline.bind(
+        bind_lit(
             cmd,
+            &self.scene_pipeline,
+            scene,
             &[
                 Binding::Uniform(uniforms),
                 Binding::Sampled(&self_shadow.texture, &self.nearest),
@@ -346,6 +348,7 @@ impl PrtTechnique {
                 layers: [first_layer, layer_count, self.dominant.slot(mesh.group), occlusion.resolution],
                 covered: occlusion.covered[mesh.group],
             };
+            scene.bind_albedo_map(cmd, &self.scene_pipeline, mesh);
             self.scene_pipeline.push(cmd, bytes_of(&push));
             ctx.draw_indexed(
                 cmd,

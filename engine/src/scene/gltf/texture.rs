@@ -1,0 +1,135 @@
+//! A glTF material's `baseColorTexture` as an albedo map: its image (decoded by the gltf crate,
+//! turned into 8-bit RGBA), its sampler's wrap and filter modes, its texture coordinate set and
+//! its `KHR_texture_transform` baked into the coordinates.
+use super::super::albedo_map::{AlbedoMap, Filter, Texturing, Wrap};
+use gltf::image::Format;
+use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// The albedo maps read so far, by (image, sampler): primitives that share a texture share
+/// one map (and one GPU image).
+pub struct AlbedoMaps<'a> {
+    images: &'a [gltf::image::Data],
+    read: HashMap<(usize, Option<usize>), Arc<AlbedoMap>>,
+}
+
+impl<'a> AlbedoMaps<'a> {
+    pub fn new(images: &'a [gltf::image::Data]) -> AlbedoMaps<'a> {
+        AlbedoMaps { images, read: HashMap::new() }
+    }
+
+    /// The base colour texture of `primitive`'s material with its texture coordinates (`count`
+    /// of them, one per position, `tex_coords(set)` reads a set), or `None` where the material
+    /// has none.
+    pub fn texturing(
+        &mut self,
+        primitive: &gltf::Primitive,
+        tex_coords: impl Fn(u32) -> Option<Vec<[f32; 2]>>,
+        count: usize,
+    ) -> Result<Option<Texturing>, String> {
+        let Some(info) = primitive.material().pbr_metallic_roughness().base_color_texture() else {
+            return Ok(None);
+        };
+        let transform = info.texture_transform();
+        let set = transform.as_ref().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord());
+        let uvs = tex_coords(set)
+            .ok_or_else(|| format!("its base colour texture reads TEXCOORD_{set}, which it does not have"))?;
+        if uvs.len() != count {
+            return Err(format!("TEXCOORD_{set} has {} coordinates for {count} positions", uvs.len()));
+        }
+        let uvs = match transform {
+            Some(t) => {
+                let ([ox, oy], [sx, sy], (sin, cos)) = (t.offset(), t.scale(), t.rotation().sin_cos());
+                uvs.into_iter()
+                    .map(|[u, v]| [cos * sx * u + sin * sy * v + ox, -sin * sx * u + cos * sy * v + oy])
+                    .collect()
+            }
+            None => uvs,
+        };
+        let texture = info.texture();
+        let key = (texture.source().index(), texture.sampler().index());
+        let map = match self.read.get(&key) {
+            Some(map) => map.clone(),
+            None => {
+                let map = Arc::new(self.map(&texture)?);
+                self.read.insert(key, map.clone());
+                map
+            }
+        };
+        Ok(Some(Texturing { map, uvs }))
+    }
+
+    fn map(&self, texture: &gltf::Texture) -> Result<AlbedoMap, String> {
+        let index = texture.source().index();
+        let name = texture.source().name().map_or_else(|| format!("image {index}"), str::to_owned);
+        let image = self.images.get(index).ok_or_else(|| format!("its base colour {name} is missing"))?;
+        let texels = rgba8(image).ok_or_else(|| format!("its base colour {name} has format {:?}", image.format))?;
+        let sampler = texture.sampler();
+        let wrap = |mode| match mode {
+            WrappingMode::Repeat => Wrap::Repeat,
+            WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        };
+        let filter = Filter {
+            magnify_linear: sampler.mag_filter() != Some(MagFilter::Nearest),
+            minify_linear: !matches!(
+                sampler.min_filter(),
+                Some(MinFilter::Nearest | MinFilter::NearestMipmapNearest | MinFilter::NearestMipmapLinear)
+            ),
+            mipmaps: match sampler.min_filter() {
+                Some(MinFilter::Nearest | MinFilter::Linear) => None,
+                Some(MinFilter::NearestMipmapNearest | MinFilter::LinearMipmapNearest) => Some(false),
+                _ => Some(true),
+            },
+        };
+        AlbedoMap::new(name, image.width, image.height, texels, [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())], filter)
+            .map_err(|e| e.to_string())
+    }
+}
+
+/// The image's texels as 8-bit RGBA: grey and grey-alpha spread to RGB, 16-bit channels
+/// rounded to 8 bits, float channels (linear values, rare in a base colour) encoded as sRGB.
+fn rgba8(image: &gltf::image::Data) -> Option<Vec<[u8; 4]>> {
+    let (channels, bytes) = match image.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let value = |c: &[u8]| -> u8 {
+        match bytes {
+            1 => c[0],
+            2 => (f32::from(u16::from_le_bytes([c[0], c[1]])) / 257.0).round() as u8,
+            _ => {
+                let linear = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+                (crate::imageio::srgb_oetf(linear.clamp(0.0, 1.0)) * 255.0).round() as u8
+            }
+        }
+    };
+    let texel = channels * bytes;
+    if image.pixels.len() != texel * image.width as usize * image.height as usize {
+        return None;
+    }
+    Some(
+        image
+            .pixels
+            .chunks_exact(texel)
+            .map(|t| {
+                let c: Vec<u8> = t.chunks_exact(bytes).map(value).collect();
+                match channels {
+                    1 => [c[0], c[0], c[0], 255],
+                    2 => [c[0], c[0], c[0], c[1]],
+                    3 => [c[0], c[1], c[2], 255],
+                    _ => [c[0], c[1], c[2], c[3]],
+                }
+            })
+            .collect(),
+    )
+}
