@@ -625,3 +625,60 @@ fn box_animated_plays_with_every_technique_where_the_reference_moves() {
         assert!(followed * 10 >= moved.len() * 9, "{kind:?}: only {followed} of {} pixels move", moved.len());
     }
 }
+
+/// A scene as a Blender user makes one (tests/assets/gltf/blender-suzanne/make.py, Blender
+/// 3.4.1's exporter): objects in creation order, so the ground comes first and the animated
+/// Suzanne last. Suzanne is the probe-lit group, wherever she goes; the ground and the textured
+/// crate keep the static technique's lighting, pixel for pixel; the 1000 W spot, written as
+/// 54,351 cd, reads back as the 1000 / 4π W/sr it radiates; the crate's colour grid is its
+/// albedo map, with the sampler Blender wrote.
+#[test]
+fn a_blender_scene_with_the_animated_object_last_lights_it_from_the_probes() {
+    use kage::scene::albedo_map::{Filter, Wrap};
+    use kage::techniques::probes::{CaptureSettings, ProbeGroups, ProbePlacement, ProbeSettings};
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/blender-suzanne/scene.glb");
+    let scene = Scene::load(&path).unwrap();
+    let names: Vec<&str> = scene.groups.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, ["Ground", "Crate", "Suzanne"]);
+    assert_eq!(ProbeGroups::of(&scene).moving(), [2], "Suzanne, the only group with keyframes");
+    match scene.lights[..] {
+        [Light::Spot { intensity, fov_deg, .. }] => {
+            let expected = 1000.0 / (4.0 * std::f32::consts::PI);
+            assert!(intensity.iter().all(|i| (i - expected).abs() < 1e-4 * expected), "{intensity:?}");
+            assert!((fov_deg - 70.0).abs() < 1e-3, "{fov_deg}");
+        }
+        ref other => panic!("one spot light expected: {other:?}"),
+    }
+    let crate_map = &scene.groups[1].meshes[0].texturing.as_ref().expect("the crate's texture").map;
+    assert_eq!((crate_map.name.as_str(), crate_map.width, crate_map.height), ("grid", 64, 64));
+    assert_eq!((crate_map.wrap, crate_map.filter), ([Wrap::Repeat; 2], Filter::SMOOTH));
+
+    let ctx = Validated::new();
+    let probes = TechniqueDesc::Probes {
+        probes: ProbeSettings {
+            placement: ProbePlacement::Grid([3, 2, 3]),
+            capture: CaptureSettings { cube_size: 8, samples: 16, ..Default::default() },
+            ..Default::default()
+        },
+        prt: PrtParams::DEFAULT,
+    };
+    let render = |technique: TechniqueDesc, time: f32| {
+        let options = RenderOptions { width: 64, height: 48, technique, transfer: None };
+        let mut renderer = Renderer::new(&ctx, &scene, &options).unwrap();
+        renderer.set_time(time).unwrap();
+        renderer.render().unwrap();
+        renderer.image().unwrap().pixels
+    };
+    // The pixels the probes light: those that differ from the unshadowed picture, whose static
+    // groups the probes technique lights unshadowed too. Their mean column follows Suzanne.
+    let probe_lit_column = |time: f32| {
+        let (lit, plain) = (render(probes.clone(), time), render(TechniqueDesc::Unshadowed, time));
+        let columns: Vec<usize> =
+            lit.iter().zip(&plain).enumerate().filter(|(_, (a, b))| a != b).map(|(i, _)| i % 64).collect();
+        assert!(columns.len() > 30, "at {time} s only {} pixels are lit by the probes", columns.len());
+        assert!(columns.len() < 64 * 48 / 4, "at {time} s the probes light {} pixels", columns.len());
+        columns.iter().sum::<usize>() as f32 / columns.len() as f32
+    };
+    let (start, end) = (probe_lit_column(0.0), probe_lit_column(2.0));
+    assert!(end > start + 10.0, "Suzanne moves right across the picture: column {start} -> {end}");
+}
