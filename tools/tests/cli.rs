@@ -1336,3 +1336,28 @@ fn an_obj_alone_renders_with_its_zero_normal_repaired() {
     );
     assert!(!output.contains("panicked") && !output.contains("JSON"), "{output}");
 }
+
+/// `kage scene info --json` says what Kage made of a file users bring: BoxAnimated's static
+/// outer box and its animated inner box (a node two levels down, named node2 as it has no name)
+/// as two groups, the inner one moving; and BoxTextured's albedo map.
+#[test]
+fn scene_info_names_the_groups_that_move_and_the_maps() {
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/assets/gltf");
+    let info = |file: &str| {
+        let run = kage(&["scene", "info", "--scene", assets.join(file).to_str().unwrap(), "--json"]);
+        assert!(run.status.success(), "{}", text(&run));
+        serde_json::from_slice::<serde_json::Value>(&run.stdout).unwrap()
+    };
+    let animated = info("khronos-box-animated/BoxAnimated.gltf");
+    let groups: Vec<(&str, bool)> = animated["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| (g["name"].as_str().unwrap(), g["moving"].as_bool().unwrap()))
+        .collect();
+    assert_eq!(groups, [("node3", false), ("node2", true)]);
+    assert!(animated["read_ms"].as_f64().is_some_and(|ms| ms > 0.0));
+    let textured = info("khronos-box-textured/BoxTextured.gltf");
+    assert_eq!(textured["albedo_map_texels"], 256 * 256);
+    assert_eq!(textured["groups"][0]["albedo_maps"][0], "image 0");
+}
