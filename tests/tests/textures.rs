@@ -287,3 +287,32 @@ fn textured_scenes_export_and_read_back() {
         assert!(back.groups[1].meshes[0].texturing.is_none(), "the floor has no map");
     }
 }
+
+/// Bad texturing in a glTF file is an error naming the file and what is wrong: a coordinate
+/// set the primitive lacks, coordinates a texture transform makes infinite, an image that does
+/// not decode.
+#[test]
+fn bad_texturing_is_refused_naming_the_file_and_the_problem() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box-textured/BoxTextured.gltf");
+    let original: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let dir = scratch_dir("texture-hostile");
+    let error_of = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut gltf = original.clone();
+        edit(&mut gltf);
+        let file = dir.join(format!("{name}.gltf"));
+        std::fs::write(&file, serde_json::to_vec(&gltf).unwrap()).unwrap();
+        let message = Scene::load(&file).unwrap_err().to_string();
+        assert!(message.contains(&format!("{name}.gltf")), "{message}");
+        message
+    };
+    let texture = "/materials/0/pbrMetallicRoughness/baseColorTexture";
+    let set = error_of("set", &|g| g.pointer_mut(texture).unwrap()["texCoord"] = 1.into());
+    assert!(set.contains("reads TEXCOORD_1, which it does not have"), "{set}");
+    let infinite = error_of("infinite", &|g| {
+        g.pointer_mut(texture).unwrap()["extensions"] =
+            serde_json::json!({"KHR_texture_transform": {"scale": [1e39, 1]}});
+    });
+    assert!(infinite.contains("texture coordinate") && infinite.contains("NaN or infinite"), "{infinite}");
+    let image = error_of("image", &|g| g["images"][0]["uri"] = "data:image/png;base64,AAAA".into());
+    assert!(image.contains("not a glTF 2.0 file Kage can read"), "{image}");
+}

@@ -39,6 +39,11 @@ bpy.ops.mesh.primitive_monkey_add(size=1, location=(-1.5, 0.8, 0.6))
 suzanne = bpy.context.object
 suzanne.name = "Suzanne"
 bpy.ops.object.shade_smooth()
+levels = int(os.environ.get("SUBDIVISIONS", "0"))
+if levels > 0:
+    modifier = suzanne.modifiers.new("subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = levels
+    bpy.ops.object.modifier_apply(modifier=modifier.name)
 for frame, x in [(1, -1.5), (49, 1.0)]:
     suzanne.location.x = x
     suzanne.keyframe_insert(data_path="location", frame=frame)
@@ -51,10 +56,11 @@ spot.rotation_euler = (math.radians(35), 0.0, math.radians(45))
 scene.collection.objects.link(spot)
 
 camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-camera.location = (0.0, -6.0, 3.5)
-camera.rotation_euler = (math.radians(62), 0.0, 0.0)
+camera.data.lens = 28
+camera.location = (0.0, -7.5, 4.5)
+camera.rotation_euler = (math.radians(59), 0.0, 0.0)
 scene.collection.objects.link(camera)
 scene.camera = camera
 
-out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scene.glb")
+out = os.environ.get("OUT") or os.path.join(os.path.dirname(os.path.abspath(__file__)), "scene.glb")
 bpy.ops.export_scene.gltf(filepath=out, export_format="GLB", export_lights=True, export_cameras=True)
