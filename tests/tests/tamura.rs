@@ -438,7 +438,12 @@ fn the_floor_gets_no_layer_over_the_teapot_from_above() {
 /// writes a timestamp at its next flush, which can move part of one pass's work into its
 /// neighbour: up to ~3× measured; a pass timed at nothing is hundreds of times off); and the
 /// passes' times together must hold most of the frame's span (at least 70 %: gaps between
-/// passes are the device's own work, ~13 % of the frame when a pass's work went untimed).
+/// passes are the device's own work, ~13 % of the frame when a pass's work went untimed). The
+/// device is the CPU: a frame during which the system took lavapipe's threads away has gaps no
+/// pass owns (67 % failed a fresh-clone run; 60–76 % are common on a busy host), and such
+/// interference only ever lowers the share. So the share is judged on the best of 9 frames,
+/// the one nearest the device's own timing (0.84–0.99 measured, under two CPU hogs too), while
+/// work that is never timed lowers every frame.
 #[test]
 fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
     let ctx = Validated::new();
@@ -448,7 +453,7 @@ fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
     for _ in 0..2 {
         renderer.render().unwrap(); // warm-up: shader compilation
     }
-    let frames: Vec<Vec<kage::pass::PassTiming>> = (0..5).map(|_| renderer.render().unwrap()).collect();
+    let frames: Vec<Vec<kage::pass::PassTiming>> = (0..9).map(|_| renderer.render().unwrap()).collect();
     let median = |name: &str| {
         let mut ms: Vec<f64> =
             frames.iter().flatten().filter(|t| t.name == name).map(|t| t.gpu_ms.unwrap()).collect();
@@ -460,10 +465,12 @@ fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
     assert!(horizontal > 0.0 && vertical > 0.0);
     let ratio = vertical / horizontal;
     assert!((0.1..=10.0).contains(&ratio), "filter passes {horizontal:.3} and {vertical:.3} ms");
+    let mut shares = Vec::new();
     for frame in &frames {
         let span = kage::pass::frame_ms(frame).unwrap();
         let sum: f64 = frame.iter().map(|t| t.gpu_ms.unwrap()).sum();
-        assert!(sum >= 0.7 * span && sum <= span * 1.001, "passes {sum:.2} ms of a {span:.2} ms frame");
+        assert!(sum <= span * 1.001, "passes {sum:.2} ms of a {span:.2} ms frame");
+        shares.push(sum / span);
         for t in frame.iter().filter(|t| t.name != "readback") {
             assert!(
                 t.gpu_ms.unwrap() > 1e-3 * span,
@@ -473,4 +480,7 @@ fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
             );
         }
     }
+    let best = shares.iter().copied().fold(0.0, f64::max);
+    println!("passes hold {shares:.2?} of their frames");
+    assert!(best >= 0.7, "the passes hold at best {best:.2} of their frames ({shares:.2?})");
 }
