@@ -7,6 +7,12 @@
 // error. Visibility is tested against the vertex's own group, in its object space, or against
 // the whole scene as it stands (the ray taken to world space; the basis stays in object space).
 //
+// KAGE_PRT_LANES invocations share a vertex, and cast its rays in an order that keeps them
+// coherent (`hammersley_index`): side by side they leave one point in neighbouring directions,
+// so the SIMD lanes of a CPU driver, or a GPU's, walk the same BVH nodes instead of eight
+// vertices' unrelated ones. Each lane sums its own rays; the vertex's first lane adds the
+// lanes' sums, in lane order, to the vertex's running sums.
+//
 // One dispatch casts rays [first, first + count) of every vertex in its range and adds their
 // sums to the vertex's running sums (the first dispatch stores), so one invocation never loops
 // long: llvmpipe (Mesa 22.3) ends every loop of an invocation, silently, once all its loops
@@ -29,6 +35,16 @@ layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) buffer Transfer { float
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) buffer RaysCast { uint rays_cast[]; };
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer BackHits { uint back_hits[]; };
 layout(push_constant) uniform Push { PrtTransferPush p; };
+// Coefficients per vertex (bands²): the sums and basis functions past it are compiled out.
+layout(constant_id = 0) const uint COEFFS = 25u;
+// False: every ray is taken as a miss without tracing it, which times everything but the
+// traversal (engine/src/prt/transfer.rs reports the split).
+layout(constant_id = 1) const bool TRACE = true;
+
+// Each lane's sums (7 vec4s hold 25 coefficients), rays cast and back hits, for its vertex's
+// first lane to add up.
+shared vec4 lane_sums[KAGE_PRT_GROUP][7];
+shared uvec2 lane_counts[KAGE_PRT_GROUP];
 
 // PCG output permutation (Jarzynski and Olano 2020, "Hash Functions for GPU Rendering").
 uint pcg_hash(uint v) {
@@ -46,12 +62,28 @@ void tangent_frame(vec3 n, out vec3 t, out vec3 b) {
     b = vec3(c, s + n.y * n.y * a, -n.y);
 }
 
+// The Hammersley index k of a vertex's j-th ray, a permutation of 0 .. rays - 1 (the estimator
+// sums the same points in another order). For rays = 2^m (m ≥ 3), k's bits are [A | c | D]:
+// c = j mod 8 (the lane), A (its top h bits) and D (its low m - 3 - h bits) the rest of j.
+// The eight rays of one (A, D) have k/N within 2^-h of each other and radical inverses within
+// 2^-(m-3-h): the Hammersley set is a (0, m, 2)-net in base 2, so every such elementary
+// interval holds exactly eight points, and the eight lanes cast them together. Other counts
+// keep k = j.
+uint hammersley_index(uint j, uint rays) {
+    if (rays < 8u || (rays & (rays - 1u)) != 0u) return j;
+    uint m = uint(findMSB(rays));
+    uint h = (m - 3u) / 2u;
+    uint l = m - 3u - h;
+    uint cell = j >> 3u;
+    return ((cell >> l) << (l + 3u)) | ((j & 7u) << l) | (cell & ((1u << l) - 1u));
+}
+
 // Adds sums 4j .. 4j + 3 of a vertex to its running sums (stores them on the first
-// dispatch), those below `coeffs`; on the last dispatch divides by the ray count.
-void add(uint base, uint coeffs, uint j, vec4 sums, bool first, float scale) {
+// dispatch), those below COEFFS; on the last dispatch divides by the ray count.
+void add(uint base, uint j, vec4 sums, bool first, float scale) {
     for (uint c = 0u; c < 4u; ++c) {
         uint i = 4u * j + c;
-        if (i < coeffs) {
+        if (i < COEFFS) {
             float before = first ? 0.0 : transfer[base + i];
             transfer[base + i] = (before + sums[c]) * scale;
         }
@@ -59,12 +91,13 @@ void add(uint base, uint coeffs, uint j, vec4 sums, bool first, float scale) {
 }
 
 void main() {
-    uint local = gl_GlobalInvocationID.x;
-    if (local >= p.range.y) return;
-    uint vertex = p.range.x + local;
+    uint lane = gl_LocalInvocationID.x % KAGE_PRT_LANES;
+    uint local = gl_GlobalInvocationID.x / KAGE_PRT_LANES;
+    // Every invocation reaches the barrier below; those past the range cast nothing.
+    bool casting = local < p.range.y;
+    uint vertex = p.range.x + min(local, p.range.y - 1u);
     uint group = p.range.z;
     uint rays = p.range.w;
-    uint coeffs = p.params.x;
 
     vec3 n = normalize(vertices[vertex].normal.xyz);
     vec3 origin = offset_ray_origin(vertices[vertex].position.xyz, n);
@@ -75,12 +108,14 @@ void main() {
 
     vec4 s0 = vec4(0.0), s1 = vec4(0.0), s2 = vec4(0.0), s3 = vec4(0.0), s4 = vec4(0.0),
          s5 = vec4(0.0), s6 = vec4(0.0);
-    bool whole_scene = p.params.w == 1u;
+    bool whole_scene = p.params.z == 1u;
     mat4 to_world = bvh_instances[group].object_to_world;
     vec3 world_origin = (to_world * vec4(origin, 1.0)).xyz;
-    uint first = p.params.y;
+    uint first = p.params.x;
+    uint end = casting ? first + p.params.y : first;
     uint done = 0u, back = 0u;
-    for (uint k = first; k < first + p.params.z; ++k) {
+    for (uint j = first + lane; j < end; j += KAGE_PRT_LANES) {
+        uint k = hammersley_index(j, rays);
         vec2 u = fract(vec2(float(k) / float(rays), float(bitfieldReverse(k)) * to_unit) + shift);
         // Cosine-weighted: a uniform point on the unit disc lifted onto the hemisphere.
         float r = sqrt(u.x);
@@ -91,10 +126,10 @@ void main() {
         // the rotation part carries normals).
         RayHit hit = RayHit(1e30, KAGE_NO_HIT, 0u, vec2(0.0));
         vec3 ray_dir = dir;
-        if (whole_scene) {
+        if (TRACE && whole_scene) {
             ray_dir = normalize(mat3(to_world) * dir);
             bvh_traverse(world_origin, ray_dir, false, hit);
-        } else {
+        } else if (TRACE) {
             bvh_traverse_blas(group, origin, dir, false, hit);
         }
         if (hit.instance != KAGE_NO_HIT) {
@@ -106,21 +141,39 @@ void main() {
         } else {
             vec4 c0, c1, c2, c3, c4, c5, c6;
             sh25_basis(dir, c0, c1, c2, c3, c4, c5, c6);
-            s0 += c0; s1 += c1; s2 += c2; s3 += c3; s4 += c4; s5 += c5; s6 += c6;
+            s0 += c0;
+            if (COEFFS > 4u) { s1 += c1; s2 += c2; }
+            if (COEFFS > 12u) { s3 += c3; }
+            if (COEFFS > 16u) { s4 += c4; s5 += c5; s6 += c6; }
         }
         ++done;
     }
+    uint slot = gl_LocalInvocationID.x;
+    lane_sums[slot][0] = s0; lane_sums[slot][1] = s1; lane_sums[slot][2] = s2;
+    lane_sums[slot][3] = s3; lane_sums[slot][4] = s4; lane_sums[slot][5] = s5;
+    lane_sums[slot][6] = s6;
+    lane_counts[slot] = uvec2(done, back);
+    barrier();
+    if (!casting || lane != 0u) return;
+    for (uint other = 1u; other < KAGE_PRT_LANES; ++other) {
+        s0 += lane_sums[slot + other][0]; s1 += lane_sums[slot + other][1];
+        s2 += lane_sums[slot + other][2]; s3 += lane_sums[slot + other][3];
+        s4 += lane_sums[slot + other][4]; s5 += lane_sums[slot + other][5];
+        s6 += lane_sums[slot + other][6];
+        done += lane_counts[slot + other].x;
+        back += lane_counts[slot + other].y;
+    }
     bool first_dispatch = first == 0u;
     // The last dispatch turns the sums into means.
-    float scale = first + p.params.z == rays ? 1.0 / float(rays) : 1.0;
-    uint base = vertex * coeffs;
-    add(base, coeffs, 0u, s0, first_dispatch, scale);
-    add(base, coeffs, 1u, s1, first_dispatch, scale);
-    add(base, coeffs, 2u, s2, first_dispatch, scale);
-    add(base, coeffs, 3u, s3, first_dispatch, scale);
-    add(base, coeffs, 4u, s4, first_dispatch, scale);
-    add(base, coeffs, 5u, s5, first_dispatch, scale);
-    add(base, coeffs, 6u, s6, first_dispatch, scale);
+    float scale = first + p.params.y == rays ? 1.0 / float(rays) : 1.0;
+    uint base = vertex * COEFFS;
+    add(base, 0u, s0, first_dispatch, scale);
+    add(base, 1u, s1, first_dispatch, scale);
+    add(base, 2u, s2, first_dispatch, scale);
+    add(base, 3u, s3, first_dispatch, scale);
+    add(base, 4u, s4, first_dispatch, scale);
+    add(base, 5u, s5, first_dispatch, scale);
+    add(base, 6u, s6, first_dispatch, scale);
     rays_cast[vertex] = (first_dispatch ? 0u : rays_cast[vertex]) + done;
     back_hits[vertex] = (first_dispatch ? 0u : back_hits[vertex]) + back;
 }

@@ -128,44 +128,69 @@ int bvh_children(BvhNode left_node, BvhNode right_node, uint index, vec3 origin,
 
 // Traverses one bottom-level tree, ray in object space. With any_hit it returns at the first
 // hit found; otherwise it narrows hit.t to the closest one. hit.t is the running tmax.
+//
+// "While-while" (Aila and Laine 2009): the invocations of a SIMD group run in lockstep, and a
+// CPU driver (lavapipe) runs both sides of every branch under a lane mask, so each step kind
+// has its own loop that all lanes run together: down through inner nodes until each lane holds
+// a leaf or finds no child entered, then the leaves' triangles, then one pop. Measured on the
+// Stanford bunny (`kage bench rays`, lavapipe): 1.3-1.4x the rays per second of one loop
+// whose every iteration held all three. The stack keeps each entry's entry distance beside its
+// index, so a pop skips an entry that a hit found since has moved out of reach without
+// fetching its node again.
 bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
     uint root = bvh_instances[instance].info.x;
     WatertightRay wray = bvh_watertight_ray(origin, dir);
     vec3 inv_dir = 1.0 / dir;
     bool found = false;
     uint stack[KAGE_BVH_STACK];
+    float stack_enter[KAGE_BVH_STACK];
     int top = 0;
     BvhNode node = bvh_blas_nodes[root];
-    if (bvh_enter_box(node, origin, inv_dir, hit.t) == 1.0 / 0.0) return false;
-    while (true) {
+    // node is one to visit: it is entered before hit.t.
+    bool live = bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0;
+    while (live) {
+        // Down through inner nodes while a child is entered.
         uint count = bvh_node_count(node);
-        uint index = bvh_node_index(node);
-        if (count > 0u) {
-            for (uint tri = index; tri < index + count; ++tri) {
-                float t;
-                vec2 bary;
-                if (bvh_intersect_triangle(wray, tri, hit.t, t, bary)) {
-                    hit = RayHit(t, instance, tri, bary);
-                    found = true;
-                    if (any_hit) return true;
-                }
+        while (count == 0u) {
+            uint index = bvh_node_index(node);
+            BvhNode left_node = bvh_blas_nodes[index];
+            BvhNode right_node = bvh_blas_nodes[index + 1u];
+            float enter_left = bvh_enter_box(left_node, origin, inv_dir, hit.t);
+            float enter_right = bvh_enter_box(right_node, origin, inv_dir, hit.t);
+            bool left = enter_left != 1.0 / 0.0;
+            bool right = enter_right != 1.0 / 0.0;
+            if (!left && !right) break;
+            // The nearer first, so that a hit in it shrinks hit.t and prunes the other.
+            bool left_first = left && (!right || enter_left <= enter_right);
+            if (left && right) {
+                stack[top] = left_first ? index + 1u : index;
+                stack_enter[top] = left_first ? enter_right : enter_left;
+                ++top;
             }
-        } else {
-            uint pushed;
-            int entered = bvh_children(bvh_blas_nodes[index], bvh_blas_nodes[index + 1u], index, origin, inv_dir, hit.t, node, pushed);
-            if (entered == 2) stack[top++] = pushed;
-            if (entered > 0) continue;
+            node = left_first ? left_node : right_node;
+            count = bvh_node_count(node);
         }
-        // Entries pushed earlier may lie beyond a hit found since: test them again on pop.
-        bool next = false;
+        // A leaf: its triangles, all lanes that hold one together.
+        uint first = bvh_node_index(node);
+        for (uint tri = first; tri < first + count; ++tri) {
+            float t;
+            vec2 bary;
+            if (bvh_intersect_triangle(wray, tri, hit.t, t, bary)) {
+                hit = RayHit(t, instance, tri, bary);
+                found = true;
+            }
+        }
+        if (found && any_hit) return true;
+        // Pop the next entry still within reach.
+        live = false;
         while (top > 0) {
-            node = bvh_blas_nodes[stack[--top]];
-            if (bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0) {
-                next = true;
+            --top;
+            if (stack_enter[top] < hit.t) {
+                node = bvh_blas_nodes[stack[top]];
+                live = true;
                 break;
             }
         }
-        if (!next) break;
     }
     return found;
 }

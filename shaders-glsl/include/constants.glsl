@@ -29,7 +29,7 @@
 // Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.
 #define KAGE_BVH_STACK 32
 // Invocations per workgroup of the ray casting test and benchmark shader.
-#define KAGE_RAYCAST_GROUP 64
+#define KAGE_RAYCAST_GROUP 256
 
 // Samples one invocation of the reference shaders takes per dispatch. llvmpipe silently ends an
 // invocation's loops after about 65,535 iterations in all; with BVH traversals inside every
@@ -40,8 +40,11 @@
 // Invocations per workgroup of the reference irradiance shader (one point each).
 #define KAGE_IRRADIANCE_GROUP 64
 
-// Invocations per workgroup of the PRT transfer shader (one vertex each).
+// Invocations per workgroup of the PRT transfer shader.
 #define KAGE_PRT_GROUP 64
+// Invocations that cast one vertex's rays side by side (a SIMD group on lavapipe's 256-bit
+// vectors): its workgroup holds KAGE_PRT_GROUP / KAGE_PRT_LANES vertices.
+#define KAGE_PRT_LANES 8
 
 // vec4s per vertex holding its PRT transfer vector: ceil(25 / 4), enough for 5 SH bands
 // (fewer bands leave the rest zero).

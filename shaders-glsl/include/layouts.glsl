@@ -150,7 +150,7 @@ struct PrtVertex {
 // Push constants of the PRT transfer shader; one dispatch covers some rays of some vertices of one mesh.
 struct PrtTransferPush {
     uvec4 range; // x: first vertex (into the vertex buffer), y: vertex count, z: group (BVH instance), w: rays per vertex
-    uvec4 params; // x: coefficients per vertex (bands squared), y: first ray of this dispatch, z: rays in it, w: 1 to test visibility against the whole scene (world space), 0 against the vertex's group
+    uvec4 params; // x: first ray of this dispatch, y: rays in it, z: 1 to test visibility against the whole scene (world space), 0 against the vertex's group, w: zero
 };
 
 // The environment's SH as one group's object space sees it, for the self-shadow pass: one

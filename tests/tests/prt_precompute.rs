@@ -305,3 +305,38 @@ fn bad_parameters_are_errors_not_panics() {
         assert!(err.contains("PRT with"), "{err}");
     }
 }
+
+/// The shader's lanes cast a vertex's rays in another order than the Hammersley index (eight
+/// neighbouring points side by side); the sums must still be over every point once. On a
+/// sphere nothing is occluded, so each coefficient is the mean of the basis over the shader's
+/// directions, which `directions::direction` computes on the CPU in index order. A point
+/// cast twice and another never moves a mean by about 1/rays (5e-4 at 2048), far beyond the
+/// float rounding of 2048 terms (~1e-6, the bound 1e-5); 2048 rays are reordered, 100 (not a
+/// power of two) are not.
+#[test]
+fn every_direction_is_cast_once_whatever_order_the_lanes_take() {
+    let ctx = Validated::new();
+    let sphere = shapes::sphere("sphere", 1.0, 6, [0.5; 3]).unwrap();
+    let scene = scene_of(vec![vec![sphere.clone()]]);
+    for rays in [2048, 100] {
+        let set = precompute(&ctx, &scene, 3, rays);
+        for vertex in [0, 7, sphere.vertex_count() / 2, sphere.vertex_count() - 1] {
+            let n = Vec3::from(sphere.normals[vertex]).normalize();
+            let mut want = [0.0f64; 9];
+            for k in 0..rays {
+                let mut y = [0.0f32; 9];
+                sh::eval_basis(3, kage::prt::directions::direction(vertex as u32, n, k, rays), &mut y);
+                for (w, y) in want.iter_mut().zip(y) {
+                    *w += f64::from(y) / f64::from(rays);
+                }
+            }
+            let got = set.vertex(0, 0, vertex).unwrap();
+            for (i, (g, w)) in got.iter().zip(want).enumerate() {
+                assert!(
+                    (f64::from(*g) - w).abs() < 1e-5,
+                    "{rays} rays, vertex {vertex}, coefficient {i}: GPU {g}, CPU mean over every point {w}"
+                );
+            }
+        }
+    }
+}

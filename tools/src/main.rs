@@ -3,6 +3,7 @@ mod bench;
 mod bench_asm;
 mod bench_probe_count;
 mod bench_probes;
+mod bench_scale;
 mod compare;
 mod env_cmd;
 mod info;

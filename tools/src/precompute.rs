@@ -61,11 +61,21 @@ fn report(set: &TransferSet, file_bytes: u64, device: Option<&str>) {
     let rays = set.vertex_count() as f64 * f64::from(set.params.rays);
     match device {
         Some(device) => println!(
-            "time: {:.2} s (BVH build, upload and transfer; {:.1} M rays/s) on {device}",
+            "time: {:.2} s (BVH build, upload and transfer; {:.2} M rays/s) on {device}",
             set.seconds,
             rays / set.seconds.max(1e-9) * 1e-6
         ),
         None => println!("time: {:.2} s when the cache file was made", set.seconds),
+    }
+    if set.traversal_seconds > 0.0 && set.seconds > 0.0 {
+        let traversal = f64::from(set.traversal_seconds);
+        let rest = (set.seconds - traversal).max(0.0);
+        println!(
+            "split: ray traversal {traversal:.2} s ({:.2} M rays/s), everything else {rest:.2} s = {:.1} % \
+             (BVH build and upload, ray generation, SH sums, mending, readback)",
+            rays / traversal * 1e-6,
+            100.0 * rest / set.seconds.max(1e-9)
+        );
     }
     println!(
         "size: {} bytes of transfer data ({:.1} KB, f32, albedo not included), {} bytes of \

@@ -494,6 +494,17 @@ fn precompute_caches_and_tamura_renders_from_the_cache() {
     let first = kage(&["precompute", "--rays", "64", "--cache", cache, "--validate"]);
     assert!(first.status.success(), "{}", text(&first));
     assert!(text(&first).contains("computing") && text(&first).contains("cache: wrote"), "{}", text(&first));
+    // The split of the time: traversal plus everything else is the whole.
+    let split = |out: &Output| -> Option<(f64, f64)> {
+        let all = text(out);
+        let time: f64 = all.lines().find_map(|l| l.strip_prefix("time: "))?.split(' ').next()?.parse().ok()?;
+        let line = all.lines().find_map(|l| l.strip_prefix("split: ray traversal "))?;
+        let traversal: f64 = line.split(' ').next()?.parse().ok()?;
+        let rest: f64 = line.split("everything else ").nth(1)?.split(' ').next()?.parse().ok()?;
+        Some((time, traversal + rest))
+    };
+    let (time, sum) = split(&first).unwrap_or_else(|| panic!("no time and split lines:\n{}", text(&first)));
+    assert!((time - sum).abs() <= 0.011, "traversal and the rest add up to {sum} s of {time} s");
     let second = kage(&["precompute", "--rays", "64", "--cache", cache]);
     assert!(text(&second).contains("is valid, nothing to compute"), "{}", text(&second));
     let forced = kage(&["precompute", "--rays", "64", "--cache", cache, "--force"]);
@@ -1360,4 +1371,27 @@ fn scene_info_names_the_groups_that_move_and_the_maps() {
     let textured = info("khronos-box-textured/BoxTextured.gltf");
     assert_eq!(textured["albedo_map_texels"], 256 * 256);
     assert_eq!(textured["groups"][0]["albedo_maps"][0], "image 0");
+}
+
+/// `kage bench scale` at two small sizes: a row per size, every technique's figures, the slopes,
+/// the CSV with one line per size and the chart.
+#[test]
+fn bench_scale_writes_its_table_and_chart() {
+    let dir = scratch_dir("cli-scale");
+    let out = dir.to_str().unwrap();
+    let run = kage(&[
+        "bench", "scale", "--triangles", "300,3000", "--rays", "32", "--techniques", "unshadowed,sloan-self",
+        "--size", "32", "--frames", "1", "--out", out, "--validate",
+    ]);
+    let all = text(&run);
+    assert!(run.status.success(), "{all}");
+    let rows: Vec<&str> = all.lines().filter(|l| l.contains("unshadowed: ") && l.contains("sloan-self: ")).collect();
+    assert_eq!(rows.len(), 2, "{all}");
+    assert!(all.contains("log-log slopes") && all.contains("sloan-self frame"), "{all}");
+    let csv = std::fs::read_to_string(dir.join("scale.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    // 300 requested triangles on the 1,800-triangle floor.
+    assert!(csv.lines().nth(1).unwrap().starts_with("2088,"), "{csv}");
+    let png = image::open(dir.join("scale.png")).unwrap();
+    assert!(png.width() > 1000, "{}x{}", png.width(), png.height());
 }

@@ -16,7 +16,7 @@
 //! | 40 | 16 | geometry hash ([`geometry_hash`]) |
 //! | 56 | 8 | FNV-1a 64 checksum of the coefficient bytes |
 //! | 64 | 4 | visibility: 0 the vertex's group, 1 the whole scene at rest |
-//! | 68 | 4 | zero |
+//! | 68 | 4 | seconds of those spent tracing rays (f32) |
 //! | 72 | 12·M | per mesh: group index, mesh index, vertex count (u32 each) |
 //! | 72 + 12·M | 4·V·bands² | coefficients (f32), mesh after mesh, vertex-major |
 //!
@@ -38,7 +38,7 @@ pub const MAGIC: [u8; 8] = *b"KAGEPRT\0";
 /// Version 1: Hammersley points with a per-vertex Cranley–Patterson shift, cosine-weighted.
 /// Version 2: the visibility field.
 /// Version 3: buried vertices filled from their neighbours (`prt::buried`).
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 /// File name extension of cache files.
 pub const EXTENSION: &str = "kageprt";
 const HEADER_BYTES: usize = 72;
@@ -233,7 +233,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
     let geometry = r.u128().unwrap_or_default();
     let checksum = r.u64().unwrap_or_default();
     let visibility = r.u32().unwrap_or_default();
-    let _zero = r.u32();
+    let traversal_seconds = f32::from_bits(r.u32().unwrap_or_default());
 
     if bands != key.params.bands {
         return Err(Stale::Bands { found: bands, wanted: key.params.bands });
@@ -295,7 +295,7 @@ fn parse(bytes: &[u8], key: &CacheKey) -> Result<TransferSet, Stale> {
             coefficients: floats.by_ref().take(vertices * coeffs).collect(),
         })
         .collect();
-    Ok(TransferSet { params: key.params, seconds, meshes })
+    Ok(TransferSet { params: key.params, seconds, traversal_seconds, meshes })
 }
 
 /// Writes `set` to `path` atomically (a temporary file in the same folder, then a rename), so a
@@ -342,7 +342,7 @@ fn encode(set: &TransferSet, key: &CacheKey) -> Vec<u8> {
     out.extend_from_slice(&key.geometry.to_le_bytes());
     out.extend_from_slice(&checksum.finish().to_le_bytes());
     out.extend_from_slice(&visibility_code(set.params.visibility).to_le_bytes());
-    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&set.traversal_seconds.to_le_bytes());
     let coeffs = set.params.coeffs().max(1);
     for m in &set.meshes {
         let vertices = m.coefficients.len() / coeffs;

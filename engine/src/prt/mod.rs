@@ -13,10 +13,12 @@
 //!   it; the renderer rotates the environment's SH into the group's frame instead.
 //!
 //! [`transfer`] computes a [`TransferSet`] on the GPU, [`buried`] mends the vertices that lie
-//! inside their own mesh, [`cache`] stores it on disk, and [`lobe`] gives the unshadowed
-//! transfer in closed form (the check for convex objects).
+//! inside their own mesh, [`cache`] stores it on disk, [`lobe`] gives the unshadowed
+//! transfer in closed form (the check for convex objects) and [`directions`] the rays the
+//! shader casts.
 pub mod buried;
 pub mod cache;
+pub mod directions;
 pub mod lobe;
 pub mod transfer;
 
@@ -106,6 +108,10 @@ pub struct TransferSet {
     pub params: PrtParams,
     /// Wall-clock seconds the precomputation took (when loaded from a cache: when it was made).
     pub seconds: f64,
+    /// Of those, the seconds spent tracing rays: the transfer jobs' time (submission to
+    /// completion) less the same jobs' time with tracing switched off (every ray taken as a
+    /// miss, so the rest of their work is if anything overcounted).
+    pub traversal_seconds: f32,
     /// One per mesh, in scene order (groups, then meshes within a group).
     pub meshes: Vec<MeshTransfer>,
 }

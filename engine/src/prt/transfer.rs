@@ -21,9 +21,10 @@ use crate::scene::Scene;
 /// on a discrete GPU, where the per-submission cost is still small beside it.
 pub const RAYS_PER_SUBMISSION: u64 = 1 << 21;
 
-/// Rays per vertex per dispatch: few enough that llvmpipe's limit of 65,535 loop iterations
-/// per invocation leaves each ray's traversal about 2,000 iterations.
-pub const RAYS_PER_DISPATCH: u32 = 32;
+/// Rays per vertex per dispatch, shared by its [`constants::PRT_LANES`] invocations: 32 per
+/// invocation, few enough that llvmpipe's limit of 65,535 loop iterations per invocation
+/// leaves each ray's traversal about 2,000 iterations.
+pub const RAYS_PER_DISPATCH: u32 = 32 * constants::PRT_LANES;
 
 /// Computes the transfer of every vertex of `scene`: builds and uploads the BVH, runs the
 /// compute jobs and reads the result back. `progress(done, total)` is called with vertex counts
@@ -39,13 +40,16 @@ pub fn precompute(
     let start = Instant::now();
     let layout = mesh_layout(scene);
     let total: usize = layout.iter().map(|m| m.2).sum();
-    let coefficients = if total == 0 {
-        Vec::new()
+    let (coefficients, seconds, traversal_seconds) = if total == 0 {
+        (Vec::new(), start.elapsed().as_secs_f64(), 0.0)
     } else {
         let bvh = GpuBvh::new(ctx, &SceneBvh::build(scene)?)?;
-        let (mut coefficients, back_hits) = run_jobs(ctx, scene, &bvh, params, total, progress)?;
+        let mut jobs = Jobs::new(ctx, scene, &bvh, params, total)?;
+        let (mut coefficients, back_hits) = jobs.run(progress)?;
         buried::fill(scene, params, &back_hits, &mut coefficients);
-        coefficients
+        let seconds = start.elapsed().as_secs_f64();
+        // Timed after the wall clock stops: the jobs' own dispatches again with tracing off.
+        (coefficients, seconds, jobs.traversal_seconds()?)
     };
     let mut rest = coefficients.as_slice();
     let meshes = layout
@@ -56,112 +60,164 @@ pub fn precompute(
             MeshTransfer { group, mesh, coefficients: mine.to_vec() }
         })
         .collect();
-    Ok(TransferSet { params, seconds: start.elapsed().as_secs_f64(), meshes })
+    Ok(TransferSet { params, seconds, traversal_seconds, meshes })
 }
 
-/// Runs the shader over all `total` vertices; returns their coefficients in scene order and
-/// how many of each vertex's rays ended on the back of a surface.
-fn run_jobs(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    bvh: &GpuBvh,
+/// The transfer jobs of one scene: the shader, its buffers and the dispatches.
+struct Jobs<'a> {
+    ctx: &'a Arc<Context>,
+    bvh: &'a GpuBvh,
     params: PrtParams,
     total: usize,
-    progress: &mut Progress,
-) -> Result<(Vec<f32>, Vec<u32>)> {
-    let too_many = || {
-        Error::InvalidArgument(format!(
-            "PRT over {total} vertices × {} coefficients exceeds the 32-bit indices of the \
-             transfer shader",
-            params.coeffs()
-        ))
-    };
-    let out_floats = total.checked_mul(params.coeffs()).ok_or_else(too_many)?;
-    u32::try_from(out_floats).map_err(|_| too_many())?;
+    batches: Vec<Vec<PrtTransferPush>>,
+    vertices: Buffer,
+    output: Buffer,
+    rays_cast: Buffer,
+    back_hits: Buffer,
+    executor: FrameExecutor,
+    /// Seconds the jobs run so far took from submission to completion.
+    job_seconds: f64,
+}
 
-    let vertices: Vec<PrtVertex> = scene
-        .meshes()
-        .flat_map(|(_, mesh)| mesh.positions.iter().zip(&mesh.normals))
-        .map(|(p, n)| PrtVertex { position: [p[0], p[1], p[2], 0.0], normal: [n[0], n[1], n[2], 0.0] })
-        .collect();
-    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-    let vertex_buffer = Buffer::with_data(ctx, "prt_vertices", storage, bytes_of_slice(&vertices))?;
-    let readback = |name, size| {
-        Buffer::new(
+impl<'a> Jobs<'a> {
+    fn new(ctx: &'a Arc<Context>, scene: &Scene, bvh: &'a GpuBvh, params: PrtParams, total: usize) -> Result<Self> {
+        let too_many = || {
+            Error::InvalidArgument(format!(
+                "PRT over {total} vertices × {} coefficients exceeds the 32-bit indices of the \
+                 transfer shader",
+                params.coeffs()
+            ))
+        };
+        let out_floats = total.checked_mul(params.coeffs()).ok_or_else(too_many)?;
+        u32::try_from(out_floats).map_err(|_| too_many())?;
+
+        let vertices: Vec<PrtVertex> = scene
+            .meshes()
+            .flat_map(|(_, mesh)| mesh.positions.iter().zip(&mesh.normals))
+            .map(|(p, n)| PrtVertex { position: [p[0], p[1], p[2], 0.0], normal: [n[0], n[1], n[2], 0.0] })
+            .collect();
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let readback = |name, size| {
+            Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name,
+                    size,
+                    usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        Ok(Jobs {
             ctx,
-            &BufferDesc {
-                name,
-                size,
-                usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
-                location: MemoryLocation::GpuOnly,
-            },
-        )
-    };
-    let output = readback("prt_transfer", out_floats as u64 * 4)?;
-    let rays_cast = readback("prt_rays_cast", total as u64 * 4)?;
-    let back_hits = readback("prt_back_hits", total as u64 * 4)?;
-    let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
-    kinds.extend([BindingKind::StorageBuffer; 4]);
-    let pipeline = ComputePipeline::new(
-        ctx,
-        "prt_transfer",
-        spirv::PRT_TRANSFER_COMP,
-        &kinds,
-        size_of::<PrtTransferPush>() as u32,
-    )?;
-    let mut bindings: Vec<Binding> = bvh.bindings().into_iter().collect();
-    bindings.extend([
-        Binding::Storage(&vertex_buffer),
-        Binding::Storage(&output),
-        Binding::Storage(&rays_cast),
-        Binding::Storage(&back_hits),
-    ]);
-
-    let mut executor = FrameExecutor::new(ctx, "prt_precompute")?;
-    let mut done = 0;
-    let cancelled = || Error::Cancelled("the PRT precomputation");
-    if !progress(done, total) {
-        return Err(cancelled());
+            bvh,
+            params,
+            total,
+            batches: submissions(&mesh_layout(scene), params),
+            vertices: Buffer::with_data(ctx, "prt_vertices", storage, bytes_of_slice(&vertices))?,
+            output: readback("prt_transfer", out_floats as u64 * 4)?,
+            rays_cast: readback("prt_rays_cast", total as u64 * 4)?,
+            back_hits: readback("prt_back_hits", total as u64 * 4)?,
+            executor: FrameExecutor::new(ctx, "prt_precompute")?,
+            job_seconds: 0.0,
+        })
     }
-    for batch in submissions(&mesh_layout(scene), params) {
+
+    /// The transfer shader, tracing its rays or (`trace` false) taking every ray as a miss.
+    fn pipeline(&self, trace: bool) -> Result<ComputePipeline> {
+        let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
+        kinds.extend([BindingKind::StorageBuffer; 4]);
+        ComputePipeline::specialized(
+            self.ctx,
+            if trace { "prt_transfer" } else { "prt_transfer_untraced" },
+            spirv::PRT_TRANSFER_COMP,
+            &kinds,
+            size_of::<PrtTransferPush>() as u32,
+            &[self.params.coeffs() as u32, u32::from(trace)],
+        )
+    }
+
+    /// Casts `rays` rays per vertex of `batch`, from ray `first` on, as dispatches of at most
+    /// [`RAYS_PER_DISPATCH`] rays, and waits for them; returns the seconds from submission to
+    /// completion, timed on the host (a CPU driver's timestamps around compute work are not
+    /// reliable, see vendor-notes.md).
+    fn submit(&mut self, pipeline: &ComputePipeline, batch: &[PrtTransferPush], first: u32, rays: u32) -> Result<f64> {
+        let mut bindings: Vec<Binding> = self.bvh.bindings().into_iter().collect();
+        bindings.extend([
+            Binding::Storage(&self.vertices),
+            Binding::Storage(&self.output),
+            Binding::Storage(&self.rays_cast),
+            Binding::Storage(&self.back_hits),
+        ]);
+        let ctx = self.ctx;
         let pass = Pass::new("prt_transfer", &[BVH], &[Resource("prt_transfer")], |cmd| {
-            for first_ray in (0..params.rays).step_by(RAYS_PER_DISPATCH as usize) {
+            for first_ray in (first..first + rays).step_by(RAYS_PER_DISPATCH as usize) {
                 // Each dispatch adds to the sums the previous one wrote.
-                if first_ray > 0 {
+                if first_ray > first {
                     ctx.full_barrier(cmd);
                 }
-                let count = RAYS_PER_DISPATCH.min(params.rays - first_ray);
-                for push in &batch {
-                    let push = PrtTransferPush {
-                        params: [push.params[0], first_ray, count, push.params[3]],
-                        ..*push
-                    };
-                    let groups = push.range[1].div_ceil(constants::PRT_GROUP);
+                let count = RAYS_PER_DISPATCH.min(first + rays - first_ray);
+                for push in batch {
+                    let push = PrtTransferPush { params: [first_ray, count, push.params[2], 0], ..*push };
+                    let groups = push.range[1].div_ceil(constants::PRT_GROUP / constants::PRT_LANES);
                     pipeline.dispatch(cmd, &bindings, bytes_of(&push), [groups, 1, 1]);
                 }
             }
         });
-        executor.run(&[BVH], vec![pass])?;
-        done += batch.iter().map(|p| p.range[1] as usize).sum::<usize>();
+        let start = Instant::now();
+        self.executor.run(&[BVH], vec![pass])?;
+        Ok(start.elapsed().as_secs_f64())
+    }
+
+    /// Runs the shader over every vertex; returns the coefficients in scene order and how many
+    /// of each vertex's rays ended on the back of a surface.
+    fn run(&mut self, progress: &mut Progress) -> Result<(Vec<f32>, Vec<u32>)> {
+        let (total, rays) = (self.total, self.params.rays);
+        let pipeline = self.pipeline(true)?;
+        let mut done = 0;
+        let cancelled = || Error::Cancelled("the PRT precomputation");
         if !progress(done, total) {
             return Err(cancelled());
         }
+        for batch in std::mem::take(&mut self.batches) {
+            self.job_seconds += self.submit(&pipeline, &batch, 0, rays)?;
+            done += batch.iter().map(|p| p.range[1] as usize).sum::<usize>();
+            self.batches.push(batch);
+            if !progress(done, total) {
+                return Err(cancelled());
+            }
+        }
+        if let Some((vertex, &got)) = words(self.rays_cast.read()?).iter().enumerate().find(|(_, n)| **n != rays) {
+            return Err(Error::Unsupported(format!(
+                "shader loops as long as the PRT needs: the driver stopped after {got} of {rays} rays \
+                 for vertex {vertex}, so the transfer would be wrong"
+            )));
+        }
+        let bytes = self.output.read()?;
+        let coefficients = bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+        Ok((coefficients, words(self.back_hits.read()?)))
     }
-    let words = |bytes: Vec<u8>| -> Vec<u32> {
-        bytes.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
-    };
-    if let Some((vertex, &got)) =
-        words(rays_cast.read()?).iter().enumerate().find(|(_, n)| **n != params.rays)
-    {
-        return Err(Error::Unsupported(format!(
-            "shader loops as long as the PRT needs: the driver stopped after {got} of {} rays \
-             for vertex {vertex}, so the transfer would be wrong",
-            params.rays
-        )));
+
+    /// The seconds the jobs spent tracing rays (see [`TransferSet::traversal_seconds`]): the
+    /// jobs' time less that of one dispatch per batch with tracing off, scaled from its rays to
+    /// all of them. Overwrites the results, which [`Jobs::run`] has read.
+    fn traversal_seconds(mut self) -> Result<f32> {
+        let rays = self.params.rays.min(RAYS_PER_DISPATCH);
+        let pipeline = self.pipeline(false)?;
+        let batches = std::mem::take(&mut self.batches);
+        // An untimed warm-up first (on a CPU driver, the shader's compilation).
+        self.submit(&pipeline, &batches[0], 0, rays)?;
+        let mut untraced = 0.0;
+        for batch in &batches {
+            untraced += self.submit(&pipeline, batch, 0, rays)?;
+        }
+        let rest = untraced * f64::from(self.params.rays) / f64::from(rays);
+        Ok((self.job_seconds - rest).max(0.0) as f32)
     }
-    let bytes = output.read()?;
-    let coefficients = bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
-    Ok((coefficients, words(back_hits.read()?)))
+}
+
+fn words(bytes: Vec<u8>) -> Vec<u32> {
+    bytes.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
 }
 
 /// Splits the meshes into dispatches (a dispatch never spans two meshes: the group is a push
@@ -179,7 +235,7 @@ fn submissions(layout: &[(usize, usize, usize)], params: PrtParams) -> Vec<Vec<P
             batch.push(PrtTransferPush {
                 range: [first as u32, count as u32, group as u32, params.rays],
                 // The ray range is filled in per dispatch.
-                params: [params.coeffs() as u32, 0, 0, (params.visibility == Visibility::Scene) as u32],
+                params: [0, 0, u32::from(params.visibility == Visibility::Scene), 0],
             });
             first += count;
             left -= count;

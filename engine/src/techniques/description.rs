@@ -142,6 +142,23 @@ impl TechniqueDesc {
         }
     }
 
+    /// The same technique with `prt` as its transfer's bands and rays, where it has a
+    /// transfer (the visibility stays the technique's own, see [`TechniqueDesc::precomputation`]).
+    pub fn with_prt(mut self, params: PrtParams) -> TechniqueDesc {
+        match &mut self {
+            TechniqueDesc::SloanSelf { prt }
+            | TechniqueDesc::SloanScene { prt }
+            | TechniqueDesc::Tamura { prt, .. }
+            | TechniqueDesc::TamuraPaper { prt, .. }
+            | TechniqueDesc::Probes { prt, .. } => *prt = params,
+            TechniqueDesc::Unshadowed
+            | TechniqueDesc::ParallelLights { .. }
+            | TechniqueDesc::ShadowMap { .. }
+            | TechniqueDesc::Asm(_) => {}
+        }
+        self
+    }
+
     /// The PRT precomputation the technique needs before its first frame, if any.
     pub fn precomputation(&self) -> Option<PrtParams> {
         let group = |prt: &PrtParams| Some(PrtParams { visibility: Visibility::Group, ..*prt });
@@ -257,7 +274,7 @@ mod tests {
 
     fn transfer(bands: u32, visibility: Visibility) -> Option<Arc<TransferSet>> {
         let params = PrtParams { bands, rays: 1, visibility };
-        Some(Arc::new(TransferSet { params, seconds: 0.0, meshes: vec![] }))
+        Some(Arc::new(TransferSet { params, seconds: 0.0, traversal_seconds: 0.0, meshes: vec![] }))
     }
 
     fn invalid(desc: TechniqueDesc) -> String {

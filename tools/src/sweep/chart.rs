@@ -11,12 +11,12 @@ use std::sync::OnceLock;
 
 /// The chart's text face: DejaVu Sans from Debian's fonts-dejavu-core, or `$KAGE_CHART_FONT`.
 const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-const SIZE: (u32, u32) = (960, 640);
+pub(crate) const SIZE: (u32, u32) = (960, 640);
 /// DejaVu Sans is 0.7 MiB; the largest fonts (CJK collections) some 30.
 const FONT: files::Limit = files::Limit { kind: "a font", bytes: 64 << 20 };
 
 /// Registers the font once per process (plotters keeps fonts for the program's life).
-fn font() -> Result<()> {
+pub(crate) fn font() -> Result<()> {
     static REGISTERED: OnceLock<std::result::Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
@@ -124,14 +124,14 @@ fn draw(
 
 /// A tick's value as written: the ticks are one digit times a power of ten, so one significant
 /// digit is exact (and hides the float's rounding: 0.009, not 0.009000000000001).
-fn tick_label(value: &f64) -> String {
+pub(crate) fn tick_label(value: &f64) -> String {
     let exponent = (value.log10() + 1e-9).floor() as i32;
     format!("{value:.*}", (-exponent).max(0) as usize)
 }
 
 /// Labelled values of a log axis: 1, 2 and 5 times the powers of ten within `range`, and every
 /// digit's where fewer than four of those fall inside (a narrow range).
-fn ticks(range: &std::ops::Range<f64>) -> Vec<f64> {
+pub(crate) fn ticks(range: &std::ops::Range<f64>) -> Vec<f64> {
     let within = |mantissas: &[f64]| -> Vec<f64> {
         let (lo, hi) = (range.start.log10().floor() as i32, range.end.log10().ceil() as i32);
         (lo..=hi)
