@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Kage's ray casting and PRT precomputation against Embree 4 on one CPU thread, on the same
+# rays, in one run: `kage bench rays --export` (any and closest hits, coherent and incoherent
+# rays), `kage precompute --force` (its rays per second and the split of its time), then
+# scripts/embree-rays.py on the exported rays; prints each Kage rate over Embree's and the
+# time Embree would take for the precomputation's rays (its rate on the PRT rays of every 16th
+# vertex).
+#
+# Benchmark only, not part of CI: needs `pip install embreex numpy`.
+# Run by hand: bash scripts/embree-compare.sh [SCENE]   (default: the full Stanford bunny)
+# Environment: KAGE_DEVICE (device name substring), KAGE (the kage binary; default: build it).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+scene="${1:-tests/assets/stanford-bunny/scene.json}"
+if [ -z "${KAGE:-}" ]; then
+  cargo build --release -p kage-tools
+  KAGE=target/release/kage
+fi
+device=()
+[ -n "${KAGE_DEVICE:-}" ] && device=(--device "$KAGE_DEVICE")
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+"$KAGE" bench rays --scene "$scene" --export "$work" "${device[@]}" | tee "$work/kage.txt"
+"$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" | tee "$work/precompute.txt"
+python3 scripts/embree-rays.py "$work" | tee "$work/embree.txt"
+
+python3 - "$work" <<'PY'
+import re, sys
+folder = sys.argv[1]
+kage = open(f"{folder}/kage.txt").read()
+embree = open(f"{folder}/embree.txt").read()
+precompute = open(f"{folder}/precompute.txt").read()
+print("\nKage over Embree (one thread), Mrays/s:")
+for query in ["closest hit", "any hit"]:
+    k = re.search(rf"^{query}\s+\S+\s+(\S+)\s+\S+\s+(\S+)", kage, re.M)
+    for ray_set, value in [("coherent", float(k.group(1))), ("incoherent", float(k.group(2)))]:
+        e = float(re.search(rf"^{query}\s+{ray_set}\s+\S+\s+(\S+)", embree, re.M).group(1))
+        print(f"  {query:<12} {ray_set:<11} {value:8.3f} / {e:8.3f} = {value / e:.2f}x")
+seconds = float(re.search(r"^time: (\S+) s", precompute, re.M).group(1))
+vertices, per_vertex = re.search(r"(\d+) vertices; .* (\d+) rays per vertex", precompute).groups()
+rays = float(vertices) * float(per_vertex)
+e = float(re.search(r"^closest hit\s+prt\s+\S+\s+(\S+)", embree, re.M).group(1)) * 1e6
+print(f"  precompute: Kage {seconds:.2f} s for {rays / 1e6:.1f} M rays; Embree at its PRT-ray rate "
+      f"{e / 1e6:.2f} Mrays/s: {rays / e:.2f} s; Kage / Embree = {seconds / (rays / e):.2f}x")
+PY
