@@ -11,7 +11,7 @@
 #include "constants.glsl"
 #include "layouts.glsl"
 
-layout(set = 0, binding = 0, std430) readonly buffer BvhBlasNodes { BvhNode bvh_blas_nodes[]; };
+layout(set = 0, binding = 0, std430) readonly buffer BvhBlasPairs { BvhPair bvh_blas_pairs[]; };
 layout(set = 0, binding = 1, std430) readonly buffer BvhTlasNodes { BvhNode bvh_tlas_nodes[]; };
 layout(set = 0, binding = 2, std430) readonly buffer BvhInstances { BvhInstance bvh_instances[]; };
 layout(set = 0, binding = 3, std430) readonly buffer BvhTriangles { BvhTriangle bvh_triangles[]; };
@@ -95,17 +95,21 @@ bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, 
     return t > 0.0 && t < tmax;
 }
 
-// Entry distance of the ray into the node's box, or +inf when it misses the box or enters at
+// Entry distance of the ray into the box lo .. hi, or +inf when it misses the box or enters at
 // or past tmax. inv_dir may hold infinities (axis-parallel rays); max/min discard the NaN of
 // 0 * inf, which happens only for origins exactly on a slab plane.
-float bvh_enter_box(BvhNode node, vec3 origin, vec3 inv_dir, float tmax) {
-    vec3 t0 = (node.lo.xyz - origin) * inv_dir;
-    vec3 t1 = (node.hi.xyz - origin) * inv_dir;
+float bvh_enter(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float tmax) {
+    vec3 t0 = (lo - origin) * inv_dir;
+    vec3 t1 = (hi - origin) * inv_dir;
     vec3 near = min(t0, t1);
     vec3 far = max(t0, t1);
     float enter = max(max(near.x, near.y), max(near.z, 0.0));
     float leave = min(min(far.x, far.y), min(far.z, tmax));
     return enter <= leave ? enter : 1.0 / 0.0;
+}
+
+float bvh_enter_box(BvhNode node, vec3 origin, vec3 inv_dir, float tmax) {
+    return bvh_enter(node.lo.xyz, node.hi.xyz, origin, inv_dir, tmax);
 }
 
 uint bvh_node_index(BvhNode node) { return floatBitsToUint(node.lo.w); }
@@ -138,40 +142,46 @@ int bvh_children(BvhNode left_node, BvhNode right_node, uint index, vec3 origin,
 // index, so a pop skips an entry that a hit found since has moved out of reach without
 // fetching its node again.
 bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
-    uint root = bvh_instances[instance].info.x;
     WatertightRay wray = bvh_watertight_ray(origin, dir);
     vec3 inv_dir = 1.0 / dir;
     bool found = false;
     uint stack[KAGE_BVH_STACK];
     float stack_enter[KAGE_BVH_STACK];
     int top = 0;
-    BvhNode node = bvh_blas_nodes[root];
-    // node is one to visit: it is entered before hit.t.
-    bool live = bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0;
+    // What the ray visits next: a pair, or a leaf (KAGE_BVH_LEAF set). The root pair's own
+    // box is not tested: its children's are.
+    uint next = bvh_instances[instance].info.w;
+    bool live = true;
     while (live) {
-        // Down through inner nodes while a child is entered.
-        uint count = bvh_node_count(node);
-        while (count == 0u) {
-            uint index = bvh_node_index(node);
-            BvhNode left_node = bvh_blas_nodes[index];
-            BvhNode right_node = bvh_blas_nodes[index + 1u];
-            float enter_left = bvh_enter_box(left_node, origin, inv_dir, hit.t);
-            float enter_right = bvh_enter_box(right_node, origin, inv_dir, hit.t);
-            bool left = enter_left != 1.0 / 0.0;
-            bool right = enter_right != 1.0 / 0.0;
+        // Down through pairs while a child is entered.
+        while ((next & KAGE_BVH_LEAF) == 0u) {
+            BvhPair pair = bvh_blas_pairs[next];
+            uint exponents = floatBitsToUint(pair.origin.w);
+            vec3 step = uintBitsToFloat((uvec3(exponents, exponents >> 8, exponents >> 16) & 0xffu) << 23);
+            // Grid steps to coordinates: q * step is exact, so the one rounding of the sum is
+            // the one the builder checked (engine/src/raycast/pairs.rs).
+            vec3 left_lo = pair.origin.xyz + vec3(uvec3(pair.boxes.x, pair.boxes.x >> 8, pair.boxes.x >> 16) & 0xffu) * step;
+            vec3 left_hi = pair.origin.xyz + vec3(uvec3(pair.boxes.y, pair.boxes.y >> 8, pair.boxes.y >> 16) & 0xffu) * step;
+            vec3 right_lo = pair.origin.xyz + vec3(uvec3(pair.boxes.z, pair.boxes.z >> 8, pair.boxes.z >> 16) & 0xffu) * step;
+            vec3 right_hi = pair.origin.xyz + vec3(uvec3(pair.boxes.w, pair.boxes.w >> 8, pair.boxes.w >> 16) & 0xffu) * step;
+            float enter_left = bvh_enter(left_lo, left_hi, origin, inv_dir, hit.t);
+            float enter_right = bvh_enter(right_lo, right_hi, origin, inv_dir, hit.t);
+            bool left = enter_left != 1.0 / 0.0 && pair.refs.x != KAGE_NO_HIT;
+            bool right = enter_right != 1.0 / 0.0 && pair.refs.y != KAGE_NO_HIT;
             if (!left && !right) break;
             // The nearer first, so that a hit in it shrinks hit.t and prunes the other.
             bool left_first = left && (!right || enter_left <= enter_right);
             if (left && right) {
-                stack[top] = left_first ? index + 1u : index;
+                stack[top] = left_first ? pair.refs.y : pair.refs.x;
                 stack_enter[top] = left_first ? enter_right : enter_left;
                 ++top;
             }
-            node = left_first ? left_node : right_node;
-            count = bvh_node_count(node);
+            next = left_first ? pair.refs.x : pair.refs.y;
         }
-        // A leaf: its triangles, all lanes that hold one together.
-        uint first = bvh_node_index(node);
+        // A leaf: its triangles, all lanes that hold one together (none where the walk above
+        // ended on a pair with no child entered).
+        uint count = (next & KAGE_BVH_LEAF) != 0u ? (next >> 28) & 7u : 0u;
+        uint first = next & 0x0fffffffu;
         for (uint tri = first; tri < first + count; ++tri) {
             float t;
             vec2 bary;
@@ -186,7 +196,7 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
         while (top > 0) {
             --top;
             if (stack_enter[top] < hit.t) {
-                node = bvh_blas_nodes[stack[top]];
+                next = stack[top];
                 live = true;
                 break;
             }

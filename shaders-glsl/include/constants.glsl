@@ -26,6 +26,9 @@
 #define KAGE_WRAP_CLAMP 2
 // RayHit.instance of a ray that hit nothing (0xffffffff).
 #define KAGE_NO_HIT 4294967295u
+// A BvhPair child reference with this bit set is a leaf: its count in bits 28-30, its first
+// triangle in bits 0-27.
+#define KAGE_BVH_LEAF 2147483648u
 // Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.
 #define KAGE_BVH_STACK 32
 // Invocations per workgroup of the ray casting test and benchmark shader.

@@ -12,7 +12,7 @@ const BINDINGS: usize = constants::BVH_BINDINGS as usize;
 pub const BVH: Resource = Resource("bvh");
 
 pub struct GpuBvh {
-    blas_nodes: Buffer,
+    blas_pairs: Buffer,
     tlas_nodes: Buffer,
     instances: Buffer,
     triangles: Buffer,
@@ -27,7 +27,7 @@ impl GpuBvh {
 
     pub fn new(ctx: &Arc<Context>, bvh: &SceneBvh) -> Result<GpuBvh> {
         Ok(GpuBvh {
-            blas_nodes: upload(ctx, "bvh.blas_nodes", &bvh.blas_nodes)?,
+            blas_pairs: upload(ctx, "bvh.blas_pairs", &bvh.blas_pairs)?,
             tlas_nodes: upload(ctx, "bvh.tlas_nodes", &bvh.tlas_nodes)?,
             instances: upload(ctx, "bvh.instances", &bvh.instances)?,
             triangles: upload(ctx, "bvh.triangles", &bvh.triangles)?,
@@ -62,7 +62,7 @@ impl GpuBvh {
     /// The buffers in binding order 0 .. KAGE_BVH_BINDINGS - 1.
     pub fn bindings(&self) -> [Binding<'_>; BINDINGS] {
         [
-            Binding::Storage(&self.blas_nodes),
+            Binding::Storage(&self.blas_pairs),
             Binding::Storage(&self.tlas_nodes),
             Binding::Storage(&self.instances),
             Binding::Storage(&self.triangles),
@@ -72,9 +72,9 @@ impl GpuBvh {
         ]
     }
 
-    /// The bottom-level node buffer, for checks that it stays untouched by updates.
+    /// The bottom-level pair buffer, for checks that it stays untouched by updates.
     pub fn blas_node_buffer(&self) -> &Buffer {
-        &self.blas_nodes
+        &self.blas_pairs
     }
 }
 

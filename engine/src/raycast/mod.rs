@@ -10,14 +10,17 @@
 //! without renormalising the direction, so t is the same world-space distance in both spaces.
 //!
 //! # GPU layout (bindings 0 .. `KAGE_BVH_BINDINGS` - 1, structs in layouts.glsl)
-//! 0. `BvhNode[]`, bottom-level nodes of every group, each group's tree contiguous from its root
-//!    (`BvhInstance.info.x`); 1. `BvhNode[]`, the top level, root at 0; 2. `BvhInstance[]`, per
-//!    group: both matrices, root node, first triangle, triangle count; 3. `BvhTriangle[]`,
+//! 0. `BvhPair[]`, the bottom-level trees of every group as the GPU reads them, one pair per
+//!    interior node holding its two children's quantized boxes and references (see [`pairs`]),
+//!    each group's from its root pair (`BvhInstance.info.w`); 1. `BvhNode[]`, the top level,
+//!    root at 0; 2. `BvhInstance[]`, per group: both matrices, root node (of the CPU's tree),
+//!    first triangle, triangle count, root pair; 3. `BvhTriangle[]`,
 //!    object-space positions; 4. `BvhTriangleAttributes[]`: vertex normals, albedo, albedo map
 //!    and texture coordinates at the same index; 5. `BvhAlbedoMap[]`, the albedo maps (entry 0
 //!    unused); 6. `u32[]`, their texels (RGBA8 sRGB), sampled at level 0 (`bvh_albedo_texel`).
 //!
-//! A node is 32 bytes: `lo = (min.xyz, index)`, `hi = (max.xyz, count)`, index and count as
+//! The CPU keeps the bottom level as built ([`SceneBvh::blas_nodes`], traversed by
+//! [`SceneBvh::closest_hit`] and the checks). A node is 32 bytes: `lo = (min.xyz, index)`, `hi = (max.xyz, count)`, index and count as
 //! float bits. `count == 0`: interior node whose children are `index` and `index + 1`.
 //! `count > 0`: a leaf; in the bottom level its triangles are `index .. index + count` (global
 //! indices into the triangle buffer, which is ordered leaf by leaf), in the top level
@@ -30,6 +33,7 @@ mod aabb;
 mod brute_force;
 mod caster;
 mod gpu;
+mod pairs;
 mod sah;
 mod scene_bvh;
 mod traverse;

@@ -1,10 +1,11 @@
 //! The CPU side of the scene BVH: building both levels from a [`Scene`], moving groups, and the
 //! flattened arrays that [`super::GpuBvh`] uploads.
 use super::aabb::Aabb;
+use super::pairs;
 use super::sah::{self, node_bounds};
 use crate::error::{Error, Result};
 use crate::layouts::{
-    constants, BvhAlbedoMap, BvhInstance, BvhNode, BvhTexel, BvhTriangle, BvhTriangleAttributes,
+    constants, BvhAlbedoMap, BvhInstance, BvhNode, BvhPair, BvhTexel, BvhTriangle, BvhTriangleAttributes,
 };
 use crate::scene::albedo_map::{AlbedoMap, Wrap};
 use crate::scene::Scene;
@@ -27,7 +28,10 @@ pub struct TriangleOrigin {
 /// group's object space) and a top level over the groups' world-space bounds.
 #[derive(Clone, Debug)]
 pub struct SceneBvh {
+    /// The bottom-level trees as built, traversed on the CPU.
     pub(super) blas_nodes: Vec<BvhNode>,
+    /// The same trees as the GPU reads them (see [`super::pairs`]).
+    pub(super) blas_pairs: Vec<BvhPair>,
     pub(super) tlas_nodes: Vec<BvhNode>,
     pub(super) instances: Vec<BvhInstance>,
     pub(super) triangles: Vec<BvhTriangle>,
@@ -43,6 +47,7 @@ impl SceneBvh {
         scene.validate()?;
         let mut bvh = SceneBvh {
             blas_nodes: Vec::new(),
+            blas_pairs: Vec::new(),
             tlas_nodes: Vec::new(),
             instances: Vec::with_capacity(scene.groups.len()),
             triangles: Vec::with_capacity(scene.triangle_count()),
@@ -90,6 +95,9 @@ impl SceneBvh {
                 let index = if count > 0 { first + index } else { root + index };
                 sah::node(node_bounds(n), index, count)
             }));
+            let (pairs, root_pair) =
+                pairs::pairs(&tree.nodes, first, to_u32(bvh.blas_pairs.len(), "BVH nodes")?)?;
+            bvh.blas_pairs.extend(pairs);
             for &i in &tree.order {
                 bvh.triangles.push(triangles[i as usize]);
                 bvh.attributes.push(attributes[i as usize]);
@@ -99,7 +107,7 @@ impl SceneBvh {
             bvh.instances.push(BvhInstance {
                 object_to_world: matrix.to_cols_array_2d(),
                 world_to_object: matrix.inverse().to_cols_array_2d(),
-                info: [root, first, to_u32(triangles.len(), "triangles")?, 0],
+                info: [root, first, to_u32(triangles.len(), "triangles")?, root_pair],
             });
         }
         bvh.rebuild_top_level();
@@ -143,14 +151,15 @@ impl SceneBvh {
         Ok(added.len() as u32)
     }
 
-    /// Nodes of both levels.
+    /// Nodes of both levels as the GPU holds them: the bottom level's pairs (one per interior
+    /// node) and the top level's nodes.
     pub fn node_count(&self) -> usize {
-        self.blas_nodes.len() + self.tlas_nodes.len()
+        self.blas_pairs.len() + self.tlas_nodes.len()
     }
 
     /// Bytes of all its GPU buffers together.
     pub fn byte_size(&self) -> usize {
-        size_of_val(self.blas_nodes.as_slice())
+        size_of_val(self.blas_pairs.as_slice())
             + size_of_val(self.tlas_nodes.as_slice())
             + size_of_val(self.instances.as_slice())
             + size_of_val(self.triangles.as_slice())
