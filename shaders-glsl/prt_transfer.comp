@@ -8,10 +8,12 @@
 // the whole scene as it stands (the ray taken to world space; the basis stays in object space).
 //
 // KAGE_PRT_LANES invocations share a vertex, and cast its rays in an order that keeps them
-// coherent (`hammersley_index`): side by side they leave one point in neighbouring directions,
-// so the SIMD lanes of a CPU driver, or a GPU's, walk the same BVH nodes instead of eight
-// vertices' unrelated ones. Each lane sums its own rays; the vertex's first lane adds the
-// lanes' sums, in lane order, to the vertex's running sums.
+// coherent (`hammersley_index`): each invocation traces the KAGE_BVH_PACKET rays of one cell
+// of the point set (neighbouring directions from one point) together, reading each BVH node
+// once for all of them (`bvh_closest_hits_packet`), and the lanes side by side take
+// neighbouring cells, so the SIMD lanes of a CPU driver, or a GPU's, walk nearly the same
+// nodes. Each lane sums its own rays; the vertex's first lane adds the lanes' sums, in lane
+// order, to the vertex's running sums.
 //
 // One dispatch casts rays [first, first + count) of every vertex in its range and adds their
 // sums to the vertex's running sums (the first dispatch stores), so one invocation never loops
@@ -40,6 +42,10 @@ layout(constant_id = 0) const uint COEFFS = 25u;
 // False: every ray is taken as a miss without tracing it, which times everything but the
 // traversal (engine/src/prt/transfer.rs reports the split).
 layout(constant_id = 1) const bool TRACE = true;
+// True: visibility against the whole scene as it stands (each ray taken to world space and
+// traced alone through both levels); false: against the vertex's own group, in its object
+// space, KAGE_BVH_PACKET rays of one Hammersley cell traced together.
+layout(constant_id = 2) const bool WHOLE_SCENE = false;
 
 // Each lane's sums (7 vec4s hold 25 coefficients), rays cast and back hits, for its vertex's
 // first lane to add up.
@@ -63,19 +69,31 @@ void tangent_frame(vec3 n, out vec3 t, out vec3 b) {
 }
 
 // The Hammersley index k of a vertex's j-th ray, a permutation of 0 .. rays - 1 (the estimator
-// sums the same points in another order). For rays = 2^m (m ≥ 3), k's bits are [A | c | D]:
-// c = j mod 8 (the lane), A (its top h bits) and D (its low m - 3 - h bits) the rest of j.
-// The eight rays of one (A, D) have k/N within 2^-h of each other and radical inverses within
-// 2^-(m-3-h): the Hammersley set is a (0, m, 2)-net in base 2, so every such elementary
-// interval holds exactly eight points, and the eight lanes cast them together. Other counts
-// keep k = j.
+// sums the same points in another order). With P = KAGE_BVH_PACKET = 2^b and rays = 2^m
+// (m ≥ b), k's bits are [A | c | D]: c = j mod P (the ray within its packet), A (its top h
+// bits) and D (its low m - b - h bits) the rest of j. The P rays of one (A, D) have k/N within
+// 2^-h of each other and radical inverses within 2^-(m-b-h): the Hammersley set is a
+// (0, m, 2)-net in base 2, so every such elementary interval holds exactly P points, and one
+// packet casts them together. Other counts keep k = j.
 uint hammersley_index(uint j, uint rays) {
-    if (rays < 8u || (rays & (rays - 1u)) != 0u) return j;
+    // b bits of k pick the point within a cell of KAGE_BVH_PACKET points.
+    uint b = uint(findMSB(uint(KAGE_BVH_PACKET)));
+    if (rays < uint(KAGE_BVH_PACKET) || (rays & (rays - 1u)) != 0u) return j;
     uint m = uint(findMSB(rays));
-    uint h = (m - 3u) / 2u;
-    uint l = m - 3u - h;
-    uint cell = j >> 3u;
-    return ((cell >> l) << (l + 3u)) | ((j & 7u) << l) | (cell & ((1u << l) - 1u));
+    uint h = (m - b) / 2u;
+    uint l = m - b - h;
+    uint cell = j >> b;
+    return ((cell >> l) << (l + b)) | ((j & (uint(KAGE_BVH_PACKET) - 1u)) << l) | (cell & ((1u << l) - 1u));
+}
+
+// The cosine-weighted direction of Hammersley point k of `rays` about n, shifted: a uniform
+// point on the unit disc lifted onto the hemisphere.
+vec3 ray_direction(uint k, uint rays, vec2 shift, vec3 n, vec3 tangent, vec3 bitangent) {
+    const float to_unit = 1.0 / 4294967296.0;
+    vec2 u = fract(vec2(float(k) / float(rays), float(bitfieldReverse(k)) * to_unit) + shift);
+    float r = sqrt(u.x);
+    float phi = 2.0 * KAGE_PI * u.y;
+    return normalize(r * cos(phi) * tangent + r * sin(phi) * bitangent + sqrt(max(1.0 - u.x, 0.0)) * n);
 }
 
 // Adds sums 4j .. 4j + 3 of a vertex to its running sums (stores them on the first
@@ -103,50 +121,58 @@ void main() {
     vec3 origin = offset_ray_origin(vertices[vertex].position.xyz, n);
     vec3 tangent, bitangent;
     tangent_frame(n, tangent, bitangent);
-    const float to_unit = 1.0 / 4294967296.0;
-    vec2 shift = vec2(pcg_hash(2u * vertex), pcg_hash(2u * vertex + 1u)) * to_unit;
+    vec2 shift = vec2(pcg_hash(2u * vertex), pcg_hash(2u * vertex + 1u)) * (1.0 / 4294967296.0);
 
     vec4 s0 = vec4(0.0), s1 = vec4(0.0), s2 = vec4(0.0), s3 = vec4(0.0), s4 = vec4(0.0),
          s5 = vec4(0.0), s6 = vec4(0.0);
-    bool whole_scene = p.params.z == 1u;
     mat4 to_world = bvh_instances[group].object_to_world;
     vec3 world_origin = (to_world * vec4(origin, 1.0)).xyz;
     uint first = p.params.x;
     uint end = casting ? first + p.params.y : first;
     uint done = 0u, back = 0u;
-    for (uint j = first + lane; j < end; j += KAGE_PRT_LANES) {
-        uint k = hammersley_index(j, rays);
-        vec2 u = fract(vec2(float(k) / float(rays), float(bitfieldReverse(k)) * to_unit) + shift);
-        // Cosine-weighted: a uniform point on the unit disc lifted onto the hemisphere.
-        float r = sqrt(u.x);
-        float phi = 2.0 * KAGE_PI * u.y;
-        vec3 dir = normalize(r * cos(phi) * tangent + r * sin(phi) * bitangent
-                             + sqrt(max(1.0 - u.x, 0.0)) * n);
-        // The hit normal is taken to the space the ray was cast in (the scale is uniform, so
-        // the rotation part carries normals).
-        RayHit hit = RayHit(1e30, KAGE_NO_HIT, 0u, vec2(0.0));
-        vec3 ray_dir = dir;
-        if (TRACE && whole_scene) {
-            ray_dir = normalize(mat3(to_world) * dir);
-            bvh_traverse(world_origin, ray_dir, false, hit);
+    // Each lane casts whole cells (first is a multiple of the packet), the lanes side by side.
+    for (uint cell = first / KAGE_BVH_PACKET + lane; cell * KAGE_BVH_PACKET < end; cell += KAGE_PRT_LANES) {
+        vec3 dirs[KAGE_BVH_PACKET];
+        RayHit hits[KAGE_BVH_PACKET];
+        uint cast_rays = 0u;
+        for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+            uint j = cell * KAGE_BVH_PACKET + uint(r);
+            dirs[r] = ray_direction(hammersley_index(min(j, rays - 1u), rays), rays, shift, n, tangent, bitangent);
+            hits[r] = RayHit(1e30, KAGE_NO_HIT, 0u, vec2(0.0));
+            if (j < end) cast_rays |= 1u << r;
+        }
+        if (TRACE && WHOLE_SCENE) {
+            for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+                if ((cast_rays & (1u << r)) != 0u) bvh_traverse(world_origin, normalize(mat3(to_world) * dirs[r]), false, hits[r]);
+            }
         } else if (TRACE) {
-            bvh_traverse_blas(group, origin, dir, false, hit);
+            bvh_closest_hits_packet(group, origin, dirs, cast_rays, hits);
         }
-        if (hit.instance != KAGE_NO_HIT) {
-            BvhTriangleAttributes a = bvh_attributes[hit.triangle];
-            vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
-            vec3 normal = w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz;
-            if (whole_scene) normal = mat3(bvh_instances[hit.instance].object_to_world) * normal;
-            if (dot(normal, ray_dir) > 0.0) ++back;
-        } else {
-            vec4 c0, c1, c2, c3, c4, c5, c6;
-            sh25_basis(dir, c0, c1, c2, c3, c4, c5, c6);
-            s0 += c0;
-            if (COEFFS > 4u) { s1 += c1; s2 += c2; }
-            if (COEFFS > 12u) { s3 += c3; }
-            if (COEFFS > 16u) { s4 += c4; s5 += c5; s6 += c6; }
+        for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+            if ((cast_rays & (1u << r)) == 0u) continue;
+            RayHit hit = hits[r];
+            if (hit.instance != KAGE_NO_HIT) {
+                // The hit normal is taken to the space the ray was cast in (the scale is
+                // uniform, so the rotation part carries normals).
+                BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+                vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
+                vec3 normal = w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz;
+                vec3 ray_dir = dirs[r];
+                if (WHOLE_SCENE) {
+                    normal = mat3(bvh_instances[hit.instance].object_to_world) * normal;
+                    ray_dir = mat3(to_world) * ray_dir;
+                }
+                if (dot(normal, ray_dir) > 0.0) ++back;
+            } else {
+                vec4 c0, c1, c2, c3, c4, c5, c6;
+                sh25_basis(dirs[r], c0, c1, c2, c3, c4, c5, c6);
+                s0 += c0;
+                if (COEFFS > 4u) { s1 += c1; s2 += c2; }
+                if (COEFFS > 12u) { s3 += c3; }
+                if (COEFFS > 16u) { s4 += c4; s5 += c5; s6 += c6; }
+            }
+            ++done;
         }
-        ++done;
     }
     uint slot = gl_LocalInvocationID.x;
     lane_sums[slot][0] = s0; lane_sums[slot][1] = s1; lane_sums[slot][2] = s2;

@@ -16,10 +16,35 @@ const uint QUERY_CLOSEST = 0u;
 const uint QUERY_OCCLUDED = 1u;
 const uint QUERY_OCCLUDED_OBJECT_SPACE = 2u;
 const uint QUERY_SURFACE = 3u;
+const uint QUERY_PACKET_OBJECT_SPACE = 4u;
+
+// Rays first .. first + KAGE_BVH_PACKET - 1 (those in the list) as one packet from the first
+// one's origin through group p.params.z, in its object space: bvh_closest_hits_packet.
+void cast_packet(uint first) {
+    vec3 dirs[KAGE_BVH_PACKET];
+    RayHit hits[KAGE_BVH_PACKET];
+    uint in_list = 0u;
+    for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+        uint i = min(first + uint(r), p.params.x - 1u);
+        dirs[r] = rays[i].direction.xyz;
+        hits[r] = RayHit(rays[i].origin.w, KAGE_NO_HIT, 0u, vec2(0.0));
+        if (first + uint(r) < p.params.x) in_list |= 1u << r;
+    }
+    bvh_closest_hits_packet(p.params.z, rays[first].origin.xyz, dirs, in_list, hits);
+    for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+        if ((in_list & (1u << r)) == 0u) continue;
+        results[first + uint(r)].hit = vec4(hits[r].t, hits[r].barycentric, 0.0);
+        results[first + uint(r)].ids = uvec4(hits[r].instance, hits[r].triangle, 0u, 0u);
+    }
+}
 
 void main() {
     uint i = p.params.w + gl_GlobalInvocationID.x;
     if (i >= p.params.x) return;
+    if (p.params.y == QUERY_PACKET_OBJECT_SPACE) {
+        if (i % KAGE_BVH_PACKET == 0u) cast_packet(i);
+        return;
+    }
     CastRay ray = rays[i];
     vec3 origin = ray.origin.xyz;
     vec3 dir = ray.direction.xyz;

@@ -66,8 +66,7 @@ WatertightRay bvh_watertight_ray(vec3 origin, vec3 dir) {
 // multiply-adds, so that an edge shared by two triangles gets bit-identical (negated) edge
 // functions in both and no ray slips between them. Edge functions of exactly zero count as
 // inside, so a ray exactly through a shared edge hits both triangles rather than neither.
-bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, out vec2 bary) {
-    BvhTriangle v = bvh_triangles[tri];
+bool bvh_intersect(WatertightRay r, BvhTriangle v, float tmax, out float t, out vec2 bary) {
     precise vec3 a = v.v0.xyz - r.origin;
     precise vec3 b = v.v1.xyz - r.origin;
     precise vec3 c = v.v2.xyz - r.origin;
@@ -95,17 +94,27 @@ bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, 
     return t > 0.0 && t < tmax;
 }
 
+// The same against triangle `tri` of the triangle buffer.
+bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, out vec2 bary) {
+    return bvh_intersect(r, bvh_triangles[tri], tmax, t, bary);
+}
+
 // Entry distance of the ray into the box lo .. hi, or +inf when it misses the box or enters at
 // or past tmax. inv_dir may hold infinities (axis-parallel rays); max/min discard the NaN of
 // 0 * inf, which happens only for origins exactly on a slab plane.
-float bvh_enter(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float tmax) {
-    vec3 t0 = (lo - origin) * inv_dir;
-    vec3 t1 = (hi - origin) * inv_dir;
+// The same with the box's corners given relative to the ray's origin (for rays sharing one).
+float bvh_enter_from(vec3 lo, vec3 hi, vec3 inv_dir, float tmax) {
+    vec3 t0 = lo * inv_dir;
+    vec3 t1 = hi * inv_dir;
     vec3 near = min(t0, t1);
     vec3 far = max(t0, t1);
     float enter = max(max(near.x, near.y), max(near.z, 0.0));
     float leave = min(min(far.x, far.y), min(far.z, tmax));
     return enter <= leave ? enter : 1.0 / 0.0;
+}
+
+float bvh_enter(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float tmax) {
+    return bvh_enter_from(lo - origin, hi - origin, inv_dir, tmax);
 }
 
 float bvh_enter_box(BvhNode node, vec3 origin, vec3 inv_dir, float tmax) {
@@ -128,6 +137,22 @@ int bvh_children(BvhNode left_node, BvhNode right_node, uint index, vec3 origin,
     pushed = left_first ? index + 1u : index;
     if (left || right) next = left_first ? left_node : right_node;
     return int(left) + int(right);
+}
+
+// One corner of a pair's child box: 3 bytes of grid steps from the pair's origin. q * step is
+// exact, so the one rounding of the sum is the one the builder checked
+// (engine/src/raycast/pairs.rs).
+vec3 bvh_pair_corner(BvhPair pair, vec3 step, uint steps) {
+    return pair.origin.xyz + vec3(uvec3(steps, steps >> 8, steps >> 16) & 0xffu) * step;
+}
+
+void bvh_pair_boxes(BvhPair pair, out vec3 left_lo, out vec3 left_hi, out vec3 right_lo, out vec3 right_hi) {
+    uint exponents = floatBitsToUint(pair.origin.w);
+    vec3 step = uintBitsToFloat((uvec3(exponents, exponents >> 8, exponents >> 16) & 0xffu) << 23);
+    left_lo = bvh_pair_corner(pair, step, pair.boxes.x);
+    left_hi = bvh_pair_corner(pair, step, pair.boxes.y);
+    right_lo = bvh_pair_corner(pair, step, pair.boxes.z);
+    right_hi = bvh_pair_corner(pair, step, pair.boxes.w);
 }
 
 // Traverses one bottom-level tree, ray in object space. With any_hit it returns at the first
@@ -156,14 +181,8 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
         // Down through pairs while a child is entered.
         while ((next & KAGE_BVH_LEAF) == 0u) {
             BvhPair pair = bvh_blas_pairs[next];
-            uint exponents = floatBitsToUint(pair.origin.w);
-            vec3 step = uintBitsToFloat((uvec3(exponents, exponents >> 8, exponents >> 16) & 0xffu) << 23);
-            // Grid steps to coordinates: q * step is exact, so the one rounding of the sum is
-            // the one the builder checked (engine/src/raycast/pairs.rs).
-            vec3 left_lo = pair.origin.xyz + vec3(uvec3(pair.boxes.x, pair.boxes.x >> 8, pair.boxes.x >> 16) & 0xffu) * step;
-            vec3 left_hi = pair.origin.xyz + vec3(uvec3(pair.boxes.y, pair.boxes.y >> 8, pair.boxes.y >> 16) & 0xffu) * step;
-            vec3 right_lo = pair.origin.xyz + vec3(uvec3(pair.boxes.z, pair.boxes.z >> 8, pair.boxes.z >> 16) & 0xffu) * step;
-            vec3 right_hi = pair.origin.xyz + vec3(uvec3(pair.boxes.w, pair.boxes.w >> 8, pair.boxes.w >> 16) & 0xffu) * step;
+            vec3 left_lo, left_hi, right_lo, right_hi;
+            bvh_pair_boxes(pair, left_lo, left_hi, right_lo, right_hi);
             float enter_left = bvh_enter(left_lo, left_hi, origin, inv_dir, hit.t);
             float enter_right = bvh_enter(right_lo, right_hi, origin, inv_dir, hit.t);
             bool left = enter_left != 1.0 / 0.0 && pair.refs.x != KAGE_NO_HIT;
@@ -203,6 +222,83 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
         }
     }
     return found;
+}
+
+// Closest hits of KAGE_BVH_PACKET rays from one origin through one bottom-level tree, in
+// object space: the rays whose bit is set in `rays` (hits[r].t each ray's running tmax). The
+// packet walks the tree once, entering a child where any of its rays does, so each pair and
+// triangle is read once for all of them: on a CPU driver a read is a gather over the SIMD
+// lanes, the largest cost of a step, and rays from one point in neighbouring directions (the
+// PRT's) enter nearly the same nodes.
+void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACKET], uint rays,
+                             inout RayHit hits[KAGE_BVH_PACKET]) {
+    vec3 inv_dirs[KAGE_BVH_PACKET];
+    WatertightRay wrays[KAGE_BVH_PACKET];
+    for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+        inv_dirs[r] = 1.0 / dirs[r];
+        wrays[r] = bvh_watertight_ray(origin, dirs[r]);
+    }
+    uint stack[KAGE_BVH_STACK];
+    // The nearest entry of any ray into each stacked child.
+    float stack_enter[KAGE_BVH_STACK];
+    int top = 0;
+    uint next = bvh_instances[instance].info.w;
+    bool live = rays != 0u;
+    while (live) {
+        while ((next & KAGE_BVH_LEAF) == 0u) {
+            BvhPair pair = bvh_blas_pairs[next];
+            vec3 left_lo, left_hi, right_lo, right_hi;
+            bvh_pair_boxes(pair, left_lo, left_hi, right_lo, right_hi);
+            // The rays share their origin: the corners relative to it once, as bvh_enter has them.
+            left_lo -= origin;
+            left_hi -= origin;
+            right_lo -= origin;
+            right_hi -= origin;
+            float enter_left = 1.0 / 0.0, enter_right = 1.0 / 0.0;
+            for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+                if ((rays & (1u << r)) != 0u) {
+                    enter_left = min(enter_left, bvh_enter_from(left_lo, left_hi, inv_dirs[r], hits[r].t));
+                    enter_right = min(enter_right, bvh_enter_from(right_lo, right_hi, inv_dirs[r], hits[r].t));
+                }
+            }
+            bool left = enter_left != 1.0 / 0.0 && pair.refs.x != KAGE_NO_HIT;
+            bool right = enter_right != 1.0 / 0.0 && pair.refs.y != KAGE_NO_HIT;
+            if (!left && !right) break;
+            bool left_first = left && (!right || enter_left <= enter_right);
+            if (left && right) {
+                stack[top] = left_first ? pair.refs.y : pair.refs.x;
+                stack_enter[top] = left_first ? enter_right : enter_left;
+                ++top;
+            }
+            next = left_first ? pair.refs.x : pair.refs.y;
+        }
+        uint count = (next & KAGE_BVH_LEAF) != 0u ? (next >> 28) & 7u : 0u;
+        uint first = next & 0x0fffffffu;
+        for (uint tri = first; tri < first + count; ++tri) {
+            BvhTriangle v = bvh_triangles[tri];
+            for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+                float t;
+                vec2 bary;
+                if ((rays & (1u << r)) != 0u && bvh_intersect(wrays[r], v, hits[r].t, t, bary)) {
+                    hits[r] = RayHit(t, instance, tri, bary);
+                }
+            }
+        }
+        // Pop the next entry some ray still reaches.
+        float reach = 0.0;
+        for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
+            if ((rays & (1u << r)) != 0u) reach = max(reach, hits[r].t);
+        }
+        live = false;
+        while (top > 0) {
+            --top;
+            if (stack_enter[top] < reach) {
+                next = stack[top];
+                live = true;
+                break;
+            }
+        }
+    }
 }
 
 // Traverses the top-level tree (world space) and, at each instance leaf, that instance's tree.

@@ -29,6 +29,8 @@
 // A BvhPair child reference with this bit set is a leaf: its count in bits 28-30, its first
 // triangle in bits 0-27.
 #define KAGE_BVH_LEAF 2147483648u
+// Rays traced together by bvh_closest_hits_packet (one Hammersley cell of the PRT).
+#define KAGE_BVH_PACKET 8
 // Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.
 #define KAGE_BVH_STACK 32
 // Invocations per workgroup of the ray casting test and benchmark shader.

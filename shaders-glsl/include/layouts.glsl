@@ -111,7 +111,7 @@ struct CastResult {
 
 // Push constants of the ray casting shader.
 struct CastPush {
-    uvec4 params; // x: ray count, y: query (0 closest, 1 occluded, 2 occluded in object space, 3 closest with surface), z: instance, w: first ray
+    uvec4 params; // x: ray count, y: query (0 closest, 1 occluded, 2 occluded in object space, 3 closest with surface, 4 closest in object space by packets), z: instance, w: first ray
 };
 
 // The reference's running statistics of one pixel or point: mean and sum of squared deviations
@@ -159,7 +159,7 @@ struct PrtVertex {
 // Push constants of the PRT transfer shader; one dispatch covers some rays of some vertices of one mesh.
 struct PrtTransferPush {
     uvec4 range; // x: first vertex (into the vertex buffer), y: vertex count, z: group (BVH instance), w: rays per vertex
-    uvec4 params; // x: first ray of this dispatch, y: rays in it, z: 1 to test visibility against the whole scene (world space), 0 against the vertex's group, w: zero
+    uvec4 params; // x: first ray of this dispatch (a multiple of KAGE_BVH_PACKET), y: rays in it, zw: zero
 };
 
 // The environment's SH as one group's object space sees it, for the self-shadow pass: one

@@ -341,6 +341,33 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
         compared > 450 && blocked > 50 && blocked < compared,
         "{compared} rays compared, {blocked} occluded"
     );
+
+    // The same rays by packets as the PRT casts them: 8 directions from each origin, closest
+    // hits in object space, against brute force over the group alone.
+    let packets: Vec<(Vec3, Vec3, f32)> = rays
+        .iter()
+        .step_by(constants::BVH_PACKET as usize)
+        .flat_map(|&(o, _, tmax)| {
+            let dirs: Vec<Vec3> = (0..constants::BVH_PACKET).map(|_| rng.direction()).collect();
+            dirs.into_iter().map(move |d| (o, d, tmax))
+        })
+        .collect();
+    let hits = cast(&ctx, &mut caster, &gpu, &packets, Query::PacketObjectSpace { instance: 0 });
+    let (mut compared, mut found) = (0, 0);
+    for (i, &(o, d, tmax)) in packets.iter().enumerate() {
+        if edge_distance(&alone, o, d, tmax) < EDGE_MARGIN {
+            continue;
+        }
+        compared += 1;
+        let want = closest_hit_brute_force(&alone, o, d, tmax).map(|h| h.0);
+        found += want.is_some() as usize;
+        let got = hit(&hits[i]);
+        assert!(
+            got.is_some() == want.is_some() && got.zip(want).is_none_or(|(g, w)| close(g, w)),
+            "packet ray {i} from {o} along {d}: GPU {got:?}, brute force {want:?}"
+        );
+    }
+    assert!(compared > 450 && found > 50 && found < compared, "{compared} packet rays compared, {found} hit");
 }
 
 #[test]

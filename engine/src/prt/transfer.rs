@@ -133,7 +133,7 @@ impl<'a> Jobs<'a> {
             spirv::PRT_TRANSFER_COMP,
             &kinds,
             size_of::<PrtTransferPush>() as u32,
-            &[self.params.coeffs() as u32, u32::from(trace)],
+            &[self.params.coeffs() as u32, u32::from(trace), u32::from(self.params.visibility == Visibility::Scene)],
         )
     }
 
@@ -158,7 +158,7 @@ impl<'a> Jobs<'a> {
                 }
                 let count = RAYS_PER_DISPATCH.min(first + rays - first_ray);
                 for push in batch {
-                    let push = PrtTransferPush { params: [first_ray, count, push.params[2], 0], ..*push };
+                    let push = PrtTransferPush { params: [first_ray, count, 0, 0], ..*push };
                     let groups = push.range[1].div_ceil(constants::PRT_GROUP / constants::PRT_LANES);
                     pipeline.dispatch(cmd, &bindings, bytes_of(&push), [groups, 1, 1]);
                 }
@@ -235,7 +235,7 @@ fn submissions(layout: &[(usize, usize, usize)], params: PrtParams) -> Vec<Vec<P
             batch.push(PrtTransferPush {
                 range: [first as u32, count as u32, group as u32, params.rays],
                 // The ray range is filled in per dispatch.
-                params: [0, 0, u32::from(params.visibility == Visibility::Scene), 0],
+                params: [0; 4],
             });
             first += count;
             left -= count;

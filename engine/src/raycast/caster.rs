@@ -25,6 +25,10 @@ pub enum Query {
     /// [`Query::ClosestHit`] plus `bvh_surface` at the hit (the surface members of
     /// `CastResult`, which other queries leave undefined).
     Surface,
+    /// Closest hits against one group, rays in its object space, traced by packets of
+    /// `constants::BVH_PACKET` consecutive rays from the first one's origin
+    /// (`bvh_closest_hits_packet`, the PRT's traversal); reported as for [`Query::ClosestHit`].
+    PacketObjectSpace { instance: u32 },
 }
 
 /// Rays on the GPU with room for their results.
@@ -114,6 +118,7 @@ impl RayCaster {
             Query::Occluded => (1, 0),
             Query::OccludedObjectSpace { instance } => (2, instance),
             Query::Surface => (3, 0),
+            Query::PacketObjectSpace { instance } => (4, instance),
         };
         let per_dispatch = MAX_GROUPS * constants::RAYCAST_GROUP;
         let pipeline = &self.pipeline;
