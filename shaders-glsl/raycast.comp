@@ -17,6 +17,9 @@ const uint QUERY_OCCLUDED = 1u;
 const uint QUERY_OCCLUDED_OBJECT_SPACE = 2u;
 const uint QUERY_SURFACE = 3u;
 const uint QUERY_PACKET_OBJECT_SPACE = 4u;
+// The packet query's pipeline: a specialization, because a CPU driver would otherwise run its
+// code, masked off, beside every single ray's (both sides of a branch run there).
+layout(constant_id = 0) const bool PACKETS = false;
 
 // Rays first .. first + KAGE_BVH_PACKET - 1 (those in the list) as one packet from the first
 // one's origin through group p.params.z, in its object space: bvh_closest_hits_packet.
@@ -41,7 +44,7 @@ void cast_packet(uint first) {
 void main() {
     uint i = p.params.w + gl_GlobalInvocationID.x;
     if (i >= p.params.x) return;
-    if (p.params.y == QUERY_PACKET_OBJECT_SPACE) {
+    if (PACKETS) {
         if (i % KAGE_BVH_PACKET == 0u) cast_packet(i);
         return;
     }

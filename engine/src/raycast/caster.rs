@@ -87,6 +87,8 @@ impl GpuRays {
 
 pub struct RayCaster {
     pipeline: ComputePipeline,
+    /// The same shader specialized for [`Query::PacketObjectSpace`].
+    packet_pipeline: ComputePipeline,
     executor: FrameExecutor,
 }
 
@@ -97,14 +99,19 @@ impl RayCaster {
     pub fn new(ctx: &Arc<Context>) -> Result<RayCaster> {
         let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
         kinds.extend([BindingKind::StorageBuffer, BindingKind::StorageBuffer]);
-        Ok(RayCaster {
-            pipeline: ComputePipeline::new(
+        let pipeline = |name, packets: bool| {
+            ComputePipeline::specialized(
                 ctx,
-                "raycast",
+                name,
                 spirv::RAYCAST_COMP,
                 &kinds,
                 size_of::<CastPush>() as u32,
-            )?,
+                &[u32::from(packets)],
+            )
+        };
+        Ok(RayCaster {
+            pipeline: pipeline("raycast", false)?,
+            packet_pipeline: pipeline("raycast_packets", true)?,
             executor: FrameExecutor::new(ctx, "raycast")?,
         })
     }
@@ -121,7 +128,10 @@ impl RayCaster {
             Query::PacketObjectSpace { instance } => (4, instance),
         };
         let per_dispatch = MAX_GROUPS * constants::RAYCAST_GROUP;
-        let pipeline = &self.pipeline;
+        let pipeline = match query {
+            Query::PacketObjectSpace { .. } => &self.packet_pipeline,
+            _ => &self.pipeline,
+        };
         let timings = self.executor.run(
             &[],
             vec![Pass::new("raycast", &[], &[RESULTS], move |cmd| {
