@@ -11,7 +11,7 @@
 //!
 //! # GPU layout (bindings 0 .. `KAGE_BVH_BINDINGS` - 1, structs in layouts.glsl)
 //! 0. `BvhPair[]`, the bottom-level trees of every group as the GPU reads them, one pair per
-//!    interior node holding its two children's quantized boxes and references (see [`pairs`]),
+//!    interior node holding its two children's quantized boxes and references (see `raycast/pairs.rs`),
 //!    each group's from its root pair (`BvhInstance.info.w`); 1. `BvhNode[]`, the top level,
 //!    root at 0; 2. `BvhInstance[]`, per group: both matrices, root node (of the CPU's tree),
 //!    first triangle, triangle count, root pair; 3. `BvhTriangle[]`,

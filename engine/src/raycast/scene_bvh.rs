@@ -30,7 +30,7 @@ pub struct TriangleOrigin {
 pub struct SceneBvh {
     /// The bottom-level trees as built, traversed on the CPU.
     pub(super) blas_nodes: Vec<BvhNode>,
-    /// The same trees as the GPU reads them (see [`super::pairs`]).
+    /// The same trees as the GPU reads them (see `pairs.rs`).
     pub(super) blas_pairs: Vec<BvhPair>,
     pub(super) tlas_nodes: Vec<BvhNode>,
     pub(super) instances: Vec<BvhInstance>,
