@@ -10,7 +10,8 @@ use kage_tests::{every_technique, scratch_dir, Validated};
 use std::path::PathBuf;
 
 fn box_textured() -> Scene {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box-textured/BoxTextured.gltf");
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box-textured/BoxTextured.gltf");
     Scene::load(&path).unwrap()
 }
 
@@ -202,7 +203,8 @@ fn hit_uv(
 ) -> Option<[f32; 2]> {
     let mut best: Option<(f32, [f32; 2])> = None;
     for tri in mesh.indices.chunks_exact(3) {
-        let [a, b, c] = [0, 1, 2].map(|k| model.transform_point3(Vec3::from(mesh.positions[tri[k] as usize])));
+        let [a, b, c] =
+            [0, 1, 2].map(|k| model.transform_point3(Vec3::from(mesh.positions[tri[k] as usize])));
         let (e1, e2) = (b - a, c - a);
         let p = direction.cross(e2);
         let det = e1.dot(p);
@@ -249,12 +251,14 @@ fn obj_map_kd_is_the_albedo_map() {
     // vt 0 0 (the image's bottom-left in OBJ) is v = 1 in glTF's convention.
     assert_eq!(a.uvs[0], [0.0, 1.0]);
 
-    std::fs::write(dir.join("lost.obj"), format!("mtllib nowhere.mtl\n{quad}usemtl a\nf 1/1 2/2 3/3\n")).unwrap();
+    std::fs::write(dir.join("lost.obj"), format!("mtllib nowhere.mtl\n{quad}usemtl a\nf 1/1 2/2 3/3\n"))
+        .unwrap();
     let plain = kage::scene::load_obj(&dir.join("lost.obj"), [1.0; 3]).unwrap();
     assert!(plain.len() == 1 && plain[0].texturing.is_none());
 
     std::fs::write(dir.join("gone.mtl"), "newmtl a\nmap_Kd gone.png\n").unwrap();
-    std::fs::write(dir.join("gone.obj"), format!("mtllib gone.mtl\n{quad}usemtl a\nf 1/1 2/2 3/3\n")).unwrap();
+    std::fs::write(dir.join("gone.obj"), format!("mtllib gone.mtl\n{quad}usemtl a\nf 1/1 2/2 3/3\n"))
+        .unwrap();
     let error = kage::scene::load_obj(&dir.join("gone.obj"), [1.0; 3]).unwrap_err().to_string();
     assert!(error.contains("gone.png"), "{error}");
 }
@@ -293,7 +297,8 @@ fn textured_scenes_export_and_read_back() {
 /// not decode.
 #[test]
 fn bad_texturing_is_refused_naming_the_file_and_the_problem() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box-textured/BoxTextured.gltf");
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/gltf/khronos-box-textured/BoxTextured.gltf");
     let original: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
     let dir = scratch_dir("texture-hostile");
     let error_of = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {

@@ -100,7 +100,8 @@ fn rays(args: &RaysArgs) -> Result<()> {
     if let Some(dir) = &args.export {
         export(dir, &scene, &coherent, &incoherent)?;
     }
-    let sets = [("coherent", GpuRays::new(&ctx, &coherent)?), ("incoherent", GpuRays::new(&ctx, &incoherent)?)];
+    let sets =
+        [("coherent", GpuRays::new(&ctx, &coherent)?), ("incoherent", GpuRays::new(&ctx, &incoherent)?)];
     let queries = [("closest hit", Query::ClosestHit), ("any hit", Query::Occluded)];
 
     let bar = Bar::new((sets.len() * queries.len()) as u64 * (args.runs as u64 + 1), "casts");
@@ -170,17 +171,17 @@ fn export(dir: &std::path::Path, scene: &Scene, coherent: &[CastRay], incoherent
         .groups
         .iter()
         .enumerate()
-        .flat_map(|(g, group)| std::iter::repeat_n(g as u32, group.meshes.iter().map(|m| m.indices.len() / 3).sum()))
+        .flat_map(|(g, group)| {
+            std::iter::repeat_n(g as u32, group.meshes.iter().map(|m| m.indices.len() / 3).sum())
+        })
         .flat_map(u32::to_le_bytes)
         .collect();
     let path = dir.join("triangle-groups.u32");
     std::fs::write(&path, groups).with_context(|| format!("writing {}", path.display()))?;
     write("prt.f32", prt_rays(scene, PRT_SAMPLE))?;
     for (name, rays) in [("coherent.f32", coherent), ("incoherent.f32", incoherent)] {
-        let floats = rays
-            .iter()
-            .flat_map(|r| [&r.origin[..3], &r.direction[..3], &r.origin[3..]].concat())
-            .collect();
+        let floats =
+            rays.iter().flat_map(|r| [&r.origin[..3], &r.direction[..3], &r.origin[3..]].concat()).collect();
         write(name, floats)?;
     }
     Ok(())
@@ -196,14 +197,18 @@ fn prt_rays(scene: &Scene, every: usize) -> Vec<f32> {
     let rays = PrtParams::DEFAULT.rays;
     let mut out = Vec::new();
     let vertices = scene.groups.iter().enumerate().flat_map(|(g, group)| {
-        group.meshes.iter().flat_map(move |m| m.positions.iter().zip(&m.normals).map(move |(p, n)| (g, group, *p, *n)))
+        group
+            .meshes
+            .iter()
+            .flat_map(move |m| m.positions.iter().zip(&m.normals).map(move |(p, n)| (g, group, *p, *n)))
     });
     for (vertex, (g, group, position, normal)) in vertices.enumerate().step_by(every) {
         let n = Vec3::from(normal).normalize();
         let to_world = group.transform.matrix();
         let origin = to_world.transform_point3(offset_ray_origin(position.into(), n));
         for k in 0..rays {
-            let dir = to_world.transform_vector3(directions::direction(vertex as u32, n, k, rays)).normalize();
+            let dir =
+                to_world.transform_vector3(directions::direction(vertex as u32, n, k, rays)).normalize();
             out.extend(origin.to_array());
             out.extend(dir.to_array());
             out.extend([1e30, g as f32]);

@@ -84,7 +84,9 @@ pub fn run(args: &ScaleArgs) -> Result<()> {
             step.bvh_mb,
             step.precompute_s.map_or("-".into(), |s| format!("{s:.2}")),
             step.precompute_s.map_or("-".into(), |s| format!("{:.2}", rays(&step, prt) / s * 1e-6)),
-            step.precompute_s.zip(step.traversal_s).map_or("-".into(), |(s, t)| format!("{:.1} %", 100.0 * (s - t) / s)),
+            step.precompute_s
+                .zip(step.traversal_s)
+                .map_or("-".into(), |(s, t)| format!("{:.1} %", 100.0 * (s - t) / s)),
             step.peak_rss_mb
         );
         for (kind, mb, ms) in &step.techniques {
@@ -110,7 +112,8 @@ pub fn run(args: &ScaleArgs) -> Result<()> {
 }
 
 fn name(kind: TechniqueKind) -> String {
-    clap::ValueEnum::to_possible_value(&kind).map_or_else(|| format!("{kind:?}"), |v| v.get_name().to_string())
+    clap::ValueEnum::to_possible_value(&kind)
+        .map_or_else(|| format!("{kind:?}"), |v| v.get_name().to_string())
 }
 
 /// The PRT rays of a step: every vertex casts `prt.rays`.
@@ -139,7 +142,8 @@ fn measure(ctx: &Arc<kage::backend::Context>, args: &ScaleArgs, prt: PrtParams, 
                 let set = match transfers.get(&key) {
                     Some(set) => set.clone(),
                     None => {
-                        let set = Arc::new(transfer::precompute(ctx, &scene, params, &mut kage::progress::silent)?);
+                        let set =
+                            Arc::new(transfer::precompute(ctx, &scene, params, &mut kage::progress::silent)?);
                         transfers.insert(key, set.clone());
                         set
                     }
@@ -217,7 +221,8 @@ fn scene(triangles: u32) -> Result<Scene> {
 fn peak_rss_bytes() -> Result<u64> {
     let status = std::fs::read_to_string("/proc/self/status").context("reading /proc/self/status")?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:")).ok_or_else(|| anyhow!("no VmHWM line"))?;
-    let kb: u64 = line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).ok_or_else(|| anyhow!("bad {line}"))?;
+    let kb: u64 =
+        line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).ok_or_else(|| anyhow!("bad {line}"))?;
     Ok(kb * 1024)
 }
 
@@ -225,13 +230,25 @@ fn peak_rss_bytes() -> Result<u64> {
 fn series(steps: &[Step], prt: PrtParams) -> Vec<(String, &'static str, Vec<Option<f64>>)> {
     let mut out = vec![
         ("BVH build".to_string(), "ms", steps.iter().map(|s| Some(s.bvh_ms)).collect()),
-        (format!("PRT precompute ({} rays)", prt.rays), "ms", steps.iter().map(|s| s.precompute_s.map(|v| v * 1e3)).collect()),
+        (
+            format!("PRT precompute ({} rays)", prt.rays),
+            "ms",
+            steps.iter().map(|s| s.precompute_s.map(|v| v * 1e3)).collect(),
+        ),
         ("BVH".to_string(), "MB", steps.iter().map(|s| Some(s.bvh_mb)).collect()),
         ("peak RSS".to_string(), "MB", steps.iter().map(|s| Some(s.peak_rss_mb)).collect()),
     ];
     for (t, (kind, _, _)) in steps[0].techniques.iter().enumerate() {
-        out.push((format!("{} frame", name(*kind)), "ms", steps.iter().map(|s| Some(s.techniques[t].2)).collect()));
-        out.push((format!("{} memory", name(*kind)), "MB", steps.iter().map(|s| Some(s.techniques[t].1)).collect()));
+        out.push((
+            format!("{} frame", name(*kind)),
+            "ms",
+            steps.iter().map(|s| Some(s.techniques[t].2)).collect(),
+        ));
+        out.push((
+            format!("{} memory", name(*kind)),
+            "MB",
+            steps.iter().map(|s| Some(s.techniques[t].1)).collect(),
+        ));
     }
     out
 }

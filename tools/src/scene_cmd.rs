@@ -70,8 +70,12 @@ fn describe(scene: &Scene, read_ms: f64) -> serde_json::Value {
         .enumerate()
         .map(|(g, group)| {
             let triangles: usize = group.meshes.iter().map(|m| m.triangle_count()).sum();
-            let maps: Vec<String> =
-                group.meshes.iter().filter_map(|m| m.texturing.as_ref()).map(|t| t.map.name.clone()).collect();
+            let maps: Vec<String> = group
+                .meshes
+                .iter()
+                .filter_map(|m| m.texturing.as_ref())
+                .map(|t| t.map.name.clone())
+                .collect();
             json!({
                 "name": group.name,
                 "meshes": group.meshes.len(),

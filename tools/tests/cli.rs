@@ -497,7 +497,8 @@ fn precompute_caches_and_tamura_renders_from_the_cache() {
     // The split of the time: traversal plus everything else is the whole.
     let split = |out: &Output| -> Option<(f64, f64)> {
         let all = text(out);
-        let time: f64 = all.lines().find_map(|l| l.strip_prefix("time: "))?.split(' ').next()?.parse().ok()?;
+        let time: f64 =
+            all.lines().find_map(|l| l.strip_prefix("time: "))?.split(' ').next()?.parse().ok()?;
         let line = all.lines().find_map(|l| l.strip_prefix("split: ray traversal "))?;
         let traversal: f64 = line.split(' ').next()?.parse().ok()?;
         let rest: f64 = line.split("everything else ").nth(1)?.split(' ').next()?.parse().ok()?;
@@ -1246,8 +1247,7 @@ fn scene_files_around_the_same_geometry_share_one_cache_file() {
     assert_eq!(long_name.len(), 300);
     let second = box_on_floor(&dir, "second.json", &long_name, far, "");
     let precompute = |scene: &str| {
-        let run =
-            kage(&["precompute", "--scene", scene, "--rays", "16", "--cache", cache_arg, "--validate"]);
+        let run = kage(&["precompute", "--scene", scene, "--rays", "16", "--cache", cache_arg, "--validate"]);
         assert!(run.status.success(), "{}", text(&run));
         text(&run)
     };
@@ -1255,14 +1255,9 @@ fn scene_files_around_the_same_geometry_share_one_cache_file() {
     assert!(made.contains("cache: wrote"), "{made}");
     let hit = precompute(&second);
     assert!(hit.contains("is valid, nothing to compute"), "{hit}");
-    let files: Vec<String> = std::fs::read_dir(&cache)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into())
-        .collect();
-    assert!(
-        files.len() == 1 && files[0].starts_with("prt-") && files[0].ends_with(".kageprt"),
-        "{files:?}"
-    );
+    let files: Vec<String> =
+        std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into()).collect();
+    assert!(files.len() == 1 && files[0].starts_with("prt-") && files[0].ends_with(".kageprt"), "{files:?}");
     let out = dir.join("second.png");
     let args =
         ["render", "--scene", &second, "--technique", "sloan-self", "--rays", "16", "--cache", cache_arg];
@@ -1291,16 +1286,12 @@ fn the_default_sky_note_is_printed_only_when_the_default_stays() {
     let map = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/sun/sun2-45-sky.exr");
     let render = |scene: &str, extra: &[&str]| {
         let out = dir.join("out.exr");
-        let args =
-            ["render", "--scene", scene, "--technique", "unshadowed", "--width", "8", "--height", "8"];
+        let args = ["render", "--scene", scene, "--technique", "unshadowed", "--width", "8", "--height", "8"];
         let run = kage(&[&args[..], &["--out", out.to_str().unwrap()], extra].concat());
         assert!(run.status.success(), "{}", text(&run));
         text(&run).contains("has no environment: lit by a constant sky of radiance 1")
     };
-    assert!(
-        render(gltf, &[]) && render(&composed, &[]),
-        "the note where the default sky lights the scene"
-    );
+    assert!(render(gltf, &[]) && render(&composed, &[]), "the note where the default sky lights the scene");
     assert!(!render(gltf, &["--env", map]) && !render(&composed, &["--env", map]), "no note under --env");
     assert!(!render(&given, &[]), "no note where the file gives an environment");
 }
@@ -1318,10 +1309,7 @@ fn an_obj_alone_renders_with_its_zero_normal_repaired() {
     let run = kage(&[&args[..], &size[..]].concat());
     let output = text(&run);
     assert!(run.status.success(), "{output}");
-    assert!(
-        output.contains("kage: note: mesh \"bunny\": 1 normal(s) were zero or not finite"),
-        "{output}"
-    );
+    assert!(output.contains("kage: note: mesh \"bunny\": 1 normal(s) were zero or not finite"), "{output}");
     assert!(
         output.contains("read alone") && output.contains("albedo 0.8") && output.contains("no ground"),
         "{output}"
@@ -1380,12 +1368,26 @@ fn bench_scale_writes_its_table_and_chart() {
     let dir = scratch_dir("cli-scale");
     let out = dir.to_str().unwrap();
     let run = kage(&[
-        "bench", "scale", "--triangles", "300,3000", "--rays", "32", "--techniques", "unshadowed,sloan-self",
-        "--size", "32", "--frames", "1", "--out", out, "--validate",
+        "bench",
+        "scale",
+        "--triangles",
+        "300,3000",
+        "--rays",
+        "32",
+        "--techniques",
+        "unshadowed,sloan-self",
+        "--size",
+        "32",
+        "--frames",
+        "1",
+        "--out",
+        out,
+        "--validate",
     ]);
     let all = text(&run);
     assert!(run.status.success(), "{all}");
-    let rows: Vec<&str> = all.lines().filter(|l| l.contains("unshadowed: ") && l.contains("sloan-self: ")).collect();
+    let rows: Vec<&str> =
+        all.lines().filter(|l| l.contains("unshadowed: ") && l.contains("sloan-self: ")).collect();
     assert_eq!(rows.len(), 2, "{all}");
     assert!(all.contains("log-log slopes") && all.contains("sloan-self frame"), "{all}");
     let csv = std::fs::read_to_string(dir.join("scale.csv")).unwrap();

@@ -80,7 +80,13 @@ struct Jobs<'a> {
 }
 
 impl<'a> Jobs<'a> {
-    fn new(ctx: &'a Arc<Context>, scene: &Scene, bvh: &'a GpuBvh, params: PrtParams, total: usize) -> Result<Self> {
+    fn new(
+        ctx: &'a Arc<Context>,
+        scene: &Scene,
+        bvh: &'a GpuBvh,
+        params: PrtParams,
+        total: usize,
+    ) -> Result<Self> {
         let too_many = || {
             Error::InvalidArgument(format!(
                 "PRT over {total} vertices × {} coefficients exceeds the 32-bit indices of the \
@@ -133,7 +139,11 @@ impl<'a> Jobs<'a> {
             spirv::PRT_TRANSFER_COMP,
             &kinds,
             size_of::<PrtTransferPush>() as u32,
-            &[self.params.coeffs() as u32, u32::from(trace), u32::from(self.params.visibility == Visibility::Scene)],
+            &[
+                self.params.coeffs() as u32,
+                u32::from(trace),
+                u32::from(self.params.visibility == Visibility::Scene),
+            ],
         )
     }
 
@@ -141,7 +151,13 @@ impl<'a> Jobs<'a> {
     /// [`RAYS_PER_DISPATCH`] rays, and waits for them; returns the seconds from submission to
     /// completion, timed on the host (a CPU driver's timestamps around compute work are not
     /// reliable, see vendor-notes.md).
-    fn submit(&mut self, pipeline: &ComputePipeline, batch: &[PrtTransferPush], first: u32, rays: u32) -> Result<f64> {
+    fn submit(
+        &mut self,
+        pipeline: &ComputePipeline,
+        batch: &[PrtTransferPush],
+        first: u32,
+        rays: u32,
+    ) -> Result<f64> {
         let mut bindings: Vec<Binding> = self.bvh.bindings().into_iter().collect();
         bindings.extend([
             Binding::Storage(&self.vertices),
@@ -187,14 +203,17 @@ impl<'a> Jobs<'a> {
                 return Err(cancelled());
             }
         }
-        if let Some((vertex, &got)) = words(self.rays_cast.read()?).iter().enumerate().find(|(_, n)| **n != rays) {
+        if let Some((vertex, &got)) =
+            words(self.rays_cast.read()?).iter().enumerate().find(|(_, n)| **n != rays)
+        {
             return Err(Error::Unsupported(format!(
                 "shader loops as long as the PRT needs: the driver stopped after {got} of {rays} rays \
                  for vertex {vertex}, so the transfer would be wrong"
             )));
         }
         let bytes = self.output.read()?;
-        let coefficients = bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let coefficients =
+            bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
         Ok((coefficients, words(self.back_hits.read()?)))
     }
 

@@ -63,13 +63,15 @@ pub fn pairs(nodes: &[BvhNode], first_triangle: u32, base: u32) -> Result<(Vec<B
 
 /// One pair: the children's boxes on a grid over their union, with their references.
 fn pair(children: [Aabb; 2], refs: [u32; 2]) -> BvhPair {
-    let live: Vec<Aabb> = children.iter().zip(refs).filter(|(_, r)| *r != constants::NO_HIT).map(|(b, _)| *b).collect();
+    let live: Vec<Aabb> =
+        children.iter().zip(refs).filter(|(_, r)| *r != constants::NO_HIT).map(|(b, _)| *b).collect();
     let union = live.iter().fold(Aabb::EMPTY, |u, b| u.union(*b));
     let origin = if union.is_empty() { Vec3::ZERO } else { union.lo };
     let mut exponents = [0u32; 3];
     let mut boxes = [0u32; 4];
     for axis in 0..3 {
-        let (exponent, quantized) = quantize_axis(origin[axis], &children.map(|b| (b.lo[axis], b.hi[axis])), refs);
+        let (exponent, quantized) =
+            quantize_axis(origin[axis], &children.map(|b| (b.lo[axis], b.hi[axis])), refs);
         exponents[axis] = exponent;
         for (c, (lo, hi)) in quantized.into_iter().enumerate() {
             boxes[2 * c] |= lo << (8 * axis);
@@ -77,7 +79,9 @@ fn pair(children: [Aabb; 2], refs: [u32; 2]) -> BvhPair {
         }
     }
     BvhPair {
-        origin: origin.extend(f32::from_bits(exponents[0] | exponents[1] << 8 | exponents[2] << 16)).to_array(),
+        origin: origin
+            .extend(f32::from_bits(exponents[0] | exponents[1] << 8 | exponents[2] << 16))
+            .to_array(),
         boxes,
         refs: [refs[0], refs[1], 0, 0],
     }
@@ -94,16 +98,19 @@ fn quantize_axis(origin: f32, children: &[(f32, f32); 2], refs: [u32; 2]) -> (u3
         .map(|((_, hi), _)| f64::from(*hi) - f64::from(origin))
         .fold(0.0, f64::max);
     // The smallest normal step, else the step that spans the extent in 255.
-    let mut exponent = if extent > 0.0 { ((extent / 255.0).log2().ceil() as i32 + 127).max(1) as u32 } else { 1 };
+    let mut exponent =
+        if extent > 0.0 { ((extent / 255.0).log2().ceil() as i32 + 127).max(1) as u32 } else { 1 };
     loop {
         let step = f32::from_bits(exponent << 23);
         let corner = |q: u32| origin + q as f32 * step;
         let fit = |(lo, hi): (f32, f32)| -> Option<(u32, u32)> {
-            let mut q_lo = ((f64::from(lo) - f64::from(origin)) / f64::from(step)).floor().clamp(0.0, 255.0) as u32;
+            let mut q_lo =
+                ((f64::from(lo) - f64::from(origin)) / f64::from(step)).floor().clamp(0.0, 255.0) as u32;
             while q_lo > 0 && corner(q_lo) > lo {
                 q_lo -= 1;
             }
-            let mut q_hi = ((f64::from(hi) - f64::from(origin)) / f64::from(step)).ceil().clamp(0.0, 255.0) as u32;
+            let mut q_hi =
+                ((f64::from(hi) - f64::from(origin)) / f64::from(step)).ceil().clamp(0.0, 255.0) as u32;
             while q_hi < 255 && corner(q_hi) < hi {
                 q_hi += 1;
             }
@@ -126,7 +133,8 @@ fn quantize_axis(origin: f32, children: &[(f32, f32); 2], refs: [u32; 2]) -> (u3
 pub fn child_box(pair: &BvhPair, child: usize) -> Aabb {
     let origin = Vec3::from_slice(&pair.origin[..3]);
     let exponents = pair.origin[3].to_bits();
-    let step = Vec3::from_array(std::array::from_fn(|a| f32::from_bits(((exponents >> (8 * a)) & 0xff) << 23)));
+    let step =
+        Vec3::from_array(std::array::from_fn(|a| f32::from_bits(((exponents >> (8 * a)) & 0xff) << 23)));
     let corner = |word: u32| {
         let q = Vec3::from_array(std::array::from_fn(|a| ((word >> (8 * a)) & 0xff) as f32));
         origin + q * step
@@ -184,7 +192,10 @@ mod tests {
                     // steps of the coordinates, 1e4 at most here, where those are coarser).
                     let slack = (quantized.hi - quantized.lo) - (exact.hi - exact.lo);
                     let span = node_bounds(&tree.nodes[node]).hi - node_bounds(&tree.nodes[node]).lo;
-                    assert!(slack.cmple(span * (4.0 / 255.0) + Vec3::splat(1e-2)).all(), "{slack} over {span}");
+                    assert!(
+                        slack.cmple(span * (4.0 / 255.0) + Vec3::splat(1e-2)).all(),
+                        "{slack} over {span}"
+                    );
                     let reference = pair.refs[c];
                     let (child_index, child_count) = node_range(&tree.nodes[child]);
                     if child_count > 0 {

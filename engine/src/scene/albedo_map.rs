@@ -87,9 +87,11 @@ impl AlbedoMap {
             .with_guessed_format()
             .map_err(|e| fail(format!("cannot read: {e}")))?;
         let mut limits = image::Limits::default();
-        (limits.max_image_width, limits.max_image_height) = (Some(MAX_ALBEDO_MAP_SIDE), Some(MAX_ALBEDO_MAP_SIDE));
+        (limits.max_image_width, limits.max_image_height) =
+            (Some(MAX_ALBEDO_MAP_SIDE), Some(MAX_ALBEDO_MAP_SIDE));
         reader.limits(limits);
-        let image = reader.decode().map_err(|e| fail(format!("not a PNG or JPEG image Kage can read: {e}")))?;
+        let image =
+            reader.decode().map_err(|e| fail(format!("not a PNG or JPEG image Kage can read: {e}")))?;
         let rgba = image.to_rgba8();
         let (width, height) = rgba.dimensions();
         let texels = rgba.pixels().map(|p| p.0).collect();

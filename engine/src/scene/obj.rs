@@ -29,17 +29,22 @@ pub fn load_obj(path: &Path, albedo: [f32; 3]) -> Result<Vec<Mesh>, SceneError> 
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let folder = path.parent().unwrap_or(Path::new(""));
     let library = |mtl: &Path| {
-        let bytes = files::read(&folder.join(mtl), files::OBJ).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        let bytes =
+            files::read(&folder.join(mtl), files::OBJ).map_err(|_| tobj::LoadError::OpenFileFailed)?;
         tobj::load_mtl_buf(&mut Cursor::new(bytes))
     };
     let (models, materials) = models(&bytes, library).map_err(|e| SceneError::in_file(path, e.problem()))?;
     let materials = materials.unwrap_or_else(|e| {
-        eprintln!("kage: note: {}: its material library cannot be read ({e}): no albedo maps", path.display());
+        eprintln!(
+            "kage: note: {}: its material library cannot be read ({e}): no albedo maps",
+            path.display()
+        );
         Vec::new()
     });
     let mut read: HashMap<String, Arc<AlbedoMap>> = HashMap::new();
     let mut map_of = |material: Option<usize>| -> Result<Option<Arc<AlbedoMap>>, SceneError> {
-        let Some(file) = material.and_then(|m| materials.get(m)).and_then(|m| m.diffuse_texture.clone()) else {
+        let Some(file) = material.and_then(|m| materials.get(m)).and_then(|m| m.diffuse_texture.clone())
+        else {
             return Ok(None);
         };
         if !read.contains_key(&file) {
@@ -81,25 +86,27 @@ fn meshes(
     let mut parts: Vec<Part> = Vec::new();
     for model in models {
         let map = map_of(model.mesh.material_id)?;
-        let at = match parts.iter().position(|p| p.map.as_ref().map(Arc::as_ptr) == map.as_ref().map(Arc::as_ptr)) {
-            Some(at) => at,
-            None => {
-                let part = Part {
-                    map,
-                    positions: Vec::new(),
-                    normals: Vec::new(),
-                    uvs: Vec::new(),
-                    indices: Vec::new(),
-                    all_normals: true,
-                    all_uvs: true,
-                };
-                parts.push(part);
-                parts.len() - 1
-            }
-        };
+        let at =
+            match parts.iter().position(|p| p.map.as_ref().map(Arc::as_ptr) == map.as_ref().map(Arc::as_ptr))
+            {
+                Some(at) => at,
+                None => {
+                    let part = Part {
+                        map,
+                        positions: Vec::new(),
+                        normals: Vec::new(),
+                        uvs: Vec::new(),
+                        indices: Vec::new(),
+                        all_normals: true,
+                        all_uvs: true,
+                    };
+                    parts.push(part);
+                    parts.len() - 1
+                }
+            };
         let (part, mesh) = (&mut parts[at], model.mesh);
-        let base =
-            u32::try_from(part.positions.len()).map_err(|_| SceneError::invalid("OBJ has too many vertices"))?;
+        let base = u32::try_from(part.positions.len())
+            .map_err(|_| SceneError::invalid("OBJ has too many vertices"))?;
         let count = mesh.positions.len() / 3;
         part.all_normals &= mesh.normals.len() == 3 * count;
         part.all_uvs &= mesh.texcoords.len() == 2 * count;
@@ -153,7 +160,8 @@ pub fn write_obj(mesh: &Mesh, path: &Path) -> Result<(), SceneError> {
         write(&mtl, format!("newmtl albedo_map\nmap_Kd {}\n", file_name(&png)).as_bytes())?;
         write(&png, &texturing.map.png())?;
         let map = &texturing.map;
-        if map.wrap != [super::albedo_map::Wrap::Repeat; 2] || map.filter != super::albedo_map::Filter::SMOOTH {
+        if map.wrap != [super::albedo_map::Wrap::Repeat; 2] || map.filter != super::albedo_map::Filter::SMOOTH
+        {
             eprintln!(
                 "kage: note: {}: OBJ has no sampler; albedo map {} reads back repeating, with linear filtering and mipmaps",
                 path.display(),

@@ -160,8 +160,16 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
                         ))
                     };
                     meshes.push(
-                        primitive_mesh(&primitive, &mesh, p, relative, &buffers, &mut albedo_maps, &mut unused)
-                            .map_err(at)?,
+                        primitive_mesh(
+                            &primitive,
+                            &mesh,
+                            p,
+                            relative,
+                            &buffers,
+                            &mut albedo_maps,
+                            &mut unused,
+                        )
+                        .map_err(at)?,
                     );
                 }
             }

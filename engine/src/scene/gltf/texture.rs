@@ -64,7 +64,8 @@ impl<'a> AlbedoMaps<'a> {
         let index = texture.source().index();
         let name = texture.source().name().map_or_else(|| format!("image {index}"), str::to_owned);
         let image = self.images.get(index).ok_or_else(|| format!("its base colour {name} is missing"))?;
-        let texels = rgba8(image).ok_or_else(|| format!("its base colour {name} has format {:?}", image.format))?;
+        let texels =
+            rgba8(image).ok_or_else(|| format!("its base colour {name} has format {:?}", image.format))?;
         let sampler = texture.sampler();
         let wrap = |mode| match mode {
             WrappingMode::Repeat => Wrap::Repeat,
@@ -83,8 +84,15 @@ impl<'a> AlbedoMaps<'a> {
                 _ => Some(true),
             },
         };
-        AlbedoMap::new(name, image.width, image.height, texels, [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())], filter)
-            .map_err(|e| e.to_string())
+        AlbedoMap::new(
+            name,
+            image.width,
+            image.height,
+            texels,
+            [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+            filter,
+        )
+        .map_err(|e| e.to_string())
     }
 }
 

@@ -1,7 +1,7 @@
 //! Writing a scene's groups, lights, camera and motion as binary glTF (.glb), in the mapping
 //! the module documents; [`super::parts`] reads them back identical.
-use super::super::camera::{FAR, NEAR};
 use super::super::albedo_map::{AlbedoMap, Wrap};
+use super::super::camera::{FAR, NEAR};
 use super::super::motion::{Key, Motion};
 use super::super::{Camera, Group, Light, Mesh, Scene};
 use super::{Extras, KageExtras};
@@ -96,7 +96,8 @@ impl Builder {
         // Each view starts 4-byte aligned, as accessors after it need.
         self.bin.resize(self.bin.len().next_multiple_of(4), 0);
         let index = self.maps.len();
-        self.images.push(json!({"name": map.name, "mimeType": "image/png", "bufferView": self.views.len() - 1}));
+        self.images
+            .push(json!({"name": map.name, "mimeType": "image/png", "bufferView": self.views.len() - 1}));
         let wrap = |w| match w {
             Wrap::Repeat => 10497,
             Wrap::MirroredRepeat => 33648,

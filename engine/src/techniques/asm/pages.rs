@@ -139,7 +139,16 @@ impl PageStore {
         let (width, height) = (layout.columns * ASM_PAGE_TEXELS, layout.rows * ASM_PAGE_TEXELS);
         let atlas_usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
         let atlas = |name, format| {
-            let desc = ImageDesc { name, width, height, layers: 1, levels: 1, array: false, format, usage: atlas_usage };
+            let desc = ImageDesc {
+                name,
+                width,
+                height,
+                layers: 1,
+                levels: 1,
+                array: false,
+                format,
+                usage: atlas_usage,
+            };
             Image::new(ctx, &desc).map_err(|e| match e {
                 Error::InvalidArgument(e) => Error::InvalidArgument(format!(
                     "an ASM budget of {budget_bytes} bytes is {} pages: {e}",

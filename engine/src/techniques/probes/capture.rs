@@ -207,7 +207,16 @@ impl ProbeCapture {
         let image = |name, format, usage| {
             Image::new(
                 ctx,
-                &ImageDesc { name, width: side, height: 6 * side, layers: 1, levels: 1, array: false, format, usage },
+                &ImageDesc {
+                    name,
+                    width: side,
+                    height: 6 * side,
+                    layers: 1,
+                    levels: 1,
+                    array: false,
+                    format,
+                    usage,
+                },
             )
         };
         let faces = (0..6)

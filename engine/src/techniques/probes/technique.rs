@@ -166,7 +166,12 @@ impl Technique for ProbeTechnique {
             }
             // Each moving group with its own light.
             for lit in self.lit.iter().filter(|lit| lit.centre.is_some()) {
-                bind_lit(cmd, &self.pipeline, scene, &[Binding::Uniform(uniforms), Binding::Uniform(&lit.light)]);
+                bind_lit(
+                    cmd,
+                    &self.pipeline,
+                    scene,
+                    &[Binding::Uniform(uniforms), Binding::Uniform(&lit.light)],
+                );
                 draw_lit_meshes(ctx, cmd, &self.pipeline, scene, |m| {
                     (m.group == lit.group).then_some(m.albedo)
                 });

@@ -183,7 +183,8 @@ mod tests {
             .flat_map(|(_, t)| t.to_vec())
             .collect();
         let normals = vec![[0.0, 1.0, 0.0]; positions.len()];
-        let mesh = Mesh { name: "grid".into(), positions, normals, indices, albedo: [0.5; 3], texturing: None };
+        let mesh =
+            Mesh { name: "grid".into(), positions, normals, indices, albedo: [0.5; 3], texturing: None };
         Group { name: "floor".into(), meshes: vec![mesh], transform: Transform::default(), motion: None }
     }
 
