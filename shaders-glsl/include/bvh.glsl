@@ -99,10 +99,10 @@ bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, 
     return bvh_intersect(r, bvh_triangles[tri], tmax, t, bary);
 }
 
-// Entry distance of the ray into the box lo .. hi, or +inf when it misses the box or enters at
-// or past tmax. inv_dir may hold infinities (axis-parallel rays); max/min discard the NaN of
-// 0 * inf, which happens only for origins exactly on a slab plane.
-// The same with the box's corners given relative to the ray's origin (for rays sharing one).
+// Entry distance of a ray into the box lo .. hi given relative to the ray's origin, or +inf
+// when it misses the box or enters at or past tmax. inv_dir may hold infinities (axis-parallel
+// rays); max/min discard the NaN of 0 * inf, which happens only for origins exactly on a slab
+// plane.
 float bvh_enter_from(vec3 lo, vec3 hi, vec3 inv_dir, float tmax) {
     vec3 t0 = lo * inv_dir;
     vec3 t1 = hi * inv_dir;
@@ -113,6 +113,7 @@ float bvh_enter_from(vec3 lo, vec3 hi, vec3 inv_dir, float tmax) {
     return enter <= leave ? enter : 1.0 / 0.0;
 }
 
+// The same for a box in the ray's space.
 float bvh_enter(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float tmax) {
     return bvh_enter_from(lo - origin, hi - origin, inv_dir, tmax);
 }
@@ -124,19 +125,37 @@ float bvh_enter_box(BvhNode node, vec3 origin, vec3 inv_dir, float tmax) {
 uint bvh_node_index(BvhNode node) { return floatBitsToUint(node.lo.w); }
 uint bvh_node_count(BvhNode node) { return floatBitsToUint(node.hi.w); }
 
+// Of two children entered at these distances (+inf: not entered), how many are entered (0, 1
+// or 2) and whether to visit the left one first: the nearer, so that a hit in it shrinks tmax
+// and prunes the other.
+int bvh_order(float enter_left, float enter_right, out bool left_first) {
+    bool left = enter_left != 1.0 / 0.0;
+    bool right = enter_right != 1.0 / 0.0;
+    left_first = left && (!right || enter_left <= enter_right);
+    return int(left) + int(right);
+}
+
+// A pair's children as bvh_order takes them: entered at these distances and present.
+int bvh_pair_order(BvhPair pair, float enter_left, float enter_right, out bool left_first) {
+    return bvh_order(pair.refs.x != KAGE_NO_HIT ? enter_left : 1.0 / 0.0,
+                     pair.refs.y != KAGE_NO_HIT ? enter_right : 1.0 / 0.0, left_first);
+}
+
+// The triangles of a child reference: none for a pair, count and first for a leaf.
+uint bvh_leaf_count(uint ref) { return (ref & KAGE_BVH_LEAF) != 0u ? (ref >> 28) & 7u : 0u; }
+uint bvh_leaf_first(uint ref) { return ref & 0x0fffffffu; }
+
 // The children of inner node `index` (at index and index + 1) that the ray enters before
 // `tmax`: how many (0, 1 or 2); `next`, the one to visit now (the nearer of two, so that tmax
 // shrinks early and prunes the farther one); `pushed`, the other one's index when both.
 int bvh_children(BvhNode left_node, BvhNode right_node, uint index, vec3 origin, vec3 inv_dir, float tmax,
                  inout BvhNode next, out uint pushed) {
-    float enter_left = bvh_enter_box(left_node, origin, inv_dir, tmax);
-    float enter_right = bvh_enter_box(right_node, origin, inv_dir, tmax);
-    bool left = enter_left != 1.0 / 0.0;
-    bool right = enter_right != 1.0 / 0.0;
-    bool left_first = left && (!right || enter_left <= enter_right);
+    bool left_first;
+    int entered = bvh_order(bvh_enter_box(left_node, origin, inv_dir, tmax),
+                            bvh_enter_box(right_node, origin, inv_dir, tmax), left_first);
     pushed = left_first ? index + 1u : index;
-    if (left || right) next = left_first ? left_node : right_node;
-    return int(left) + int(right);
+    if (entered > 0) next = left_first ? left_node : right_node;
+    return entered;
 }
 
 // One corner of a pair's child box: 3 bytes of grid steps from the pair's origin. q * step is
@@ -185,12 +204,10 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
             bvh_pair_boxes(pair, left_lo, left_hi, right_lo, right_hi);
             float enter_left = bvh_enter(left_lo, left_hi, origin, inv_dir, hit.t);
             float enter_right = bvh_enter(right_lo, right_hi, origin, inv_dir, hit.t);
-            bool left = enter_left != 1.0 / 0.0 && pair.refs.x != KAGE_NO_HIT;
-            bool right = enter_right != 1.0 / 0.0 && pair.refs.y != KAGE_NO_HIT;
-            if (!left && !right) break;
-            // The nearer first, so that a hit in it shrinks hit.t and prunes the other.
-            bool left_first = left && (!right || enter_left <= enter_right);
-            if (left && right) {
+            bool left_first;
+            int entered = bvh_pair_order(pair, enter_left, enter_right, left_first);
+            if (entered == 0) break;
+            if (entered == 2) {
                 stack[top] = left_first ? pair.refs.y : pair.refs.x;
                 stack_enter[top] = left_first ? enter_right : enter_left;
                 ++top;
@@ -199,8 +216,8 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
         }
         // A leaf: its triangles, all lanes that hold one together (none where the walk above
         // ended on a pair with no child entered).
-        uint count = (next & KAGE_BVH_LEAF) != 0u ? (next >> 28) & 7u : 0u;
-        uint first = next & 0x0fffffffu;
+        uint count = bvh_leaf_count(next);
+        uint first = bvh_leaf_first(next);
         for (uint tri = first; tri < first + count; ++tri) {
             float t;
             vec2 bary;
@@ -261,19 +278,18 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
                     enter_right = min(enter_right, bvh_enter_from(right_lo, right_hi, inv_dirs[r], hits[r].t));
                 }
             }
-            bool left = enter_left != 1.0 / 0.0 && pair.refs.x != KAGE_NO_HIT;
-            bool right = enter_right != 1.0 / 0.0 && pair.refs.y != KAGE_NO_HIT;
-            if (!left && !right) break;
-            bool left_first = left && (!right || enter_left <= enter_right);
-            if (left && right) {
+            bool left_first;
+            int entered = bvh_pair_order(pair, enter_left, enter_right, left_first);
+            if (entered == 0) break;
+            if (entered == 2) {
                 stack[top] = left_first ? pair.refs.y : pair.refs.x;
                 stack_enter[top] = left_first ? enter_right : enter_left;
                 ++top;
             }
             next = left_first ? pair.refs.x : pair.refs.y;
         }
-        uint count = (next & KAGE_BVH_LEAF) != 0u ? (next >> 28) & 7u : 0u;
-        uint first = next & 0x0fffffffu;
+        uint count = bvh_leaf_count(next);
+        uint first = bvh_leaf_first(next);
         for (uint tri = first; tri < first + count; ++tri) {
             BvhTriangle v = bvh_triangles[tri];
             for (int r = 0; r < KAGE_BVH_PACKET; ++r) {

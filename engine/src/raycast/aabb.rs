@@ -77,3 +77,14 @@ impl Aabb {
         (enter <= leave).then_some(enter)
     }
 }
+
+/// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator), for
+/// the builders' tests.
+#[cfg(test)]
+pub fn test_random(seed: u32) -> impl FnMut() -> f32 {
+    let mut state = seed;
+    move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1 << 24) as f32
+    }
+}

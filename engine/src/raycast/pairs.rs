@@ -16,10 +16,10 @@ use crate::layouts::{constants, BvhNode, BvhPair};
 use glam::Vec3;
 
 /// The pairs of one tree (`nodes` as the SAH builder flattened it, its leaves' triangle ranges
-/// offset by `first_triangle`), numbered from `base` in the order of their interior nodes.
-/// Returns them and the index of the root's pair: a tree whose root is a leaf (or empty) gets
-/// one pair of that leaf (or of nothing) and an empty second child.
-pub fn pairs(nodes: &[BvhNode], first_triangle: u32, base: u32) -> Result<(Vec<BvhPair>, u32)> {
+/// offset by `first_triangle`), numbered from `base` in the order of their interior nodes, so
+/// the root's pair is `base`: a tree whose root is a leaf (or empty) gets one pair of that leaf
+/// (or of nothing) and an empty second child.
+pub fn pairs(nodes: &[BvhNode], first_triangle: u32, base: u32) -> Result<Vec<BvhPair>> {
     let mut pair_of = Vec::with_capacity(nodes.len());
     let mut interior = 0u32;
     for node in nodes {
@@ -58,14 +58,16 @@ pub fn pairs(nodes: &[BvhNode], first_triangle: u32, base: u32) -> Result<(Vec<B
         // The root is a leaf, or the tree is empty: one pair of the root and nothing.
         out.push(pair([node_bounds(&nodes[0]), Aabb::EMPTY], [reference(0)?, constants::NO_HIT]));
     }
-    Ok((out, base))
+    Ok(out)
 }
 
 /// One pair: the children's boxes on a grid over their union, with their references.
 fn pair(children: [Aabb; 2], refs: [u32; 2]) -> BvhPair {
-    let live: Vec<Aabb> =
-        children.iter().zip(refs).filter(|(_, r)| *r != constants::NO_HIT).map(|(b, _)| *b).collect();
-    let union = live.iter().fold(Aabb::EMPTY, |u, b| u.union(*b));
+    let union = children
+        .iter()
+        .zip(refs)
+        .filter(|(_, r)| *r != constants::NO_HIT)
+        .fold(Aabb::EMPTY, |u, (b, _)| u.union(*b));
     let origin = if union.is_empty() { Vec3::ZERO } else { union.lo };
     let mut exponents = [0u32; 3];
     let mut boxes = [0u32; 4];
@@ -149,11 +151,7 @@ mod tests {
 
     /// Boxes of every size and place, including tiny ones far from the origin and flat ones.
     fn boxes(n: usize) -> Vec<Aabb> {
-        let mut state = 7u32;
-        let mut next = move || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1 << 24) as f32
-        };
+        let mut next = super::super::aabb::test_random(7);
         (0..n)
             .map(|i| {
                 let scale = [1e-3, 1.0, 1e3][i % 3];
@@ -173,8 +171,8 @@ mod tests {
         for n in [1, 2, 3, 50, 2000] {
             let input = boxes(n);
             let tree = sah::build(&input, 4);
-            let (pairs, root) = pairs(&tree.nodes, 100, 10).unwrap();
-            assert_eq!(root, 10);
+            let pairs = pairs(&tree.nodes, 100, 10).unwrap();
+            let root = 10;
             // Walk the pairs from the root and the tree from its root together.
             let mut stack = vec![(root, 0usize)];
             let mut leaves = 0;
@@ -216,8 +214,8 @@ mod tests {
     #[test]
     fn an_empty_tree_has_one_pair_of_no_children() {
         let tree = sah::build(&[], 4);
-        let (pairs, root) = pairs(&tree.nodes, 0, 3).unwrap();
-        assert_eq!((pairs.len(), root), (1, 3));
+        let pairs = pairs(&tree.nodes, 0, 3).unwrap();
+        assert_eq!(pairs.len(), 1);
         assert_eq!(pairs[0].refs[..2], [constants::NO_HIT; 2]);
     }
 }

@@ -182,11 +182,7 @@ mod tests {
 
     /// A deterministic scatter of small boxes, some coincident, so that the median fallback runs.
     fn boxes(n: usize) -> Vec<Aabb> {
-        let mut state = 12345u32;
-        let mut next = move || {
-            state = state.wrapping_mul(1664525).wrapping_add(1013904223);
-            (state >> 8) as f32 / (1 << 24) as f32
-        };
+        let mut next = super::super::aabb::test_random(12345);
         (0..n)
             .map(|i| {
                 let c = if i % 7 == 0 { Vec3::ONE } else { Vec3::new(next(), next(), next()) * 10.0 };

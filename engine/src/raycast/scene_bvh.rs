@@ -95,9 +95,8 @@ impl SceneBvh {
                 let index = if count > 0 { first + index } else { root + index };
                 sah::node(node_bounds(n), index, count)
             }));
-            let (pairs, root_pair) =
-                pairs::pairs(&tree.nodes, first, to_u32(bvh.blas_pairs.len(), "BVH nodes")?)?;
-            bvh.blas_pairs.extend(pairs);
+            let root_pair = to_u32(bvh.blas_pairs.len(), "BVH nodes")?;
+            bvh.blas_pairs.extend(pairs::pairs(&tree.nodes, first, root_pair)?);
             for &i in &tree.order {
                 bvh.triangles.push(triangles[i as usize]);
                 bvh.attributes.push(attributes[i as usize]);
