@@ -1,7 +1,8 @@
 //! Opening the files a user names (scene files, meshes, maps, images, probe lists, caches): only
 //! regular files, and none larger than a limit for its kind, both checked before a byte is read,
 //! so that a path to `/dev/zero` cannot fill memory nor a FIFO hang the caller. Every file Kage
-//! and its command line read goes through [`open`] or [`read`].
+//! and its command line read goes through [`open`], [`read`] or
+//! [`read_prefix`].
 use std::fs::{File, FileType};
 use std::io::Read;
 use std::path::Path;
@@ -24,6 +25,10 @@ pub const OBJ: Limit = Limit { kind: "an OBJ mesh", bytes: 1 << 30 };
 /// ([`crate::image_size::MAX_IMAGE_PIXELS`]) stored uncompressed as 32-bit float RGB.
 pub const IMAGE: Limit = Limit { kind: "an image", bytes: 2 << 30 };
 
+/// glTF files (.gltf, .glb, whose binary chunk holds the meshes and textures) and the buffer
+/// files beside them: 2 GiB, as [`IMAGE`] (a buffer holds vertices or encoded images).
+pub const GLTF: Limit = Limit { kind: "a glTF file or buffer", bytes: 2 << 30 };
+
 /// Why a file was not read. The messages name no file: the caller's error does.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
@@ -38,6 +43,15 @@ pub enum ReadError {
 /// Opens `path` if it is a regular file (after following links) of at most `limit` bytes;
 /// returns the file and its length.
 pub fn open(path: &Path, limit: Limit) -> Result<(File, u64), ReadError> {
+    let (file, bytes) = open_regular(path)?;
+    if bytes > limit.bytes {
+        return Err(ReadError::TooLarge { bytes, limit });
+    }
+    Ok((file, bytes))
+}
+
+/// Opens `path` if it is a regular file (after following links); returns it and its length.
+fn open_regular(path: &Path) -> Result<(File, u64), ReadError> {
     // Checked before opening: opening a FIFO for reading blocks until a writer comes.
     let file_type = std::fs::metadata(path)?.file_type();
     if !file_type.is_file() {
@@ -45,10 +59,17 @@ pub fn open(path: &Path, limit: Limit) -> Result<(File, u64), ReadError> {
     }
     let file = File::open(path)?;
     let bytes = file.metadata()?.len();
-    if bytes > limit.bytes {
-        return Err(ReadError::TooLarge { bytes, limit });
-    }
     Ok((file, bytes))
+}
+
+/// The first `bytes` bytes of the regular file `path` (all of it where it is shorter): the
+/// part of a file its reader declares it needs (a glTF buffer's `byteLength`), however large
+/// the file is. The caller bounds `bytes`.
+pub fn read_prefix(path: &Path, bytes: u64) -> Result<Vec<u8>, ReadError> {
+    let (file, length) = open_regular(path)?;
+    let mut data = Vec::with_capacity(bytes.min(length) as usize);
+    file.take(bytes).read_to_end(&mut data)?;
+    Ok(data)
 }
 
 /// The whole of `path`, checked as [`open`] does.

@@ -319,5 +319,5 @@ fn bad_texturing_is_refused_naming_the_file_and_the_problem() {
     });
     assert!(infinite.contains("texture coordinate") && infinite.contains("NaN or infinite"), "{infinite}");
     let image = error_of("image", &|g| g["images"][0]["uri"] = "data:image/png;base64,AAAA".into());
-    assert!(image.contains("not a glTF 2.0 file Kage can read"), "{image}");
+    assert!(image.contains("its base colour image 0: not a PNG or JPEG image Kage can read"), "{image}");
 }

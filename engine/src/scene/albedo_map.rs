@@ -83,18 +83,7 @@ impl AlbedoMap {
     pub fn read(path: &Path) -> Result<AlbedoMap, SceneError> {
         let fail = |problem: String| SceneError::in_file(path, problem);
         let bytes = files::read(path, files::IMAGE).map_err(|e| fail(e.to_string()))?;
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-            .with_guessed_format()
-            .map_err(|e| fail(format!("cannot read: {e}")))?;
-        let mut limits = image::Limits::default();
-        (limits.max_image_width, limits.max_image_height) =
-            (Some(MAX_ALBEDO_MAP_SIDE), Some(MAX_ALBEDO_MAP_SIDE));
-        reader.limits(limits);
-        let image =
-            reader.decode().map_err(|e| fail(format!("not a PNG or JPEG image Kage can read: {e}")))?;
-        let rgba = image.to_rgba8();
-        let (width, height) = rgba.dimensions();
-        let texels = rgba.pixels().map(|p| p.0).collect();
+        let (width, height, texels) = decode(&bytes).map_err(fail)?;
         let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
         AlbedoMap::new(name, width, height, texels, [Wrap::Repeat; 2], Filter::SMOOTH)
             .map_err(|e| fail(e.problem().to_owned()))
@@ -114,6 +103,22 @@ impl AlbedoMap {
         .expect("encoding to memory fails only on a size the map's own checks refuse");
         bytes
     }
+}
+
+/// A PNG or JPEG file's bytes as 8-bit RGBA texels (16-bit channels rounded, grey spread to
+/// RGB), each side at most [`MAX_ALBEDO_MAP_SIDE`], checked in the header before decoding.
+pub fn decode(bytes: &[u8]) -> Result<(u32, u32, Vec<[u8; 4]>), String> {
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read: {e}"))?;
+    let mut limits = image::Limits::default();
+    (limits.max_image_width, limits.max_image_height) =
+        (Some(MAX_ALBEDO_MAP_SIDE), Some(MAX_ALBEDO_MAP_SIDE));
+    reader.limits(limits);
+    let image = reader.decode().map_err(|e| format!("not a PNG or JPEG image Kage can read: {e}"))?;
+    let rgba = image.to_rgba8();
+    let (width, height) = rgba.dimensions();
+    Ok((width, height, rgba.pixels().map(|p| p.0).collect()))
 }
 
 /// sRGB decoding of one 8-bit channel (the curve `imageio` decodes with).

@@ -54,3 +54,30 @@ impl fmt::Display for SceneError {
         }
     }
 }
+
+/// The longest name or text from an input that a message quotes whole, in characters.
+pub const CLIP_CHARS: usize = 200;
+
+/// `text` as a message quotes it: whole up to [`CLIP_CHARS`] characters, else its first
+/// [`CLIP_CHARS`] and how many more there are (a 100 MB name must not make a 100 MB message).
+pub fn clip(text: &str) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(CLIP_CHARS) {
+        None => text.into(),
+        Some((end, _)) => {
+            let more = text[end..].chars().count();
+            format!("{}… ({more} more characters)", &text[..end]).into()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_texts_are_clipped_with_a_count() {
+        assert_eq!(clip("short"), "short");
+        let long = "é".repeat(CLIP_CHARS + 5);
+        assert_eq!(clip(&long), format!("{}… (5 more characters)", "é".repeat(CLIP_CHARS)));
+    }
+}

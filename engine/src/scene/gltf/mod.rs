@@ -17,6 +17,7 @@
 //! a light's colour and cone, a motion's loop), Kage writes its own values in the node's or
 //! animation's `extras` (`{"kage": {...}}`); the reader takes them only where they agree with the
 //! glTF values, so a file edited in another tool is read from what that tool wrote.
+mod import;
 mod read;
 mod texture;
 mod write;

@@ -91,12 +91,7 @@ fn node_name(node: &gltf::Node) -> String {
 
 fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Result<Parts, SceneError> {
     let fail = |problem: String| SceneError::in_file(path, problem);
-    let (document, buffers, images) = gltf::import(path).map_err(|e| {
-        fail(match missing_file(path) {
-            Some(what) => format!("{what} cannot be read: {e}"),
-            None => format!("not a glTF 2.0 file Kage can read: {e}"),
-        })
-    })?;
+    let super::import::Import { document, buffers, images } = super::import::import(path).map_err(fail)?;
     let mut unused: Vec<String> = document
         .extensions_used()
         .filter(|e| !["KHR_lights_punctual", "KHR_texture_transform"].contains(e))
@@ -151,12 +146,20 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
             }
             let world = top_matrix * relative;
             if let Some(mesh) = node.mesh() {
+                if mesh.primitives().len() == 0 {
+                    // glTF requires one; dropping the node's geometry unsaid would hide it.
+                    return Err(fail(format!(
+                        "mesh {} (\"{}\"): it has no primitives",
+                        mesh.index(),
+                        crate::scene::clip(mesh.name().unwrap_or(""))
+                    )));
+                }
                 for (p, primitive) in mesh.primitives().enumerate() {
                     let at = |problem: String| {
                         fail(format!(
                             "mesh {} (\"{}\") primitive {p}: {problem}",
                             mesh.index(),
-                            mesh.name().unwrap_or("")
+                            crate::scene::clip(mesh.name().unwrap_or(""))
                         ))
                     };
                     meshes.push(
@@ -245,24 +248,6 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
     Ok(Parts { groups, lights, camera })
 }
 
-/// The first buffer or image of the file at `path` whose own file (a relative path beside it)
-/// is not there, named: what a failed import that reads no further is most likely about.
-fn missing_file(path: &Path) -> Option<String> {
-    let document = gltf::Gltf::open(path).ok()?.document;
-    let folder = path.parent().unwrap_or(Path::new(""));
-    let absent = |uri: &str| !uri.starts_with("data:") && !folder.join(uri).is_file();
-    let buffers = document.buffers().filter_map(|b| match b.source() {
-        gltf::buffer::Source::Uri(uri) => Some((format!("buffer {}", b.index()), uri)),
-        gltf::buffer::Source::Bin => None,
-    });
-    let images = document.images().filter_map(|i| match i.source() {
-        gltf::image::Source::Uri { uri, .. } => Some((format!("image {}", i.index()), uri)),
-        gltf::image::Source::View { .. } => None,
-    });
-    let (what, uri) = buffers.chain(images).find(|(_, uri)| absent(uri))?;
-    Some(format!("{what}'s file \"{uri}\""))
-}
-
 /// One triangle primitive as a mesh, its vertices placed by `relative` (within its group).
 fn primitive_mesh(
     primitive: &gltf::Primitive,
@@ -286,6 +271,21 @@ fn primitive_mesh(
                 "indices of component type {:?}: they must be unsigned integers",
                 indices.data_type()
             ));
+        }
+    }
+    // The crate reads POSITION and NORMAL as float triples whatever the accessor declares.
+    for semantic in [gltf::Semantic::Positions, gltf::Semantic::Normals] {
+        use gltf::accessor::{DataType, Dimensions};
+        if let Some(accessor) = primitive.get(&semantic) {
+            if (accessor.data_type(), accessor.dimensions()) != (DataType::F32, Dimensions::Vec3) {
+                return Err(format!(
+                    "its {} accessor {} holds {:?} of component type {:?}: glTF's are VEC3 of FLOAT (5126)",
+                    semantic.to_string(),
+                    accessor.index(),
+                    accessor.dimensions(),
+                    accessor.data_type()
+                ));
+            }
         }
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
@@ -319,7 +319,17 @@ fn primitive_mesh(
     }
     let material = primitive.material();
     let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
-    let albedo = [r, g, b].map(|c| c.clamp(0.0, 1.0));
+    // Albedo outside [0, 1] is an error, as in a scene file: a surface reflects no more than
+    // arrives, and clamping would hide a unit mistake.
+    if ![r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) {
+        let material = match (material.index(), material.name()) {
+            (Some(i), Some(name)) => format!("material {i} (\"{}\")", crate::scene::clip(name)),
+            (Some(i), None) => format!("material {i}"),
+            (None, _) => "the default material".into(),
+        };
+        return Err(format!("{material}: baseColorFactor {:?} is outside [0, 1]", [r, g, b]));
+    }
+    let albedo = [r, g, b];
     let texturing = albedo_maps.texturing(
         primitive,
         |set| reader.read_tex_coords(set).map(|c| c.into_f32().collect()),

@@ -1,8 +1,7 @@
-//! A glTF material's `baseColorTexture` as an albedo map: its image (decoded by the gltf crate,
-//! turned into 8-bit RGBA), its sampler's wrap and filter modes, its texture coordinate set and
+//! A glTF material's `baseColorTexture` as an albedo map: its image (PNG or JPEG, decoded into
+//! 8-bit RGBA as an OBJ's map is), its sampler's wrap and filter modes, its texture coordinate set and
 //! its `KHR_texture_transform` baked into the coordinates.
 use super::super::albedo_map::{AlbedoMap, Filter, Texturing, Wrap};
-use gltf::image::Format;
 use gltf::texture::{MagFilter, MinFilter, WrappingMode};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -10,12 +9,13 @@ use std::sync::Arc;
 /// The albedo maps read so far, by (image, sampler): primitives that share a texture share
 /// one map (and one GPU image).
 pub struct AlbedoMaps<'a> {
-    images: &'a [gltf::image::Data],
+    /// Each image's encoded bytes, decoded when a texture first uses it.
+    images: &'a [Vec<u8>],
     read: HashMap<(usize, Option<usize>), Arc<AlbedoMap>>,
 }
 
 impl<'a> AlbedoMaps<'a> {
-    pub fn new(images: &'a [gltf::image::Data]) -> AlbedoMaps<'a> {
+    pub fn new(images: &'a [Vec<u8>]) -> AlbedoMaps<'a> {
         AlbedoMaps { images, read: HashMap::new() }
     }
 
@@ -64,8 +64,8 @@ impl<'a> AlbedoMaps<'a> {
         let index = texture.source().index();
         let name = texture.source().name().map_or_else(|| format!("image {index}"), str::to_owned);
         let image = self.images.get(index).ok_or_else(|| format!("its base colour {name} is missing"))?;
-        let texels =
-            rgba8(image).ok_or_else(|| format!("its base colour {name} has format {:?}", image.format))?;
+        let (width, height, texels) =
+            super::super::albedo_map::decode(image).map_err(|e| format!("its base colour {name}: {e}"))?;
         let sampler = texture.sampler();
         let wrap = |mode| match mode {
             WrappingMode::Repeat => Wrap::Repeat,
@@ -84,60 +84,7 @@ impl<'a> AlbedoMaps<'a> {
                 _ => Some(true),
             },
         };
-        AlbedoMap::new(
-            name,
-            image.width,
-            image.height,
-            texels,
-            [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
-            filter,
-        )
-        .map_err(|e| e.to_string())
+        AlbedoMap::new(name, width, height, texels, [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())], filter)
+            .map_err(|e| e.to_string())
     }
-}
-
-/// The image's texels as 8-bit RGBA: grey and grey-alpha spread to RGB, 16-bit channels
-/// rounded to 8 bits, float channels (linear values, rare in a base colour) encoded as sRGB.
-fn rgba8(image: &gltf::image::Data) -> Option<Vec<[u8; 4]>> {
-    let (channels, bytes) = match image.format {
-        Format::R8 => (1, 1),
-        Format::R8G8 => (2, 1),
-        Format::R8G8B8 => (3, 1),
-        Format::R8G8B8A8 => (4, 1),
-        Format::R16 => (1, 2),
-        Format::R16G16 => (2, 2),
-        Format::R16G16B16 => (3, 2),
-        Format::R16G16B16A16 => (4, 2),
-        Format::R32G32B32FLOAT => (3, 4),
-        Format::R32G32B32A32FLOAT => (4, 4),
-    };
-    let value = |c: &[u8]| -> u8 {
-        match bytes {
-            1 => c[0],
-            2 => (f32::from(u16::from_le_bytes([c[0], c[1]])) / 257.0).round() as u8,
-            _ => {
-                let linear = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
-                (crate::imageio::srgb_oetf(linear.clamp(0.0, 1.0)) * 255.0).round() as u8
-            }
-        }
-    };
-    let texel = channels * bytes;
-    if image.pixels.len() != texel * image.width as usize * image.height as usize {
-        return None;
-    }
-    Some(
-        image
-            .pixels
-            .chunks_exact(texel)
-            .map(|t| {
-                let c: Vec<u8> = t.chunks_exact(bytes).map(value).collect();
-                match channels {
-                    1 => [c[0], c[0], c[0], 255],
-                    2 => [c[0], c[0], c[0], c[1]],
-                    3 => [c[0], c[1], c[2], 255],
-                    _ => [c[0], c[1], c[2], c[3]],
-                }
-            })
-            .collect(),
-    )
 }
