@@ -4,7 +4,7 @@
 //! and its command line read goes through [`open`], [`read`] or
 //! [`read_prefix`].
 use std::fs::{File, FileType};
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::Path;
 
 /// The largest file of one kind that Kage reads; `kind` names it in the error.
@@ -79,6 +79,31 @@ pub fn read(path: &Path, limit: Limit) -> Result<Vec<u8>, ReadError> {
     // `take`: a file that grows while it is read still stops at the limit.
     file.take(limit.bytes).read_to_end(&mut data)?;
     Ok(data)
+}
+
+/// Writes `bytes` to `path` so that every failure is reported and none leaves a partial file:
+/// where `path` is (or links to) a regular file, or nothing yet, the bytes go to a temporary
+/// file beside the final one, flushed to the disk and renamed over it (removed on failure);
+/// where it is (or links to) something else, a device, they are written to it directly with
+/// every write checked (`/dev/full` fails). A buffered writer dropped unflushed, as the image
+/// crate's `save_buffer` does, loses the error of its last write.
+pub fn write(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    // Through links: the file they name is replaced, not the link.
+    let target = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    if std::fs::metadata(&target).is_ok_and(|m| !m.is_file()) {
+        let mut file = std::fs::OpenOptions::new().write(true).open(&target)?;
+        file.write_all(bytes)?;
+        return file.flush();
+    }
+    let name = target.file_name().unwrap_or_default().to_string_lossy();
+    let temporary = target.with_file_name(format!(".{name}.{}.partial", std::process::id()));
+    let written = File::create(&temporary)
+        .and_then(|mut file| file.write_all(bytes).and_then(|()| file.sync_all()))
+        .and_then(|()| std::fs::rename(&temporary, &target));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&temporary);
+    }
+    written
 }
 
 /// `bytes` without a leading UTF-8 byte order mark, which some editors write at the start of a

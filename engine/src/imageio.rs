@@ -29,6 +29,8 @@ pub enum ImageIoError {
     // reason reaches the user whichever way the error is printed.
     #[error("{}: PNG failed: {error}", path.display())]
     Png { path: PathBuf, error: image::ImageError },
+    #[error("{}: cannot write: {error}", path.display())]
+    Write { path: PathBuf, error: std::io::Error },
     #[error("{}: OpenEXR failed: {error}", path.display())]
     Exr { path: PathBuf, error: exr::error::Error },
     #[error("{}: {error}", path.display())]
@@ -113,15 +115,23 @@ fn write_png(path: &Path, image: &RgbaF32Image, exposure: f32) -> Result<(), Ima
     }
     let bytes: Vec<u8> =
         image.pixels.iter().flat_map(|&[r, g, b, _]| tonemap_srgb8([r, g, b], exposure)).collect();
-    image::save_buffer_with_format(
-        path,
-        &bytes,
-        image.width,
-        image.height,
+    write_rgb8_png(path, &bytes, image.width, image.height)
+}
+
+/// Writes 8-bit sRGB triples as a PNG file: encoded in memory, then written by
+/// [`files::write`], so that a full disk or a device that refuses the bytes is an error and
+/// leaves no truncated file.
+pub fn write_rgb8_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), ImageIoError> {
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
+        rgb,
+        width,
+        height,
         image::ExtendedColorType::Rgb8,
-        image::ImageFormat::Png,
     )
-    .map_err(|error| ImageIoError::Png { path: path.to_owned(), error })
+    .map_err(|error| ImageIoError::Png { path: path.to_owned(), error })?;
+    files::write(path, &png).map_err(|error| ImageIoError::Write { path: path.to_owned(), error })
 }
 
 fn write_exr(path: &Path, image: &RgbaF32Image) -> Result<(), ImageIoError> {

@@ -1397,3 +1397,35 @@ fn bench_scale_writes_its_table_and_chart() {
     let png = image::open(dir.join("scale.png")).unwrap();
     assert!(png.width() > 1000, "{}x{}", png.width(), png.height());
 }
+
+/// A PNG that cannot be written is an error, not "wrote" and exit 0 over an empty file: before,
+/// the image crate's buffered writer dropped the error of its last write. `--out` and
+/// `--diff` as links to `/dev/full` fail naming the file and the cause; a PNG written to a
+/// regular file leaves no temporary file beside it.
+#[cfg(unix)]
+#[test]
+fn png_writes_that_fail_are_errors() {
+    use kage::imageio::RgbaF32Image;
+    let dir = scratch_dir("cli-png-full");
+    let full = dir.join("full.png");
+    std::os::unix::fs::symlink("/dev/full", &full).unwrap();
+    let full = full.to_str().unwrap();
+    let exr = dir.join("a.exr");
+    let pixels = vec![[0.5, 0.5, 0.5, 1.0]; 64];
+    kage::imageio::write(&exr, &RgbaF32Image { width: 8, height: 8, pixels }, 1.0).unwrap();
+    let exr = exr.to_str().unwrap();
+    let render = ["render", "--technique", "unshadowed", "--width", "16", "--height", "16", "--frames", "1"];
+    for args in [vec!["compare", exr, exr, "--diff", full], [&render[..], &["--out", full]].concat()] {
+        let out = kage(&args);
+        let message = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {message}");
+        assert!(!message.contains("wrote"), "{args:?}: {message}");
+        assert!(message.contains("full.png: cannot write") && message.contains("No space left"), "{message}");
+    }
+    let good = dir.join("diff.png");
+    let out = kage(&["compare", exr, exr, "--diff", good.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(left.len(), 3, "{left:?}");
+    assert!(image::open(&good).is_ok());
+}

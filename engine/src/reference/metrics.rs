@@ -250,15 +250,7 @@ pub fn shadow_mismatch_image(
 
 impl DiffImage {
     pub fn write_png(&self, path: &Path) -> Result<()> {
-        image::save_buffer_with_format(
-            path,
-            &self.rgb,
-            self.width,
-            self.height,
-            image::ExtendedColorType::Rgb8,
-            image::ImageFormat::Png,
-        )
-        .map_err(|e| Error::InvalidArgument(format!("{}: cannot write PNG: {e}", path.display())))
+        crate::imageio::write_rgb8_png(path, &self.rgb, self.width, self.height).map_err(Error::Image)
     }
 }
 
