@@ -16,6 +16,11 @@
 // cube map stacked top to bottom in one image (include/cube.glsl).
 #define KAGE_SH_MAPPING_EQUIRECT 0
 #define KAGE_SH_MAPPING_CUBE 1
+// Rows an equirectangular map's SH projection integrates over at least: a map of fewer rows
+// has each texel split into n x n sub-texels (n = ceil(this / rows)), each with its exact solid angle and its centre's direction. With
+// one sample per texel, a 2x1 map's single row put the whole sphere on the horizon (irradiance
+// 1.18 and 7.07 for pi); with 512 rows the midpoint rule's error, O((pi / rows)^2), is ~1e-5.
+#define KAGE_SH_MIN_ROWS 512
 
 // Storage buffers that bvh.glsl declares at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1; a shader
 // that includes it numbers its own bindings from here.

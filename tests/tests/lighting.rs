@@ -31,6 +31,23 @@ fn constant_map_projects_to_the_first_coefficient_only() {
     }
 }
 
+/// Maps of a few texels: the GPU projects each texel as cells (constants::SH_MIN_ROWS rows in
+/// all). Before, a 2×1 map of radiance 1 gave irradiance 1.18 at +Y and 7.07 at +X,
+/// a 4×2 map 4.12 and 2.65, against π. Tolerance: the sub-texels' midpoint rule errs by about
+/// 4e-5 and the f32 sums by a few 1e-6; 1e-3 relative leaves room for both.
+#[test]
+fn tiny_constant_maps_give_irradiance_pi_everywhere() {
+    let ctx = Validated::new();
+    for (w, h) in [(2u32, 1u32), (4, 2), (16, 8)] {
+        let map = EnvMap::from_pixels(w, h, vec![[1.0; 3]; (w * h) as usize]).unwrap();
+        let sh = sh_projection::project(&ctx, &map).unwrap();
+        for n in [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::new(0.6, 0.48, 0.64)] {
+            let e = sh.irradiance(n)[0];
+            assert!((e / PI - 1.0).abs() < 1e-3, "{w}x{h} at {n}: irradiance {e}, not π");
+        }
+    }
+}
+
 #[test]
 fn linear_map_projects_to_bands_0_and_1() {
     let ctx = Validated::new();

@@ -30,9 +30,14 @@ pub const SOURCE_WIDTH: u32 = 128;
 /// `L · (n · ∫ω dω)` to its irradiance, so only the bins the horizon cuts carry an error (and
 /// there the cosine is near 0). With the direction (sinθ sinφ, cosθ, −sinθ cosφ), the integral
 /// over a texel is a row factor (∫ sin²θ dθ, ∫ cosθ sinθ dθ) times a column factor.
+///
+/// A map of fewer than `SOURCE_WIDTH / 2` rows is gathered as if each texel were `s` × `s`
+/// sub-texels of its radiance, so that its bins are as small as a larger map's: a 2×1 map's
+/// two hemispheres as two bins give no light to a normal their boundary contains.
 fn bins(map: &EnvMap) -> Vec<[DVec3; 3]> {
     use std::f64::consts::PI;
-    let (w, h) = (map.width(), map.height());
+    let s = (SOURCE_WIDTH / 2).div_ceil(map.height());
+    let (w, h) = (map.width() * s, map.height() * s);
     let sin2 = |t: f64| t / 2.0 - (2.0 * t).sin() / 4.0;
     let rows: Vec<(f64, f64)> = (0..h)
         .map(|y| {
@@ -50,12 +55,14 @@ fn bins(map: &EnvMap) -> Vec<[DVec3; 3]> {
     let (bw, bh) = (w.min(SOURCE_WIDTH), h.min(SOURCE_WIDTH / 2));
     let mut sums = vec![[DVec3::ZERO; 3]; (bw * bh) as usize];
     for (t, p) in map.pixels().iter().enumerate() {
-        let (x, y) = (t as u32 % w, t as u32 / w);
-        let ((ss, cs), (sx, dphi, sz)) = (rows[y as usize], columns[x as usize]);
-        let moment = DVec3::new(ss * sx, cs * dphi, -ss * sz);
-        let bin = &mut sums[((y * bh / h) * bw + x * bw / w) as usize];
-        for c in 0..3 {
-            bin[c] += f64::from(p[c]) * moment;
+        let (texel_x, texel_y) = (t as u32 % map.width(), t as u32 / map.width());
+        for (x, y) in (0..s * s).map(|i| (texel_x * s + i % s, texel_y * s + i / s)) {
+            let ((ss, cs), (sx, dphi, sz)) = (rows[y as usize], columns[x as usize]);
+            let moment = DVec3::new(ss * sx, cs * dphi, -ss * sz);
+            let bin = &mut sums[((y * bh / h) * bw + x * bw / w) as usize];
+            for c in 0..3 {
+                bin[c] += f64::from(p[c]) * moment;
+            }
         }
     }
     sums
@@ -105,6 +112,18 @@ mod tests {
                 // Exact for the bins wholly above the horizon; those it cuts (5.6° texels of
                 // this small map) err where the cosine is near 0.
                 assert!((f64::from(*got) / want - 1.0).abs() < 1e-3, "{got} against {want}");
+            }
+        }
+    }
+
+    /// Maps of a few texels: each texel gathered as sub-texels. Before, a 2×1 map's two bins
+    /// left normals on their boundary unlit. Tolerance as above.
+    #[test]
+    fn tiny_constant_maps_give_pi_everywhere() {
+        for (w, h) in [(2, 1), (4, 2), (16, 8)] {
+            let map = EnvMap::from_pixels(w, h, vec![[1.0; 3]; (w * h) as usize]).unwrap();
+            for p in irradiance_table(&map) {
+                assert!((f64::from(p[0]) / PI - 1.0).abs() < 1e-3, "{w}x{h}: {} against π", p[0]);
             }
         }
     }

@@ -32,6 +32,14 @@ impl Mapping {
         }
     }
 
+    /// Cells per side of a texel that `sh_project.comp` integrates over (it computes the same).
+    fn subdivisions(self) -> u32 {
+        match self {
+            Mapping::Equirect { height, .. } => crate::sh::equirect_subdivisions(height),
+            Mapping::Cube { .. } => 1,
+        }
+    }
+
     fn id(self) -> u32 {
         match self {
             Mapping::Equirect { .. } => constants::SH_MAPPING_EQUIRECT,
@@ -70,7 +78,9 @@ impl ShProjection {
     pub fn new(ctx: &Arc<Context>, mapping: Mapping, names: ProjectionNames) -> Result<ShProjection> {
         let [width, height] = mapping.size();
         let texels_per_group = constants::SH_GROUP * constants::SH_TEXELS_PER_INVOCATION;
-        let groups = (width * height).div_ceil(texels_per_group);
+        // Below 512 rows, at most 2·(2·512)² cells: no overflow; above, one cell per texel.
+        let cells = width * height * mapping.subdivisions().pow(2);
+        let groups = cells.div_ceil(texels_per_group);
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         Ok(ShProjection {
             project: ComputePipeline::new(

@@ -259,23 +259,40 @@ pub fn project_equirect(width: u32, height: u32, pixels: &[[f32; 3]], bands: usi
     }
 
     let n = coeff_count(bands);
+    // Each texel as s × s sub-texels of its radiance (see `equirect_subdivisions`).
+    let s = equirect_subdivisions(height);
+    let (columns, rows) = (width * s, height * s);
     let mut coeffs = vec![[0.0f64; 3]; n];
     let mut basis = [0.0f64; 25];
     for (j, row) in pixels.chunks_exact(w).enumerate() {
-        let d_omega = equirect_texel_solid_angle(width, height, j as u32);
-        let v = (j as f64 + 0.5) / f64::from(height);
-        for (i, p) in row.iter().enumerate() {
-            let u = (i as f64 + 0.5) / f64::from(width);
-            eval_basis_f64(bands, equirect_direction(u, v), &mut basis);
-            for (c, y) in coeffs.iter_mut().zip(&basis[..n]) {
-                let wy = y * d_omega;
-                for ch in 0..3 {
-                    c[ch] += wy * f64::from(p[ch]);
+        for sub_row in j as u32 * s..(j as u32 + 1) * s {
+            let d_omega = equirect_texel_solid_angle(columns, rows, sub_row);
+            let v = (f64::from(sub_row) + 0.5) / f64::from(rows);
+            for (i, p) in row.iter().enumerate() {
+                for sub_column in i as u32 * s..(i as u32 + 1) * s {
+                    let u = (f64::from(sub_column) + 0.5) / f64::from(columns);
+                    eval_basis_f64(bands, equirect_direction(u, v), &mut basis);
+                    for (c, y) in coeffs.iter_mut().zip(&basis[..n]) {
+                        let wy = y * d_omega;
+                        for ch in 0..3 {
+                            c[ch] += wy * f64::from(p[ch]);
+                        }
+                    }
                 }
             }
         }
     }
     Ok(coeffs)
+}
+
+/// Sub-texels per side that an equirectangular map of `height` rows is projected with, as
+/// `sh_project.comp` does: enough for [`constants::SH_MIN_ROWS`] rows (1 from that height on),
+/// each sub-texel with its exact solid angle and its centre's direction. One sample per texel
+/// puts a 2×1 map's whole sphere on its horizon.
+///
+/// [`constants::SH_MIN_ROWS`]: crate::layouts::constants::SH_MIN_ROWS
+pub(crate) fn equirect_subdivisions(height: u32) -> u32 {
+    crate::layouts::constants::SH_MIN_ROWS.div_ceil(height.max(1))
 }
 
 #[cfg(test)]
@@ -493,6 +510,20 @@ mod tests {
         for d in test_dirs() {
             for e in sh.irradiance(d.as_vec3()) {
                 assert!((f64::from(e) - PI).abs() < 1e-4, "{d}: {e}");
+            }
+        }
+    }
+
+    /// Maps of a few texels, each texel projected as sub-texels: before, a 2×1 map gave 1.18 at
+    /// +Y and 7.07 at +X. The sub-texels' midpoint rule errs by O((π / 512)²) ≈ 4e-5 relative.
+    #[test]
+    fn tiny_constant_maps_give_irradiance_pi() {
+        for (w, h) in [(2, 1), (4, 2), (16, 8)] {
+            let coeffs = project_equirect(w, h, &map(w, h, |_| [1.0; 3]), 3).unwrap();
+            let sh = ShRgb9::from_f64(&coeffs).unwrap();
+            for d in test_dirs() {
+                let e = f64::from(sh.irradiance(d.as_vec3())[0]);
+                assert!((e / PI - 1.0).abs() < 1e-3, "{w}x{h} at {d}: {e}");
             }
         }
     }
