@@ -48,6 +48,10 @@ pub fn run(args: &PrecomputeArgs) -> Result<()> {
             println!("cache: wrote {}", path.display());
             report(&set, file_bytes, Some(&ctx.info().name));
         }
+        // Writing the cache is this command's purpose.
+        Origin::Unsaved { path, error } => {
+            anyhow::bail!("writing the cache file {}: {error}", path.display())
+        }
     }
     args.gpu.finish(&ctx)
 }

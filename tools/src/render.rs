@@ -221,6 +221,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 Origin::Computed { path, .. } => {
                     eprintln!("transfer: computed in {:.2} s, cached in {}", transfer.seconds, path.display())
                 }
+                Origin::Unsaved { path, error } => eprintln!(
+                    "kage: warning: transfer computed in {:.2} s but not cached, {} cannot be written: {error}",
+                    transfer.seconds,
+                    path.display()
+                ),
             }
             Some(std::sync::Arc::new(transfer))
         }

@@ -30,6 +30,9 @@ pub enum Origin {
     Cached(PathBuf),
     /// Computed on the GPU and written to this file, of this many bytes.
     Computed { path: PathBuf, file_bytes: u64 },
+    /// Computed on the GPU, but this file could not be written (a read-only folder, a file in
+    /// the folder's place): why, with its causes.
+    Unsaved { path: PathBuf, error: String },
 }
 
 impl PrtArgs {
@@ -39,7 +42,7 @@ impl PrtArgs {
 
     /// The transfer of `scene` with `params` (this struct's bands and rays, the visibility the
     /// technique needs): cached when valid (saying why not otherwise), else computed with a
-    /// progress bar and cached.
+    /// progress bar and cached (where the cache cannot be written, [`Origin::Unsaved`]).
     pub fn obtain(
         &self,
         ctx: &Arc<Context>,
@@ -68,7 +71,10 @@ impl PrtArgs {
             transfer::precompute(ctx, scene, params, progress)
         })
         .context("precomputing the transfer on the GPU")?;
-        let file_bytes = cache::save(&path, &set, &key)?;
-        Ok((set, Origin::Computed { path, file_bytes }))
+        // An unusable cache costs the next run the computation, not this one its result.
+        match cache::save(&path, &set, &key) {
+            Ok(file_bytes) => Ok((set, Origin::Computed { path, file_bytes })),
+            Err(e) => Ok((set, Origin::Unsaved { path, error: format!("{:#}", anyhow::Error::from(e)) })),
+        }
     }
 }

@@ -1429,3 +1429,24 @@ fn png_writes_that_fail_are_errors() {
     assert_eq!(left.len(), 3, "{left:?}");
     assert!(image::open(&good).is_ok());
 }
+
+/// An unusable cache folder (here a file in its place) no longer fails a render: the transfer
+/// is computed, used and not cached, with a warning naming the file and why. `kage
+/// precompute`, whose purpose is the cache file, still fails.
+#[test]
+fn render_degrades_without_a_usable_cache() {
+    let dir = scratch_dir("cli-cache-file");
+    let cache = dir.join("not-a-folder");
+    std::fs::write(&cache, b"a file").unwrap();
+    let cache = cache.to_str().unwrap();
+    let out = dir.join("out.exr");
+    let prt = ["--cache", cache, "--rays", "16", "--bands", "2"];
+    let render = ["render", "--technique", "sloan-self", "--width", "16", "--height", "16", "--frames", "1"];
+    let run = kage(&[&render[..], &prt, &["--out", out.to_str().unwrap()]].concat());
+    let message = text(&run);
+    assert!(run.status.success(), "{message}");
+    assert!(message.contains("warning: transfer computed") && message.contains("not-a-folder"), "{message}");
+    assert!(out.is_file());
+    let run = kage(&[&["precompute"][..], &prt].concat());
+    assert_eq!(run.status.code(), Some(1), "{}", text(&run));
+}
