@@ -77,6 +77,24 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     dir
 }
 
+/// The first fenced block of `lang` in README.md after the line `after` (a heading), without
+/// its fences: the tests that run README's commands and compile its example read them here, so
+/// README shows what the tests execute.
+pub fn readme_block(after: &str, lang: &str) -> String {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+        .expect("README.md");
+    let section =
+        readme.find(&format!("\n{after}\n")).unwrap_or_else(|| panic!("README has no line '{after}'"));
+    let fence = format!("```{lang}\n");
+    let start = section
+        + readme[section..]
+            .find(&fence)
+            .unwrap_or_else(|| panic!("README has no {lang} block after '{after}'"))
+        + fence.len();
+    let len = readme[start..].find("```").expect("the block's closing fence");
+    readme[start..start + len].to_string()
+}
+
 /// Every technique (each [`TechniqueKind`]) at its cheapest settings, with the PRT transfer it
 /// needs computed for `scene` (once per kind of visibility); the callers set the image size.
 pub fn every_technique(ctx: &Arc<Context>, scene: &Scene) -> Vec<(TechniqueKind, RenderOptions)> {

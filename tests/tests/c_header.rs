@@ -38,18 +38,14 @@ fn header_compiles_as_cpp() {
     assert!(output.status.success(), "kage.h as C++:\n{}", String::from_utf8_lossy(&output.stderr));
 }
 
-/// A host uses every enumeration value and every struct field by name (tests/c_host/names.c):
-/// it compiles as strict C11 and as C++17.
-/// README's C example, the first ```c block, compiles as C11 with every warning an error.
+/// README's C example, the first ```c block of its C ABI section, compiles as C11 with every
+/// warning an error (tests/tests/c_hosts.rs also links and runs it as README says).
 #[test]
 fn the_readme_c_example_compiles() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let readme = std::fs::read_to_string(repo.join("README.md")).unwrap();
-    let start = readme.find("```c\n").expect("README has a C example") + "```c\n".len();
-    let example = &readme[start..start + readme[start..].find("```").unwrap()];
     let dir = kage_tests::scratch_dir("readme-c");
     let source = dir.join("example.c");
-    std::fs::write(&source, example).unwrap();
+    std::fs::write(&source, kage_tests::readme_block("## C ABI", "c")).unwrap();
     let output = std::process::Command::new("cc")
         .args(["-std=c11", "-fsyntax-only", "-Wall", "-Wextra", "-Werror", "-pedantic", "-I"])
         .arg(repo.join("engine/include"))
@@ -59,6 +55,8 @@ fn the_readme_c_example_compiles() {
     assert!(output.status.success(), "README's C example:\n{}", String::from_utf8_lossy(&output.stderr));
 }
 
+/// A host uses every enumeration value and every struct field by name (tests/c_host/names.c):
+/// it compiles as strict C11 and as C++17.
 #[test]
 fn every_name_compiles_in_c_and_cpp() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");

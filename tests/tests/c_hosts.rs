@@ -115,6 +115,31 @@ fn c_hosts_run_with_validation() {
     assert!(out.contains("frame 9:") && out.ends_with("ok\n"), "{out}");
 }
 
+/// README's "Building a host": its commands run verbatim in a folder holding README's C
+/// example as host.c, with `KAGE` this repository; the host it links renders the teapot and
+/// prints its pass timings. Before scripts/install.sh made `libkage.so.1`, a host linked
+/// `-lkage` against the cargo output failed to start.
+#[test]
+fn readmes_link_and_run_commands_build_a_host_that_runs() {
+    let folder = kage_tests::scratch_dir("readme-host");
+    std::fs::write(folder.join("host.c"), kage_tests::readme_block("## C ABI", "c")).unwrap();
+    let commands = kage_tests::readme_block("### Building a host", "sh");
+    // The libraries this test's cargo build made: `<target>/release`.
+    let target = library("libkage.so").parent().and_then(Path::parent).expect("<target>").to_path_buf();
+    let output = Command::new("bash")
+        .args(["-euo", "pipefail", "-c", &commands])
+        .current_dir(&folder)
+        .env("KAGE", repo())
+        .env("CARGO_TARGET_DIR", &target)
+        .output()
+        .expect("bash");
+    let out = succeeded(&format!("README's commands:\n{commands}"), output);
+    let soname = folder.join("kage/lib").join(soname());
+    assert!(soname.is_file(), "{} was not installed:\n{out}", soname.display());
+    // The example prints one line per pass of the last frame, the Tamura passes among them.
+    assert!(out.contains("blur_horizontal ") && out.contains(" ms\n"), "{out}");
+}
+
 /// Threads and stale handles (tests/c_host/threads.c): one renderer called from four threads,
 /// a renderer per thread on one context, a destroy racing a render, destroyed handles reused:
 /// every call OK, BUSY or INVALID_HANDLE as the case is, validation on, no crash.
