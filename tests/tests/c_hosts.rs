@@ -163,11 +163,8 @@ fn c_hosts_are_clean_under_valgrind() {
             .args([
                 "--error-exitcode=99",
                 "--leak-check=full",
-                "--show-leak-kinds=definite",
-                "--errors-for-leak-kinds=definite",
-                // Keeps the symbols of the driver after the loader unloads it, so that the
-                // suppressions can name it in leak reports made at exit.
-                "--keep-debuginfo=yes",
+                "--show-leak-kinds=definite,possible",
+                "--errors-for-leak-kinds=definite,possible",
                 "--num-callers=40",
             ])
             .arg(format!("--suppressions={}", suppressions.display()))

@@ -62,6 +62,15 @@ fn scene_load(path: &str) -> (kage_result, String) {
     (result, String::from_utf8_lossy(&bytes).into_owned())
 }
 
+/// A name of any length is quoted clipped in the last error message: before, a
+/// 100,000-character scene name was copied whole into it.
+#[test]
+fn long_names_are_clipped_in_the_last_error_message() {
+    let (result, message) = scene_load(&"q".repeat(100_000));
+    assert_ne!(result, kage_result::Ok);
+    assert!(message.len() < 600 && message.contains("more characters)"), "{message}");
+}
+
 /// A 65536 × 32768 header in a file of a few hundred bytes: before the check, reading it
 /// allocated 24 GiB for the pixels and aborted. Every reader refuses it naming the file, the
 /// declared size and the limit; a header within the limit that the file cannot hold is refused
@@ -269,4 +278,49 @@ fn gltf_accessor_indices_past_the_end_are_refused_without_a_panic() {
     let message = Scene::load(&path).unwrap_err().to_string();
     assert!(!panicked.load(std::sync::atomic::Ordering::SeqCst), "the reader panicked: {message}");
     assert_says(&message, &["index.gltf", "mesh 0 primitive 0", "POSITION accessor 99 does not exist"]);
+}
+
+/// A large environment map costs its pixels once on the host and once in the image: before,
+/// the upload made an RGBA copy of the whole map and a staging buffer as large as the image
+/// beside it, so a valid 16384×8192 half EXR peaked at 7.9 GB resident (3.8 GB now, of which
+/// 2 GiB is the image, which lavapipe keeps in host memory). Measured in a process of its own
+/// (this test binary running the ignored test below), where no parallel test moves the peak.
+#[test]
+fn a_large_environment_map_peaks_at_its_pixels_and_its_image() {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let output = std::process::Command::new(exe)
+        .args(["--exact", "environment_map_peak_in_this_process", "--ignored", "--nocapture"])
+        .output()
+        .expect("the child test process");
+    let text =
+        String::from_utf8_lossy(&output.stdout).into_owned() + &String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success() && text.contains("1 passed"), "the measurement failed:\n{text}");
+}
+
+#[test]
+#[ignore = "run by a_large_environment_map_peaks_at_its_pixels_and_its_image in its own process"]
+fn environment_map_peak_in_this_process() {
+    let (width, height) = (4096u32, 2048u32);
+    let dir = scratch_dir("large-env");
+    let path = dir.join("large.exr");
+    let pixels =
+        (0..height).flat_map(|y| (0..width).map(move |x| [x as f32 / 4096.0, y as f32 / 2048.0, 0.5]));
+    EnvMap::from_pixels(width, height, pixels.collect()).unwrap().write_exr(&path).unwrap();
+    let ctx = kage_tests::Validated::new();
+    let before = peak_rss();
+    let map = EnvMap::load(&path).unwrap();
+    let image = kage::frame::environment::GpuEnvironment::new(&ctx, &map).unwrap();
+    let grown = peak_rss() - before;
+    // The map (12 bytes a texel), the RGBA32F image (16), the file (read whole while decoding),
+    // one staging band; 32 MiB for the decoder's blocks and the driver. The copies removed were
+    // 32 bytes a texel more (268 MiB here).
+    let texels = (width * height) as u64;
+    let file = std::fs::metadata(&path).unwrap().len();
+    let bound = 28 * texels + file + kage::backend::STAGING_BAND_BYTES + (32 << 20);
+    println!("peak grew by {} MiB (bound {} MiB)", grown >> 20, bound >> 20);
+    assert!(
+        grown <= bound,
+        "loading and uploading a {width}x{height} map raised the peak by {grown} bytes, over {bound}"
+    );
+    drop((image, map));
 }

@@ -195,7 +195,8 @@ fn main() {
         Command::Probes(command) => probes::run(&command),
     };
     if let Err(e) = result {
-        eprintln!("kage: error: {e:#}");
+        // Arguments and file contents quoted in the message are clipped to a readable length.
+        eprintln!("kage: error: {}", kage::scene::clip_message(&format!("{e:#}")));
         std::process::exit(1);
     }
 }

@@ -1450,3 +1450,44 @@ fn render_degrades_without_a_usable_cache() {
     let run = kage(&[&["precompute"][..], &prt].concat());
     assert_eq!(run.status.code(), Some(1), "{}", text(&run));
 }
+
+/// Inputs of any length are quoted clipped with a count: before, a 100,000-character scene
+/// name made a 100 KB message and a scene file's 1,000,000-character unknown key a 1 MB one.
+#[test]
+fn long_names_in_messages_are_clipped_with_a_count() {
+    let dir = scratch_dir("cli-long-names");
+    let long_key = dir.join("long-key.json");
+    std::fs::write(&long_key, format!(r#"{{"{}": 1}}"#, "k".repeat(1_000_000))).unwrap();
+    let cases = [("q".repeat(100_000), "(998"), (long_key.display().to_string(), "(999")];
+    for (scene, count) in cases {
+        let output = kage(&["render", "--scene", &scene, "--out", dir.join("x.png").to_str().unwrap()]);
+        let message = text(&output);
+        assert!(!output.status.success(), "{message}");
+        assert!(
+            message.len() < 2000 && message.contains(count),
+            "{} bytes: {}",
+            message.len(),
+            &message[..message.len().min(600)]
+        );
+    }
+    // A 300-character scene name never reaches a file name: the cache is named by a hash.
+    let named = dir.join("named.json");
+    let ball = r#"{"name": "ball", "meshes": [{"sphere": {"radius": 1, "segments": 8}, "albedo": [0.5, 0.5, 0.5]}]}"#;
+    let json = format!(
+        r#"{{"name": "{}", "camera": {{"position": [0, 2, 6], "target": [0, 0, 0], "fov_y_deg": 40}},
+            "environment": {{"constant": [1, 1, 1]}}, "groups": [{ball}]}}"#,
+        "n".repeat(300)
+    );
+    std::fs::write(&named, json).unwrap();
+    let cache = dir.join("cache");
+    let output = kage(&[
+        "precompute",
+        "--scene",
+        named.to_str().unwrap(),
+        "--rays",
+        "16",
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", text(&output));
+}

@@ -101,6 +101,20 @@ impl Buffer {
         self.allocation.as_ref()?.mapped_slice().map(|s| &s[..self.size as usize])
     }
 
+    /// The first `len` bytes of a host-visible buffer, to be written in place.
+    pub(crate) fn mapped_mut(&mut self, len: u64) -> Result<&mut [u8]> {
+        let (name, size) = (&self.name, self.size);
+        if len > size {
+            return Err(Error::Internal(format!("{len} bytes of buffer {name} ({size} bytes)")));
+        }
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| Error::Internal(format!("buffer {name} is not host-visible")))?;
+        Ok(&mut slice[..len as usize])
+    }
+
     /// Writes into a host-visible buffer at `offset`.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
         let end = offset.checked_add(data.len() as u64).filter(|&e| e <= self.size).ok_or_else(|| {
@@ -111,13 +125,7 @@ impl Buffer {
                 self.size
             ))
         })?;
-        let name = &self.name;
-        let slice = self
-            .allocation
-            .as_mut()
-            .and_then(|a| a.mapped_slice_mut())
-            .ok_or_else(|| Error::Internal(format!("buffer {name} is not host-visible")))?;
-        slice[offset as usize..end as usize].copy_from_slice(data);
+        self.mapped_mut(end)?[offset as usize..].copy_from_slice(data);
         Ok(())
     }
 

@@ -1,7 +1,7 @@
 //! Images and samplers. Layout policy: every image is moved to `GENERAL` when it is created and
 //! stays there between commands (see `pass` for why), so passes never track layouts. Copies
-//! alone step into the transfer layout drivers prefer and back, inside `record_copy_to` and
-//! `upload`.
+//! alone step into the transfer layout drivers prefer and back, inside `record_copy_to`,
+//! `upload` and `upload_rows`.
 use super::buffer::allocation_error;
 use super::{Buffer, BufferDesc, Context};
 use crate::error::{Error, Result};
@@ -9,6 +9,9 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
+
+/// The most bytes [`Image::upload_rows`] stages at once.
+pub const STAGING_BAND_BYTES: u64 = 64 << 20;
 
 pub struct ImageDesc<'a> {
     pub name: &'a str,
@@ -386,6 +389,53 @@ impl Image {
             unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &regions) }
             self.transition(cmd, dst, vk::ImageLayout::GENERAL);
         })
+    }
+
+    /// Fills a one-level, one-layer image band by band through one staging buffer of at most
+    /// [`STAGING_BAND_BYTES`]: `fill(first_row, texels)` writes the tightly packed texels of
+    /// the rows from `first_row` on. A large image (a 16k environment map is 2 GiB as RGBA32F)
+    /// then never has a second copy of itself on the host.
+    pub fn upload_rows(&self, mut fill: impl FnMut(u32, &mut [u8])) -> Result<()> {
+        if self.levels != 1 || self.layers != 1 {
+            return Err(Error::Internal(format!(
+                "upload_rows into image {} of several levels or layers",
+                self.name
+            )));
+        }
+        let row_bytes = self.byte_size()? / self.height as u64;
+        let band_rows = (STAGING_BAND_BYTES / row_bytes.max(1)).clamp(1, self.height as u64) as u32;
+        let mut staging = Buffer::new(
+            &self.ctx,
+            &BufferDesc {
+                name: &format!("{}.staging", self.name),
+                size: row_bytes * band_rows as u64,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        for first in (0..self.height).step_by(band_rows as usize) {
+            let rows = band_rows.min(self.height - first);
+            fill(first, staging.mapped_mut(row_bytes * rows as u64)?);
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: aspect_of(self.format),
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_offset(vk::Offset3D { x: 0, y: first as i32, z: 0 })
+                .image_extent(vk::Extent3D { width: self.width, height: rows, depth: 1 });
+            self.ctx.one_shot(&format!("{}.upload rows {first}..{}", self.name, first + rows), |cmd| {
+                let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
+                self.transition(cmd, vk::ImageLayout::GENERAL, dst);
+                // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
+                unsafe {
+                    self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region])
+                }
+                self.transition(cmd, dst, vk::ImageLayout::GENERAL);
+            })?;
+        }
+        Ok(())
     }
 
     /// Reads the whole image back (waits for the GPU).

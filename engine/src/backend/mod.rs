@@ -19,7 +19,7 @@ pub use commands::CommandRecorder;
 pub use context::{Calibration, Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
 pub use device::{CALIBRATED_TIMESTAMPS, FRAGMENT_STORES, GEOMETRY_SHADER};
-pub use image::{Edge, Image, ImageDesc, Sampler, SamplerDesc};
+pub use image::{Edge, Image, ImageDesc, Sampler, SamplerDesc, STAGING_BAND_BYTES};
 pub use pipeline::{
     ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
 };

@@ -99,8 +99,10 @@ thread_local! {
 }
 
 fn set_last_error(message: &str) {
-    // An interior NUL would cut the C string short: show it as a space instead.
-    LAST_ERROR.with(|last| *last.borrow_mut() = message.replace('\0', " "));
+    // An interior NUL would cut the C string short: show it as a space instead. A name of any
+    // length the host passed is quoted clipped.
+    let message = crate::scene::clip_message(message).replace('\0', " ");
+    LAST_ERROR.with(|last| *last.borrow_mut() = message);
 }
 
 /// Runs an export's body: its error becomes the code and the thread's last message, and a

@@ -37,9 +37,15 @@ impl GpuEnvironment {
                 usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
             },
         )?;
-        let texels: Vec<u8> =
-            pixels.iter().flat_map(|p| [p[0], p[1], p[2], 0.0]).flat_map(f32::to_ne_bytes).collect();
-        image.upload(&texels)?;
+        // Row by row: the RGBA copy of a large map never exists whole on the host.
+        image.upload_rows(|first_row, texels| {
+            let start = first_row as usize * width as usize;
+            for (texel, p) in texels.chunks_exact_mut(16).zip(&pixels[start..]) {
+                for (bytes, v) in texel.chunks_exact_mut(4).zip([p[0], p[1], p[2], 0.0]) {
+                    bytes.copy_from_slice(&v.to_ne_bytes());
+                }
+            }
+        })?;
         let sampler = Sampler::new(ctx, &format!("{name}.sampler"), true, Edge::Repeat, Edge::Clamp)?;
         Ok(GpuEnvironment { image, sampler })
     }

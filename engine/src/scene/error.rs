@@ -70,9 +70,38 @@ pub fn clip(text: &str) -> std::borrow::Cow<'_, str> {
     }
 }
 
+/// A whole message as the command line and the C ABI show it: every run of non-blank
+/// characters clipped as [`clip`] clips a text. Names and values quoted by code that never
+/// clipped them (a parser's "unknown field `…`", a path from an argument) stay bounded too.
+pub fn clip_message(message: &str) -> std::borrow::Cow<'_, str> {
+    // No run can be longer than the whole; bytes bound characters.
+    if message.len() <= CLIP_CHARS {
+        return message.into();
+    }
+    let mut clipped = String::new();
+    for piece in message.split_inclusive(char::is_whitespace) {
+        let word = piece.trim_end_matches(char::is_whitespace);
+        clipped.push_str(&clip(word));
+        clipped.push_str(&piece[word.len()..]);
+    }
+    clipped.into()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_words_of_a_message_are_clipped_and_the_rest_kept() {
+        let long = "x".repeat(CLIP_CHARS + 7);
+        let message = format!("unknown field `{long}`, expected one of `name`\n  at line 1");
+        let expected = format!(
+            "unknown field `{}… (10 more characters) expected one of `name`\n  at line 1",
+            "x".repeat(CLIP_CHARS - 1)
+        );
+        assert_eq!(clip_message(&message), expected);
+        assert_eq!(clip_message("short message"), "short message");
+    }
 
     #[test]
     fn long_texts_are_clipped_with_a_count() {

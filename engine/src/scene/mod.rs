@@ -48,7 +48,7 @@ pub use albedo_map::{AlbedoMap, Texturing};
 pub use builtin::BUILTIN;
 pub use camera::{Camera, FAR, NEAR};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
-pub use error::{clip, SceneError, CLIP_CHARS};
+pub use error::{clip, clip_message, SceneError, CLIP_CHARS};
 pub use export::{SceneFormat, ENVIRONMENT_FILE, GLTF_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
 pub use load::LONE_OBJ_ALBEDO;
