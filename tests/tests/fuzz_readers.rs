@@ -1,4 +1,5 @@
-//! A bounded mutation fuzzer over the readers of what users hand Kage: scene JSON, glTF, OBJ, EXR
+//! A bounded mutation fuzzer over the readers of what users hand Kage: scene JSON, glTF (JSON and
+//! GLB), OBJ, EXR
 //! and HDR maps, probe position files, and probe positions (tetrahedralized). Each starts from its committed seed
 //! (tests/fuzz/seeds/), which must read cleanly, and reads `KAGE_FUZZ_ITERATIONS` (default 2,000)
 //! mutants of it: bytes flipped, inserted, deleted, repeated, and numbers replaced by extreme
@@ -185,14 +186,34 @@ fn probe_files() {
     });
 }
 
+/// glTF as JSON (a .gltf with the buffers and images it names beside it) and as GLB (one binary
+/// file: its chunk headers, JSON and embedded buffer and images): textures and samplers, node
+/// animation, cameras, and a Blender export with a spot light. Each seed is copied with its
+/// folder's files into a scratch folder, where its mutants are read.
 #[test]
 fn gltf_files() {
-    let seed = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/gltf/two-groups.gltf")).unwrap();
-    let path = scratch().join("mutant.gltf");
-    std::fs::write(&path, &seed).unwrap();
-    Scene::load(&path).expect("the seed glTF loads");
-    fuzz("two-groups.gltf", &seed, 8, |bytes| {
-        std::fs::write(&path, bytes).unwrap();
-        let _ = Scene::load(&path);
-    });
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/gltf");
+    let seeds = [
+        "two-groups.gltf",
+        "khronos-box-textured/BoxTextured.gltf",
+        "khronos-box-animated/BoxAnimated.gltf",
+        "blender-suzanne/scene.glb",
+    ];
+    for (stream, name) in (8..).zip(seeds) {
+        let source = assets.join(name);
+        let dir = scratch();
+        for entry in std::fs::read_dir(source.parent().unwrap()).unwrap() {
+            let entry = entry.unwrap().path();
+            if entry.is_file() {
+                std::fs::copy(&entry, dir.join(entry.file_name().unwrap())).unwrap();
+            }
+        }
+        let path = dir.join(source.file_name().unwrap());
+        Scene::load(&path).unwrap_or_else(|e| panic!("the seed {name} loads: {e}"));
+        let seed = std::fs::read(&path).unwrap();
+        fuzz(name, &seed, stream, |bytes| {
+            std::fs::write(&path, bytes).unwrap();
+            let _ = Scene::load(&path);
+        });
+    }
 }
