@@ -4,7 +4,9 @@
 // either). Environment mode adds `frame.w` Monte Carlo samples of the reflected radiance
 // albedo / pi * E (see reference.glsl) to each pixel's statistics; a ray that misses shows the
 // environment bilinearly filtered, as the raster background does. Local mode is deterministic:
-// point and spot lights with hard shadows, one shadow ray each, black background.
+// point and spot lights with hard shadows, one shadow ray each, black background; it also
+// records the lowest and highest luminance the pixel takes when its primary ray moves by the
+// rasterizer's sub-pixel precision along x or y (edge ties, see metrics.rs).
 #include "constants.glsl"
 #include "layouts.glsl"
 #include "bvh.glsl"
@@ -26,29 +28,49 @@ vec3 local_lighting(SurfacePoint s) {
     return s.albedo / REFERENCE_PI * sum;
 }
 
+// The primary ray through `at` (in pixels from the image's top-left corner).
+vec3 primary_dir(vec2 at) {
+    // Row 0 at the top is NDC y = -1, as in the rasterizer's framebuffer.
+    vec2 ndc = at / vec2(p.frame.xy) * 2.0 - 1.0;
+    vec4 far = p.inv_view_proj * vec4(ndc, 0.5, 1.0);
+    return normalize(far.xyz / far.w - p.camera_pos.xyz);
+}
+
+// Local lighting seen along a primary ray: black where it misses.
+vec3 local_radiance(vec3 dir) {
+    RayHit hit = bvh_closest_hit(p.camera_pos.xyz, dir, REFERENCE_FAR);
+    return hit.instance == KAGE_NO_HIT ? vec3(0.0) : local_lighting(bvh_surface(hit, dir));
+}
+
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;
     uint width = p.frame.x, height = p.frame.y;
     if (pixel.x >= width || pixel.y >= height) return;
     uint index = pixel.y * width + pixel.x;
-    // Row 0 at the top is NDC y = -1, as in the rasterizer's framebuffer.
-    vec2 ndc = (vec2(pixel) + 0.5) / vec2(width, height) * 2.0 - 1.0;
-    vec4 far = p.inv_view_proj * vec4(ndc, 0.5, 1.0);
+    vec2 centre = vec2(pixel) + 0.5;
     vec3 origin = p.camera_pos.xyz;
-    vec3 dir = normalize(far.xyz / far.w - origin);
-    bool local = p.params.x == 1u;
+    vec3 dir = primary_dir(centre);
     uint before = p.frame.z, count = p.frame.w;
 
-    RayHit hit = bvh_closest_hit(origin, dir, REFERENCE_FAR);
-    if (hit.instance == KAGE_NO_HIT || local) {
-        // Deterministic: every sample would be the same value.
-        vec3 value = vec3(0.0);
-        if (hit.instance != KAGE_NO_HIT) {
-            value = local_lighting(bvh_surface(hit, dir));
-        } else if (!local) {
-            value = textureLod(env, env_dir_to_uv(dir), 0.0).rgb;
+    if (p.params.x == 1u) {
+        // Deterministic: one sample is the value. The rasterizer places vertices to
+        // 1 / 2^params.w px, so the pixel is also seen from that far to each side.
+        vec3 value = local_radiance(dir);
+        float step = 1.0 / float(1u << p.params.w);
+        float lowest = luminance(value), highest = lowest;
+        for (uint k = 0u; k < 4u; ++k) {
+            vec2 offset = vec2[4](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1))[k] * step;
+            float l = luminance(local_radiance(primary_dir(centre + offset)));
+            lowest = min(lowest, l);
+            highest = max(highest, l);
         }
-        accum[index] = ReferenceAccum(vec4(value, 0.0), vec4(0.0));
+        accum[index] = ReferenceAccum(vec4(value, lowest), vec4(0.0, 0.0, 0.0, highest));
+        return;
+    }
+    RayHit hit = bvh_closest_hit(origin, dir, REFERENCE_FAR);
+    if (hit.instance == KAGE_NO_HIT) {
+        // Deterministic: every sample would be the same value.
+        accum[index] = ReferenceAccum(vec4(textureLod(env, env_dir_to_uv(dir), 0.0).rgb, 0.0), vec4(0.0));
         return;
     }
 

@@ -74,7 +74,7 @@ mod tests {
             ..Default::default()
         };
         let bytes = bytes_of(&frame);
-        assert_eq!(bytes.len(), 160);
+        assert_eq!(bytes.len(), 176);
         assert_eq!(floats(&bytes[128..144]), [1.0, 2.0, 3.0, 0.0]);
         assert_eq!(floats(&bytes[144..160]), [4.0, 0.5, 0.0, 0.0]);
         assert!(floats(&bytes[..128]).iter().all(|&x| x == 0.0));

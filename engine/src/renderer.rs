@@ -172,6 +172,7 @@ impl Renderer {
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             camera_pos: self.camera.position.extend(1.0).to_array(),
             env_params: [1.0, self.env_rotation, 0.0, 0.0],
+            viewport: [width as f32, height as f32, 0.0, 0.0],
         };
         self.frame_uniforms.write(0, bytes_of(&uniforms))?;
 

@@ -15,6 +15,7 @@ struct FrameUniforms {
     mat4 inv_view_proj;
     vec4 camera_pos; // xyz: world-space camera position, w: unused
     vec4 env_params; // x: intensity, y: rotation in radians, z, w: unused
+    vec4 viewport; // xy: the target's size in pixels, zw: unused
 };
 
 // Per-draw data (push constants).
@@ -118,8 +119,8 @@ struct CastPush {
 // of its samples (Welford), merged batch by batch with Chan et al.'s formula, which stays
 // accurate where a raw sum of squares would cancel.
 struct ReferenceAccum {
-    vec4 mean; // rgb: mean of the samples so far, w: unused
-    vec4 m2; // rgb: sum of squared deviations from the mean, w: unused
+    vec4 mean; // rgb: mean of the samples so far, w: local mode: the lowest luminance at the edge-tie offsets
+    vec4 m2; // rgb: sum of squared deviations from the mean, w: local mode: the highest one
 };
 
 // A point or spot light as the reference's --light local mode reads it.
@@ -134,7 +135,7 @@ struct ReferencePush {
     mat4 inv_view_proj;
     vec4 camera_pos; // xyz: camera position, w: the environment's sum of luminance x solid angle (0: no environment sampling)
     uvec4 frame; // x: width, y: height, z: samples accumulated before this batch, w: samples in this batch
-    uvec4 params; // x: 0 environment light, 1 local lights, y: light count, z: seed, w: unused
+    uvec4 params; // x: 0 environment light, 1 local lights, y: light count, z: seed, w: the rasterizer's sub-pixel precision bits
 };
 
 // A point of the reference's irradiance mode.

@@ -46,7 +46,7 @@ fn mismatches(r: &mut Renderer, truth: &RgbaF32Image, frames: usize) -> Vec<kage
     (0..frames)
         .map(|_| {
             r.render().unwrap();
-            shadow_mismatch(&r.image().unwrap(), truth, SHADOW_THRESHOLD).unwrap()
+            shadow_mismatch(&r.image().unwrap(), truth, SHADOW_THRESHOLD, None).unwrap()
         })
         .collect()
 }

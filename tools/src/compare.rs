@@ -2,7 +2,9 @@
 //! JSON, with thresholds that set the exit status (for CI).
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
-use kage::reference::{compare, diff_image, shadow_mismatch, shadow_mismatch_image, SHADOW_THRESHOLD};
+use kage::reference::{
+    compare, diff_image, shadow_mismatch, shadow_mismatch_image, EdgeTies, SHADOW_THRESHOLD,
+};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -27,6 +29,11 @@ pub struct CompareArgs {
     /// brightest pixel.
     #[arg(long, default_value_t = SHADOW_THRESHOLD)]
     shadow_threshold: f64,
+    /// With --shadow-mismatch and --mismatch-image: B's edge ties (`kage reference --light
+    /// local --edges`): pixels where an edge passes closer to the centre than the rasterizer
+    /// places geometry are counted apart (yellow in the mismatch image), not as mismatches.
+    #[arg(long)]
+    edges: Option<PathBuf>,
     /// Print the metrics as one JSON object on stdout instead of text.
     #[arg(long)]
     json: bool,
@@ -65,10 +72,17 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     let a = kage::imageio::read_exr(&args.a)?;
     let b = kage::imageio::read_exr(&args.b)?;
+    let edges = match &args.edges {
+        Some(path) => Some(
+            EdgeTies::from_image(&kage::imageio::read_exr(path)?)
+                .with_context(|| format!("in {}", path.display()))?,
+        ),
+        None => None,
+    };
     let m = compare(&a, &b)
         .with_context(|| format!("comparing {} with {}", args.a.display(), args.b.display()))?;
     let mismatch = match args.shadow_mismatch || args.max_mismatch.is_some() {
-        true => Some(shadow_mismatch(&a, &b, args.shadow_threshold)?),
+        true => Some(shadow_mismatch(&a, &b, args.shadow_threshold, edges.as_ref())?),
         false => None,
     };
     let mut beyond = Vec::new();
@@ -96,6 +110,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 "fraction": s.fraction,
                 "differing_pixels": s.differing,
                 "lit_in_a_only": s.lit_in_render_only,
+                "edge_ties": edges.as_ref().map(|_| s.at_edges),
                 "lit_above": s.threshold,
             })),
             "max_rel_rmse": args.max_rel_rmse,
@@ -122,15 +137,23 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 "shadow mismatch  {:.6e}   ({} pixels lit in one image only, {} of them lit in A only; lit above {:.3e} = {relative} x B's brightest)",
                 s.fraction, s.differing, s.lit_in_render_only, s.threshold
             );
+            match &edges {
+                Some(edges) => println!(
+                    "edge ties        {} more pixels lit in one image only lie within 1/{} px of an edge (not counted)",
+                    s.at_edges,
+                    1u32 << edges.bits
+                ),
+                None => println!("edge ties        counted above (no --edges)"),
+            }
         }
     }
     // With --json, stdout holds the JSON alone.
     let note = |line: String| if args.json { eprintln!("{line}") } else { println!("{line}") };
     if let Some(path) = &args.mismatch_image {
-        let mismatch = shadow_mismatch_image(&a, &b, args.shadow_threshold)?;
+        let mismatch = shadow_mismatch_image(&a, &b, args.shadow_threshold, edges.as_ref())?;
         mismatch.write_png(path)?;
         note(format!(
-            "wrote {}: red lit in A only, blue lit in B only (lit above {:.3e})",
+            "wrote {}: red lit in A only, blue lit in B only, yellow either on an edge tie (lit above {:.3e})",
             path.display(),
             mismatch.scale
         ));

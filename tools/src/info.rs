@@ -12,6 +12,11 @@ pub fn run(args: &GpuArgs) -> Result<()> {
         Some(period) => println!("timestamps:     {period} ns per tick"),
         None => println!("timestamps:     not available (pass timings will be missing)"),
     }
+    let bits = info.sub_pixel_precision_bits;
+    println!(
+        "sub-pixel:      {bits} bits (vertices placed to 1/{} px; the edge ties of `kage compare --edges`)",
+        1u64 << bits
+    );
     println!("features Kage uses:");
     for (name, present) in &info.features {
         println!("  [{}] {name}", if *present { "x" } else { " " });

@@ -33,6 +33,12 @@ pub struct ReferenceArgs {
     /// sample per pixel is exact and --spp is not used).
     #[arg(long, value_enum, default_value_t = LightArg::Env)]
     light: LightArg,
+    /// With --light local: also write the edge ties (.exr) for `kage compare --edges`: per
+    /// pixel the lowest (R) and highest (G) luminance with the primary ray moved by the
+    /// device's sub-pixel precision (B, in bits) to each side, where a raster render cannot
+    /// be told right from wrong.
+    #[arg(long)]
+    edges: Option<PathBuf>,
     /// Stop after this many seconds (at a batch boundary) even if --spp is not reached.
     #[arg(long)]
     time_budget: Option<f64>,
@@ -119,6 +125,12 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     // Irradiance results are written as .json, images as .png or .exr.
     let extensions: &[&str] = if args.irradiance.is_some() { &["json"] } else { &["png", "exr"] };
     crate::outputs::check(&args.out, "--out", extensions)?;
+    if let Some(edges) = &args.edges {
+        if args.light != LightArg::Local || args.irradiance.is_some() {
+            bail!("--edges comes with --light local (the edge ties of a local-light image)");
+        }
+        crate::outputs::check(edges, "--edges", &["exr"])?;
+    }
     // Bad input files fail before the GPU is set up.
     let points = args.irradiance.as_deref().map(read_points).transpose()?;
     let scene = args.scene.load()?;
@@ -164,6 +176,11 @@ fn run_image(
     };
     let image = renderer.to_image(&statistics);
     kage::imageio::write(&args.out, &image, exposure.for_image(&image))?;
+    if let Some(path) = &args.edges {
+        let edges = renderer.edge_ties()?;
+        kage::imageio::write(path, &edges.to_image(), 1.0)?;
+        println!("wrote {} (edge ties at 1/{} px)", path.display(), 1u32 << edges.bits);
+    }
     println!(
         "wrote {} ({}x{}, scene {}, {} light, {} spp, {:.1} s, {})",
         args.out.display(),

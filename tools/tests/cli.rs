@@ -142,7 +142,7 @@ fn sh_prints_coefficients_and_irradiance() {
 #[test]
 fn shadowmap_against_the_local_reference_reports_the_mismatch() {
     let dir = scratch_dir("cli-shadowmap");
-    let (map, truth) = (dir.join("sm.exr"), dir.join("ref.exr"));
+    let (map, truth, ties) = (dir.join("sm.exr"), dir.join("ref.exr"), dir.join("ties.exr"));
     let size = ["--scene", "asm", "--width", "48", "--height", "48", "--validate"];
     let out = kage(
         &[
@@ -154,15 +154,36 @@ fn shadowmap_against_the_local_reference_reports_the_mismatch() {
     );
     assert!(out.status.success(), "{}", text(&out));
     let out = kage(
-        &[&["reference", "--light", "local", "--spp", "1"], &size[..], &["--out", truth.to_str().unwrap()]]
-            .concat(),
+        &[
+            &["reference", "--light", "local", "--spp", "1"],
+            &size[..],
+            &["--out", truth.to_str().unwrap(), "--edges", ties.to_str().unwrap()],
+        ]
+        .concat(),
     );
-    assert!(out.status.success(), "{}", text(&out));
-    let out = kage(&["compare", map.to_str().unwrap(), truth.to_str().unwrap(), "--shadow-mismatch"]);
-    let all = text(&out);
-    let line = all.lines().find(|l| l.starts_with("shadow mismatch")).unwrap_or_else(|| panic!("{all}"));
-    let fraction: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
-    assert!((0.0..0.05).contains(&fraction), "{line}");
+    assert!(out.status.success() && text(&out).contains("edge ties at 1/"), "{}", text(&out));
+    let compare = |edges: &[&str]| {
+        let out = kage(
+            &[&["compare", map.to_str().unwrap(), truth.to_str().unwrap(), "--shadow-mismatch"], edges]
+                .concat(),
+        );
+        let all = text(&out);
+        let line = all.lines().find(|l| l.starts_with("shadow mismatch")).unwrap_or_else(|| panic!("{all}"));
+        let differing: usize =
+            line.split('(').nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+        let fraction: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
+        assert!((0.0..0.05).contains(&fraction), "{line}");
+        let ties =
+            all.lines().find(|l| l.starts_with("edge ties")).unwrap_or_else(|| panic!("{all}")).to_string();
+        (differing, ties)
+    };
+    // The ties are counted apart: together with the mismatches they are what the comparison
+    // without them counts.
+    let (all, none) = compare(&[]);
+    assert!(none.contains("no --edges"), "{none}");
+    let (apart, ties_line) = compare(&["--edges", ties.to_str().unwrap()]);
+    let ties: usize = ties_line.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert_eq!(apart + ties, all, "{ties_line}");
     assert_clear_errors(&[
         (&["render", "--technique", "shadowmap", "--width", "8", "--height", "8"], "point or spot lights"),
         (
@@ -175,6 +196,14 @@ fn shadowmap_against_the_local_reference_reports_the_mismatch() {
                 "2",
             ],
             "between 0 and 1",
+        ),
+        (
+            &["reference", "--scene", "asm", "--out", "x.exr", "--edges", "t.exr"],
+            "--edges comes with --light local",
+        ),
+        (
+            &["compare", map.to_str().unwrap(), truth.to_str().unwrap(), "--edges", map.to_str().unwrap()],
+            "edge-tie image",
         ),
     ]);
 }
@@ -680,7 +709,7 @@ fn keyframes_of_the_walkthrough_are_cameras_for_render_and_reference() {
     let read = |name: &str| kage::imageio::read_exr(dir.join(name)).unwrap();
     assert!(read("k1.exr").pixels != read("k2.exr").pixels, "two keyframes, one picture");
     let mismatch = |a: &str, b: &str| {
-        kage::reference::shadow_mismatch(&read(a), &read(b), kage::reference::SHADOW_THRESHOLD)
+        kage::reference::shadow_mismatch(&read(a), &read(b), kage::reference::SHADOW_THRESHOLD, None)
             .unwrap()
             .fraction
     };

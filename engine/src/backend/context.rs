@@ -65,6 +65,8 @@ pub struct DeviceInfo {
     pub api_version: String,
     /// Nanoseconds per timestamp tick; `None` when the queue cannot write timestamps.
     pub timestamp_period_ns: Option<f64>,
+    /// `subPixelPrecisionBits`: the rasterizer places vertices to 1 / 2^bits of a pixel.
+    pub sub_pixel_precision_bits: u32,
     /// Every optional feature or extension Kage looks at, and whether it is there.
     pub features: Vec<(&'static str, bool)>,
 }

@@ -80,6 +80,7 @@ pub(crate) fn probe(
         driver: driver_text,
         api_version: version_string(props.api_version),
         timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
+        sub_pixel_precision_bits: props.limits.sub_pixel_precision_bits,
         features: vec![
             (
                 "VK_KHR_dynamic_rendering (required)",

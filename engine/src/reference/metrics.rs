@@ -81,8 +81,10 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 pub struct ShadowMismatch {
     /// `differing` / all pixels.
     pub fraction: f64,
-    /// Pixels lit in one image and shadowed in the other.
+    /// Pixels lit in one image and shadowed in the other, edge ties apart.
     pub differing: usize,
+    /// Pixels lit in one image only that are edge ties ([`EdgeTies`]): not in `differing`.
+    pub at_edges: usize,
     /// Of those, pixels the render lights and the reference shadows (light leaks).
     pub lit_in_render_only: usize,
     /// The luminance that separates lit from shadowed.
@@ -93,26 +95,93 @@ pub struct ShadowMismatch {
 /// (a lit point at 100 times the brightest point's distance, or at grazing light, still counts).
 pub const SHADOW_THRESHOLD: f64 = 1e-4;
 
+/// Where a local-light reference cannot say lit or shadowed more precisely than a rasterizer:
+/// per pixel, the lowest and highest luminance the reference takes at the pixel centre and
+/// with its primary ray moved by 1 / 2^`bits` px (the device's `subPixelPrecisionBits`, the
+/// precision to which the rasterizer places vertices) to each side along x and y. Where that
+/// range straddles the lit threshold, an edge (a silhouette, a shadow's edge, a spot's cone,
+/// light grazing a face) passes closer to the pixel centre than a rasterizer can place it, so
+/// a raster render's state there is a tie, whatever its shadow technique: [`shadow_mismatch`]
+/// counts such pixels apart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EdgeTies {
+    pub width: u32,
+    pub height: u32,
+    pub bits: u32,
+    /// Row-major, row 0 at the top: [lowest, highest] luminance.
+    pub ranges: Vec<[f32; 2]>,
+}
+
+impl EdgeTies {
+    /// As `kage reference --edges` writes them: R the lowest, G the highest luminance, B `bits`.
+    pub fn to_image(&self) -> RgbaF32Image {
+        let bits = self.bits as f32;
+        let pixels = self.ranges.iter().map(|&[low, high]| [low, high, bits, 1.0]).collect();
+        RgbaF32Image { width: self.width, height: self.height, pixels }
+    }
+
+    /// Reads what [`EdgeTies::to_image`] wrote; anything else is an error naming the problem.
+    pub fn from_image(image: &RgbaF32Image) -> Result<EdgeTies> {
+        let bits = image.pixels.first().map_or(0.0, |p| p[2]);
+        let ordered = image.pixels.iter().all(|p| p[0] <= p[1] && p[2] == bits);
+        if !(ordered && (1.0..=16.0).contains(&bits) && bits.fract() == 0.0) {
+            return Err(Error::InvalidArgument(
+                "not an edge-tie image of `kage reference --light local --edges` (R <= G per pixel, B the bits, 1 to 16)"
+                    .into(),
+            ));
+        }
+        let ranges = image.pixels.iter().map(|p| [p[0], p[1]]).collect();
+        Ok(EdgeTies { width: image.width, height: image.height, bits: bits as u32, ranges })
+    }
+
+    /// Whether each pixel is a tie at the luminance `threshold`.
+    fn ties(&self, threshold: f64) -> impl Iterator<Item = bool> + '_ {
+        self.ranges.iter().map(move |&[low, high]| f64::from(low) <= threshold && f64::from(high) > threshold)
+    }
+}
+
 /// The lit/shadowed disagreement of `a` against the reference `b`; `relative_threshold` in
-/// (0, 1) (see [`ShadowMismatch`]).
+/// (0, 1) (see [`ShadowMismatch`]); with `edges` (of the same reference), edge ties apart.
 pub fn shadow_mismatch(
     a: &RgbaF32Image,
     b: &RgbaF32Image,
     relative_threshold: f64,
+    edges: Option<&EdgeTies>,
 ) -> Result<ShadowMismatch> {
     check_sizes(a, b)?;
     let threshold = lit_threshold(b, relative_threshold)?;
-    let (mut differing, mut lit_in_render_only) = (0, 0);
-    for (lit_a, lit_b) in lit_states(a, threshold).zip(lit_states(b, threshold)) {
-        differing += usize::from(lit_a != lit_b);
-        lit_in_render_only += usize::from(lit_a && !lit_b);
+    let (mut differing, mut at_edges, mut lit_in_render_only) = (0, 0, 0);
+    for ((lit_a, lit_b), tie) in
+        lit_states(a, threshold).zip(lit_states(b, threshold)).zip(ties(a, edges, threshold)?)
+    {
+        let counted = lit_a != lit_b && !tie;
+        differing += usize::from(counted);
+        at_edges += usize::from(lit_a != lit_b && tie);
+        lit_in_render_only += usize::from(counted && lit_a);
     }
     Ok(ShadowMismatch {
         fraction: differing as f64 / a.pixels.len() as f64,
         differing,
+        at_edges,
         lit_in_render_only,
         threshold,
     })
+}
+
+/// Per pixel of `image`, whether it is an edge tie (never without `edges`).
+fn ties<'a>(
+    image: &RgbaF32Image,
+    edges: Option<&'a EdgeTies>,
+    threshold: f64,
+) -> Result<Box<dyn Iterator<Item = bool> + 'a>> {
+    let Some(edges) = edges else { return Ok(Box::new(std::iter::repeat(false))) };
+    if (edges.width, edges.height) != (image.width, image.height) {
+        return Err(Error::InvalidArgument(format!(
+            "edge ties of {}x{} for images of {}x{}: take them from the same reference",
+            edges.width, edges.height, image.width, image.height
+        )));
+    }
+    Ok(Box::new(edges.ties(threshold)))
 }
 
 /// The luminance above which a pixel counts as lit: `relative_threshold` in (0, 1) times the
@@ -227,22 +296,26 @@ pub fn diff_image(a: &RgbaF32Image, b: &RgbaF32Image) -> Result<DiffImage> {
 }
 
 /// Where `a` and the reference `b` disagree on lit and shadowed (as [`shadow_mismatch`]
-/// counts): red where only `a` is lit (a leak), blue where only `b` is, light grey where both
-/// are lit and dark grey where both are shadowed. `scale` is the luminance threshold.
+/// counts): red where only `a` is lit (a leak), blue where only `b` is, yellow where they
+/// disagree on an edge tie, light grey where both are lit and dark grey where both are
+/// shadowed. `scale` is the luminance threshold.
 pub fn shadow_mismatch_image(
     a: &RgbaF32Image,
     b: &RgbaF32Image,
     relative_threshold: f64,
+    edges: Option<&EdgeTies>,
 ) -> Result<DiffImage> {
     check_sizes(a, b)?;
     let threshold = lit_threshold(b, relative_threshold)?;
     let rgb = lit_states(a, threshold)
         .zip(lit_states(b, threshold))
+        .zip(ties(a, edges, threshold)?)
         .flat_map(|states| match states {
-            (true, false) => [230, 40, 40],
-            (false, true) => [40, 110, 255],
-            (true, true) => [170, 170, 170],
-            (false, false) => [50, 50, 50],
+            ((true, false), true) | ((false, true), true) => [240, 210, 40],
+            ((true, false), false) => [230, 40, 40],
+            ((false, true), false) => [40, 110, 255],
+            ((true, true), _) => [170, 170, 170],
+            ((false, false), _) => [50, 50, 50],
         })
         .collect();
     Ok(DiffImage { width: a.width, height: a.height, rgb, scale: threshold })
@@ -305,26 +378,47 @@ mod tests {
         let reference = image(4, 2, &[0.0, 2.0, 0.6, 0.9, 0.0, 0.0, 0.4, 0.0]);
         // Pixel 0 leaks light, pixel 2 is shadowed wrongly, pixel 6 stays under the threshold.
         let render = image(4, 2, &[0.7, 1.5, 0.0, 0.9, 0.0, 0.0, 0.5, 0.0]);
-        let m = shadow_mismatch(&render, &reference, 0.25).unwrap();
+        let m = shadow_mismatch(&render, &reference, 0.25, None).unwrap();
         assert_eq!(m.threshold, 0.5);
         assert_eq!((m.differing, m.lit_in_render_only), (2, 1));
         assert_eq!(m.fraction, 0.25);
         // Any two images that agree on every pixel's state, whatever the values, match.
         let brighter = image(4, 2, &[0.0, 4.0, 3.0, 2.0, 0.0, 0.0, 0.1, 0.0]);
-        assert_eq!(shadow_mismatch(&brighter, &reference, 0.25).unwrap().differing, 0);
+        assert_eq!(shadow_mismatch(&brighter, &reference, 0.25, None).unwrap().differing, 0);
         for bad in [0.0, 1.0, -1.0, f64::NAN] {
-            let err = shadow_mismatch(&render, &reference, bad).unwrap_err().to_string();
+            let err = shadow_mismatch(&render, &reference, bad, None).unwrap_err().to_string();
             assert!(err.contains("between 0 and 1"), "{bad}: {err}");
         }
-        assert!(shadow_mismatch(&image(2, 1, &[0.0; 2]), &reference, 0.25).is_err());
+        assert!(shadow_mismatch(&image(2, 1, &[0.0; 2]), &reference, 0.25, None).is_err());
         // The picture of the same: a colour per pixel for each pair of states, counted alike.
-        let picture = shadow_mismatch_image(&render, &reference, 0.25).unwrap();
+        let picture = shadow_mismatch_image(&render, &reference, 0.25, None).unwrap();
         let colours: Vec<&[u8]> = picture.rgb.chunks(3).collect();
         let (red, blue) = ([230, 40, 40], [40, 110, 255]);
         assert_eq!((colours[0], colours[2]), (&red[..], &blue[..]));
         assert_eq!(colours.iter().filter(|c| **c == red || **c == blue).count(), m.differing);
         assert_eq!((colours[1], colours[4]), (&[170u8, 170, 170][..], &[50u8, 50, 50][..]));
         assert_eq!((picture.width, picture.height, picture.scale), (4, 2, 0.5));
+    }
+
+    #[test]
+    fn edge_ties_are_counted_apart() {
+        // As above; pixel 0's reference range straddles the threshold 0.5 (a tie), pixel 2's
+        // does not (0.55 to 0.6: lit wherever the ray moves), pixel 3's range is a tie but
+        // both images agree there.
+        let reference = image(4, 2, &[0.0, 2.0, 0.6, 0.9, 0.0, 0.0, 0.4, 0.0]);
+        let render = image(4, 2, &[0.7, 1.5, 0.0, 0.9, 0.0, 0.0, 0.5, 0.0]);
+        let mut ranges = reference.pixels.iter().map(|p| [p[0], p[0]]).collect::<Vec<_>>();
+        (ranges[0], ranges[2], ranges[3]) = ([0.0, 0.8], [0.55, 0.6], [0.3, 0.9]);
+        let edges = EdgeTies { width: 4, height: 2, bits: 8, ranges };
+        let m = shadow_mismatch(&render, &reference, 0.25, Some(&edges)).unwrap();
+        assert_eq!((m.differing, m.at_edges, m.lit_in_render_only), (1, 1, 0));
+        assert_eq!(m.fraction, 0.125);
+        let picture = shadow_mismatch_image(&render, &reference, 0.25, Some(&edges)).unwrap();
+        assert_eq!(&picture.rgb[0..3], &[240, 210, 40]);
+        assert_eq!(EdgeTies::from_image(&edges.to_image()).unwrap(), edges);
+        let other = EdgeTies { width: 2, height: 1, bits: 8, ranges: vec![[0.0, 0.0]; 2] };
+        assert!(shadow_mismatch(&render, &reference, 0.25, Some(&other)).is_err());
+        assert!(EdgeTies::from_image(&render).is_err(), "an ordinary image is no edge-tie image");
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! projection matrices and one primary ray through each pixel centre ((i + ½) / width, row 0 at
 //! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
 use super::lighting::{ReferenceLighting, IMPORTS};
+use super::metrics::EdgeTies;
 use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
@@ -42,6 +43,9 @@ pub struct ReferenceRenderer {
     options: ReferenceOptions,
     samples: u32,
     executor: FrameExecutor,
+    /// The device's sub-pixel precision in bits, at most 16 (offsets of 1/2^16 px stay
+    /// representable beside a pixel coordinate of a few thousand): see [`EdgeTies`].
+    edge_bits: u32,
 }
 
 impl ReferenceRenderer {
@@ -66,6 +70,7 @@ impl ReferenceRenderer {
             options: options.clone(),
             samples: 0,
             executor: FrameExecutor::new(ctx, "reference")?,
+            edge_bits: ctx.info().sub_pixel_precision_bits.min(16),
         })
     }
 
@@ -85,7 +90,7 @@ impl ReferenceRenderer {
             (self.options.light == LightMode::Local) as u32,
             self.lighting.light_count,
             self.options.seed,
-            0,
+            self.edge_bits,
         ];
         let passes = super::sample_passes(spp, self.samples, |first, count| {
             let push =
@@ -121,6 +126,18 @@ impl ReferenceRenderer {
     /// The image so far: linear radiance, row 0 at the top, alpha 1.
     pub fn image(&self) -> Result<RgbaF32Image> {
         Ok(self.to_image(&self.statistics()?))
+    }
+
+    /// Local mode: the pixels that lie closer to an edge than the rasterizer can place one
+    /// (see [`EdgeTies`]), from the last batch.
+    pub fn edge_ties(&self) -> Result<EdgeTies> {
+        if self.options.light != LightMode::Local || self.samples == 0 {
+            return Err(Error::Internal(
+                "edge ties come from a local-light reference with its batch run".into(),
+            ));
+        }
+        let ranges = Statistics::read(&self.accum, self.samples)?.luminance_range;
+        Ok(EdgeTies { width: self.options.width, height: self.options.height, bits: self.edge_bits, ranges })
     }
 
     pub fn to_image(&self, statistics: &Statistics) -> RgbaF32Image {

@@ -36,6 +36,9 @@ pub struct Statistics {
     pub mean: Vec<[f32; 3]>,
     /// sqrt(s² / n) per channel with the unbiased sample variance s²; `None` below two samples.
     pub standard_error: Option<Vec<[f32; 3]>>,
+    /// The local-light reference's lowest and highest luminance per pixel at the edge-tie
+    /// offsets ([`super::EdgeTies`]); zeros from the other modes.
+    pub luminance_range: Vec<[f32; 2]>,
 }
 
 impl Statistics {
@@ -46,13 +49,14 @@ impl Statistics {
             bytes.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
         let items = floats.chunks_exact(8);
         let mean = items.clone().map(|a| [a[0], a[1], a[2]]).collect();
+        let luminance_range = items.clone().map(|a| [a[3], a[7]]).collect();
         let standard_error = (samples >= 2).then(|| {
             let n = f64::from(samples);
             items
                 .map(|a| [a[4], a[5], a[6]].map(|m2| (f64::from(m2.max(0.0)) / (n - 1.0) / n).sqrt() as f32))
                 .collect()
         });
-        Ok(Statistics { samples, mean, standard_error })
+        Ok(Statistics { samples, mean, standard_error, luminance_range })
     }
 
     /// The noise left in the estimate, relative: the RMS over items and channels of the standard

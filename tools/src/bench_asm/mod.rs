@@ -298,7 +298,7 @@ fn walk(
     let mut series: Vec<Series> = (0..n).map(|_| Series::default()).collect();
     let mut rows = Vec::new();
     // The last frame's reference and renders, for the flips.
-    let mut previous: Option<(RgbaF32Image, Vec<RgbaF32Image>)> = None;
+    let mut previous: Option<(references::Truth, Vec<RgbaF32Image>)> = None;
     for (i, frame) in plan.iter().enumerate() {
         bar.message(format!("frame {i}: reference"));
         let truth = references.get(&frame.camera)?;
@@ -314,11 +314,13 @@ fn walk(
         let images: Vec<RgbaF32Image> = renderers.iter().map(|r| r.image()).collect::<kage::Result<_>>()?;
         let frame_ms = |c: usize| kage::pass::frame_ms(&timings[c]).unwrap_or(0.0);
         for (c, image) in images.iter().enumerate() {
-            let mismatch = shadow_mismatch(image, &truth, SHADOW_THRESHOLD)?;
+            let mismatch = shadow_mismatch(image, &truth.image, SHADOW_THRESHOLD, Some(&truth.edges))?;
             let flips = match (&previous, slow) {
-                (Some((truth_before, before)), true) => {
-                    Some(shadow_flips([&before[c], image], [truth_before, &truth], SHADOW_THRESHOLD)?)
-                }
+                (Some((truth_before, before)), true) => Some(shadow_flips(
+                    [&before[c], image],
+                    [&truth_before.image, &truth.image],
+                    SHADOW_THRESHOLD,
+                )?),
                 _ => None,
             };
             let row = FrameRow {
@@ -330,6 +332,7 @@ fn walk(
                 config: c,
                 error: mismatch.fraction,
                 leaks: mismatch.lit_in_render_only,
+                edge_ties: mismatch.at_edges,
                 frame_ms: frame_ms(c),
                 ratio: frame_ms(c) / frame_ms(0),
                 flips,

@@ -4,19 +4,26 @@
 //!
 //! A reference is a 32-bit EXR named for a hash of everything it depends on: the geometry
 //! (`geometry_hash`), the group transforms, the lights, the camera and the image size, and a
-//! version to bump when the reference renderer's output changes. A file that cannot be read is
-//! computed again and replaced.
+//! version to bump when the reference renderer's output changes, with its edge ties beside it
+//! (`-edges.exr`, see [`EdgeTies`]). A pair that cannot be read is computed again and replaced.
 use anyhow::{Context as _, Result};
 use kage::backend::Context;
 use kage::imageio::RgbaF32Image;
 use kage::prt::cache::{geometry_hash, Fnv64};
-use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
+use kage::reference::{EdgeTies, LightMode, ReferenceOptions, ReferenceRenderer};
 use kage::scene::{Camera, Scene};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Part of every file name's hash: bump it when `kage reference --light local` changes.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
+
+/// A frame's reference: the image and where a raster render's state is a tie.
+#[derive(Clone)]
+pub struct Truth {
+    pub image: RgbaF32Image,
+    pub edges: EdgeTies,
+}
 
 pub struct References {
     ctx: Arc<Context>,
@@ -29,7 +36,7 @@ pub struct References {
     /// Built at the first reference not found on disk.
     renderer: Option<ReferenceRenderer>,
     /// The last camera's reference: a camera held still asks for it again.
-    last: Option<(Camera, RgbaF32Image)>,
+    last: Option<(Camera, Truth)>,
     pub computed: usize,
     pub loaded: usize,
 }
@@ -59,56 +66,70 @@ impl References {
     }
 
     /// The reference seen from `camera`, from the disk if it is there, else ray cast (and kept).
-    pub fn get(&mut self, camera: &Camera) -> Result<RgbaF32Image> {
-        if let Some((last, image)) = &self.last {
+    pub fn get(&mut self, camera: &Camera) -> Result<Truth> {
+        if let Some((last, truth)) = &self.last {
             if last == camera {
-                return Ok(image.clone());
+                return Ok(truth.clone());
             }
         }
-        let image = self.load_or_compute(camera)?;
-        self.last = Some((*camera, image.clone()));
-        Ok(image)
+        let truth = self.load_or_compute(camera)?;
+        self.last = Some((*camera, truth.clone()));
+        Ok(truth)
     }
 
-    fn load_or_compute(&mut self, camera: &Camera) -> Result<RgbaF32Image> {
-        let path = self.dir.as_deref().map(|dir| self.path(dir, camera));
-        if let Some(path) = &path {
-            if path.exists() {
-                match kage::imageio::read_exr(path) {
-                    Ok(image) if (image.width, image.height) == (self.size, self.size) => {
+    fn load_or_compute(&mut self, camera: &Camera) -> Result<Truth> {
+        let paths = self.dir.as_deref().map(|dir| self.paths(dir, camera));
+        if let Some((image_path, edges_path)) = &paths {
+            if image_path.exists() && edges_path.exists() {
+                match self.load(image_path, edges_path) {
+                    Ok(truth) => {
                         self.loaded += 1;
-                        return Ok(image);
+                        return Ok(truth);
                     }
-                    Ok(_) => {
-                        eprintln!("kage: note: {} has the wrong size; computing it again", path.display())
-                    }
-                    Err(e) => eprintln!("kage: note: {e}; computing {} again", path.display()),
+                    Err(e) => eprintln!("kage: note: {e:#}; computing {} again", image_path.display()),
                 }
             }
         }
-        let image = self.compute(camera)?;
-        if let Some(path) = &path {
-            kage::imageio::write(path, &image, 1.0)
-                .with_context(|| format!("keeping the reference in {}", path.display()))?;
+        let truth = self.compute(camera)?;
+        if let Some((image_path, edges_path)) = &paths {
+            for (path, image) in [(image_path, &truth.image), (edges_path, &truth.edges.to_image())] {
+                kage::imageio::write(path, image, 1.0)
+                    .with_context(|| format!("keeping the reference in {}", path.display()))?;
+            }
         }
         self.computed += 1;
-        Ok(image)
+        Ok(truth)
     }
 
-    fn path(&self, dir: &Path, camera: &Camera) -> PathBuf {
+    fn load(&self, image_path: &Path, edges_path: &Path) -> Result<Truth> {
+        let image = kage::imageio::read_exr(image_path)?;
+        let edges = EdgeTies::from_image(&kage::imageio::read_exr(edges_path)?)
+            .with_context(|| format!("in {}", edges_path.display()))?;
+        let size = (self.size, self.size);
+        if (image.width, image.height) != size || (edges.width, edges.height) != size {
+            anyhow::bail!("{} or its edges have the wrong size", image_path.display());
+        }
+        Ok(Truth { image, edges })
+    }
+
+    /// The image's file and its edge ties' beside it.
+    fn paths(&self, dir: &Path, camera: &Camera) -> (PathBuf, PathBuf) {
         let mut key = Fnv64::new();
         key.write(&self.key.finish().to_le_bytes());
         key.write(format!("{camera:?}").as_bytes());
+        // The name only helps a reader: its first 40 characters keep the file name short.
         let name: String = self
             .scene
             .name
             .chars()
+            .take(40)
             .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
             .collect();
-        dir.join(format!("{name}-{:016x}-{}.exr", key.finish(), self.size))
+        let stem = format!("{name}-{:016x}-{}", key.finish(), self.size);
+        (dir.join(format!("{stem}.exr")), dir.join(format!("{stem}-edges.exr")))
     }
 
-    fn compute(&mut self, camera: &Camera) -> Result<RgbaF32Image> {
+    fn compute(&mut self, camera: &Camera) -> Result<Truth> {
         let renderer = match &mut self.renderer {
             Some(renderer) => renderer,
             slot => {
@@ -126,6 +147,6 @@ impl References {
         renderer.set_camera(*camera)?;
         // Local lights with hard shadows are deterministic: one sample per pixel is exact.
         renderer.run_batch(1)?;
-        Ok(renderer.image()?)
+        Ok(Truth { image: renderer.image()?, edges: renderer.edge_ties()? })
     }
 }

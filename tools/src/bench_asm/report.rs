@@ -20,10 +20,12 @@ pub struct FrameRow {
     pub motion_px: Option<f32>,
     /// Index into the configurations.
     pub config: usize,
-    /// Fraction of the pixels shadowed differently from the reference.
+    /// Fraction of the pixels shadowed differently from the reference, edge ties apart.
     pub error: f64,
     /// Of those, pixels lit in the render and shadowed in the reference.
     pub leaks: usize,
+    /// Pixels shadowed differently on an edge tie (`kage::reference::EdgeTies`): not in `error`.
+    pub edge_ties: usize,
     /// GPU ms of the frame's passes, and that over the first configuration's in this frame.
     pub frame_ms: f64,
     pub ratio: f64,
@@ -162,7 +164,7 @@ pub fn write(
 ) -> Result<Vec<PathBuf>> {
     let optional = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:.6}"));
     let mut frames = String::from(
-        "frame,t,rest,extra,motion_px,config,technique,value,error,leaks,frame_ms,ratio,flips_render,flips_reference,flips_spurious\n",
+        "frame,t,rest,extra,motion_px,config,technique,value,error,leaks,edge_ties,frame_ms,ratio,flips_render,flips_reference,flips_spurious\n",
     );
     for r in rows {
         let c = &configs[r.config];
@@ -171,7 +173,7 @@ pub fn write(
             .map_or_else(|| ",,".to_string(), |f| format!("{},{},{}", f.render, f.reference, f.spurious));
         writeln!(
             frames,
-            "{},{:.5},{},{},{},{},{},{},{:.6},{},{:.4},{:.4},{flips}",
+            "{},{:.5},{},{},{},{},{},{},{:.6},{},{},{:.4},{:.4},{flips}",
             r.frame,
             r.t,
             r.rest.map_or_else(String::new, |k| k.to_string()),
@@ -182,6 +184,7 @@ pub fn write(
             c.value,
             r.error,
             r.leaks,
+            r.edge_ties,
             r.frame_ms,
             r.ratio
         )

@@ -284,6 +284,7 @@ impl ProbeCapture {
                 inv_view_proj: view_proj.inverse().to_cols_array_2d(),
                 camera_pos: position.extend(1.0).to_array(),
                 env_params: [1.0, 0.0, 0.0, 0.0],
+                viewport: [self.settings.cube_size as f32, self.settings.cube_size as f32, 0.0, 0.0],
             };
             buffer.write(0, bytes_of(&uniforms))?;
         }
