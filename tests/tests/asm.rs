@@ -7,6 +7,7 @@ use kage::imageio::RgbaF32Image;
 use kage::reference::{shadow_mismatch, LightMode, ReferenceOptions, ReferenceRenderer, SHADOW_THRESHOLD};
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{Light, Scene};
+use kage::techniques::asm::memory::{edge_records, AsmMemory};
 use kage::techniques::asm::pool::{DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
 use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::tile::TileKey;
@@ -87,8 +88,8 @@ fn refinement_converges_within_the_budget_and_beats_a_map_of_equal_memory() {
     // A tiny budget: the root and two more tiles (N tiles take 3N + 1 pages, beside the
     // scratch). Light leaks (lit here, shadowed in the reference) come from the coarse level's
     // texels, so they are no more than the root tile alone (the least budget) gives.
-    let least = AsmTest::Bias.least_budget_bytes();
-    let tiny = least + 6 * DEPTH_PAGE_BYTES;
+    let least = AsmTest::Bias.least_budget_bytes((SIZE, SIZE));
+    let tiny = AsmMemory::of(10, DEPTH_PAGE_BYTES, edge_records((SIZE, SIZE))).total();
     let mut small = renderer(&ctx, &scene, TechniqueDesc::Asm(settings(tiny, AsmTest::Bias)));
     let small_errors = mismatches(&mut small, &truth, 8);
     let stats = small.stats().asm.unwrap();
@@ -312,4 +313,40 @@ fn the_light_inside_the_view() {
         errors[0].differing
     );
     assert!(last <= conventional, "asm {last} against the conventional map's {conventional}");
+}
+
+/// Every byte ASM allocates counts in its budget: the device memory a renderer with ASM takes
+/// beyond one with the unshadowed technique (same scene and size) is what ASM reports, part by
+/// part, within the allocator's alignment, and never more than the budget. Before, the page
+/// table's directory, the analysis's buffers and the light records (1.3 MiB at 512² and
+/// 16 MiB) were outside it.
+#[test]
+fn the_budget_holds_every_byte_asm_allocates() {
+    let ctx = Validated::new();
+    let scene = close_up(1);
+    let allocated = |technique| {
+        let before = ctx.allocated_bytes();
+        let r = renderer(&ctx, &scene, technique);
+        (ctx.allocated_bytes() - before, r.stats())
+    };
+    let (plain, _) = allocated(TechniqueDesc::Unshadowed);
+    for budget in [4 * MB, 16 * MB] {
+        let (total, stats) = allocated(TechniqueDesc::Asm(settings(budget, AsmTest::Bias)));
+        let asm = stats.asm.unwrap();
+        let reported = asm.memory.total();
+        assert_eq!(stats.shadow_memory_bytes, Some(reported));
+        // Used up to the pages the atlas's rows and columns leave over (under 1 %).
+        assert!(reported <= budget && reported as f64 > 0.99 * budget as f64, "{:?} of {budget}", asm.memory);
+        // What the unshadowed renderer does not allocate is ASM's: its buffers and images, each
+        // rounded up by the allocator to at most 256 bytes.
+        let beyond = total - plain;
+        eprintln!(
+            "budget {budget}: reported {reported}, allocated beyond unshadowed {beyond} ({:?})",
+            asm.memory
+        );
+        assert!(
+            beyond >= reported && beyond <= reported + 16 * 256,
+            "{beyond} allocated, {reported} reported"
+        );
+    }
 }

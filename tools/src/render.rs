@@ -306,10 +306,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     drop(bar);
     if let Some(stats) = renderer.stats().asm {
         println!(
-            "asm: {} tiles resident, {:.2} of {:.2} MB, deepest level {}, {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",
+            "asm: {} tiles resident, {:.2} of {:.2} MB in use (allocated {:.2}: pages {:.2}, scratch {:.2}, page table {:.2}, analysis {:.2}, lights {:.3}), deepest level {}, {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",
             stats.resident_tiles,
             stats.bytes_used as f64 / MB as f64,
             stats.budget_bytes as f64 / MB as f64,
+            stats.memory.total() as f64 / MB as f64,
+            stats.memory.pages as f64 / MB as f64,
+            stats.memory.scratch as f64 / MB as f64,
+            stats.memory.page_table as f64 / MB as f64,
+            stats.memory.analysis as f64 / MB as f64,
+            stats.memory.lights as f64 / MB as f64,
             stats.deepest_level,
             stats.refreshed.len() + stats.rendered.len(),
             stats.cost.0,

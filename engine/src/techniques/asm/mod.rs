@@ -20,6 +20,7 @@
 //!   missing tile falls back to its nearest resident ancestor, at worst the root (always
 //!   resident), never to "lit".
 pub mod light_view;
+pub mod memory;
 pub mod page_table;
 pub mod pages;
 pub mod plan;

@@ -119,23 +119,17 @@ pub struct PageStore {
 }
 
 impl PageStore {
-    /// The atlas and scratch of the most pages of `page_bytes` whose bytes, with the scratch
-    /// tile's, stay within `budget_bytes`; with polygon IDs when `ids` (`page_bytes` then counts
-    /// a depth and an ID per texel).
+    /// The atlas of at most `most_pages` pages of `page_bytes` (the budget's share,
+    /// [`super::memory::AsmMemory::within`]) and the scratch; with polygon IDs when `ids`
+    /// (`page_bytes` then counts a depth and an ID per texel).
     pub fn new(
         ctx: &Arc<Context>,
         gpu: &GpuScene,
-        budget_bytes: u64,
+        most_pages: u32,
         page_bytes: u64,
         ids: bool,
     ) -> Result<PageStore> {
-        let scratch = scratch_bytes(page_bytes);
-        let layout = AtlasLayout::within(budget_bytes.saturating_sub(scratch), page_bytes).map_err(|_| {
-            Error::InvalidArgument(format!(
-                "an ASM budget of {budget_bytes} bytes holds no tile: the root and the scratch take {} bytes",
-                scratch + TILE_PAGES * page_bytes
-            ))
-        })?;
+        let layout = AtlasLayout::within(u64::from(most_pages) * page_bytes, page_bytes)?;
         let (width, height) = (layout.columns * ASM_PAGE_TEXELS, layout.rows * ASM_PAGE_TEXELS);
         let atlas_usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
         let atlas = |name, format| {
@@ -150,10 +144,9 @@ impl PageStore {
                 usage: atlas_usage,
             };
             Image::new(ctx, &desc).map_err(|e| match e {
-                Error::InvalidArgument(e) => Error::InvalidArgument(format!(
-                    "an ASM budget of {budget_bytes} bytes is {} pages: {e}",
-                    layout.pages()
-                )),
+                Error::InvalidArgument(e) => {
+                    Error::InvalidArgument(format!("an ASM budget of {} pages: {e}", layout.pages()))
+                }
                 e => e,
             })
         };
@@ -170,11 +163,6 @@ impl PageStore {
 
     pub fn layout(&self) -> AtlasLayout {
         self.layout
-    }
-
-    /// Bytes of the atlas and the scratch (the ID test's IDs included).
-    pub fn bytes(&self, page_bytes: u64) -> u64 {
-        u64::from(self.layout.pages()) * page_bytes + scratch_bytes(page_bytes)
     }
 
     /// The depth atlas as the lookups sample it.

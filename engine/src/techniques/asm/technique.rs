@@ -23,8 +23,9 @@
 //! Dropping them instead would cut the quadtree: every ancestor of a refined tile overlaps a
 //! group somewhere in its square.
 use super::light_view::{tile_view_proj, UvRect};
+use super::memory::{self, edge_records, AsmMemory};
 use super::page_table;
-use super::pages::{scratch_bytes, PageStore, TileWrite};
+use super::pages::{PageStore, TileWrite};
 use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{Insert, PageOp, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES, TILE_PAGES};
 use super::tile::TileKey;
@@ -79,9 +80,11 @@ impl AsmTest {
         }
     }
 
-    /// The least budget: the root tile's pages and the scratch every page write goes through.
-    pub fn least_budget_bytes(self) -> u64 {
-        TILE_PAGES * self.page_bytes() + scratch_bytes(self.page_bytes())
+    /// The least budget for images of `size` (width, height): the root tile's pages beside
+    /// everything else the technique allocates ([`AsmMemory`]); (0, 0) gives the part no image
+    /// size changes.
+    pub fn least_budget_bytes(self, size: (u32, u32)) -> u64 {
+        AsmMemory::of(TILE_PAGES as u32, self.page_bytes(), edge_records(size)).total()
     }
 }
 
@@ -106,7 +109,7 @@ impl Default for AsmSettings {
 impl AsmSettings {
     pub fn validated(self) -> Result<AsmSettings> {
         let bytes = self.budget_mb * MB as f64;
-        let least = self.test.least_budget_bytes();
+        let least = self.test.least_budget_bytes((0, 0));
         if !bytes.is_finite() {
             return Err(Error::InvalidArgument(format!(
                 "an ASM budget of {} MB: the budget must be a finite number of MB",
@@ -115,7 +118,7 @@ impl AsmSettings {
         }
         if bytes < least as f64 {
             return Err(Error::InvalidArgument(format!(
-                "an ASM budget of {} MB holds no tile: the root tile and the scratch take {} KiB",
+                "an ASM budget of {} MB holds no tile: the root tile, the scratch and the page directory take {} KiB",
                 self.budget_mb,
                 least / 1024
             )));
@@ -138,8 +141,11 @@ impl AsmSettings {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AsmStats {
     pub budget_bytes: u64,
-    /// Bytes of the resident tiles' pages and the scratch (never above the budget).
+    /// Bytes of the resident tiles' pages and of everything else the technique allocated
+    /// (never above the budget).
     pub bytes_used: u64,
+    /// What the technique allocated, part by part (its total within the budget).
+    pub memory: AsmMemory,
     pub resident_tiles: usize,
     /// The finest resident level (0: the root alone).
     pub deepest_level: u32,
@@ -173,7 +179,9 @@ pub struct Asm {
     table: Buffer,
     /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by `analysed`.
     requests: Buffer,
-    /// Edge records `requests` holds: one per pixel the analysis looks at in a frame.
+    /// The bytes of every buffer and image above, part by part.
+    memory: AsmMemory,
+    /// Edge records `requests` holds ([`edge_records`]).
     edge_capacity: u32,
     /// Per page-table node, the last frame whose lighting looked a point up in its tile.
     used: Buffer,
@@ -235,9 +243,12 @@ impl Asm {
             )));
         }
         let page_bytes = settings.test.page_bytes();
-        let pages = PageStore::new(ctx, gpu, settings.budget_bytes(), page_bytes, ids)?;
+        let edge_capacity = edge_records(size);
+        let (most_pages, _) = AsmMemory::within(settings.budget_bytes(), page_bytes, edge_capacity)?;
+        let pages = PageStore::new(ctx, gpu, most_pages, page_bytes, ids)?;
         let pool = PagePool::new(pages.layout().pages(), page_bytes)?;
         let nodes = pool.max_tiles();
+        let memory = AsmMemory::of(pages.layout().pages(), page_bytes, edge_capacity);
         let mut bindings = vec![
             BindingKind::UniformBuffer,
             BindingKind::UniformBuffer,
@@ -278,7 +289,7 @@ impl Asm {
             |name, size, usage, location| Buffer::new(ctx, &BufferDesc { name, size, usage, location });
         let records = buffer(
             "asm.lights",
-            u64::from(constants::MAX_LOCAL_LIGHTS) * size_of::<ShadowLight>() as u64,
+            memory::lights_bytes(),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
@@ -288,17 +299,15 @@ impl Asm {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
-        // The analysis looks at one pixel of each 2×2 block per frame.
-        let edge_capacity = size.0.div_ceil(2) * size.1.div_ceil(2);
         let requests = buffer(
             "asm.requests",
-            4 * (1 + u64::from(nodes) + 4 * u64::from(edge_capacity)),
+            memory::requests_bytes(nodes, edge_capacity),
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
         let used = buffer(
             "asm.used",
-            u64::from(nodes) * 4,
+            memory::used_bytes(nodes),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
@@ -316,6 +325,7 @@ impl Asm {
             records,
             table,
             requests,
+            memory,
             edge_capacity,
             used,
             lit_keys: Vec::new(),
@@ -331,7 +341,8 @@ impl Asm {
             refresh: Vec::new(),
             render: Vec::new(),
             evicted: 0,
-            stats: AsmStats::default(),
+            // The memory is known from the start, before the first frame's statistics.
+            stats: AsmStats { memory, budget_bytes: settings.budget_bytes(), ..Default::default() },
         };
         asm.cost = asm.calibrate(ctx, gpu)?;
         Ok(asm)
@@ -649,7 +660,8 @@ impl Technique for Asm {
         self.lit_keys.clone_from(&self.table_keys);
         self.stats = AsmStats {
             budget_bytes: self.settings.budget_bytes(),
-            bytes_used: self.pool.bytes_in_use() + scratch_bytes(self.settings.test.page_bytes()),
+            bytes_used: self.pool.bytes_in_use() + self.memory.total() - self.memory.pages,
+            memory: self.memory,
             resident_tiles: self.table_keys.len(),
             deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
             refreshed: self.refresh.iter().map(|w| w.key).collect(),
@@ -692,11 +704,11 @@ impl Technique for Asm {
         }
     }
 
-    /// Shadow memory: the whole atlas and the scratch, allocated up front (within the
-    /// budget), whatever is resident.
+    /// Shadow memory: everything the technique allocated up front (within the budget),
+    /// whatever is resident.
     fn stats(&self) -> TechniqueStats {
         TechniqueStats {
-            shadow_memory_bytes: Some(self.pages.bytes(self.settings.test.page_bytes())),
+            shadow_memory_bytes: Some(self.memory.total()),
             asm: Some(self.stats.clone()),
             ..Default::default()
         }
