@@ -20,13 +20,13 @@ pub enum EnvCommand {
         #[arg(long, default_value_t = SunMap::DEFAULT.radius_deg)]
         radius: f64,
         /// The sun's radiance, r,g,b.
-        #[arg(long, value_parser = crate::parse_xyz::<f32>, default_value = "2000,2000,2000")]
+        #[arg(long, value_parser = crate::args::parse_xyz::<f32>, default_value = "2000,2000,2000")]
         radiance: [f32; 3],
         /// Radiance of the rest of the upper hemisphere, r,g,b.
-        #[arg(long, value_parser = crate::parse_xyz::<f32>, default_value = "0,0,0")]
+        #[arg(long, value_parser = crate::args::parse_xyz::<f32>, default_value = "0,0,0")]
         sky: [f32; 3],
         /// Radiance of the lower hemisphere, r,g,b.
-        #[arg(long, value_parser = crate::parse_xyz::<f32>, default_value = "0,0,0")]
+        #[arg(long, value_parser = crate::args::parse_xyz::<f32>, default_value = "0,0,0")]
         ground: [f32; 3],
         /// Map width in texels (the height is half).
         #[arg(long, default_value_t = SunMap::DEFAULT.width)]

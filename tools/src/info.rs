@@ -1,5 +1,5 @@
 //! `kage info`: what the device offers, feature by feature.
-use crate::GpuArgs;
+use crate::args::GpuArgs;
 use anyhow::Result;
 
 pub fn run(args: &GpuArgs) -> Result<()> {

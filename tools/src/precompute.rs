@@ -1,8 +1,8 @@
 //! `kage precompute`: the PRT transfer of every vertex of a scene, from the cache when a valid
 //! file is there, else computed on the GPU and cached; prints the time and the bytes beside the
 //! paper's figures.
+use crate::args::GpuArgs;
 use crate::transfer_source::{Origin, PrtArgs};
-use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use kage::prt::{PrtParams, TransferSet, Visibility};

@@ -2,7 +2,7 @@
 //! or HDR image, as Morishige 2014 captured street-view panoramas: the image projected to 9 SH
 //! coefficients per channel on the GPU (the same projection as `kage sh`, so the coefficients
 //! are identical), with the irradiance at the six axis normals.
-use crate::GpuArgs;
+use crate::args::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use glam::Vec3;
@@ -46,7 +46,7 @@ struct ProbeImageFile {
 pub fn run(args: &CaptureImageArgs) -> Result<()> {
     let dering = Dering::parse(&args.dering)?;
     let map = EnvMap::load(&args.image)?;
-    crate::report_clamped(&map);
+    crate::args::report_clamped(&map);
     let ctx = args.gpu.context()?;
     let sh = kage::frame::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
     let sh: ShRgb9 = dering.apply(&sh);

@@ -47,7 +47,7 @@ pub struct PlaceArgs {
     #[arg(long)]
     out: PathBuf,
     #[command(flatten)]
-    gpu: crate::GpuArgs,
+    gpu: crate::args::GpuArgs,
 }
 
 #[derive(Args)]
@@ -66,7 +66,7 @@ pub struct LookupArgs {
     #[arg(long = "in")]
     input: PathBuf,
     /// The point, as x,y,z.
-    #[arg(long, value_parser = crate::parse_xyz::<f64>, allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::args::parse_xyz::<f64>, allow_hyphen_values = true)]
     at: [f64; 3],
 }
 
@@ -85,7 +85,7 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
 }
 
 fn place(args: &PlaceArgs) -> Result<()> {
-    let scene = crate::read_scene(&args.scene, false)?;
+    let scene = crate::args::read_scene(&args.scene, false)?;
     let placement = crate::render::probe_placement(&args.probes, &scene)?;
     if !matches!(placement, ProbePlacement::Auto { .. }) {
         anyhow::bail!("--probes {}: expected auto, auto:TOL or auto:TOL:NX,NY,NZ", args.probes);

@@ -1,8 +1,8 @@
 //! `kage reference`: the ray-traced ground truth, rendered progressively in batches with a
 //! progress bar and a running estimate of the noise left; or, with `--irradiance`, E(p, n) at
 //! listed points.
+use crate::args::GpuArgs;
 use crate::progress::Bar;
-use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use kage::files;
@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 #[derive(Args)]
 pub struct ReferenceArgs {
     #[command(flatten)]
-    scene: crate::SceneArgs,
+    scene: crate::args::SceneArgs,
     /// Samples per pixel (or per point). Each sample casts two shadow rays (one drawn from the
     /// environment, one cosine-weighted). The paper's reference uses 16384.
     #[arg(long, default_value_t = 1024)]

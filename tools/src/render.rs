@@ -1,7 +1,7 @@
 //! `kage render`: renders frames offscreen, writes the last one, and reports pass timings.
+use crate::args::GpuArgs;
 use crate::progress::Bar;
 use crate::transfer_source::{Origin, PrtArgs};
-use crate::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use kage::pass::TimingTable;
@@ -98,7 +98,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     prt: PrtArgs,
     #[command(flatten)]
-    scene: crate::SceneArgs,
+    scene: crate::args::SceneArgs,
     #[arg(long, default_value_t = 512)]
     width: u32,
     #[arg(long, default_value_t = 512)]

@@ -38,7 +38,7 @@ pub enum SceneCommand {
 pub fn run(command: &SceneCommand) -> Result<()> {
     match command {
         SceneCommand::Export { scene, out, format } => {
-            let loaded = crate::read_scene(scene, false)?;
+            let loaded = crate::args::read_scene(scene, false)?;
             loaded.export(out, *format).with_context(|| format!("exporting scene {scene}"))?;
             println!("wrote {}", out.join(kage::scene::SCENE_FILE).display());
             if *format == SceneFormat::Gltf {
@@ -48,7 +48,7 @@ pub fn run(command: &SceneCommand) -> Result<()> {
         }
         SceneCommand::Info { scene, json } => {
             let start = Instant::now();
-            let loaded = crate::read_scene(scene, false)?;
+            let loaded = crate::args::read_scene(scene, false)?;
             let read_ms = 1e3 * start.elapsed().as_secs_f64();
             let info = describe(&loaded, read_ms);
             if *json {

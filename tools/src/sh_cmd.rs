@@ -1,5 +1,5 @@
 //! `kage sh MAP`: the environment's SH coefficients, and optionally the irradiance they give.
-use crate::GpuArgs;
+use crate::args::GpuArgs;
 use anyhow::{Context as _, Result};
 use clap::Args;
 use kage::scene::EnvMap;
@@ -17,12 +17,12 @@ pub struct ShArgs {
 }
 
 fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
-    crate::parse_xyz(s).map(glam::Vec3::from_array)
+    crate::args::parse_xyz(s).map(glam::Vec3::from_array)
 }
 
 pub fn run(args: &ShArgs) -> Result<()> {
     let map = EnvMap::load(&args.map)?;
-    crate::report_clamped(&map);
+    crate::args::report_clamped(&map);
     let ctx = args.gpu.context()?;
     let sh = kage::frame::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
     print_coefficients(&sh);

@@ -3,9 +3,9 @@
 //! measures them (error against the ray-traced hard-shadow reference, GPU time side by side,
 //! shadow memory), written as the sweep's CSV and chart, with the picks.
 use super::{write_outputs, SweepArgs, Terms, FRAME_TIME};
-use crate::bench_asm::report::{points, ERROR_AXIS};
-use crate::bench_asm::{measure, AsmBenchArgs, DEFAULT_CONFIGS};
-use crate::sweep::chart;
+use crate::bench::asm::report::{points, ERROR_AXIS};
+use crate::bench::asm::{measure, AsmBenchArgs, DEFAULT_CONFIGS};
+use crate::chart;
 use anyhow::Result;
 use std::fmt::Write as _;
 

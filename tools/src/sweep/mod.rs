@@ -3,14 +3,14 @@
 //! while the scene moves, its precomputation time and its device memory, in `DIR/sweep.csv`;
 //! time against error in `DIR/pareto.png`; and, asked, the setting to pick under a bound.
 mod asm;
-pub(crate) mod chart;
 mod converged;
-pub(crate) mod pick;
 mod probes;
 
+use crate::args::GpuArgs;
+use crate::chart;
+use crate::chart::pick::{self, Point};
 use crate::progress::Bar;
 use crate::transfer_source::PrtArgs;
-use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use kage::backend::Context;
@@ -21,7 +21,6 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{EnvMap, Scene};
 use kage::techniques::description::{TechniqueDesc, TechniqueKind};
 use kage::techniques::tamura::technique::OcclusionSettings;
-use pick::Point;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -107,7 +106,7 @@ pub struct SweepArgs {
     /// probes: where the test points are, as `kage bench probe-count --test-region` (`box`:
     /// grids and placement over the static box, measured anywhere in it).
     #[arg(long, value_enum)]
-    test_region: Option<crate::bench_probe_count::TestRegion>,
+    test_region: Option<crate::bench::probe_count::TestRegion>,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -276,7 +275,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
 
 fn run_prt(args: &SweepArgs) -> Result<()> {
     let settings = chosen(&args.only)?;
-    let scene = crate::read_scene(args.scene.as_deref().unwrap_or("teapot"), !args.envs.is_empty())?;
+    let scene = crate::args::read_scene(args.scene.as_deref().unwrap_or("teapot"), !args.envs.is_empty())?;
     if scene.groups.is_empty() {
         bail!("scene {} has no groups to move", scene.name);
     }
@@ -287,7 +286,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
             .iter()
             .map(|path| {
                 let map = EnvMap::load(path).with_context(|| format!("--env {}", path.display()))?;
-                crate::report_clamped(&map);
+                crate::args::report_clamped(&map);
                 let name = path
                     .file_name()
                     .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into());

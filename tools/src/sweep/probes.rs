@@ -7,9 +7,9 @@
 //! here (SH storage and captures; the per-frame lookup is one walk per object whatever the
 //! count), so the chart's x axis counts probes and `--pick` takes `--max-probes`.
 use super::{write_outputs, SweepArgs, Terms};
-use crate::bench_probe_count::{measure, Params, TestRegion, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
-use crate::sweep::chart::Axes;
-use crate::sweep::pick::Point;
+use crate::bench::probe_count::{measure, Params, TestRegion, DEFAULT_GRIDS, DEFAULT_TOLERANCES};
+use crate::chart::pick::Point;
+use crate::chart::Axes;
 use anyhow::{bail, Context as _, Result};
 use kage::sh::ShRgb9;
 use kage::techniques::probes::CaptureSettings;
@@ -34,7 +34,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     if !args.only.is_empty() {
         bail!("--only: the probe sweep measures every grid level and tolerance together (the automatic placement starts from the finest grid)");
     }
-    let scene = crate::read_scene(args.scene.as_deref().unwrap_or("probe-room"), false)?;
+    let scene = crate::args::read_scene(args.scene.as_deref().unwrap_or("probe-room"), false)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let ctx = args.gpu.context()?;
     let cache = args.out.join("reference-cache");

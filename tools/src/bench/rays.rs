@@ -1,36 +1,15 @@
-//! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU; `kage bench
-//! probes` (in bench_probes.rs): how fast probe sets are tetrahedralized and looked up; `kage bench
-//! asm` (in bench_asm/): shadow-map techniques measured over a camera walkthrough.
+//! `kage bench rays`: how fast the BVH is built on the CPU and traversed on the GPU.
+use super::Pcg32;
+use crate::args::GpuArgs;
 use crate::progress::Bar;
-use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
-use clap::{Args, Subcommand};
+use clap::Args;
 use glam::Vec3;
 use kage::layouts::{constants, CastRay};
 use kage::prt::{directions, PrtParams};
 use kage::raycast::{offset_ray_origin, GpuBvh, GpuRays, Query, RayCaster, SceneBvh};
 use kage::scene::Scene;
 use std::time::Instant;
-
-#[derive(Subcommand)]
-pub enum BenchCommand {
-    /// BVH build time and size, and rays per second for coherent (camera) and incoherent
-    /// (random directions from random surface points) rays, closest hit and any hit.
-    Rays(RaysArgs),
-    /// Tetrahedralization time of random probe sets, and lookups per second, coherent (a moving
-    /// object) and cold (each from the first tetrahedron).
-    Probes(crate::bench_probes::ProbesBenchArgs),
-    /// Shadow-map techniques over a scene's camera walkthrough: pixels shadowed unlike the
-    /// ray-traced reference, GPU ms per pass and frame side by side, shadow memory, flicker
-    /// while the camera moves slowly, frames to converge at rest.
-    Asm(crate::bench_asm::AsmBenchArgs),
-    /// Light probes' irradiance error against the ray-cast truth as the probe count grows: a
-    /// grid with trilinear interpolation against automatic placement with tetrahedral.
-    ProbeCount(crate::bench_probe_count::ProbeCountArgs),
-    /// Costs as the scene grows: BVH build, PRT precomputation, device memory and frame time
-    /// per technique at 1k to 1M triangles of one scene family, with their log-log slopes.
-    Scale(crate::bench_scale::ScaleArgs),
-}
 
 #[derive(Args)]
 pub struct RaysArgs {
@@ -56,17 +35,7 @@ pub struct RaysArgs {
     gpu: GpuArgs,
 }
 
-pub fn run(command: &BenchCommand) -> Result<()> {
-    match command {
-        BenchCommand::Rays(args) => rays(args),
-        BenchCommand::Probes(args) => crate::bench_probes::run(args),
-        BenchCommand::Asm(args) => crate::bench_asm::run(args),
-        BenchCommand::ProbeCount(args) => crate::bench_probe_count::run(args),
-        BenchCommand::Scale(args) => crate::bench_scale::run(args),
-    }
-}
-
-fn rays(args: &RaysArgs) -> Result<()> {
+pub fn run(args: &RaysArgs) -> Result<()> {
     if args.runs == 0 {
         bail!("--runs must be at least 1");
     }
@@ -277,24 +246,4 @@ fn surface_rays(scene: &Scene, count: u32) -> Vec<CastRay> {
 
 fn ray(origin: Vec3, dir: Vec3) -> CastRay {
     CastRay { origin: origin.extend(1e30).to_array(), direction: dir.extend(0.0).to_array() }
-}
-
-/// PCG32 (O'Neill 2014): reproducible ray sets without a dependency.
-pub struct Pcg32(pub u64);
-
-impl Pcg32 {
-    /// Uniform in [0, 1).
-    pub fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        let x = ((((self.0 >> 18) ^ self.0) >> 27) as u32).rotate_right((self.0 >> 59) as u32);
-        (x >> 8) as f32 / (1 << 24) as f32
-    }
-
-    /// Uniform on the unit sphere.
-    pub fn unit_vector(&mut self) -> Vec3 {
-        let z = 2.0 * self.next() - 1.0;
-        let phi = std::f32::consts::TAU * self.next();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
 }

@@ -1,9 +1,11 @@
 //! GPU time against error on log scales (`kage sweep`'s `pareto.png`, `kage bench asm`'s
 //! `error-time.png`), one series per technique, the Pareto
 //! front drawn through the settings nothing beats.
-use super::pick::{pareto_front, Point};
+pub mod pick;
+
 use anyhow::{anyhow, Context as _, Result};
 use kage::files;
+use pick::{pareto_front, Point};
 use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 use std::path::Path;

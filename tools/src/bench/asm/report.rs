@@ -1,8 +1,8 @@
 //! What `kage bench asm` gathers per frame and reports per configuration: the table on stdout,
 //! `frames.csv`, `summary.csv` and the chart of error against frame time.
 use super::Config;
-use crate::sweep::chart;
-use crate::sweep::pick::Point;
+use crate::chart;
+use crate::chart::pick::Point;
 use anyhow::{Context as _, Result};
 use kage::pass::{median, PassTiming, TimingRow, TimingTable};
 use kage::reference::{frames_to_converge, ShadowFlips};

@@ -4,8 +4,8 @@
 //! build, PRT precomputation, device memory and frame time per technique, side by side in one
 //! run; `DIR/scale.csv` and a log-log chart `DIR/scale.png`, each curve's slope printed per
 //! decade.
-use crate::sweep::chart;
-use crate::GpuArgs;
+use crate::args::GpuArgs;
+use crate::chart;
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::Args;
 use glam::Vec3;

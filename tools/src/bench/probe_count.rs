@@ -14,8 +14,8 @@
 //! the reduction's probes with their own captures; the same probes with their SH fitted to
 //! every candidate's; and, as the engine runs it, relocated before the fit. Each grid is also
 //! measured fitted to the same candidates, to tell the fit's gain from the placement's.
+use crate::args::GpuArgs;
 use crate::bench::Pcg32;
-use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use glam::{DVec3, Vec3};
@@ -175,7 +175,7 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         args.points, args.normals, args.test_region.describe(), args.spp, args.cube_size, params.capture.light, ctx.info().name
     );
     for name in &args.scenes {
-        let scene = crate::read_scene(name, false)?;
+        let scene = crate::args::read_scene(name, false)?;
         let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {name}"))?;
         println!(
             "\nscene {}: {} test points; reference noise {:.4}, capture-at-the-point floor {:.4}; reference {:.1} s; capture {:.1} ms per probe",

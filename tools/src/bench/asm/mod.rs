@@ -12,8 +12,8 @@ mod frames;
 mod references;
 pub mod report;
 
+use crate::args::GpuArgs;
 use crate::progress::Bar;
-use crate::GpuArgs;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use kage::frame::MAX_SIZE;
