@@ -9,6 +9,12 @@ pub enum EnvCommand {
     /// Write a synthetic sun map (EXR, 32-bit float): a round sun of uniform radiance, alone or
     /// over a uniform sky and ground. The sun sits at (cos e·sin a, sin e, −cos e·cos a) for
     /// elevation e and azimuth a: azimuth 0 is −Z, 90 is +X.
+    ///
+    /// kage env sun [--elevation DEG] [--azimuth DEG] [--radius DEG] [--radiance R,G,B] [--sky
+    /// R,G,B] [--ground R,G,B] [--width W] --out MAP.exr: a synthetic sun map (equirectangular,
+    /// W×W/2, 32-bit float EXR): a disk of uniform radiance at (cos e·sin a, sin e, −cos e·cos a),
+    /// alone or over a uniform sky and ground (the test maps of tests/assets/sun/ come from
+    /// `scripts/test-maps.sh`)
     Sun {
         /// Degrees above the horizon, -90 to 90.
         #[arg(long, default_value_t = SunMap::DEFAULT.elevation_deg, allow_hyphen_values = true)]

@@ -16,16 +16,34 @@ use std::time::Instant;
 pub enum ProbesCommand {
     /// Delaunay tetrahedralization of a probe set: `{"positions": [[x,y,z], ...]}` in,
     /// `{"tetrahedra": [[i,j,k,l], ...]}` out (input indices, positively oriented).
+    ///
+    /// kage probes tetrahedralize --in PROBES.json --out TETS.json: the Delaunay tetrahedralization
+    /// of a probe set (see "Probes")
     Tetrahedralize(TetrahedralizeArgs),
     /// The tetrahedron holding a point and its four barycentric weights (outside the hull: those
     /// of the hull's nearest point).
+    ///
+    /// kage probes lookup --in PROBES.json --at x,y,z: the tetrahedron holding a point, its four
+    /// probes and their barycentric weights, and whether the point was outside the hull
+    /// (extrapolated)
     Lookup(LookupArgs),
     /// A probe from an equirectangular photograph or HDR image: its 9 SH coefficients per
     /// channel and the irradiance at the six axis normals.
+    ///
+    /// kage probes capture-image IMAGE [--out PROBE.json] [--dering W]: a probe from an
+    /// equirectangular photo or HDR image (as the paper captured street-view panoramas): its 9×3 SH
+    /// coefficients (the projection of `kage sh`, identical) and the irradiance at the six axis
+    /// normals; `--out` writes `{"sh": [[r,g,b] × 9], "irradiance": {"+x": [r,g,b], ...}}`
     CaptureImage(crate::probe_image::CaptureImageArgs),
     /// Automatic placement: candidates on a grid over the scene's static groups (those inside
     /// solids dropped) are captured, the redundant ones dropped; the kept positions are written
     /// as a probe file for `kage render --probes FILE`.
+    ///
+    /// kage probes place [--scene S] [--probes auto:TOL] [--probe-cube-size N] [--probe-light
+    /// sky-and-walls|sky] --out PROBES.json: automatic placement once: prints how many of the
+    /// candidates are kept and writes their positions for `--probes PROBES.json` (a render from the
+    /// file captures each position: the fit to the candidates needs them, so it is `--probes
+    /// auto`'s alone)
     Place(PlaceArgs),
 }
 

@@ -13,6 +13,13 @@ pub enum SceneCommand {
     /// every mesh as OBJ (--format json) or the groups, meshes, lights, camera and motion as
     /// DIR/scene.glb (--format gltf, which Blender and three.js open); `kage render --scene
     /// DIR` renders the same picture.
+    ///
+    /// kage scene export [--scene NAME|FILE] --out DIR [--format json|gltf]: writes
+    /// `DIR/scene.json` and the environment as 32-bit EXR, with every mesh as OBJ (`json`, the
+    /// default) or the groups, meshes, lights, camera and motion as `DIR/scene.glb` (`gltf`: opens
+    /// in Blender and three.js, see "glTF 2.0"); `--scene DIR` reads `DIR/scene.json` back (a
+    /// folder without one never hides a built-in name); either folder reads back as the same scene
+    /// and renders exactly the built-in scene's picture with every technique (tested)
     Export {
         /// A built-in scene name or a scene file.
         #[arg(long, default_value = "teapot")]
@@ -25,6 +32,11 @@ pub enum SceneCommand {
     /// What Kage made of a scene: the time to read it, its groups (meshes, triangles, albedo
     /// maps, moving or static: the moving ones are those with keyframes, which the probes light),
     /// lights and camera.
+    ///
+    /// kage scene info [--scene NAME|FILE] [--json]: what Kage made of a scene: the time to read
+    /// it, triangles, vertices and albedo-map texels, each group's meshes, triangles and albedo
+    /// maps and whether it moves (the groups with keyframes, which the probes light; without any,
+    /// the first), the lights
     Info {
         /// A built-in scene name, a scene file, or a glTF or OBJ file.
         #[arg(long, default_value = "teapot")]
