@@ -51,12 +51,7 @@ impl Drop for Validated {
 pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Scene {
     Scene {
         name: "test".into(),
-        groups: vec![Group {
-            name: "object".into(),
-            meshes: vec![mesh],
-            transform: Transform::default(),
-            motion: None,
-        }],
+        groups: vec![Group::new("object", vec![mesh], Transform::default())],
         environment,
         lights: vec![],
         walkthrough: vec![],

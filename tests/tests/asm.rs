@@ -194,12 +194,7 @@ fn grazing_light_with_the_id_and_the_bias_test() {
     let ctx = Validated::new();
     let cube = shapes::boxes("box", &[([-0.3, 0.0, -0.3], [0.3, 0.6, 0.3])], [0.8; 3]).unwrap();
     let floor = shapes::plane("floor", [8.0, 8.0], [9, 9], [0.6; 3]).unwrap();
-    let group = |name: &str, mesh| Group {
-        name: name.into(),
-        meshes: vec![mesh],
-        transform: Transform::default(),
-        motion: None,
-    };
+    let group = |name: &str, mesh| Group::new(name, vec![mesh], Transform::default());
     let scene = Scene {
         name: "grazing".into(),
         groups: vec![group("box", cube), group("floor", floor)],

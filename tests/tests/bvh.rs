@@ -76,22 +76,23 @@ fn random_transform(rng: &mut Rng) -> Transform {
 /// Groups of scattered random triangles (one or two meshes each) under random transforms.
 fn random_scene(rng: &mut Rng, groups: usize, triangles: usize) -> Scene {
     let groups = (0..groups)
-        .map(|g| Group {
-            name: format!("group{g}"),
-            meshes: (0..1 + g % 2)
-                .map(|m| {
-                    let positions: Vec<[f32; 3]> = (0..triangles)
-                        .flat_map(|_| {
-                            let centre = rng.vec(1.0);
-                            [0; 3].map(|_| (centre + rng.vec(0.3)).to_array())
-                        })
-                        .collect();
-                    let indices = (0..3 * triangles as u32).collect();
-                    Mesh::new(format!("mesh{m}"), positions, None, indices, [0.5; 3]).unwrap()
-                })
-                .collect(),
-            transform: random_transform(rng),
-            motion: None,
+        .map(|g| {
+            Group::new(
+                format!("group{g}"),
+                (0..1 + g % 2)
+                    .map(|m| {
+                        let positions: Vec<[f32; 3]> = (0..triangles)
+                            .flat_map(|_| {
+                                let centre = rng.vec(1.0);
+                                [0; 3].map(|_| (centre + rng.vec(0.3)).to_array())
+                            })
+                            .collect();
+                        let indices = (0..3 * triangles as u32).collect();
+                        Mesh::new(format!("mesh{m}"), positions, None, indices, [0.5; 3]).unwrap()
+                    })
+                    .collect(),
+                random_transform(rng),
+            )
         })
         .collect();
     scene(groups)
@@ -397,8 +398,7 @@ fn scenes_without_triangles_miss_everything() {
     let mut caster = RayCaster::new(&ctx).unwrap();
     let mut rng = Rng(4);
     let rays: Vec<(Vec3, Vec3, f32)> = (0..64).map(|_| (rng.vec(2.0), rng.direction(), INFINITE)).collect();
-    let empty_group =
-        Group { name: "empty".into(), meshes: vec![], transform: Transform::default(), motion: None };
+    let empty_group = Group::new("empty", vec![], Transform::default());
     for groups in [vec![], vec![empty_group]] {
         let instances = groups.len() as u32;
         let mut bvh = SceneBvh::build(&scene(groups)).unwrap();

@@ -64,12 +64,7 @@ fn scene(groups: Vec<Group>) -> Scene {
 }
 
 fn group(name: &str, meshes: Vec<Mesh>, translation: Vec3) -> Group {
-    Group {
-        name: name.into(),
-        meshes,
-        transform: Transform { translation, ..Transform::default() },
-        motion: None,
-    }
+    Group::new(name, meshes, Transform { translation, ..Transform::default() })
 }
 
 /// The static group: a floor and a box on it, so that the probe grid over it is 3D.
@@ -277,8 +272,7 @@ fn meshes_without_triangles_are_errors_and_empty_groups_draw_nothing() {
     );
     assert_error_says(Renderer::new(&ctx, &stray_index, &RenderOptions::default()), &["vertex index 99"]);
 
-    let nothing =
-        Group { name: "nothing".into(), meshes: vec![], transform: Transform::default(), motion: None };
+    let nothing = Group::new("nothing", vec![], Transform::default());
     for scene in [scene(vec![]), scene(vec![nothing.clone()]), scene(vec![nothing, room()])] {
         let groups = scene.groups.len();
         for (kind, options) in every_technique(&ctx, &scene) {

@@ -21,11 +21,12 @@ fn sun_map() -> EnvMap {
 /// A small sphere over a floor, under the sun. No group has keyframes, so the first, the sphere,
 /// is the moving one the probes light (`ProbeGroups`' fallback).
 fn sun_scene() -> Scene {
-    let group = |name: &str, mesh, y: f32| Group {
-        name: name.into(),
-        meshes: vec![mesh],
-        transform: Transform { translation: Vec3::new(0.0, y, 0.0), ..Transform::default() },
-        motion: None,
+    let group = |name: &str, mesh, y: f32| {
+        Group::new(
+            name,
+            vec![mesh],
+            Transform { translation: Vec3::new(0.0, y, 0.0), ..Transform::default() },
+        )
     };
     Scene {
         name: "sun".into(),

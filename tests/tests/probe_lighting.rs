@@ -256,7 +256,7 @@ fn captured_scene_light_matches_the_reference_with_bounces() {
 fn shelter() -> Group {
     let boxes = [([-2.5, -0.1, -1.5], [2.5, 0.0, 1.5]), ([-2.5, 1.2, -1.5], [0.0, 1.3, 1.5])];
     let mesh = shapes::boxes("shelter", &boxes, [0.5; 3]).unwrap();
-    Group { name: "shelter".into(), meshes: vec![mesh], transform: Transform::default(), motion: None }
+    Group::new("shelter", vec![mesh], Transform::default())
 }
 
 /// Where a card is in the open and under the roof, between the probes.

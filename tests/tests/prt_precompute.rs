@@ -16,12 +16,7 @@ fn scene_of(groups: Vec<Vec<Mesh>>) -> Scene {
     scene.groups = groups
         .into_iter()
         .enumerate()
-        .map(|(i, meshes)| Group {
-            name: format!("group{i}"),
-            meshes,
-            transform: Transform::default(),
-            motion: None,
-        })
+        .map(|(i, meshes)| Group::new(format!("group{i}"), meshes, Transform::default()))
         .collect();
     scene
 }

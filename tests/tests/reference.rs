@@ -22,7 +22,7 @@ fn plane(size: f32) -> Mesh {
 }
 
 fn group(name: &str, mesh: Mesh, transform: Transform) -> Group {
-    Group { name: name.into(), meshes: vec![mesh], transform, motion: None }
+    Group::new(name, vec![mesh], transform)
 }
 
 /// Low and to the side, aimed at the origin: the centre pixel of an odd-sized image looks

@@ -25,12 +25,7 @@ fn spot_at(position: Vec3) -> Light {
 fn box_over_floor_lit_from(light: Vec3) -> Scene {
     let cube = shapes::boxes("box", &[([-0.5, 0.5, -0.5], [0.5, 1.0, 0.5])], [0.8; 3]).unwrap();
     let floor = shapes::plane("floor", [6.0, 6.0], [2, 2], [0.6; 3]).unwrap();
-    let group = |name: &str, mesh| Group {
-        name: name.into(),
-        meshes: vec![mesh],
-        transform: Transform::default(),
-        motion: None,
-    };
+    let group = |name: &str, mesh| Group::new(name, vec![mesh], Transform::default());
     Scene {
         name: "box-over-floor".into(),
         groups: vec![group("box", cube), group("floor", floor)],

@@ -161,12 +161,11 @@ fn test_env(name: &str) -> EnvMap {
 }
 
 fn sphere_group(name: &str, radius: f32, centre: Vec3) -> Group {
-    Group {
-        name: name.into(),
-        meshes: vec![shapes::sphere(name, radius, 32, [0.75; 3]).unwrap()],
-        transform: Transform { translation: centre, ..Transform::default() },
-        motion: None,
-    }
+    Group::new(
+        name,
+        vec![shapes::sphere(name, radius, 32, [0.75; 3]).unwrap()],
+        Transform { translation: centre, ..Transform::default() },
+    )
 }
 
 /// Case 1: Two occluders overlapping within one region: two spheres stacked on the floor's normal
@@ -183,12 +182,11 @@ fn sphere_group(name: &str, radius: f32, centre: Vec3) -> Group {
 fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
     let ctx = Validated::new();
     let (radius, low, high) = (0.25f32, 0.6f32, 1.2f32);
-    let floor = Group {
-        name: "floor".into(),
-        meshes: vec![shapes::plane("floor", [6.0, 6.0], [31, 31], [0.6; 3]).unwrap()],
-        transform: Transform::default(),
-        motion: None,
-    };
+    let floor = Group::new(
+        "floor",
+        vec![shapes::plane("floor", [6.0, 6.0], [31, 31], [0.6; 3]).unwrap()],
+        Transform::default(),
+    );
     let base = Scene::builtin("teapot").unwrap();
     let scene_of = |name: &str, spheres: Vec<Group>| Scene {
         name: name.into(),

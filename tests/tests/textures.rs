@@ -46,7 +46,7 @@ fn box_on_floor(textured: bool) -> Scene {
     }
     let floor = shapes::plane("floor", [4.0, 4.0], [9, 9], [0.6; 3]).unwrap();
     let at = Transform { translation: Vec3::new(0.0, -0.5, 0.0), ..Transform::default() };
-    scene.groups.push(Group { name: "floor".into(), meshes: vec![floor], transform: at, motion: None });
+    scene.groups.push(Group::new("floor", vec![floor], at));
     scene.lights.push(Light::Spot {
         position: Vec3::new(1.0, 3.0, 2.5),
         direction: Vec3::new(-1.0, -3.0, -2.5).normalize(),

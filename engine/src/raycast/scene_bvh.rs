@@ -262,11 +262,12 @@ mod tests {
     use crate::scene::{shapes, Camera, EnvMap, Group, Transform};
 
     fn two_spheres() -> Scene {
-        let sphere = |name: &str, x: f32| Group {
-            name: name.into(),
-            meshes: vec![shapes::sphere(name, 1.0, 12, [0.5; 3]).unwrap()],
-            transform: Transform { translation: Vec3::new(x, 0.0, 0.0), ..Transform::default() },
-            motion: None,
+        let sphere = |name: &str, x: f32| {
+            Group::new(
+                name,
+                vec![shapes::sphere(name, 1.0, 12, [0.5; 3]).unwrap()],
+                Transform { translation: Vec3::new(x, 0.0, 0.0), ..Transform::default() },
+            )
         };
         Scene {
             name: "spheres".into(),

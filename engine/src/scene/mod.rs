@@ -23,8 +23,6 @@ use std::path::Path;
 
 pub mod albedo_map;
 pub mod animation;
-mod asm_room;
-pub mod atrium;
 mod builtin;
 mod camera;
 pub mod clusters;
@@ -39,7 +37,6 @@ mod mesh;
 pub mod motion;
 mod obj;
 mod probe;
-mod probe_room;
 pub mod shapes;
 mod sun_map;
 mod transform;
@@ -99,6 +96,11 @@ pub struct Group {
 }
 
 impl Group {
+    /// A group at rest at `transform` (no keyframes).
+    pub fn new(name: impl Into<String>, meshes: Vec<Mesh>, transform: Transform) -> Group {
+        Group { name: name.into(), meshes, transform, motion: None }
+    }
+
     /// The largest coordinate of its meshes along any axis, in object space.
     pub fn object_reach(&self) -> f32 {
         let coordinates = self.meshes.iter().flat_map(|m| m.positions.iter().flatten());

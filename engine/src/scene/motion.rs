@@ -219,7 +219,7 @@ mod tests {
         )
         .unwrap();
         let base = Transform { translation: Vec3::new(0.0, 0.5, 0.0), ..Transform::default() };
-        let group = Group { name: "g".into(), meshes: vec![mesh], transform: base, motion: None };
+        let group = Group::new("g", vec![mesh], base);
         let group = Group { motion: Some(hop(&group)), ..group };
         group.motion.as_ref().unwrap().validate().unwrap();
         let at = |t| group.pose_at(t).matrix();

@@ -199,12 +199,11 @@ fn scene(triangles: u32) -> Result<Scene> {
         })
         .collect();
     let blob = Mesh::new("blob", positions, None, sphere.indices.clone(), [0.75; 3])?;
-    scene.groups[0] = motion::hopping(Group {
-        name: "blob".into(),
-        meshes: vec![blob],
-        transform: Transform { translation: Vec3::new(0.0, 0.5, 0.0), ..Transform::default() },
-        motion: None,
-    });
+    scene.groups[0] = motion::hopping(Group::new(
+        "blob",
+        vec![blob],
+        Transform { translation: Vec3::new(0.0, 0.5, 0.0), ..Transform::default() },
+    ));
     scene.lights.push(
         Light::Spot {
             position: Vec3::new(1.0, 3.0, 1.0),

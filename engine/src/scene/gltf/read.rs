@@ -221,7 +221,7 @@ fn read(path: &Path, wanted_camera: Option<&str>, group_names: &[String]) -> Res
             let (scale, rotation, translation) = top_matrix.to_scale_rotation_translation();
             Transform { translation, rotation, scale: uniform(scale)? }
         };
-        groups.push(Group { name: node_name(&top), meshes, transform, motion: None });
+        groups.push(Group::new(node_name(&top), meshes, transform));
         let ancestors = std::iter::successors(parent[top.index()], |&a| parent[a]).collect::<Vec<_>>();
         group_nodes.push(GroupNode { node: top.index(), ancestors: ancestors.into_iter().rev().collect() });
     }

@@ -185,7 +185,7 @@ mod tests {
         let normals = vec![[0.0, 1.0, 0.0]; positions.len()];
         let mesh =
             Mesh { name: "grid".into(), positions, normals, indices, albedo: [0.5; 3], texturing: None };
-        Group { name: "floor".into(), meshes: vec![mesh], transform: Transform::default(), motion: None }
+        Group::new("floor", vec![mesh], Transform::default())
     }
 
     fn corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {

@@ -4,10 +4,16 @@
 use super::motion;
 use glam::Vec3;
 
-use super::{atrium, obj, probe_room, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
+mod asm_room;
+pub mod atrium;
+mod probe_room;
 
-const TEAPOT_OBJ: &[u8] = include_bytes!("../../assets/teapot.obj");
-const COURTYARD_EXR: &[u8] = include_bytes!("../../assets/courtyard.exr");
+use super::{obj, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
+
+const TEAPOT_OBJ: &[u8] = include_bytes!("../../../assets/teapot.obj");
+const COURTYARD_EXR: &[u8] = include_bytes!("../../../assets/courtyard.exr");
+/// The Stanford bunny (3,674 triangles) that probe-room, the atrium and the asm scene place.
+const BUNNY_OBJ: &[u8] = include_bytes!("../../../assets/bunny.obj");
 
 /// The teapot's bounds in its OBJ: +Y up, centred on the origin, 15.75 units tall.
 const TEAPOT_HEIGHT: f32 = 15.75;
@@ -34,7 +40,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     let floor_vertices = match name {
         "teapot" => 31,
         "teapot-hires-floor" => 111,
-        "asm" => return super::asm_room::asm_scene(),
+        "asm" => return asm_room::asm_scene(),
         _ => {
             return Err(SceneError::invalid(format!(
                 "no built-in scene \"{name}\"; the built-in scenes are: {}",
@@ -56,18 +62,8 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     Ok(Scene {
         name: name.to_string(),
         groups: vec![
-            motion::hopping(Group {
-                name: "teapot".into(),
-                meshes: vec![teapot],
-                transform: teapot_transform,
-                motion: None,
-            }),
-            Group {
-                name: "floor".into(),
-                meshes: vec![floor],
-                transform: Transform::default(),
-                motion: None,
-            },
+            motion::hopping(Group::new("teapot", vec![teapot], teapot_transform)),
+            Group::new("floor", vec![floor], Transform::default()),
         ],
         environment,
         lights: Vec::new(),

@@ -2,12 +2,11 @@
 //! red wall (−X), a green wall (+X), a blue wall (−Z) and grey floor, front wall and ceiling,
 //! a 1.2 × 1.2 opening in the ceiling through which the sky shows, and the Stanford bunny
 //! standing under the opening as group 0 (the group `--animate` moves).
-use super::motion;
+use crate::scene::motion;
 use glam::Vec3;
 
-use super::{obj, shapes, Group, Mesh, SceneError, Transform};
+use crate::scene::{obj, shapes, Group, Mesh, SceneError, Transform};
 
-const BUNNY_OBJ: &[u8] = include_bytes!("../../assets/bunny.obj");
 /// The bunny's bounds in its OBJ: +Y up, standing on y = 0, 9.65 units tall.
 const BUNNY_HEIGHT: f32 = 9.65;
 
@@ -27,7 +26,7 @@ const BLUE: [f32; 3] = [0.1, 0.1, 0.7];
 
 /// The bunny (group 0) and the room (group 1).
 pub fn groups() -> Result<Vec<Group>, SceneError> {
-    let bunny = obj::parse_obj(BUNNY_OBJ, "bunny", [0.75; 3])?;
+    let bunny = obj::parse_obj(super::BUNNY_OBJ, "bunny", [0.75; 3])?;
     let bunny_transform = Transform { scale: 0.7 / BUNNY_HEIGHT, ..Transform::default() };
     let (h, o, top) = (HALF, OPENING, HEIGHT);
     let v = Vec3::new;
@@ -44,13 +43,8 @@ pub fn groups() -> Result<Vec<Group>, SceneError> {
         panel("ceiling_right", v(o, top, -o), v(h, top, o), Vec3::NEG_Y, GREY)?,
     ];
     Ok(vec![
-        motion::hopping(Group {
-            name: "bunny".into(),
-            meshes: vec![bunny],
-            transform: bunny_transform,
-            motion: None,
-        }),
-        Group { name: "room".into(), meshes: room, transform: Transform::default(), motion: None },
+        motion::hopping(Group::new("bunny", vec![bunny], bunny_transform)),
+        Group::new("room", room, Transform::default()),
     ])
 }
 

@@ -12,12 +12,11 @@
 //!   and back. The scene has no walkthrough, so `--animate` moves the bunny.
 //!
 //! 1,440 triangles (120 boxes) besides the bunny's 3,674: light for lavapipe.
-use super::motion;
+use crate::scene::motion;
 use glam::Vec3;
 
-use super::{obj, shapes, Camera, Group, Mesh, SceneError, Transform};
+use crate::scene::{obj, shapes, Camera, Group, Mesh, SceneError, Transform};
 
-const BUNNY_OBJ: &[u8] = include_bytes!("../../assets/bunny.obj");
 /// The bunny's height in its OBJ (+Y up, standing on y = 0).
 const BUNNY_HEIGHT: f32 = 9.655;
 const BUNNY_SIZE: f32 = 0.9;
@@ -130,7 +129,7 @@ pub fn bunny_rest() -> Vec3 {
 
 /// The bunny (group 0) and the building (group 1).
 pub fn groups() -> Result<Vec<Group>, SceneError> {
-    let bunny = obj::parse_obj(BUNNY_OBJ, "bunny", [0.8; 3])?;
+    let bunny = obj::parse_obj(super::BUNNY_OBJ, "bunny", [0.8; 3])?;
     let (columns, arches) = arcade();
     let (floor, walls, roof) = shell();
     let stone = [0.75, 0.7, 0.6];
@@ -146,13 +145,8 @@ pub fn groups() -> Result<Vec<Group>, SceneError> {
     let bunny_transform =
         Transform { translation: bunny_rest(), scale: BUNNY_SIZE / BUNNY_HEIGHT, ..Transform::default() };
     Ok(vec![
-        motion::hopping(Group {
-            name: "bunny".into(),
-            meshes: vec![bunny],
-            transform: bunny_transform,
-            motion: None,
-        }),
-        Group { name: "building".into(), meshes, transform: Transform::default(), motion: None },
+        motion::hopping(Group::new("bunny", vec![bunny], bunny_transform)),
+        Group::new("building", meshes, Transform::default()),
     ])
 }
 

@@ -19,9 +19,8 @@
 //! bunny's, with the camera resting at each.
 use glam::{Quat, Vec3};
 
-use super::{obj, shapes, Camera, EnvMap, Group, Light, Scene, SceneError, Transform};
+use crate::scene::{obj, shapes, Camera, EnvMap, Group, Light, Scene, SceneError, Transform};
 
-const BUNNY_OBJ: &[u8] = include_bytes!("../../assets/bunny.obj");
 /// The bunny's height in its OBJ (+Y up, standing on y = 0).
 const BUNNY_HEIGHT: f32 = 9.655;
 
@@ -103,15 +102,10 @@ fn camera(position: [f32; 3], target: [f32; 3], fov_y_deg: f32) -> Camera {
 
 pub fn asm_scene() -> Result<Scene, SceneError> {
     let context = |e: SceneError| e.within("built-in scene \"asm\"");
-    let bunny = obj::parse_obj(BUNNY_OBJ, "bunny", [0.8; 3]).map_err(context)?;
+    let bunny = obj::parse_obj(super::BUNNY_OBJ, "bunny", [0.8; 3]).map_err(context)?;
     let boxes =
         |name: &str, bars: Vec<Bar>, albedo: f32| shapes::boxes(name, &bars, [albedo; 3]).map_err(context);
-    let group = |name: &str, mesh, transform| Group {
-        name: name.into(),
-        meshes: vec![mesh],
-        transform,
-        motion: None,
-    };
+    let group = |name: &str, mesh, transform| Group::new(name, vec![mesh], transform);
     let bunny_transform = Transform {
         translation: Vec3::new(-1.2, 0.0, 0.6),
         rotation: Quat::from_rotation_y(30f32.to_radians()),
