@@ -80,6 +80,7 @@ impl Error {
             | Error::Timeout(_) => Fault::Device,
             Error::Scene(e) if e.out_of_memory() => Fault::Device,
             Error::Scene(e) if e.file().is_some() => Fault::File,
+            Error::Image(e) if e.by_caller() => Fault::Caller,
             Error::Image(_) => Fault::File,
             Error::Probes(ProbeError::FitDiverged { .. }) => Fault::Internal,
             Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) | Error::Cancelled(_) => {

@@ -94,6 +94,8 @@ fn code_of(error: &Error) -> kage_result {
         Error::Vulkan { .. } | Error::Timeout(_) => kage_result::Vulkan,
         // A scene error names a file when one was read; otherwise the host's data is at fault.
         Error::Scene(e) if e.file().is_some() => kage_result::File,
+        // An image the host asked for in a format or at an exposure Kage does not write.
+        Error::Image(e) if e.by_caller() => kage_result::InvalidValue,
         Error::Image(_) => kage_result::File,
         Error::Probes(crate::error::ProbeError::FitDiverged { .. }) | Error::Internal(_) => {
             kage_result::Internal
@@ -209,6 +211,10 @@ mod tests {
         let in_mesh = crate::scene::SceneError::from(host).within("mesh 0");
         assert_eq!(boundary(|| Err(Error::from(in_mesh).into())), kage_result::OutOfMemory);
         assert_eq!(last_message(), "mesh 0: out of host memory for positions (12 bytes)");
+        // An image format Kage does not write is the caller's value, not a file's fault.
+        let jpg = crate::imageio::ImageIoError::UnsupportedExtension { path: "a/b.jpg".into() };
+        assert_eq!(boundary(|| Err(Error::from(jpg).into())), kage_result::InvalidValue);
+        assert!(last_message().contains("\".jpg\""), "{}", last_message());
     }
 
     #[test]

@@ -213,7 +213,7 @@ impl Scene {
         let indices = self.meshes().map(|(_, m)| m.indices.len()).sum();
         check_index_count(indices).map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         for (l, light) in self.lights.iter().enumerate() {
-            light.validated().map_err(|e| e.within(&format!("scene \"{}\": light {l}", self.name)))?;
+            light.validated_as(l).map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         }
         self.camera.validated().map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         animation::check_walkthrough(&self.walkthrough)
