@@ -3,7 +3,12 @@
  * Handles are opaque values, not addresses; each has a create/destroy pair, and a destroyed handle
  * stays invalid (KAGE_RESULT_INVALID_HANDLE) for good. Threading: any function may be called
  * from any thread; a call on a handle that another thread's call is using returns
- * KAGE_RESULT_BUSY and does nothing; calls on different handles may run at the same time.
+ * KAGE_RESULT_BUSY and does nothing (a destroy too: the handle stays valid, call it again once
+ * the other call has returned); calls on different handles may run at the same time.
+ * Arrays the host fills (a buffer or array, its capacity, and where the count or length it
+ * needs goes): NULL with capacity 0 asks for that count alone and returns KAGE_RESULT_OK; an
+ * array too small gets as much as fits and KAGE_RESULT_BUFFER_TOO_SMALL (the count still
+ * written); NULL with a capacity is KAGE_RESULT_NULL_ARGUMENT.
  * Compatibility: KAGE_ABI_VERSION rises with every incompatible change to this header, and
  * libkage.so carries it in its SONAME (libkage.so.1); check kage_abi_version() against it at
  * start-up. Every top-level desc struct (context, Vulkan handles, technique, renderer, scene)
@@ -399,11 +404,13 @@ typedef uint32_t kage_probe_dering;
 #endif // __cplusplus
 
 /**
- * The version of the C ABI kage.h declares. It rises with every incompatible change (a struct
- * field added, removed or moved, a function's parameters, an enumeration's values), and
- * libkage.so carries it in its SONAME (`libkage.so.1`). A host checks at start-up that
- * `kage_abi_version()` equals the `KAGE_ABI_VERSION` it was compiled with; beyond that, every
- * top-level desc struct carries its `size`, which each call checks.
+ * The version of the C ABI kage.h declares. It rises with every incompatible change that no
+ * `size` field catches (a field of a small struct added, removed or moved, a function's
+ * parameters, an enumeration's values), and libkage.so carries it in its SONAME
+ * (`libkage.so.1`). A host checks at start-up that `kage_abi_version()` equals the
+ * `KAGE_ABI_VERSION` it was compiled with; beyond that, every top-level desc struct carries its
+ * `size`, which each call checks: one that grew (fields appended) refuses a host compiled
+ * against the older kage.h with `KAGE_RESULT_INVALID_VALUE` naming it.
  */
 enum kage_abi
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -834,6 +841,13 @@ typedef struct {
   uint32_t group_count;
   kage_environment_desc environment;
   kage_camera_desc camera;
+  /**
+   * Point and spot lights (as `kage_renderer_set_light` takes them; NULL when `light_count`
+   * is 0), checked as a scene file's lights are. `KAGE_TECHNIQUE_SHADOW_MAP` and
+   * `KAGE_TECHNIQUE_ASM` light a scene by them, and need at least one.
+   */
+  const kage_light_desc *lights;
+  uint32_t light_count;
 } kage_scene_desc;
 
 /**
@@ -909,13 +923,15 @@ kage_result kage_context_create_from_vulkan(const kage_vulkan_handles *handles,
 /**
  * Destroys a context handle. Renderers made with it keep the device alive until they are
  * destroyed too (they hold their own reference); scenes do not depend on it. NULL is allowed
- * and does nothing. The handle must not be used afterwards.
+ * and does nothing. The handle must not be used after OK; on `KAGE_RESULT_BUSY` (a call on
+ * another thread is using it) nothing was destroyed: call again once that call has returned.
  */
 kage_result kage_context_destroy(kage_context *context);
 
 /**
  * Writes the device's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)") into `buffer` as a
- * NUL-terminated string; as `kage_last_error_message` for `capacity` and `length`.
+ * NUL-terminated string; as `kage_last_error_message` for `capacity` and `length` (NULL with
+ * capacity 0 asks for the length alone).
  *
  * # Safety
  * `context` must be NULL or a handle; `buffer` NULL or `capacity` writable bytes; `length`
@@ -963,9 +979,11 @@ kage_result kage_renderer_create_with(const kage_context *context,
                                       kage_renderer **renderer);
 
 /**
- * Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The
- * handle must not be used afterwards (also when this fails with `KAGE_RESULT_VALIDATION`,
- * which reports what the layer said while its objects were destroyed).
+ * Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing.
+ * After `KAGE_RESULT_OK` the handle must not be used, nor after `KAGE_RESULT_VALIDATION`
+ * (the renderer was destroyed, and this reports what the layer said meanwhile). On
+ * `KAGE_RESULT_BUSY` (a call on another thread is using the renderer) nothing was destroyed
+ * and the handle stays valid: call again once that call has returned.
  */
 kage_result kage_renderer_destroy(kage_renderer *renderer);
 
@@ -1048,6 +1066,23 @@ kage_result kage_renderer_read_pixels(const kage_renderer *renderer,
                                       size_t size);
 
 /**
+ * Writes the last frame to the file `path` (UTF-8) as `kage render --out` does, in the format
+ * its extension names (any case): `.png`, radiance × `exposure` (finite, at least 0)
+ * tonemapped and sRGB-encoded as `KAGE_PIXEL_FORMAT_RGBA8_SRGB` is, 8-bit RGB, written to a
+ * temporary file renamed over `path` (a failed write leaves no partial file); `.exr`, linear
+ * radiance as 32-bit float RGB (`exposure` is ignored). Another extension, or a bad exposure,
+ * is `KAGE_RESULT_INVALID_VALUE` naming it; a file that cannot be written (no such folder, no
+ * permission, a full disk) is `KAGE_RESULT_FILE` naming the path. Before the first
+ * `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
+ *
+ * # Safety
+ * `path` NULL or a NUL-terminated string.
+ */
+kage_result kage_renderer_write_image(const kage_renderer *renderer,
+                                      const char *path,
+                                      float exposure);
+
+/**
  * Writes to `*exposure` the exposure that makes the last frame readable whatever its units
  * (what `kage render --exposure auto` uses): 0.18 over the log-average Rec. 709 luminance of
  * its linear pixels, exp(mean ln(10⁻⁴ + L)); 1 for a black frame. Pass it to
@@ -1072,10 +1107,10 @@ kage_result kage_renderer_frame_time(const kage_renderer *renderer, double *mill
 
 /**
  * Copies the last frame's per-pass GPU timings, in the order the passes ran, into `timings`
- * (room for `capacity`), and writes how many passes the frame had to `*count`. When `capacity`
- * is smaller, the first `capacity` are written and `KAGE_RESULT_BUFFER_TOO_SMALL` is returned;
- * `timings` may be NULL when `capacity` is 0 (to ask for the count). Before the first frame
- * the count is 0.
+ * (room for `capacity`), and writes how many passes the frame had to `*count`, as every call
+ * that fills an array does (see the top of this header: NULL with capacity 0 asks for the
+ * count alone; a shorter array gets the first `capacity` and `KAGE_RESULT_BUFFER_TOO_SMALL`).
+ * Before the first frame the count is 0.
  *
  * # Safety
  * `timings` NULL or
@@ -1129,8 +1164,15 @@ kage_result kage_scene_load(const char *path, kage_scene **scene);
  * Bad data is `KAGE_RESULT_INVALID_VALUE` naming the group and mesh: no groups or meshes,
  * NaN or infinite values (but a zero or non-finite normal is recomputed: see
  * `kage_mesh_desc`), indices out of range or not a multiple of 3, albedo outside [0, 1], a map
- * that is not 2:1, a degenerate camera or transform. A NULL array with a non-zero count
- * is `KAGE_RESULT_NULL_ARGUMENT`.
+ * that is not 2:1, a degenerate camera or transform, a bad light (named `light N`, as in a
+ * scene file). A NULL array with a non-zero count is `KAGE_RESULT_NULL_ARGUMENT`.
+ *
+ * Counts beyond what Kage represents are `KAGE_RESULT_INVALID_VALUE` before anything is read
+ * or allocated, the message naming the field, its value and the limit: a mesh's
+ * `vertex_count` above 134217727 (32 bytes a vertex on the GPU, within 4 GiB), an
+ * `index_count` (of a mesh, or of all meshes together) above 805306368 (268435456 triangles,
+ * what the ray tracer numbers), a map beyond 16384x8192. Within them, memory the copies need
+ * and the machine does not give is `KAGE_RESULT_OUT_OF_MEMORY`, never an abort.
  *
  * On success `*scene` is a new handle that the host owns and frees with `kage_scene_destroy`;
  * on failure it is set to NULL.
@@ -1143,7 +1185,9 @@ kage_result kage_scene_create(const kage_scene_desc *desc, kage_scene **scene);
 
 /**
  * Destroys a scene handle. Renderers made from it keep what they need and stay usable. NULL is
- * allowed and does nothing. The handle must not be used afterwards.
+ * allowed and does nothing. The handle must not be used after OK; on `KAGE_RESULT_BUSY` (a
+ * call on another thread is using it) nothing was destroyed: call again once that call has
+ * returned.
  */
 kage_result kage_scene_destroy(kage_scene *scene);
 
@@ -1155,6 +1199,16 @@ kage_result kage_scene_destroy(kage_scene *scene);
  * `scene` must be NULL or a handle; `count` NULL or writable.
  */
 kage_result kage_scene_group_count(const kage_scene *scene, uint32_t *count);
+
+/**
+ * The number of point and spot lights in the scene (the valid `index` values of
+ * `kage_renderer_set_light` are 0 to count - 1): `kage_scene_desc.light_count`, or a scene
+ * file's lights.
+ *
+ * # Safety
+ * `scene` must be NULL or a handle; `count` NULL or writable.
+ */
+kage_result kage_scene_light_count(const kage_scene *scene, uint32_t *count);
 
 /**
  * Fills `*desc` with `technique` and the default of every parameter.

@@ -22,6 +22,9 @@ pub enum Error {
     /// memory left for it. Like the two above, a request to retry with smaller settings.
     #[error("out of device memory for {name} ({bytes} bytes): {reason}")]
     OutOfDeviceMemoryFor { name: String, bytes: u64, reason: String },
+    /// Host memory for data a caller sized (see [`crate::host_memory`]) could not be had.
+    #[error(transparent)]
+    OutOfHostMemoryFor(#[from] crate::host_memory::OutOfHostMemory),
     #[error("the Vulkan device was lost in {call}")]
     DeviceLost { call: &'static str },
     #[error("{call} failed: {result:?}")]
@@ -54,7 +57,8 @@ pub enum Fault {
     Caller,
     /// A file that could not be read or is malformed.
     File,
-    /// The Vulkan loader or device: missing, lacking a feature, out of memory, lost.
+    /// The Vulkan loader or device: missing, lacking a feature, out of memory, lost; or the
+    /// machine's own memory running out.
     Device,
     /// Kage itself.
     Internal,
@@ -69,11 +73,14 @@ impl Error {
             | Error::OutOfDeviceMemory { .. }
             | Error::OutOfHostMemory { .. }
             | Error::OutOfDeviceMemoryFor { .. }
+            | Error::OutOfHostMemoryFor(_)
             | Error::DeviceLost { .. }
             | Error::Vulkan { .. }
             | Error::Allocation { .. }
             | Error::Timeout(_) => Fault::Device,
+            Error::Scene(e) if e.out_of_memory() => Fault::Device,
             Error::Scene(e) if e.file().is_some() => Fault::File,
+            Error::Image(e) if e.by_caller() => Fault::Caller,
             Error::Image(_) => Fault::File,
             Error::Probes(ProbeError::FitDiverged { .. }) => Fault::Internal,
             Error::Scene(_) | Error::Probes(_) | Error::InvalidArgument(_) | Error::Cancelled(_) => {

@@ -12,8 +12,9 @@ use crate::image_size::{Declared, SizeError};
 #[derive(Debug, thiserror::Error)]
 pub enum ImageIoError {
     #[error(
-        "{}: unsupported image format; Kage writes .png (tonemapped sRGB) and .exr (linear float)",
-        path.display()
+        "{}: unsupported image format {}; Kage writes .png (tonemapped sRGB) and .exr (linear float)",
+        path.display(),
+        path.extension().map_or("(no extension)".into(), |e| format!("\".{}\"", e.to_string_lossy()))
     )]
     UnsupportedExtension { path: PathBuf },
     #[error(
@@ -37,6 +38,14 @@ pub enum ImageIoError {
     Read { path: PathBuf, error: ReadError },
     #[error("{}: {error}", path.display())]
     DeclaredSize { path: PathBuf, error: SizeError },
+}
+
+impl ImageIoError {
+    /// Whether the caller's values are at fault (a format or an exposure Kage does not write),
+    /// not a file.
+    pub fn by_caller(&self) -> bool {
+        matches!(self, ImageIoError::UnsupportedExtension { .. } | ImageIoError::Exposure { .. })
+    }
 }
 
 /// Linear RGBA radiance, row-major, row 0 at the top.

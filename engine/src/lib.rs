@@ -14,7 +14,8 @@
 //!
 //! Beside the layers, imported by any of them: [`scene`] (what a scene holds and its file
 //! format), [`sh`], [`layouts`] (the GPU/host structs), [`error`], [`imageio`], [`files`]
-//! (opening what a user names) and [`image_size`] (image headers checked before decoding).
+//! (opening what a user names), [`image_size`] (image headers checked before decoding) and
+//! [`host_memory`] (allocations a caller sized, made fallibly).
 //!
 //! Conventions: right-handed, +Y up; equirectangular maps map direction (x, y, z) to
 //! u = atan2(x, -z) / 2π wrapped into \[0, 1), v = acos(y) / π, row 0 at the top (+Y).
@@ -32,6 +33,7 @@ pub mod capi;
 pub mod error;
 pub mod files;
 pub mod frame;
+pub mod host_memory;
 pub mod image_size;
 pub mod imageio;
 pub mod layouts;

@@ -132,7 +132,7 @@ impl Renderer {
         let slot = self.lights.get_mut(index).ok_or_else(|| {
             Error::InvalidArgument(format!("light {index} does not exist (the scene has {count})"))
         })?;
-        *slot = light.validated().map_err(|e| e.within(&format!("light {index}")))?;
+        *slot = light.validated_as(index)?;
         Ok(())
     }
 

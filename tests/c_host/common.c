@@ -114,7 +114,7 @@ kage_scene *make_scene(void) {
       {"box", box_at(-1.0f), &box_mesh, 1},
   };
   kage_scene_desc desc = {
-      sizeof(kage_scene_desc), groups, 2, {environment, ENV_WIDTH, ENV_HEIGHT}, {{0.0f, 3.0f, 4.0f}, {0.0f, 0.3f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f}};
+      sizeof(kage_scene_desc), groups, 2, {environment, ENV_WIDTH, ENV_HEIGHT}, {{0.0f, 3.0f, 4.0f}, {0.0f, 0.3f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f}, NULL, 0};
   kage_scene *scene = NULL;
   CHECK(kage_scene_create(&desc, &scene));
   return scene;
@@ -168,7 +168,7 @@ static void run_frames(kage_context *context, kage_scene *scene, const kage_tech
     previous = column;
 
     size_t count = 0;
-    EXPECT(kage_renderer_timings(renderer, NULL, 0, &count), KAGE_RESULT_BUFFER_TOO_SMALL);
+    CHECK(kage_renderer_timings(renderer, NULL, 0, &count)); /* the count alone */
     REQUIRE(count >= 3 && count <= 16);
     kage_pass_timing timings[16];
     size_t written = 0;

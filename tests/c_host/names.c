@@ -27,6 +27,7 @@ static const struct {
     {"KAGE_RESULT_PANIC", (uint32_t)KAGE_RESULT_PANIC},
     {"KAGE_RESULT_INTERNAL", (uint32_t)KAGE_RESULT_INTERNAL},
     {"KAGE_RESULT_BUSY", (uint32_t)KAGE_RESULT_BUSY},
+    {"KAGE_RESULT_CANCELLED", (uint32_t)KAGE_RESULT_CANCELLED},
     {"KAGE_TECHNIQUE_UNSHADOWED", (uint32_t)KAGE_TECHNIQUE_UNSHADOWED},
     {"KAGE_TECHNIQUE_SLOAN_SELF", (uint32_t)KAGE_TECHNIQUE_SLOAN_SELF},
     {"KAGE_TECHNIQUE_SLOAN_SCENE", (uint32_t)KAGE_TECHNIQUE_SLOAN_SCENE},
@@ -213,6 +214,8 @@ static size_t touch_kage_scene_desc(kage_scene_desc *d) {
   bytes += sizeof d->group_count;
   bytes += sizeof d->environment;
   bytes += sizeof d->camera;
+  bytes += sizeof d->lights;
+  bytes += sizeof d->light_count;
   return bytes;
 }
 

@@ -140,6 +140,18 @@ fn readmes_link_and_run_commands_build_a_host_that_runs() {
     assert!(out.contains("blur_horizontal ") && out.contains(" ms\n"), "{out}");
 }
 
+/// Host memory that runs out (tests/c_host/arrays.c, `out-of-memory`): a scene within Kage's
+/// limits built under an address-space limit it does not fit in is KAGE_RESULT_OUT_OF_MEMORY,
+/// first for the copy of its positions, then for the normals computed from them; the host
+/// lives on. (Infallible allocations aborted it: "memory allocation of 1200000000 bytes
+/// failed".)
+#[test]
+fn c_host_out_of_memory_is_an_error_not_an_abort() {
+    let out = succeeded("arrays host", Command::new(&hosts().arrays).arg("out-of-memory").output().unwrap());
+    println!("{out}");
+    assert!(out.ends_with("ok\n"), "{out}");
+}
+
 /// Threads and stale handles (tests/c_host/threads.c): one renderer called from four threads,
 /// a renderer per thread on one context, a destroy racing a render, destroyed handles reused:
 /// every call OK, BUSY or INVALID_HANDLE as the case is, validation on, no crash.

@@ -651,6 +651,8 @@ fn scene_desc(
             up: [0.0, 1.0, 0.0],
             fov_y_deg: 60.0,
         },
+        lights: std::ptr::null(),
+        light_count: 0,
     }
 }
 

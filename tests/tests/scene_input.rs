@@ -639,6 +639,8 @@ fn the_c_abi_loads_a_lone_obj_and_repairs_normals() {
             up: [0.0, 1.0, 0.0],
             fov_y_deg: 60.0,
         },
+        lights: null(),
+        light_count: 0,
     };
     // SAFETY: the desc's arrays hold the counts it states and outlive the call.
     assert_eq!(unsafe { capi::scene::kage_scene_create(&desc, &mut scene) }, kage_result::Ok);

@@ -1,6 +1,7 @@
 //! Buffers, with staging upload and readback for device-local ones.
 use super::Context;
 use crate::error::{Error, Result};
+use crate::host_memory;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
@@ -162,10 +163,12 @@ impl Buffer {
         unsafe { self.ctx.device.cmd_fill_buffer(cmd, self.raw, 0, vk::WHOLE_SIZE, 0) };
     }
 
-    /// Reads the whole buffer back to the host (waits for the GPU).
+    /// Reads the whole buffer back to the host (waits for the GPU), into memory reserved
+    /// fallibly: a caller sized many of Kage's buffers (a frame's readback among them).
     pub fn read(&self) -> Result<Vec<u8>> {
+        let copy = |bytes: &[u8]| host_memory::collect(bytes.iter().copied(), &self.name);
         if let Some(mapped) = self.mapped() {
-            return Ok(mapped.to_vec());
+            return Ok(copy(mapped)?);
         }
         let staging = Buffer::new(
             &self.ctx,
@@ -181,10 +184,10 @@ impl Buffer {
             // SAFETY: both buffers are alive until the submission has completed.
             unsafe { self.ctx.device.cmd_copy_buffer(cmd, self.raw, staging.raw, &[region]) }
         })?;
-        staging
+        let mapped = staging
             .mapped()
-            .map(<[u8]>::to_vec)
-            .ok_or_else(|| Error::Internal(format!("{} readback memory is not mapped", self.name)))
+            .ok_or_else(|| Error::Internal(format!("{} readback memory is not mapped", self.name)))?;
+        Ok(copy(mapped)?)
     }
 }
 

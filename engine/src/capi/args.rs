@@ -122,10 +122,35 @@ pub(crate) fn enumeration<T>(value: u32, name: &str, from_repr: fn(u32) -> Optio
         .ok_or_else(|| Failure::invalid(format!("{name} {value} is not one of the values kage.h defines")))
 }
 
+/// Whether a call that fills the host's array (room for `capacity` elements at `buffer`) and
+/// reports the count it needs was asked for that count alone: NULL with `capacity` 0, which
+/// returns `KAGE_RESULT_OK`. NULL with room is `KAGE_RESULT_NULL_ARGUMENT`. (The rule is
+/// stated once for the host, at the top of kage.h.)
+pub(crate) fn count_query<T>(buffer: *const T, capacity: usize, name: &str) -> Result<bool, Failure> {
+    match (buffer.is_null(), capacity) {
+        (true, 0) => Ok(true),
+        (true, _) => Err(null(name)),
+        (false, _) => Ok(false),
+    }
+}
+
+/// `KAGE_RESULT_BUFFER_TOO_SMALL` where the host's array of `capacity` elements was short of
+/// the `needed` ones (after as many as fit were written).
+pub(crate) fn room_for(
+    capacity: usize,
+    needed: usize,
+    short: impl FnOnce() -> String,
+) -> Result<(), Failure> {
+    match capacity < needed {
+        true => Err(Failure::new(kage_result::BufferTooSmall, short())),
+        false => Ok(()),
+    }
+}
+
 /// Copies `text` into the host's `buffer` of `capacity` bytes as a NUL-terminated string and
 /// its length in bytes (without the NUL) into `*length` when that is not NULL. A buffer too
-/// small gets as much as fits, still terminated, and `KAGE_RESULT_BUFFER_TOO_SMALL`; `buffer`
-/// may be NULL when `capacity` is 0, to ask for the length.
+/// small gets as much as fits, still terminated, and `KAGE_RESULT_BUFFER_TOO_SMALL`; NULL with
+/// `capacity` 0 asks for the length alone ([`count_query`]).
 ///
 /// # Safety
 /// `buffer` must be NULL or `capacity` writable bytes; `length` NULL or writable.
@@ -140,23 +165,17 @@ pub(crate) unsafe fn copy_text(
     if let Some(length) = unsafe { length.as_mut() } {
         *length = text.len();
     }
-    let fits = text.len() < capacity;
+    if count_query(buffer, capacity, name)? {
+        return Ok(());
+    }
     if capacity > 0 {
-        if buffer.is_null() {
-            return Err(null(name));
-        }
         let n = text.len().min(capacity - 1);
         // SAFETY: the caller promises `capacity` writable bytes; n + 1 <= capacity.
         let out = unsafe { std::slice::from_raw_parts_mut(buffer.cast::<u8>(), n + 1) };
         out[..n].copy_from_slice(&text.as_bytes()[..n]);
         out[n] = 0;
     }
-    if fits {
-        Ok(())
-    } else {
-        Err(Failure::new(
-            kage_result::BufferTooSmall,
-            format!("{name}: {capacity} bytes do not hold {} bytes and the NUL", text.len()),
-        ))
-    }
+    room_for(capacity, text.len() + 1, || {
+        format!("{name}: {capacity} bytes do not hold {} bytes and the NUL", text.len())
+    })
 }

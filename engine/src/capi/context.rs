@@ -145,14 +145,16 @@ pub unsafe extern "C" fn kage_context_create_from_vulkan(
 
 /// Destroys a context handle. Renderers made with it keep the device alive until they are
 /// destroyed too (they hold their own reference); scenes do not depend on it. NULL is allowed
-/// and does nothing. The handle must not be used afterwards.
+/// and does nothing. The handle must not be used after OK; on `KAGE_RESULT_BUSY` (a call on
+/// another thread is using it) nothing was destroyed: call again once that call has returned.
 #[no_mangle]
 pub extern "C" fn kage_context_destroy(context: *mut kage_context) -> kage_result {
     boundary(|| handles::destroy(context, "context"))
 }
 
 /// Writes the device's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)") into `buffer` as a
-/// NUL-terminated string; as `kage_last_error_message` for `capacity` and `length`.
+/// NUL-terminated string; as `kage_last_error_message` for `capacity` and `length` (NULL with
+/// capacity 0 asks for the length alone).
 ///
 /// # Safety
 /// `context` must be NULL or a handle; `buffer` NULL or `capacity` writable bytes; `length`

@@ -11,6 +11,11 @@
 //!   after later objects are made.
 //! - Enumerations arrive as `uint32_t`, so that an out-of-range value from C is
 //!   `KAGE_RESULT_INVALID_VALUE` rather than an invalid Rust enum.
+//! - Counts are checked against the engine's limits before anything is allocated for them, and
+//!   what the host's data is copied into is allocated fallibly ([`crate::host_memory`]): too
+//!   much is `KAGE_RESULT_OUT_OF_MEMORY`, never an abort of the host.
+//! - A call that fills the host's array answers a count query (NULL, capacity 0) with OK
+//!   (`args::count_query`).
 //!
 //! Threading: any function may be called from any thread. A call on a handle that a call on
 //! another thread is using returns `KAGE_RESULT_BUSY` and does nothing; calls on different
@@ -18,11 +23,13 @@
 //! own command buffers). The last error message is per thread.
 #![allow(non_camel_case_types)]
 
-/// The version of the C ABI kage.h declares. It rises with every incompatible change (a struct
-/// field added, removed or moved, a function's parameters, an enumeration's values), and
-/// libkage.so carries it in its SONAME (`libkage.so.1`). A host checks at start-up that
-/// `kage_abi_version()` equals the `KAGE_ABI_VERSION` it was compiled with; beyond that, every
-/// top-level desc struct carries its `size`, which each call checks.
+/// The version of the C ABI kage.h declares. It rises with every incompatible change that no
+/// `size` field catches (a field of a small struct added, removed or moved, a function's
+/// parameters, an enumeration's values), and libkage.so carries it in its SONAME
+/// (`libkage.so.1`). A host checks at start-up that `kage_abi_version()` equals the
+/// `KAGE_ABI_VERSION` it was compiled with; beyond that, every top-level desc struct carries its
+/// `size`, which each call checks: one that grew (fields appended) refuses a host compiled
+/// against the older kage.h with `KAGE_RESULT_INVALID_VALUE` naming it.
 #[repr(u32)]
 pub enum kage_abi {
     Version = 1,

@@ -3,12 +3,11 @@ use super::args;
 use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
-use super::scene::{kage_camera_desc, kage_scene, kage_transform};
+use super::scene::{kage_camera_desc, kage_light_desc, kage_scene, kage_transform};
 use super::technique::{kage_progress_fn, kage_technique_desc};
-use crate::imageio::{auto_exposure, tonemap_srgb8};
+use crate::imageio::{self, auto_exposure, tonemap_srgb8};
 use crate::pass::PassTiming;
 use crate::renderer::{RenderOptions, Renderer};
-use crate::scene::Light;
 use std::ffi::{c_char, c_void};
 
 /// A scene on the GPU, lit by one technique, with its render targets.
@@ -116,9 +115,11 @@ pub unsafe extern "C" fn kage_renderer_create_with(
     })
 }
 
-/// Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing. The
-/// handle must not be used afterwards (also when this fails with `KAGE_RESULT_VALIDATION`,
-/// which reports what the layer said while its objects were destroyed).
+/// Destroys a renderer, waiting for its GPU work first. NULL is allowed and does nothing.
+/// After `KAGE_RESULT_OK` the handle must not be used, nor after `KAGE_RESULT_VALIDATION`
+/// (the renderer was destroyed, and this reports what the layer said meanwhile). On
+/// `KAGE_RESULT_BUSY` (a call on another thread is using the renderer) nothing was destroyed
+/// and the handle stays valid: call again once that call has returned.
 #[no_mangle]
 pub extern "C" fn kage_renderer_destroy(renderer: *mut kage_renderer) -> kage_result {
     boundary(|| {
@@ -169,33 +170,6 @@ pub unsafe extern "C" fn kage_renderer_set_camera(
     })
 }
 
-/// Kinds of `kage_light_desc`.
-#[repr(u32)]
-#[derive(Clone, Copy, strum::FromRepr)]
-pub enum kage_light_kind {
-    /// Radiant intensity in every direction.
-    Point = 0,
-    /// Radiant intensity inside a cone of full angle `fov_deg` about `direction`.
-    Spot = 1,
-}
-
-/// A point or spot light, as a scene file's `lights` entry is (README, "Scene format").
-#[repr(C)]
-#[derive(Clone, Copy)]
-pub struct kage_light_desc {
-    /// A `kage_light_kind` value.
-    pub kind: u32,
-    pub position: [f32; 3],
-    /// Spot lights: the cone's axis, any non-zero length (it is normalized). Point lights:
-    /// unused.
-    pub direction: [f32; 3],
-    /// Spot lights: the cone's full angle in degrees, above 0 and at most 170. Point lights:
-    /// unused.
-    pub fov_deg: f32,
-    /// Radiant intensity per channel (W/sr), at least 0.
-    pub intensity: [f32; 3],
-}
-
 /// Replaces light `index` of the renderer's scene (0 to its light count − 1) for the next
 /// frames, checked as a scene file's light is; a point light may become a spot light and back.
 /// Techniques redo what they derived from it (shadow maps, adaptive shadow map tiles). `light`
@@ -212,14 +186,7 @@ pub unsafe extern "C" fn kage_renderer_set_light(
     boundary(|| {
         let mut r = handles::get(renderer, "renderer")?;
         // SAFETY: the caller promises NULL or a valid light.
-        let d = unsafe { args::value(light, "light") }?;
-        let (position, intensity) = (glam::Vec3::from(d.position), d.intensity);
-        let light = match args::enumeration(d.kind, "light->kind", kage_light_kind::from_repr)? {
-            kage_light_kind::Point => Light::Point { position, intensity },
-            kage_light_kind::Spot => {
-                Light::Spot { position, direction: d.direction.into(), fov_deg: d.fov_deg, intensity }
-            }
-        };
+        let light = unsafe { args::value(light, "light") }?.light("light->kind")?;
         Ok(r.renderer.set_light(index as usize, light)?)
     })
 }
@@ -330,35 +297,59 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
         if r.timings.is_none() {
             return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
         }
-        let image = r.renderer.image()?;
-        let bytes: Vec<u8> = match format {
-            kage_pixel_format::Rgba8Srgb => {
-                if !(exposure.is_finite() && exposure > 0.0) {
-                    return Err(Failure::invalid(format!("exposure {exposure} is not a positive number")));
-                }
-                let srgb = |p: &[f32; 4]| {
-                    let [r, g, b] = tonemap_srgb8([p[0], p[1], p[2]], exposure);
-                    [r, g, b, 255]
-                };
-                image.pixels.iter().flat_map(srgb).collect()
-            }
-            kage_pixel_format::Rgba32fLinear => {
-                image.pixels.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect()
-            }
-        };
-        if size < bytes.len() {
-            return Err(Failure::new(
-                kage_result::BufferTooSmall,
-                format!(
-                    "a {}x{} frame needs {} bytes, pixels holds {size}",
-                    image.width,
-                    image.height,
-                    bytes.len()
-                ),
-            ));
+        let srgb = matches!(format, kage_pixel_format::Rgba8Srgb);
+        if srgb && !(exposure.is_finite() && exposure > 0.0) {
+            return Err(Failure::invalid(format!("exposure {exposure} is not a positive number")));
         }
-        // SAFETY: the caller promises `size` >= bytes.len() writable bytes at `pixels`.
-        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), pixels, bytes.len()) };
+        let image = r.renderer.image()?;
+        let bytes_per_pixel = if srgb { 4 } else { 16 };
+        let needed = image.pixels.len() * bytes_per_pixel;
+        args::room_for(size, needed, || {
+            format!("a {}x{} frame needs {needed} bytes, pixels holds {size}", image.width, image.height)
+        })?;
+        // Written in place: no copy of the frame the size of the host's buffer.
+        // SAFETY: the caller promises `size` >= needed writable bytes at `pixels`.
+        let out = unsafe { std::slice::from_raw_parts_mut(pixels, needed) };
+        for (to, p) in out.chunks_exact_mut(bytes_per_pixel).zip(&image.pixels) {
+            if srgb {
+                let [r, g, b] = tonemap_srgb8([p[0], p[1], p[2]], exposure);
+                to.copy_from_slice(&[r, g, b, 255]);
+            } else {
+                for (to, v) in to.chunks_exact_mut(4).zip(p) {
+                    to.copy_from_slice(&v.to_ne_bytes());
+                }
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Writes the last frame to the file `path` (UTF-8) as `kage render --out` does, in the format
+/// its extension names (any case): `.png`, radiance × `exposure` (finite, at least 0)
+/// tonemapped and sRGB-encoded as `KAGE_PIXEL_FORMAT_RGBA8_SRGB` is, 8-bit RGB, written to a
+/// temporary file renamed over `path` (a failed write leaves no partial file); `.exr`, linear
+/// radiance as 32-bit float RGB (`exposure` is ignored). Another extension, or a bad exposure,
+/// is `KAGE_RESULT_INVALID_VALUE` naming it; a file that cannot be written (no such folder, no
+/// permission, a full disk) is `KAGE_RESULT_FILE` naming the path. Before the first
+/// `kage_renderer_render`: `KAGE_RESULT_INVALID_VALUE`.
+///
+/// # Safety
+/// `path` NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_write_image(
+    renderer: *const kage_renderer,
+    path: *const c_char,
+    exposure: f32,
+) -> kage_result {
+    boundary(|| {
+        let r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or a NUL-terminated string.
+        let path = unsafe { args::text(path, "path") }?;
+        if r.timings.is_none() {
+            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
+        }
+        let image = r.renderer.image()?;
+        imageio::write(path, &image, exposure).map_err(crate::Error::from)?;
         Ok(())
     })
 }
@@ -410,10 +401,10 @@ pub unsafe extern "C" fn kage_renderer_frame_time(
 }
 
 /// Copies the last frame's per-pass GPU timings, in the order the passes ran, into `timings`
-/// (room for `capacity`), and writes how many passes the frame had to `*count`. When `capacity`
-/// is smaller, the first `capacity` are written and `KAGE_RESULT_BUFFER_TOO_SMALL` is returned;
-/// `timings` may be NULL when `capacity` is 0 (to ask for the count). Before the first frame
-/// the count is 0.
+/// (room for `capacity`), and writes how many passes the frame had to `*count`, as every call
+/// that fills an array does (see the top of this header: NULL with capacity 0 asks for the
+/// count alone; a shorter array gets the first `capacity` and `KAGE_RESULT_BUFFER_TOO_SMALL`).
+/// Before the first frame the count is 0.
 ///
 /// # Safety
 /// `timings` NULL or
@@ -431,8 +422,8 @@ pub unsafe extern "C" fn kage_renderer_timings(
         let count = unsafe { args::out(count, "count") }?;
         let frame = r.timings.as_deref().unwrap_or_default();
         *count = frame.len();
-        if capacity > 0 && timings.is_null() {
-            return Err(Failure::new(kage_result::NullArgument, "timings is NULL"));
+        if args::count_query(timings, capacity, "timings")? {
+            return Ok(());
         }
         for (at, pass) in frame.iter().take(capacity).enumerate() {
             let mut name = [0 as c_char; 32];
@@ -444,12 +435,8 @@ pub unsafe extern "C" fn kage_renderer_timings(
             // SAFETY: at < capacity, and the caller promises `capacity` writable elements.
             unsafe { timings.add(at).write(timing) };
         }
-        if capacity < frame.len() {
-            return Err(Failure::new(
-                kage_result::BufferTooSmall,
-                format!("the frame had {} passes, timings holds {capacity}", frame.len()),
-            ));
-        }
-        Ok(())
+        args::room_for(capacity, frame.len(), || {
+            format!("the frame had {} passes, timings holds {capacity}", frame.len())
+        })
     })
 }

@@ -1,6 +1,7 @@
 //! Result codes, the thread's last error message, and the panic boundary around every export.
 use super::args;
 use crate::error::Error;
+use crate::host_memory::OutOfHostMemory;
 use std::cell::RefCell;
 use std::ffi::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -72,6 +73,12 @@ impl From<Error> for Failure {
     }
 }
 
+impl From<OutOfHostMemory> for Failure {
+    fn from(error: OutOfHostMemory) -> Failure {
+        Error::from(error).into()
+    }
+}
+
 /// The one place engine errors become result codes.
 fn code_of(error: &Error) -> kage_result {
     match error {
@@ -80,11 +87,15 @@ fn code_of(error: &Error) -> kage_result {
         Error::OutOfDeviceMemory { .. }
         | Error::OutOfHostMemory { .. }
         | Error::OutOfDeviceMemoryFor { .. }
+        | Error::OutOfHostMemoryFor(_)
         | Error::Allocation { .. } => kage_result::OutOfMemory,
+        Error::Scene(e) if e.out_of_memory() => kage_result::OutOfMemory,
         Error::DeviceLost { .. } => kage_result::DeviceLost,
         Error::Vulkan { .. } | Error::Timeout(_) => kage_result::Vulkan,
         // A scene error names a file when one was read; otherwise the host's data is at fault.
         Error::Scene(e) if e.file().is_some() => kage_result::File,
+        // An image the host asked for in a format or at an exposure Kage does not write.
+        Error::Image(e) if e.by_caller() => kage_result::InvalidValue,
         Error::Image(_) => kage_result::File,
         Error::Probes(crate::error::ProbeError::FitDiverged { .. }) | Error::Internal(_) => {
             kage_result::Internal
@@ -194,6 +205,16 @@ mod tests {
         assert_eq!(last_message(), "out of device memory for mask (4294967296 bytes): limit");
         // Kage's own bugs never blame the caller.
         assert_eq!(boundary(|| Err(Error::Internal("pass order".into()).into())), kage_result::Internal);
+        // Host memory that ran out, alone or on the way to a mesh, is not the data's fault.
+        let host = OutOfHostMemory { what: "positions".into(), bytes: 12 };
+        assert_eq!(boundary(|| Err(host.clone().into())), kage_result::OutOfMemory);
+        let in_mesh = crate::scene::SceneError::from(host).within("mesh 0");
+        assert_eq!(boundary(|| Err(Error::from(in_mesh).into())), kage_result::OutOfMemory);
+        assert_eq!(last_message(), "mesh 0: out of host memory for positions (12 bytes)");
+        // An image format Kage does not write is the caller's value, not a file's fault.
+        let jpg = crate::imageio::ImageIoError::UnsupportedExtension { path: "a/b.jpg".into() };
+        assert_eq!(boundary(|| Err(Error::from(jpg).into())), kage_result::InvalidValue);
+        assert!(last_message().contains("\".jpg\""), "{}", last_message());
     }
 
     #[test]

@@ -4,13 +4,14 @@ use super::context::kage_context;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
 use super::scene::kage_scene;
+use crate::host_memory;
 use crate::prt::{cache, transfer, PrtParams};
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
 use crate::techniques::description::{TechniqueDesc, TechniqueKind};
 use crate::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use crate::techniques::probes::{
-    CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
+    self, CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
     StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
 use crate::techniques::tamura::technique::{OcclusionSettings, Penumbra};
@@ -185,9 +186,12 @@ impl kage_technique_desc {
             },
             kage_probe_placement::Positions => {
                 let count = self.probe_position_count as usize;
+                probes::check_count(count)
+                    .map_err(|e| Failure::invalid(format!("probe_position_count: {e}")))?;
                 // SAFETY: the caller promises NULL or `count` × 3 readable floats.
                 let points = unsafe { args::chunks::<3>(self.probe_positions, count, "probe_positions") }?;
-                ProbePlacement::Positions(points.iter().map(|&p| DVec3::from(p.map(f64::from))).collect())
+                let points = points.iter().map(|&p| DVec3::from(p.map(f64::from)));
+                ProbePlacement::Positions(host_memory::collect(points, "probe_positions")?.into())
             }
         };
         let width = self.probe_dering_width;

@@ -11,6 +11,8 @@ use std::sync::Arc;
 /// Vertex layout of `GpuScene` meshes: position and normal, 3 floats each, then the albedo
 /// map's texture coordinate, 2 floats (0 without a map).
 pub const VERTEX_STRIDE: u32 = 32;
+// The vertex limit of a mesh is what this stride leaves of 4 GiB.
+const _: () = assert!(crate::scene::MAX_MESH_VERTICES as u64 * VERTEX_STRIDE as u64 <= u32::MAX as u64);
 pub const MESH_ATTRIBUTES: [VertexAttribute; 3] = [
     VertexAttribute { location: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
     VertexAttribute { location: 1, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },

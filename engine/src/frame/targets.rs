@@ -2,6 +2,7 @@
 //! buffer the picture is read back through.
 use crate::backend::{vk, Buffer, BufferDesc, Context, Image, ImageDesc, MemoryLocation};
 use crate::error::{Error, Result};
+use crate::host_memory;
 use crate::imageio::RgbaF32Image;
 use std::sync::Arc;
 
@@ -76,14 +77,10 @@ impl Targets {
     /// The last frame read back: linear radiance, row 0 at the top.
     pub fn read(&self) -> Result<RgbaF32Image> {
         let bytes = self.readback.read()?;
-        let pixels = bytes
-            .chunks_exact(16)
-            .map(|t| {
-                std::array::from_fn(|k| {
-                    f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])
-                })
-            })
-            .collect();
+        let texel = |t: &[u8]| {
+            std::array::from_fn(|k| f32::from_ne_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]]))
+        };
+        let pixels = host_memory::collect(bytes.chunks_exact(16).map(texel), "the frame's pixels")?;
         Ok(RgbaF32Image { width: self.color.width, height: self.color.height, pixels })
     }
 }

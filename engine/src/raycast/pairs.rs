@@ -13,6 +13,7 @@ use super::aabb::Aabb;
 use super::sah::{node_bounds, node_range};
 use crate::error::{Error, Result};
 use crate::layouts::{constants, BvhNode, BvhPair};
+use crate::scene::MAX_TRIANGLES;
 use glam::Vec3;
 
 /// The pairs of one tree (`nodes` as the SAH builder flattened it, its leaves' triangle ranges
@@ -36,9 +37,10 @@ pub fn pairs(nodes: &[BvhNode], first_triangle: u32, base: u32) -> Result<Vec<Bv
             return Ok(pair_of[at]);
         }
         let first = first_triangle + index;
-        if count > 7 || first >= 1 << 28 {
+        if count > 7 || first as usize >= MAX_TRIANGLES {
             return Err(Error::InvalidArgument(format!(
-                "the scene has too many triangles for a BVH leaf reference ({first} + {count}; at most 2^28)"
+                "the scene has too many triangles for a BVH leaf reference ({first} + {count}; at most \
+                 {MAX_TRIANGLES})"
             )));
         }
         Ok(constants::BVH_LEAF | count << 28 | first)

@@ -14,7 +14,7 @@ use glam::{Vec2, Vec3};
 
 use super::SceneError;
 use crate::files;
-use crate::image_size::{Declared, SizeError};
+use crate::image_size::{Declared, SizeError, MAX_IMAGE_PIXELS};
 
 #[derive(Debug, Clone)]
 pub struct EnvMap {
@@ -37,17 +37,10 @@ impl PartialEq for EnvMap {
 const CONSTANT_WIDTH: u32 = 64;
 
 impl EnvMap {
-    /// Checks the shape (2:1, not empty) and that every value is finite; negative values are
+    /// Checks the size ([`EnvMap::check_size`]) and that every value is finite; negative values are
     /// clamped to 0 and counted (see [`EnvMap::clamped_negative`]).
     pub fn from_pixels(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Result<EnvMap, SceneError> {
-        if width == 0 || height == 0 {
-            return Err(SceneError::invalid(format!("environment map is empty ({width}x{height})")));
-        }
-        if u64::from(width) != 2 * u64::from(height) {
-            return Err(SceneError::invalid(format!(
-                "environment map is {width}x{height}, but an equirectangular map must be 2:1 (width = 2 x height)"
-            )));
-        }
+        EnvMap::check_size(width, height)?;
         let expected = width as usize * height as usize;
         if pixels.len() != expected {
             return Err(SceneError::invalid(format!(
@@ -65,6 +58,26 @@ impl EnvMap {
             clamped_negative += 1;
         }
         Ok(EnvMap { width, height, pixels, clamped_negative })
+    }
+
+    /// Checks a map's shape before its pixels are allocated: not empty, 2:1, and at most
+    /// [`MAX_IMAGE_PIXELS`] (16384x8192, the widest map a device image holds).
+    pub fn check_size(width: u32, height: u32) -> Result<(), SceneError> {
+        if width == 0 || height == 0 {
+            return Err(SceneError::invalid(format!("environment map is empty ({width}x{height})")));
+        }
+        if u64::from(width) != 2 * u64::from(height) {
+            return Err(SceneError::invalid(format!(
+                "environment map is {width}x{height}, but an equirectangular map must be 2:1 (width = 2 x height)"
+            )));
+        }
+        if u64::from(width) * u64::from(height) > MAX_IMAGE_PIXELS {
+            return Err(SceneError::invalid(format!(
+                "environment map is {width}x{height}, more than the {MAX_IMAGE_PIXELS} pixels (16384x8192) \
+                 Kage takes"
+            )));
+        }
+        Ok(())
     }
 
     /// A small map of one radiance in every direction.
@@ -284,6 +297,10 @@ mod tests {
         assert!(EnvMap::from_pixels(4, 2, vec![[1.0; 3]; 8]).is_ok());
         assert!(EnvMap::from_pixels(0, 0, vec![]).is_err());
         assert!(EnvMap::from_pixels(4, 4, vec![[1.0; 3]; 16]).unwrap_err().to_string().contains("2:1"));
+        // Refused by its size alone, before a host allocates its pixels.
+        assert!(EnvMap::check_size(16384, 8192).is_ok());
+        let huge = EnvMap::check_size(32768, 16384).unwrap_err().to_string();
+        assert!(huge.contains("32768x16384") && huge.contains("16384x8192"), "{huge}");
         assert!(EnvMap::from_pixels(4, 2, vec![[1.0; 3]; 7]).is_err());
         let mut pixels = vec![[1.0; 3]; 8];
         pixels[6] = [1.0, f32::NAN, 1.0];

@@ -1,5 +1,6 @@
 //! The one error type for everything a scene reads: its message always says which file (when
 //! there is one) and what is wrong with it, so a user can fix the input without a debugger.
+use crate::host_memory::OutOfHostMemory;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -7,24 +8,26 @@ use std::path::{Path, PathBuf};
 pub struct SceneError {
     file: Option<PathBuf>,
     problem: String,
+    /// The machine had no memory for the data: not the data's fault.
+    out_of_memory: bool,
 }
 
 impl SceneError {
     /// A problem with the named file.
     pub fn in_file(file: impl Into<PathBuf>, problem: impl Into<String>) -> SceneError {
-        SceneError { file: Some(file.into()), problem: problem.into() }
+        SceneError { file: Some(file.into()), problem: problem.into(), out_of_memory: false }
     }
 
     /// A problem with data that came from no file (a built-in scene, an API call).
     pub fn invalid(problem: impl Into<String>) -> SceneError {
-        SceneError { file: None, problem: problem.into() }
+        SceneError { file: None, problem: problem.into(), out_of_memory: false }
     }
 
     /// Prefixes the place the problem is at, e.g. `group 0 ("floor")`. A file this error already
     /// names moves into the message, so nested errors read
     /// `scene.json: group 0 ("teapot"): mesh 0: teapot.obj: ...` once attributed.
     pub(crate) fn within(self, place: &str) -> SceneError {
-        SceneError { file: None, problem: format!("{place}: {self}") }
+        SceneError { file: None, problem: format!("{place}: {self}"), ..self }
     }
 
     /// Names `file` as the file at fault, keeping any other file already named in the message
@@ -34,15 +37,27 @@ impl SceneError {
             Some(named) if named != file => self.to_string(),
             _ => self.problem,
         };
-        SceneError { file: Some(file.to_path_buf()), problem }
+        SceneError { file: Some(file.to_path_buf()), problem, ..self }
     }
 
     pub fn file(&self) -> Option<&Path> {
         self.file.as_deref()
     }
 
+    /// Whether the data was refused for want of memory (see [`crate::host_memory`]), not for
+    /// what it holds.
+    pub fn out_of_memory(&self) -> bool {
+        self.out_of_memory
+    }
+
     pub fn problem(&self) -> &str {
         &self.problem
+    }
+}
+
+impl From<OutOfHostMemory> for SceneError {
+    fn from(error: OutOfHostMemory) -> SceneError {
+        SceneError { file: None, problem: error.to_string(), out_of_memory: true }
     }
 }
 

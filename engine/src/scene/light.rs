@@ -50,4 +50,10 @@ impl Light {
             }
         }
     }
+
+    /// [`Light::validated`] for light `index` of a scene, its error naming the light as every
+    /// way of giving a scene lights does (a scene file, the C ABI, a renderer's light changed).
+    pub fn validated_as(self, index: usize) -> Result<Light, SceneError> {
+        self.validated().map_err(|e| e.within(&format!("light {index}")))
+    }
 }

@@ -158,7 +158,7 @@ fn assemble(file: SceneFile, name: String, folder: &Path, view_whole: bool) -> R
         .lights
         .into_iter()
         .enumerate()
-        .map(|(at, l)| light(l).map_err(|e| e.within(&format!("light {at}"))))
+        .map(|(at, l)| light(l).validated_as(at))
         .collect::<Result<_, _>>()?;
     lights.extend(listed);
     let probes = file
@@ -273,8 +273,9 @@ pub(super) fn camera(desc: &CameraDesc) -> Result<Camera, SceneError> {
     Camera::from_arrays(desc.position, desc.target, desc.up, desc.fov_y_deg)
 }
 
-pub(super) fn light(desc: LightDesc) -> Result<Light, SceneError> {
-    let light = match desc {
+/// The light a scene file describes, before [`Light::validated_as`] checks it.
+pub(super) fn light(desc: LightDesc) -> Light {
+    match desc {
         LightDesc::Point(p) => Light::Point { position: Vec3::from(p.position), intensity: p.intensity },
         LightDesc::Spot(s) => Light::Spot {
             position: Vec3::from(s.position),
@@ -282,6 +283,5 @@ pub(super) fn light(desc: LightDesc) -> Result<Light, SceneError> {
             fov_deg: s.fov_deg,
             intensity: s.intensity,
         },
-    };
-    light.validated()
+    }
 }

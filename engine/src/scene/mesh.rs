@@ -3,6 +3,38 @@ use glam::Vec3;
 
 use super::albedo_map::Texturing;
 use super::SceneError;
+use crate::host_memory::{self, OutOfHostMemory};
+
+/// The most vertices one mesh may have: the GPU holds 32 bytes a vertex (position, normal,
+/// texture coordinate) in buffers that shaders address with 32-bit offsets, at most 4 GiB.
+pub const MAX_MESH_VERTICES: usize = u32::MAX as usize / 32;
+
+/// The most triangles a scene may have: the ray tracer's BVH names a triangle in 28 bits.
+pub const MAX_TRIANGLES: usize = 1 << 28;
+
+/// Refuses a mesh of more than [`MAX_MESH_VERTICES`] vertices, before they are allocated.
+pub fn check_vertex_count(vertices: usize) -> Result<(), SceneError> {
+    if vertices > MAX_MESH_VERTICES {
+        return Err(SceneError::invalid(format!(
+            "{vertices} vertices, more than the {MAX_MESH_VERTICES} a mesh may have (32 bytes each on \
+             the GPU, in buffers of at most 4 GiB)"
+        )));
+    }
+    Ok(())
+}
+
+/// Refuses more indices than [`MAX_TRIANGLES`] triangles take (in a mesh, or a whole scene),
+/// before they are allocated.
+pub fn check_index_count(indices: usize) -> Result<(), SceneError> {
+    if indices / 3 > MAX_TRIANGLES {
+        return Err(SceneError::invalid(format!(
+            "{indices} indices ({} triangles), more than the {MAX_TRIANGLES} triangles a scene may \
+             have (its ray tracer names a triangle in 28 bits)",
+            indices / 3
+        )));
+    }
+    Ok(())
+}
 
 /// An indexed triangle mesh in object space with one diffuse albedo.
 ///
@@ -82,19 +114,27 @@ impl Mesh {
         if let Some(t) = &texturing {
             check_uvs(&name, &t.uvs, positions.len())?;
         }
+        let in_mesh = |e: OutOfHostMemory| SceneError::from(e).within(&format!("mesh \"{name}\""));
         let (normals, repaired) = match normals {
             Some(normals) if normals.len() == positions.len() => {
                 repaired_normals(normals, &positions, &indices)
             }
             _ => (area_weighted_normals(&positions, &indices), 0),
         };
-        let order = first_use_order(positions.len(), &indices);
-        let texturing = texturing.map(|t| Texturing { uvs: reordered(&t.uvs, &order.0), ..t });
+        let normals = normals.map_err(in_mesh)?;
+        let (order, indices) = first_use_order(positions.len(), &indices).map_err(in_mesh)?;
+        let texturing = match texturing {
+            Some(t) => Some(Texturing {
+                uvs: reordered(&t.uvs, &order, "texture coordinates").map_err(in_mesh)?,
+                ..t
+            }),
+            None => None,
+        };
         let mesh = Mesh {
+            positions: reordered(&positions, &order, "positions").map_err(in_mesh)?,
+            normals: reordered(&normals, &order, "normals").map_err(in_mesh)?,
             name,
-            positions: reordered(&positions, &order.0),
-            normals: reordered(&normals, &order.0),
-            indices: order.1,
+            indices,
             albedo,
             texturing,
         };
@@ -148,6 +188,9 @@ fn check_geometry(
     indices: &[u32],
     albedo: [f32; 3],
 ) -> Result<(), SceneError> {
+    let counted = |e: SceneError| e.within(&format!("mesh \"{name}\""));
+    check_vertex_count(positions.len()).map_err(counted)?;
+    check_index_count(indices.len()).map_err(counted)?;
     if indices.is_empty() {
         return Err(SceneError::invalid(format!("mesh \"{name}\" is empty: it has no triangles")));
     }
@@ -186,10 +229,10 @@ fn checked_normal(name: &str, at: usize, n: [f32; 3]) -> Result<Vec3, SceneError
 /// The given normals, normalized, with each zero or non-finite one replaced by the vertex's
 /// area-weighted normal; and how many were replaced.
 fn repaired_normals(
-    normals: Vec<[f32; 3]>,
+    mut normals: Vec<[f32; 3]>,
     positions: &[[f32; 3]],
     indices: &[u32],
-) -> (Vec<[f32; 3]>, usize) {
+) -> (Result<Vec<[f32; 3]>, OutOfHostMemory>, usize) {
     let unit = |n: [f32; 3]| {
         let v = Vec3::from(n);
         // Scaled to its largest component first, so that no finite non-zero normal over- or
@@ -198,33 +241,41 @@ fn repaired_normals(
         (v.is_finite() && largest > 0.0).then(|| (v / largest).normalize())
     };
     let repaired = normals.iter().filter(|n| unit(**n).is_none()).count();
-    let computed = (repaired > 0).then(|| area_weighted_normals(positions, indices));
-    let normals = normals
-        .into_iter()
-        .enumerate()
-        .map(|(at, n)| match unit(n) {
+    let computed = match (repaired > 0).then(|| area_weighted_normals(positions, indices)).transpose() {
+        Ok(computed) => computed,
+        Err(e) => return (Err(e), repaired),
+    };
+    for (at, n) in normals.iter_mut().enumerate() {
+        *n = match unit(*n) {
             // Already-unit normals stay bit-identical (see `Mesh`'s round-trip promise).
-            Some(_) if Vec3::from(n).is_normalized() => n,
+            Some(_) if Vec3::from(*n).is_normalized() => *n,
             Some(v) => v.to_array(),
             None => computed.as_ref().map_or([0.0, 1.0, 0.0], |c| c[at]),
-        })
-        .collect();
-    (normals, repaired)
+        };
+    }
+    (Ok(normals), repaired)
 }
 
 /// Sums each triangle's unnormalized face normal (length = twice its area) into its vertices.
 /// A vertex whose sum is zero (only degenerate triangles, or normals that cancel) gets +Y: any
 /// unit vector is as good as another there, and NaN is not.
-pub(crate) fn area_weighted_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> {
-    let mut sums = vec![Vec3::ZERO; positions.len()];
+pub(crate) fn area_weighted_normals(
+    positions: &[[f32; 3]],
+    indices: &[u32],
+) -> Result<Vec<[f32; 3]>, OutOfHostMemory> {
+    let mut sums = host_memory::filled([0.0; 3], positions.len(), "vertex normals")?;
     for tri in indices.chunks_exact(3) {
         let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| Vec3::from(positions[i as usize]));
         let face = (b - a).cross(c - a);
         for &i in tri {
-            sums[i as usize] += face;
+            let sum = &mut sums[i as usize];
+            *sum = (Vec3::from(*sum) + face).to_array();
         }
     }
-    sums.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y).to_array()).collect()
+    for n in &mut sums {
+        *n = Vec3::from(*n).try_normalize().unwrap_or(Vec3::Y).to_array();
+    }
+    Ok(sums)
 }
 
 /// The note [`Mesh::new`] prints where normals were repaired.
@@ -257,25 +308,26 @@ fn check_uvs(name: &str, uvs: &[[f32; 2]], positions: usize) -> Result<(), Scene
 
 /// The old index of each vertex in the order the triangles first use them (unused ones
 /// dropped), and the indices renumbered to that order.
-fn first_use_order(vertex_count: usize, indices: &[u32]) -> (Vec<u32>, Vec<u32>) {
-    let mut new_index = vec![u32::MAX; vertex_count];
-    let mut order = Vec::with_capacity(vertex_count);
-    let indices = indices
-        .iter()
-        .map(|&old| {
+fn first_use_order(vertex_count: usize, indices: &[u32]) -> Result<(Vec<u32>, Vec<u32>), OutOfHostMemory> {
+    let mut new_index = host_memory::filled(u32::MAX, vertex_count, "the vertex order")?;
+    let mut order = host_memory::with_room(vertex_count, "the vertex order")?;
+    let indices = host_memory::collect(
+        indices.iter().map(|&old| {
             let slot = &mut new_index[old as usize];
             if *slot == u32::MAX {
                 *slot = order.len() as u32;
+                // Within the room reserved: each vertex is pushed once.
                 order.push(old);
             }
             *slot
-        })
-        .collect();
-    (order, indices)
+        }),
+        "indices",
+    )?;
+    Ok((order, indices))
 }
 
-fn reordered<T: Copy>(items: &[T], order: &[u32]) -> Vec<T> {
-    order.iter().map(|&old| items[old as usize]).collect()
+fn reordered<T: Copy>(items: &[T], order: &[u32], what: &str) -> Result<Vec<T>, OutOfHostMemory> {
+    host_memory::collect(order.iter().map(|&old| items[old as usize]), what)
 }
 
 #[cfg(test)]
@@ -297,6 +349,18 @@ mod tests {
         for n in mesh.normals {
             assert!((Vec3::from(n).length() - 1.0).abs() < 1e-6);
         }
+    }
+
+    /// Counts beyond what the GPU buffers and the BVH hold are refused by the count alone,
+    /// naming it and the limit, so that a caller can refuse them before allocating.
+    #[test]
+    fn counts_beyond_the_limits_are_refused_before_allocation() {
+        assert!(check_vertex_count(MAX_MESH_VERTICES).is_ok());
+        let vertices = check_vertex_count(u32::MAX as usize).unwrap_err().to_string();
+        assert!(vertices.contains("4294967295 vertices") && vertices.contains("134217727"), "{vertices}");
+        assert!(check_index_count(3 * MAX_TRIANGLES + 2).is_ok());
+        let indices = check_index_count(3 * MAX_TRIANGLES + 3).unwrap_err().to_string();
+        assert!(indices.contains("805306371 indices") && indices.contains("268435456"), "{indices}");
     }
 
     #[test]
@@ -323,7 +387,7 @@ mod tests {
         let (mesh, repaired) =
             Mesh::new_reporting("m", positions.clone(), Some(given), indices.clone(), [0.5; 3]).unwrap();
         assert_eq!(repaired, 2);
-        let computed = area_weighted_normals(&positions, &indices);
+        let computed = area_weighted_normals(&positions, &indices).unwrap();
         assert_eq!(mesh.normals, vec![computed[0], computed[1], [0.0, 1.0, 0.0], [0.6, 0.0, 0.8]]);
         // Areas 0.5 (+Y) and 1 (+Z): the repaired normal leans to the larger face.
         let expected = Vec3::new(0.0, 1.0, 2.0).normalize();

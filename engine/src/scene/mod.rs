@@ -50,7 +50,7 @@ pub use export::{SceneFormat, ENVIRONMENT_FILE, GLTF_FILE, SCENE_FILE};
 pub use light::{Light, MAX_SPOT_FOV_DEG};
 pub use load::LONE_OBJ_ALBEDO;
 pub use load::{Loaded, DEFAULT_SKY};
-pub use mesh::Mesh;
+pub use mesh::{check_index_count, check_vertex_count, Mesh, MAX_MESH_VERTICES, MAX_TRIANGLES};
 pub use motion::Motion;
 pub use obj::{load_obj, parse_obj, write_obj};
 pub use probe::{ProbeRole, SceneProbe};
@@ -212,8 +212,10 @@ impl Scene {
                 }
             }
         }
+        let indices = self.meshes().map(|(_, m)| m.indices.len()).sum();
+        check_index_count(indices).map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         for (l, light) in self.lights.iter().enumerate() {
-            light.validated().map_err(|e| e.within(&format!("scene \"{}\": light {l}", self.name)))?;
+            light.validated_as(l).map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         }
         self.camera.validated().map_err(|e| e.within(&format!("scene \"{}\"", self.name)))?;
         animation::check_walkthrough(&self.walkthrough)

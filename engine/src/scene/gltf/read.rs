@@ -412,7 +412,8 @@ fn light_of(
         Ok(read) => read,
         Err(e) => return Some(Err(e.to_string())),
     };
-    let exact = Extras::of(node.extras()).light.and_then(|desc| super::super::load::light(desc).ok());
+    let exact =
+        Extras::of(node.extras()).light.and_then(|desc| super::super::load::light(desc).validated().ok());
     let numbers = |light: &Light| match *light {
         Light::Point { position, intensity } => [position.to_array(), intensity, [0.0; 3], [0.0; 3]].concat(),
         Light::Spot { position, direction, fov_deg, intensity } => {

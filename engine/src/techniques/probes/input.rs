@@ -41,10 +41,16 @@ pub struct Distinct {
     pub merged: Vec<Merged>,
 }
 
-pub fn distinct(positions: &[DVec3]) -> Result<Distinct, ProbeError> {
-    if positions.len() > MAX_PROBES {
-        return Err(ProbeError::TooMany { total: positions.len(), max: MAX_PROBES });
+/// Refuses more than [`MAX_PROBES`] probes, before their positions are allocated.
+pub fn check_count(total: usize) -> Result<(), ProbeError> {
+    match total > MAX_PROBES {
+        true => Err(ProbeError::TooMany { total, max: MAX_PROBES }),
+        false => Ok(()),
     }
+}
+
+pub fn distinct(positions: &[DVec3]) -> Result<Distinct, ProbeError> {
+    check_count(positions.len())?;
     let positions = positions
         .iter()
         .enumerate()

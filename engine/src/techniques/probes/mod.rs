@@ -48,7 +48,7 @@ pub use capture::{
     DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES, MAX_BACK_FACES, RADIANCE_SEED,
 };
 pub use dering::Dering;
-pub use input::Merged;
+pub use input::{check_count, Merged, MAX_PROBES};
 pub use lookup::{Location, Walker};
 pub use reduce::reduce;
 pub use relocate::relocate;
