@@ -326,7 +326,7 @@ unsafe fn group(at: usize, desc: &kage_group_desc) -> Result<Group, Failure> {
         let made = Mesh::new(format!("mesh{m}"), positions, normals, indices, mesh.albedo);
         built.push(made.map_err(|e| place(e.within(&format!("mesh {m}"))))?);
     }
-    Ok(Group { name, meshes: built, transform, motion: None })
+    Ok(Group::new(name, built, transform))
 }
 
 /// A scene error from data that came from no file: the host's values are at fault, or, where
