@@ -305,12 +305,14 @@ impl Asm {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let used = buffer(
+        let mut used = buffer(
             "asm.used",
             memory::used_bytes(nodes),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
+        // No frame yet: a node the lighting never marked must not read as used last frame.
+        used.write(0, &vec![0xFF; memory::used_bytes(nodes) as usize])?;
         let mut asm = Asm {
             light,
             bounds: group_bounds(scene),
