@@ -30,6 +30,7 @@
 
 pub mod backend;
 pub mod capi;
+pub mod equirect;
 pub mod error;
 pub mod files;
 pub mod frame;

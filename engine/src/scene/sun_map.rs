@@ -74,8 +74,10 @@ impl SunMap {
         let pixels = (0..w * h)
             .map(|t| {
                 let (x, y) = (t % w, t / w);
-                let d =
-                    crate::sh::equirect_direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                let d = crate::equirect::equirect_direction(
+                    (x as f64 + 0.5) / w as f64,
+                    (y as f64 + 0.5) / h as f64,
+                );
                 if d.dot(sun) >= cos_radius {
                     covered += 1;
                     self.radiance
@@ -99,7 +101,7 @@ impl SunMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sh::equirect_texel_solid_angle;
+    use crate::equirect::equirect_texel_solid_angle;
 
     /// The disk's texels add up to its solid angle 2π(1 − cos r) within the texels along its rim.
     #[test]
@@ -115,7 +117,10 @@ mod tests {
                 let d_omega = equirect_texel_solid_angle(w, h, y);
                 omega += d_omega;
                 centroid += d_omega
-                    * crate::sh::equirect_direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                    * crate::equirect::equirect_direction(
+                        (x as f64 + 0.5) / w as f64,
+                        (y as f64 + 0.5) / h as f64,
+                    );
             }
         }
         let exact = 2.0 * std::f64::consts::PI * (1.0 - 2f64.to_radians().cos());
