@@ -34,7 +34,7 @@ impl GpuArgs {
 /// The scene a command looks at: `--scene` and, optionally, a keyframe of its walkthrough.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneArgs {
-    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium), a scene
+    /// A built-in scene name (teapot, teapot-hires-floor, probe-room, asm, atrium, two-rooms), a scene
     /// file (.json), a glTF 2.0 file (.gltf, .glb), or a folder holding scene.json.
     #[arg(long, default_value = "teapot")]
     scene: String,

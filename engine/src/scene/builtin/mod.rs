@@ -7,6 +7,7 @@ use glam::Vec3;
 mod asm_room;
 pub mod atrium;
 mod probe_room;
+mod two_rooms;
 
 use super::{obj, shapes, Camera, EnvMap, Group, Scene, SceneError, Transform};
 
@@ -19,7 +20,7 @@ const BUNNY_OBJ: &[u8] = include_bytes!("../../../assets/bunny.obj");
 const TEAPOT_HEIGHT: f32 = 15.75;
 
 /// Names accepted by [`Scene::builtin`]; the first is the default.
-pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room", "asm", "atrium"];
+pub const BUILTIN: &[&str] = &["teapot", "teapot-hires-floor", "probe-room", "asm", "atrium", "two-rooms"];
 
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     if name == "probe-room" {
@@ -34,6 +35,16 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
     }
     if name == "atrium" {
         return courtyard_scene(name, atrium::groups, atrium::camera(), 1.0);
+    }
+    if name == "two-rooms" {
+        let camera = Camera {
+            position: Vec3::new(3.6, 1.9, 1.8),
+            target: Vec3::new(0.0, 0.5, -0.6),
+            up: Vec3::Y,
+            fov_y_deg: 70.0,
+        };
+        // Lit through two openings only, as probe-room is.
+        return courtyard_scene(name, two_rooms::groups, camera, 4.0);
     }
     // Floor grid vertices per side: 31×31 is the paper's low-resolution receiver, 111×111 its
     // high-resolution one.

@@ -52,7 +52,13 @@ pub fn groups() -> Result<Vec<Group>, SceneError> {
 /// made from the floor grid of [`shapes::plane`] mapped X → one in-plane axis, Y → the normal,
 /// Z → the other in-plane axis, the latter's sign chosen so the map keeps the counter-clockwise
 /// winding.
-fn panel(name: &str, lo: Vec3, hi: Vec3, normal: Vec3, albedo: [f32; 3]) -> Result<Mesh, SceneError> {
+pub(super) fn panel(
+    name: &str,
+    lo: Vec3,
+    hi: Vec3,
+    normal: Vec3,
+    albedo: [f32; 3],
+) -> Result<Mesh, SceneError> {
     let (centre, extent) = ((lo + hi) * 0.5, hi - lo);
     let mut in_plane = [Vec3::X, Vec3::Y, Vec3::Z].into_iter().filter(|a| a.dot(normal) == 0.0);
     let (Some(a), Some(b)) = (in_plane.next(), in_plane.next()) else {
