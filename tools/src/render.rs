@@ -12,7 +12,7 @@ use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::{TechniqueDesc, TechniqueKind};
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
-    DEFAULT_TOLERANCE,
+    DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
 use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use std::path::PathBuf;
@@ -29,7 +29,7 @@ pub struct RenderArgs {
     regions: usize,
     /// Penumbra of the Tamura shadows: `fixed` (the paper's box width per group pair) or
     /// `adaptive` (a width per pixel from its distance to the occluder).
-    #[arg(long, value_enum, default_value_t = Penumbra::Fixed)]
+    #[arg(long, value_enum, default_value_t = OcclusionSettings::default().penumbra)]
     penumbra: Penumbra,
     /// Side of a Tamura occlusion mask layer, texels.
     #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
@@ -53,33 +53,33 @@ pub struct RenderArgs {
     asm_time_ms: f64,
     /// Adaptive shadow maps: the shadow test, `id` (the paper's polygon IDs, depth with bias
     /// as fallback; pages take twice the bytes) or `bias` (depth with slope-scaled bias).
-    #[arg(long, value_enum, default_value_t = AsmTest::Bias)]
+    #[arg(long, value_enum, default_value_t = AsmSettings::default().test)]
     asm_test: AsmTest,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`), a file
     /// `{"positions": [[x,y,z], ...]}`, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
     /// on that grid, outside solids, captured; those the others reproduce within the relative
     /// irradiance error TOL, default 0.05, dropped).
-    #[arg(long, default_value = "grid:3,2,3")]
+    #[arg(long, default_value_t = format!("grid:{},{},{}", DEFAULT_GRID[0], DEFAULT_GRID[1], DEFAULT_GRID[2]))]
     probes: String,
     /// How the light between probes is found: `trilinear` needs a `grid:` placement.
-    #[arg(long, value_enum, default_value_t = ProbeInterpolation::Tetrahedral)]
+    #[arg(long, value_enum, default_value_t = ProbeSettings::default().interpolation)]
     probe_interpolation: ProbeInterpolation,
     /// How the probes technique lights the static groups beside the probe-lit moving ones.
-    #[arg(long, value_enum, default_value_t = StaticLighting::Unshadowed)]
+    #[arg(long, value_enum, default_value_t = ProbeSettings::default().statics)]
     probe_statics: StaticLighting,
     /// Texels per side of a probe's cube-map face, 8 to 256.
-    #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_CUBE_SIZE)]
+    #[arg(long, default_value_t = CaptureSettings::default().cube_size)]
     probe_cube_size: u32,
     /// What the probes capture besides the sky they see.
-    #[arg(long, value_enum, default_value_t = CapturedLight::SkyAndWalls)]
+    #[arg(long, value_enum, default_value_t = CaptureSettings::default().light)]
     probe_light: CapturedLight,
     /// Reflections of the walls' light the probes capture: 1 (walls lit directly) or 2 (and
     /// by each other once).
-    #[arg(long, default_value_t = kage::reference::MAX_BOUNCES)]
+    #[arg(long, default_value_t = CaptureSettings::default().bounces)]
     probe_bounces: u32,
     /// Monte Carlo samples per wall vertex and bounce for the probes' capture.
-    #[arg(long, default_value_t = kage::techniques::probes::DEFAULT_SAMPLES)]
+    #[arg(long, default_value_t = CaptureSettings::default().samples)]
     probe_samples: u32,
     /// Window on the probes' SH against ringing: off, nonnegative (irradiance never negative),
     /// hanning:W or lanczos:W (Sloan 2008).
