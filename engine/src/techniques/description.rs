@@ -194,12 +194,15 @@ impl TechniqueDesc {
             }
             TechniqueDesc::Probes { probes, .. } => *probes = probes.clone().validated()?,
             TechniqueDesc::Asm(asm) => *asm = asm.validated()?,
-            // Parallel lights and shadow maps check their sizes when built, before GPU work.
+            TechniqueDesc::ParallelLights { regions, shadow_map_size } => {
+                super::parallel_lights::check(*regions, *shadow_map_size)?
+            }
+            TechniqueDesc::ShadowMap { size } => {
+                super::shadow_map::check_map_size(*size, super::shadow_map::SHADOW_MAP_SIZES)?
+            }
             TechniqueDesc::Unshadowed
             | TechniqueDesc::SloanSelf { .. }
-            | TechniqueDesc::SloanScene { .. }
-            | TechniqueDesc::ParallelLights { .. }
-            | TechniqueDesc::ShadowMap { .. } => {}
+            | TechniqueDesc::SloanScene { .. } => {}
         }
         Ok(self)
     }
@@ -358,5 +361,10 @@ mod tests {
         assert!(invalid(asm(0.01, 8.0)).contains("holds no tile"));
         assert!(invalid(asm(f64::INFINITY, 8.0)).contains("finite number of MB"));
         assert!(invalid(asm(16.0, 0.0)).contains("time budget"));
+        // Parallel lights and shadow maps are checked here too, before anything is built.
+        let parallel = |regions, shadow_map_size| TechniqueDesc::ParallelLights { regions, shadow_map_size };
+        assert!(invalid(parallel(129, 512)).contains("q = 129 regions, must be 1 to 128"));
+        assert!(invalid(parallel(32, 4096)).contains("shadow map size 4096 must be 16 to 2048"));
+        assert!(invalid(TechniqueDesc::ShadowMap { size: 8 }).contains("shadow map size 8 must be 16 to"));
     }
 }

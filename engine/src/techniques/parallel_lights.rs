@@ -65,23 +65,21 @@ pub struct ParallelLights {
     depth_range: f32,
 }
 
+/// The settings' limits: `q` regions, 1 to the shader's `MAX_PARALLEL_LIGHTS`, and maps of
+/// [`SHADOW_MAP_SIZES`].
+pub fn check(q: usize, shadow_map_size: u32) -> Result<()> {
+    let max = constants::MAX_PARALLEL_LIGHTS as usize;
+    if !(1..=max).contains(&q) {
+        return Err(Error::InvalidArgument(format!("parallel lights: q = {q} regions, must be 1 to {max}")));
+    }
+    super::shadow_map::check_map_size(shadow_map_size, SHADOW_MAP_SIZES)
+}
+
 impl ParallelLights {
     /// `q` regions of the scene's environment (1 to `MAX_PARALLEL_LIGHTS`), shadow maps of
     /// `shadow_map_size`² texels.
     pub fn new(ctx: &Arc<Context>, scene: &Scene, q: usize, shadow_map_size: u32) -> Result<ParallelLights> {
-        let max = constants::MAX_PARALLEL_LIGHTS as usize;
-        if !(1..=max).contains(&q) {
-            return Err(Error::InvalidArgument(format!(
-                "parallel lights: q = {q} regions, must be 1 to {max}"
-            )));
-        }
-        if !SHADOW_MAP_SIZES.contains(&shadow_map_size) {
-            return Err(Error::InvalidArgument(format!(
-                "shadow map size {shadow_map_size} must be {} to {} texels",
-                SHADOW_MAP_SIZES.start(),
-                SHADOW_MAP_SIZES.end()
-            )));
-        }
+        check(q, shadow_map_size)?;
         let regions = Regions::new(&scene.environment, q)?;
         let scene_pipeline = scene_pipeline(
             ctx,
@@ -95,7 +93,7 @@ impl ParallelLights {
             ctx,
             &BufferDesc {
                 name: "parallel_lights.lights",
-                size: (max * size_of::<ParallelLight>()) as u64,
+                size: (constants::MAX_PARALLEL_LIGHTS as usize * size_of::<ParallelLight>()) as u64,
                 usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
                 location: MemoryLocation::CpuToGpu,
             },

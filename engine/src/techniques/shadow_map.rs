@@ -65,6 +65,20 @@ pub struct ShadowMap {
     records: Buffer,
 }
 
+/// A shadow map's side checked against `sizes` (the shadowmap technique's
+/// [`SHADOW_MAP_SIZES`], parallel lights' own): what `TechniqueDesc::validated` and the
+/// techniques' constructors ask.
+pub fn check_map_size(size: u32, sizes: std::ops::RangeInclusive<u32>) -> Result<()> {
+    if sizes.contains(&size) {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument(format!(
+        "shadow map size {size} must be {} to {} texels",
+        sizes.start(),
+        sizes.end()
+    )))
+}
+
 impl ShadowMap {
     /// Maps of `size`² texels for each of the scene's local lights (1 to `MAX_LOCAL_LIGHTS`).
     pub fn new(ctx: &Arc<Context>, scene: &Scene, size: u32) -> Result<ShadowMap> {
@@ -77,13 +91,7 @@ impl ShadowMap {
                 scene.lights.len()
             )));
         }
-        if !SHADOW_MAP_SIZES.contains(&size) {
-            return Err(Error::InvalidArgument(format!(
-                "shadow map size {size} must be {} to {} texels",
-                SHADOW_MAP_SIZES.start(),
-                SHADOW_MAP_SIZES.end()
-            )));
-        }
+        check_map_size(size, SHADOW_MAP_SIZES)?;
         let scene_pipeline = scene_pipeline(
             ctx,
             "scene_local_lights",
