@@ -79,6 +79,8 @@ fn refinement_converges_within_the_budget_and_beats_a_map_of_equal_memory() {
     let last = *differing.last().unwrap();
     assert!(2 * last <= differing[0], "no convergence: {differing:?}");
     assert!(stats.deepest_level >= 4, "deepest level {}", stats.deepest_level);
+    // 64² texels per tile, each level doubling the side: level 4 is a 1024² map's texels.
+    assert_eq!(stats.effective_resolution(), 64 << stats.deepest_level);
 
     let mut map = renderer(&ctx, &scene, TechniqueDesc::ShadowMap { size: 1024 });
     let conventional = mismatches(&mut map, &truth, 1)[0].differing;

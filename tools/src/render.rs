@@ -306,7 +306,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     drop(bar);
     if let Some(stats) = renderer.stats().asm {
         println!(
-            "asm: {} tiles resident, {:.2} of {:.2} MB in use (allocated {:.2}: pages {:.2}, scratch {:.2}, page table {:.2}, analysis {:.2}, lights {:.3}), deepest level {}, {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",
+            "asm: {} tiles resident, {:.2} of {:.2} MB in use (allocated {:.2}: pages {:.2}, scratch {:.2}, page table {:.2}, analysis {:.2}, lights {:.3}), deepest level {} (the texels of a {}² map), {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms",
             stats.resident_tiles,
             stats.bytes_used as f64 / MB as f64,
             stats.budget_bytes as f64 / MB as f64,
@@ -317,6 +317,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             stats.memory.analysis as f64 / MB as f64,
             stats.memory.lights as f64 / MB as f64,
             stats.deepest_level,
+            stats.effective_resolution(),
             stats.refreshed.len() + stats.rendered.len(),
             stats.cost.0,
             stats.cost.1

@@ -160,6 +160,14 @@ pub struct AsmStats {
     pub cost: (f64, f64),
 }
 
+impl AsmStats {
+    /// The side of the conventional map whose texels are as fine as the deepest resident
+    /// tile's (the paper reports 65,536² and 524,288² in its close-ups).
+    pub fn effective_resolution(&self) -> u64 {
+        u64::from(constants::ASM_TILE_TEXELS) << self.deepest_level
+    }
+}
+
 pub struct Asm {
     light: Light,
     bounds: Vec<GroupBounds>,
