@@ -5,11 +5,12 @@ use crate::transfer_source::{Origin, PrtArgs};
 use anyhow::{Context as _, Result};
 use clap::Args;
 use kage::pass::TimingTable;
+use kage::prt::PrtParams;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::{AsmTest, MB};
 use kage::techniques::asm::AsmSettings;
-use kage::techniques::description::{TechniqueDesc, TechniqueKind};
+use kage::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
 use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
     DEFAULT_GRID, DEFAULT_TOLERANCE,
@@ -138,50 +139,59 @@ struct TimingsFile {
 /// The command line's technique options as the engine's description (each technique reads its
 /// own options; the others are ignored).
 fn technique(args: &RenderArgs, scene: &Scene) -> Result<TechniqueDesc> {
-    let prt = args.prt.params()?;
-    let regions = args.regions;
-    let desc = match args.technique {
-        TechniqueKind::Unshadowed => TechniqueDesc::Unshadowed,
-        TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt },
-        TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt },
-        TechniqueKind::Tamura => TechniqueDesc::Tamura {
-            prt,
-            occlusion: OcclusionSettings {
-                regions,
-                mask_size: args.mask_size,
-                penumbra: args.penumbra,
-                dominant_lights: args.dominant_lights,
-                light_map_size: args.light_map_size,
-                ..OcclusionSettings::default()
+    Ok(TechniqueDesc::from_params(args.technique, &Flags { args, scene })?.validated()?)
+}
+
+/// The technique flags as the techniques' parameters; `scene` for the probes' placement.
+struct Flags<'a> {
+    args: &'a RenderArgs,
+    scene: &'a Scene,
+}
+
+impl TechniqueParams for Flags<'_> {
+    type Error = anyhow::Error;
+    fn prt(&self) -> Result<PrtParams> {
+        self.args.prt.params()
+    }
+    fn regions(&self) -> usize {
+        self.args.regions
+    }
+    fn mask_size(&self) -> u32 {
+        self.args.mask_size
+    }
+    fn occlusion(&self) -> Result<OcclusionSettings> {
+        let args = self.args;
+        Ok(OcclusionSettings {
+            regions: args.regions,
+            mask_size: args.mask_size,
+            penumbra: args.penumbra,
+            dominant_lights: args.dominant_lights,
+            light_map_size: args.light_map_size,
+            ..OcclusionSettings::default()
+        })
+    }
+    fn shadow_map_size(&self) -> u32 {
+        self.args.shadow_map_size
+    }
+    fn probes(&self) -> Result<ProbeSettings> {
+        let args = self.args;
+        Ok(ProbeSettings {
+            placement: probe_placement(&args.probes, self.scene)?,
+            capture: CaptureSettings {
+                cube_size: args.probe_cube_size,
+                light: args.probe_light,
+                bounces: args.probe_bounces,
+                samples: args.probe_samples,
+                dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
             },
-        },
-        TechniqueKind::TamuraPaper => TechniqueDesc::TamuraPaper { prt, regions, mask_size: args.mask_size },
-        TechniqueKind::ParallelLights => {
-            TechniqueDesc::ParallelLights { regions, shadow_map_size: args.shadow_map_size }
-        }
-        TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: args.shadow_map_size },
-        TechniqueKind::Probes => TechniqueDesc::Probes {
-            probes: ProbeSettings {
-                placement: probe_placement(&args.probes, scene)?,
-                capture: CaptureSettings {
-                    cube_size: args.probe_cube_size,
-                    light: args.probe_light,
-                    bounces: args.probe_bounces,
-                    samples: args.probe_samples,
-                    dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
-                },
-                interpolation: args.probe_interpolation,
-                statics: args.probe_statics,
-            },
-            prt,
-        },
-        TechniqueKind::Asm => TechniqueDesc::Asm(AsmSettings {
-            budget_mb: args.asm_budget_mb,
-            time_ms: args.asm_time_ms,
-            test: args.asm_test,
-        }),
-    };
-    Ok(desc.validated()?)
+            interpolation: args.probe_interpolation,
+            statics: args.probe_statics,
+        })
+    }
+    fn asm(&self) -> Result<AsmSettings> {
+        let args = self.args;
+        Ok(AsmSettings { budget_mb: args.asm_budget_mb, time_ms: args.asm_time_ms, test: args.asm_test })
+    }
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {

@@ -8,7 +8,7 @@ use crate::host_memory;
 use crate::prt::{cache, transfer, PrtParams};
 use crate::techniques::asm::technique::AsmTest;
 use crate::techniques::asm::AsmSettings;
-use crate::techniques::description::{TechniqueDesc, TechniqueKind};
+use crate::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
 use crate::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use crate::techniques::probes::{
     self, CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
@@ -134,46 +134,14 @@ impl kage_technique_desc {
         // Checked here too for the desc inside a `kage_renderer_desc`.
         args::check_size::<kage_technique_desc>(self.size, "technique")?;
         let kind = args::enumeration(self.technique, "technique", TechniqueKind::from_repr)?;
-        let prt = PrtParams { bands: self.sh_bands, rays: self.prt_rays, ..PrtParams::DEFAULT };
-        let regions = self.regions as usize;
-        let desc = match kind {
-            TechniqueKind::Unshadowed => TechniqueDesc::Unshadowed,
-            TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt },
-            TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt },
-            TechniqueKind::Tamura => TechniqueDesc::Tamura {
-                prt,
-                occlusion: OcclusionSettings {
-                    regions,
-                    mask_size: self.mask_size,
-                    penumbra: args::enumeration(self.penumbra, "penumbra", Penumbra::from_repr)?,
-                    dominant_lights: self.dominant_lights as usize,
-                    light_map_size: self.light_map_size,
-                    ..OcclusionSettings::default()
-                },
-            },
-            TechniqueKind::TamuraPaper => {
-                TechniqueDesc::TamuraPaper { prt, regions, mask_size: self.mask_size }
-            }
-            TechniqueKind::ParallelLights => {
-                TechniqueDesc::ParallelLights { regions, shadow_map_size: self.shadow_map_size }
-            }
-            TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: self.shadow_map_size },
-            // SAFETY: the caller's promise about the probe positions.
-            TechniqueKind::Probes => TechniqueDesc::Probes { probes: unsafe { self.probes() }?, prt },
-            TechniqueKind::Asm => TechniqueDesc::Asm(AsmSettings {
-                budget_mb: self.asm_budget_mb,
-                time_ms: self.asm_time_ms,
-                test: args::enumeration(self.asm_test, "asm_test", AsmTest::from_repr)?,
-            }),
-        };
-        Ok(desc.validated()?)
+        Ok(TechniqueDesc::from_params(kind, &HostParams(self))?.validated()?)
     }
 
     /// The probe fields.
     ///
     /// # Safety
     /// As [`Self::desc`].
-    unsafe fn probes(&self) -> Result<ProbeSettings, Failure> {
+    unsafe fn probe_settings(&self) -> Result<ProbeSettings, Failure> {
         let placement = match args::enumeration(
             self.probe_placement,
             "probe_placement",
@@ -217,6 +185,47 @@ impl kage_technique_desc {
                 ProbeInterpolation::from_repr,
             )?,
             statics: args::enumeration(self.probe_statics, "probe_statics", StaticLighting::from_repr)?,
+        })
+    }
+}
+
+/// A host's desc as the techniques' parameters. Made only inside [`kage_technique_desc::desc`],
+/// whose caller promises that the probe positions are readable.
+struct HostParams<'a>(&'a kage_technique_desc);
+
+impl TechniqueParams for HostParams<'_> {
+    type Error = Failure;
+    fn prt(&self) -> Result<PrtParams, Failure> {
+        Ok(PrtParams { bands: self.0.sh_bands, rays: self.0.prt_rays, ..PrtParams::DEFAULT })
+    }
+    fn regions(&self) -> usize {
+        self.0.regions as usize
+    }
+    fn mask_size(&self) -> u32 {
+        self.0.mask_size
+    }
+    fn occlusion(&self) -> Result<OcclusionSettings, Failure> {
+        Ok(OcclusionSettings {
+            regions: self.regions(),
+            mask_size: self.mask_size(),
+            penumbra: args::enumeration(self.0.penumbra, "penumbra", Penumbra::from_repr)?,
+            dominant_lights: self.0.dominant_lights as usize,
+            light_map_size: self.0.light_map_size,
+            ..OcclusionSettings::default()
+        })
+    }
+    fn shadow_map_size(&self) -> u32 {
+        self.0.shadow_map_size
+    }
+    fn probes(&self) -> Result<ProbeSettings, Failure> {
+        // SAFETY: `desc`'s caller promised the probe positions readable.
+        unsafe { self.0.probe_settings() }
+    }
+    fn asm(&self) -> Result<AsmSettings, Failure> {
+        Ok(AsmSettings {
+            budget_mb: self.0.asm_budget_mb,
+            time_ms: self.0.asm_time_ms,
+            test: args::enumeration(self.0.asm_test, "asm_test", AsmTest::from_repr)?,
         })
     }
 }

@@ -3,8 +3,10 @@
 //! and built into the running technique by [`TechniqueDesc::build`].
 //!
 //! Adding a technique: its folder or file under `techniques/`, a [`TechniqueKind`] value, a
-//! [`TechniqueDesc`] variant (the compiler then asks for its arms here), and one conversion each
-//! in the command line (`tools/src/render.rs`) and the C ABI (`capi/technique.rs`).
+//! [`TechniqueDesc`] variant (the compiler then asks for its arms here, in
+//! [`TechniqueDesc::from_params`] among them); a new kind of parameter is a [`TechniqueParams`]
+//! method, which the command line (`tools/src/render.rs`) and the C ABI (`capi/technique.rs`)
+//! then implement.
 use super::asm::technique::Asm;
 use super::asm::AsmSettings;
 use super::parallel_lights::{ParallelLights, DEFAULT_SHADOW_MAP_SIZE};
@@ -105,27 +107,86 @@ impl Default for TechniqueDesc {
     }
 }
 
+/// Where a front end keeps the techniques' parameters: the command line's flags, the C ABI's
+/// `kage_technique_desc`, or the defaults ([`Defaults`]). [`TechniqueDesc::from_params`] is the
+/// one conversion into a technique's description, and asks only for what that technique reads,
+/// so a front end never checks a field the technique ignores.
+pub trait TechniqueParams {
+    type Error;
+    fn prt(&self) -> Result<PrtParams, Self::Error>;
+    /// Environment regions q: Tamura's (both variants) and parallel lights'.
+    fn regions(&self) -> usize;
+    /// Side of a Tamura occlusion mask layer (both variants).
+    fn mask_size(&self) -> u32;
+    /// The rest of Tamura's settings, with `regions` and `mask_size`.
+    fn occlusion(&self) -> Result<OcclusionSettings, Self::Error>;
+    /// Parallel lights' and the shadowmap technique's map side.
+    fn shadow_map_size(&self) -> u32;
+    fn probes(&self) -> Result<ProbeSettings, Self::Error>;
+    fn asm(&self) -> Result<AsmSettings, Self::Error>;
+}
+
+/// Every parameter at its default.
+pub struct Defaults;
+
+impl TechniqueParams for Defaults {
+    type Error = std::convert::Infallible;
+    fn prt(&self) -> Result<PrtParams, Self::Error> {
+        Ok(PrtParams::DEFAULT)
+    }
+    fn regions(&self) -> usize {
+        OcclusionSettings::default().regions
+    }
+    fn mask_size(&self) -> u32 {
+        OcclusionSettings::default().mask_size
+    }
+    fn occlusion(&self) -> Result<OcclusionSettings, Self::Error> {
+        Ok(OcclusionSettings::default())
+    }
+    fn shadow_map_size(&self) -> u32 {
+        DEFAULT_SHADOW_MAP_SIZE
+    }
+    fn probes(&self) -> Result<ProbeSettings, Self::Error> {
+        Ok(ProbeSettings::default())
+    }
+    fn asm(&self) -> Result<AsmSettings, Self::Error> {
+        Ok(AsmSettings::default())
+    }
+}
+
 impl TechniqueDesc {
     /// `kind` with every parameter at its default.
     pub fn new(kind: TechniqueKind) -> TechniqueDesc {
-        let prt = PrtParams::DEFAULT;
-        let occlusion = OcclusionSettings::default();
-        match kind {
+        let Ok(desc) = TechniqueDesc::from_params(kind, &Defaults);
+        desc
+    }
+
+    /// `kind` with the parameters it reads from `params` (not yet checked: see
+    /// [`TechniqueDesc::validated`]).
+    pub fn from_params<P: TechniqueParams>(
+        kind: TechniqueKind,
+        params: &P,
+    ) -> Result<TechniqueDesc, P::Error> {
+        Ok(match kind {
             TechniqueKind::Unshadowed => TechniqueDesc::Unshadowed,
-            TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt },
-            TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt },
-            TechniqueKind::Tamura => TechniqueDesc::Tamura { prt, occlusion },
-            TechniqueKind::TamuraPaper => {
-                TechniqueDesc::TamuraPaper { prt, regions: occlusion.regions, mask_size: occlusion.mask_size }
+            TechniqueKind::SloanSelf => TechniqueDesc::SloanSelf { prt: params.prt()? },
+            TechniqueKind::SloanScene => TechniqueDesc::SloanScene { prt: params.prt()? },
+            TechniqueKind::Tamura => {
+                TechniqueDesc::Tamura { prt: params.prt()?, occlusion: params.occlusion()? }
             }
-            TechniqueKind::ParallelLights => TechniqueDesc::ParallelLights {
-                regions: occlusion.regions,
-                shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
+            TechniqueKind::TamuraPaper => TechniqueDesc::TamuraPaper {
+                prt: params.prt()?,
+                regions: params.regions(),
+                mask_size: params.mask_size(),
             },
-            TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: DEFAULT_SHADOW_MAP_SIZE },
-            TechniqueKind::Probes => TechniqueDesc::Probes { probes: ProbeSettings::default(), prt },
-            TechniqueKind::Asm => TechniqueDesc::Asm(AsmSettings::default()),
-        }
+            TechniqueKind::ParallelLights => TechniqueDesc::ParallelLights {
+                regions: params.regions(),
+                shadow_map_size: params.shadow_map_size(),
+            },
+            TechniqueKind::ShadowMap => TechniqueDesc::ShadowMap { size: params.shadow_map_size() },
+            TechniqueKind::Probes => TechniqueDesc::Probes { probes: params.probes()?, prt: params.prt()? },
+            TechniqueKind::Asm => TechniqueDesc::Asm(params.asm()?),
+        })
     }
 
     pub fn kind(&self) -> TechniqueKind {
