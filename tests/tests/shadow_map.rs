@@ -294,12 +294,8 @@ fn the_render_shades_the_references_points_and_edge_ties_lie_on_edges() {
     assert!(boundary > 500, "the cone's edge should cross the image: {boundary} boundary pixels");
     assert_eq!(m.differing, 0, "pixels lit in one image only away from edge ties");
 
-    let ties: Vec<usize> = (0..truth.pixels.len())
-        .filter(|&i| {
-            let [low, high] = edges.ranges[i];
-            f64::from(low) <= m.threshold && f64::from(high) > m.threshold
-        })
-        .collect();
+    let ties: Vec<usize> =
+        edges.ties(m.threshold).enumerate().filter(|&(_, tie)| tie).map(|(i, _)| i).collect();
     let lit = |i: usize| f64::from(truth.pixels[i][1]) > m.threshold;
     let w = SIZE as usize;
     let on_boundary = |i: usize| {
@@ -384,6 +380,7 @@ fn a_cube_resting_on_the_floor_has_no_dotted_line_along_its_base() {
 
     let threshold = 1e-4 * truth.pixels.iter().map(|p| f64::from(p[1])).fold(0.0, f64::max);
     let lit = |p: &[f32; 4]| f64::from(p[1]) > threshold;
+    let ties: Vec<bool> = edges.ties(threshold).collect();
     let asm = AsmSettings { budget_mb: 16.0, time_ms: 1000.0, ..AsmSettings::default() };
     for (name, technique, frames) in [
         ("shadowmap 2048²", TechniqueDesc::ShadowMap { size: 2048 }, 1),
@@ -401,11 +398,7 @@ fn a_cube_resting_on_the_floor_has_no_dotted_line_along_its_base() {
         let image = r.image().unwrap();
         let dots: Vec<(usize, usize)> = band
             .iter()
-            .filter(|&&i| {
-                let [low, high] = edges.ranges[i];
-                let tie = f64::from(low) <= threshold && f64::from(high) > threshold;
-                lit(&image.pixels[i]) != lit(&truth.pixels[i]) && !tie
-            })
+            .filter(|&&i| lit(&image.pixels[i]) != lit(&truth.pixels[i]) && !ties[i])
             .map(|&i| (i % SIZE as usize, i / SIZE as usize))
             .collect();
         eprintln!("{name}: {} of {} pixels along the base differ: {dots:?}", dots.len(), band.len());

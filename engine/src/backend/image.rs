@@ -371,22 +371,31 @@ impl Image {
                 self.name
             )));
         }
-        let mut staging = Buffer::new(
+        let mut staging = self.staging(expected)?;
+        staging.write(0, data)?;
+        self.copy_from(&format!("{}.upload", self.name), &staging, &self.copy_regions())
+    }
+
+    /// A host-visible buffer of `size` bytes to copy into this image from.
+    fn staging(&self, size: u64) -> Result<Buffer> {
+        Buffer::new(
             &self.ctx,
             &BufferDesc {
                 name: &format!("{}.staging", self.name),
-                size: expected,
+                size,
                 usage: vk::BufferUsageFlags::TRANSFER_SRC,
                 location: MemoryLocation::CpuToGpu,
             },
-        )?;
-        staging.write(0, data)?;
-        let regions = self.copy_regions();
-        self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
+        )
+    }
+
+    /// Copies `regions` of `staging` into the image in one submission, waiting for it.
+    fn copy_from(&self, label: &str, staging: &Buffer, regions: &[vk::BufferImageCopy]) -> Result<()> {
+        self.ctx.one_shot(label, |cmd| {
             let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
             self.transition(cmd, vk::ImageLayout::GENERAL, dst);
             // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
-            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &regions) }
+            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, regions) }
             self.transition(cmd, dst, vk::ImageLayout::GENERAL);
         })
     }
@@ -404,15 +413,7 @@ impl Image {
         }
         let row_bytes = self.byte_size()? / self.height as u64;
         let band_rows = (STAGING_BAND_BYTES / row_bytes.max(1)).clamp(1, self.height as u64) as u32;
-        let mut staging = Buffer::new(
-            &self.ctx,
-            &BufferDesc {
-                name: &format!("{}.staging", self.name),
-                size: row_bytes * band_rows as u64,
-                usage: vk::BufferUsageFlags::TRANSFER_SRC,
-                location: MemoryLocation::CpuToGpu,
-            },
-        )?;
+        let mut staging = self.staging(row_bytes * band_rows as u64)?;
         for first in (0..self.height).step_by(band_rows as usize) {
             let rows = band_rows.min(self.height - first);
             fill(first, staging.mapped_mut(row_bytes * rows as u64)?);
@@ -425,15 +426,11 @@ impl Image {
                 })
                 .image_offset(vk::Offset3D { x: 0, y: first as i32, z: 0 })
                 .image_extent(vk::Extent3D { width: self.width, height: rows, depth: 1 });
-            self.ctx.one_shot(&format!("{}.upload rows {first}..{}", self.name, first + rows), |cmd| {
-                let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
-                self.transition(cmd, vk::ImageLayout::GENERAL, dst);
-                // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
-                unsafe {
-                    self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, &[region])
-                }
-                self.transition(cmd, dst, vk::ImageLayout::GENERAL);
-            })?;
+            self.copy_from(
+                &format!("{}.upload rows {first}..{}", self.name, first + rows),
+                &staging,
+                &[region],
+            )?;
         }
         Ok(())
     }

@@ -18,6 +18,16 @@ pub struct kage_renderer {
     timings: Option<Vec<PassTiming>>,
 }
 
+impl kage_renderer {
+    /// The last frame's picture; before the first frame, the caller's error.
+    fn last_frame(&self) -> Result<crate::imageio::RgbaF32Image, Failure> {
+        if self.timings.is_none() {
+            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
+        }
+        Ok(self.renderer.image()?)
+    }
+}
+
 /// What `kage_renderer_create` builds.
 #[repr(C)]
 pub struct kage_renderer_desc {
@@ -294,14 +304,11 @@ pub unsafe extern "C" fn kage_renderer_read_pixels(
         if pixels.is_null() {
             return Err(Failure::new(kage_result::NullArgument, "pixels is NULL"));
         }
-        if r.timings.is_none() {
-            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
-        }
         let srgb = matches!(format, kage_pixel_format::Rgba8Srgb);
         if srgb && !(exposure.is_finite() && exposure > 0.0) {
             return Err(Failure::invalid(format!("exposure {exposure} is not a positive number")));
         }
-        let image = r.renderer.image()?;
+        let image = r.last_frame()?;
         let bytes_per_pixel = if srgb { 4 } else { 16 };
         let needed = image.pixels.len() * bytes_per_pixel;
         args::room_for(size, needed, || {
@@ -345,10 +352,7 @@ pub unsafe extern "C" fn kage_renderer_write_image(
         let r = handles::get(renderer, "renderer")?;
         // SAFETY: the caller promises NULL or a NUL-terminated string.
         let path = unsafe { args::text(path, "path") }?;
-        if r.timings.is_none() {
-            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
-        }
-        let image = r.renderer.image()?;
+        let image = r.last_frame()?;
         imageio::write(path, &image, exposure).map_err(crate::Error::from)?;
         Ok(())
     })
@@ -371,10 +375,7 @@ pub unsafe extern "C" fn kage_renderer_auto_exposure(
         let r = handles::get(renderer, "renderer")?;
         // SAFETY: the caller promises NULL or writable.
         let exposure = unsafe { args::out(exposure, "exposure") }?;
-        if r.timings.is_none() {
-            return Err(Failure::invalid("no frame yet: call kage_renderer_render first"));
-        }
-        *exposure = auto_exposure(&r.renderer.image()?);
+        *exposure = auto_exposure(&r.last_frame()?);
         Ok(())
     })
 }

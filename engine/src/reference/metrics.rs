@@ -134,8 +134,9 @@ impl EdgeTies {
         Ok(EdgeTies { width: image.width, height: image.height, bits: bits as u32, ranges })
     }
 
-    /// Whether each pixel is a tie at the luminance `threshold`.
-    fn ties(&self, threshold: f64) -> impl Iterator<Item = bool> + '_ {
+    /// Whether each pixel, row-major, is a tie at the luminance `threshold` (the lit threshold
+    /// [`ShadowMismatch::threshold`]).
+    pub fn ties(&self, threshold: f64) -> impl Iterator<Item = bool> + '_ {
         self.ranges.iter().map(move |&[low, high]| f64::from(low) <= threshold && f64::from(high) > threshold)
     }
 }
