@@ -1,8 +1,7 @@
 //! The engine's error type. Each variant says whose fault the failure is ([`Error::fault`]): the
-//! caller's values, a file's content, the device, or a bug in Kage. Every `vk::Result` is mapped
-//! by [`Error::vk`] so that the failure classes a host cares about (out of memory, device lost)
-//! stay distinguishable.
-use ash::vk;
+//! caller's values, a file's content, the device, or a bug in Kage. The backend maps every
+//! failed Vulkan call (`backend/vk_error.rs`) so that the failure classes a host cares about
+//! (out of memory, device lost) stay distinguishable.
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
@@ -27,8 +26,9 @@ pub enum Error {
     OutOfHostMemoryFor(#[from] crate::host_memory::OutOfHostMemory),
     #[error("the Vulkan device was lost in {call}")]
     DeviceLost { call: &'static str },
-    #[error("{call} failed: {result:?}")]
-    Vulkan { call: &'static str, result: vk::Result },
+    /// Any other failed Vulkan call; `result` names its `VkResult`.
+    #[error("{call} failed: {result}")]
+    Vulkan { call: &'static str, result: String },
     #[error("GPU memory allocation for {name} failed: {message}")]
     Allocation { name: String, message: String },
     #[error("timed out waiting for the GPU in {0}")]
@@ -87,18 +87,6 @@ impl Error {
                 Fault::Caller
             }
             Error::Internal(_) => Fault::Internal,
-        }
-    }
-
-    /// Maps a failed Vulkan call: out-of-memory results and device loss get their own variants,
-    /// everything else keeps its `vk::Result`.
-    pub fn vk(call: &'static str) -> impl FnOnce(vk::Result) -> Error {
-        move |result| match result {
-            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY => Error::OutOfDeviceMemory { call },
-            vk::Result::ERROR_OUT_OF_HOST_MEMORY => Error::OutOfHostMemory { call },
-            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost { call },
-            vk::Result::TIMEOUT => Error::Timeout(call),
-            result => Error::Vulkan { call, result },
         }
     }
 }

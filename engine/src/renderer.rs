@@ -1,6 +1,6 @@
 //! The renderer: a scene on the GPU, its render targets, and the frame loop that runs a
 //! technique's passes and reads the picture back.
-use crate::backend::{vk, Buffer, BufferDesc, Context, MemoryLocation};
+use crate::backend::{Buffer, BufferDesc, BufferUsage, Context, MemoryLocation};
 use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
@@ -100,7 +100,7 @@ impl Renderer {
                 &BufferDesc {
                     name: "frame_uniforms",
                     size: size_of::<FrameUniforms>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    usage: BufferUsage::UNIFORM,
                     location: MemoryLocation::CpuToGpu,
                 },
             )?,

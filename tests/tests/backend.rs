@@ -1,7 +1,8 @@
 //! The Vulkan backend on the real driver: device creation, memory round trips, a compute
 //! shader checked exactly, and the validation canary.
 use kage::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, ContextDesc, MemoryLocation,
+    vk, Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, ContextDesc,
+    MemoryLocation,
 };
 use kage::layouts::{bytes_of, bytes_of_slice, constants, spirv, ShCoeffs, ShProjectPush};
 use kage::pass::Resource;
@@ -29,7 +30,7 @@ fn unknown_device_name_is_a_clear_error() {
 fn upload_and_readback_round_trip() {
     let ctx = Validated::new();
     let data: Vec<u8> = (0..100_003u32).map(|i| (i * 7 + 3) as u8).collect();
-    let buffer = Buffer::with_data(&ctx, "round_trip", vk::BufferUsageFlags::TRANSFER_SRC, &data).unwrap();
+    let buffer = Buffer::with_data(&ctx, "round_trip", BufferUsage::TRANSFER_SRC, &data).unwrap();
     assert_eq!(buffer.read().unwrap(), data);
 }
 
@@ -48,14 +49,14 @@ fn compute_shader_result_is_exact() {
             p
         })
         .collect();
-    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    let storage = BufferUsage::STORAGE;
     let input = Buffer::with_data(&ctx, "partials", storage, bytes_of_slice(&partials)).unwrap();
     let output = Buffer::new(
         &ctx,
         &BufferDesc {
             name: "sum",
             size: size_of::<ShCoeffs>() as u64,
-            usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
+            usage: storage | BufferUsage::TRANSFER_SRC,
             location: MemoryLocation::GpuOnly,
         },
     )

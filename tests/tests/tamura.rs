@@ -2,7 +2,8 @@
 use exr::prelude::f16;
 use glam::{Mat3, Mat4, Vec3};
 use kage::backend::{
-    vk, Binding, Buffer, BufferDesc, ComputePipeline, Edge, Image, ImageDesc, MemoryLocation, Sampler,
+    Binding, Buffer, BufferDesc, BufferUsage, ComputePipeline, Edge, Format, Image, ImageDesc, ImageUsage,
+    MemoryLocation, Sampler,
 };
 use kage::frame::bounds::group_bounds;
 use kage::frame::regions::Regions;
@@ -49,19 +50,18 @@ fn filter_layer(
     texels: &[[f32; 2]],
 ) -> Vec<[f32; 4]> {
     let image = |name: &str, format, usage| {
-        let usage = usage | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC;
+        let usage = usage | ImageUsage::TRANSFER_DST | ImageUsage::TRANSFER_SRC;
         Image::new(ctx, &ImageDesc::square_array(name, size, 1, format, usage)).unwrap()
     };
-    let (sampled, storage) =
-        (vk::ImageUsageFlags::SAMPLED, vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED);
-    let mask = image("mask", vk::Format::R32G32_SFLOAT, sampled);
+    let (sampled, storage) = (ImageUsage::SAMPLED, ImageUsage::STORAGE | ImageUsage::SAMPLED);
+    let mask = image("mask", Format::RG32_FLOAT, sampled);
     let filtered = image("filtered", FILTERED_FORMAT, storage);
     let temp = Buffer::new(
         ctx,
         &BufferDesc {
             name: "temp",
             size: u64::from(size * size) * 16,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            usage: BufferUsage::STORAGE,
             location: MemoryLocation::GpuOnly,
         },
     )
@@ -73,9 +73,7 @@ fn filter_layer(
         axis_v: [0.0, 1.0, 0.0, widest as f32],
         ..Default::default()
     };
-    let layers =
-        Buffer::with_data(ctx, "layers", vk::BufferUsageFlags::STORAGE_BUFFER, bytes_of_slice(&[layer]))
-            .unwrap();
+    let layers = Buffer::with_data(ctx, "layers", BufferUsage::STORAGE, bytes_of_slice(&[layer])).unwrap();
     let nearest = Sampler::new(ctx, "nearest", false, Edge::Clamp, Edge::Clamp).unwrap();
     let penumbra = if adaptive { Penumbra::Adaptive } else { Penumbra::Fixed };
     let pass = |vertical| filter_pipeline(ctx, penumbra, vertical).unwrap();

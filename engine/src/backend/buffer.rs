@@ -1,4 +1,6 @@
 //! Buffers, with staging upload and readback for device-local ones.
+use super::BufferUsage;
+use super::Cmd;
 use super::Context;
 use crate::error::{Error, Result};
 use crate::host_memory;
@@ -10,7 +12,7 @@ use std::sync::Arc;
 pub struct BufferDesc<'a> {
     pub name: &'a str,
     pub size: u64,
-    pub usage: vk::BufferUsageFlags,
+    pub usage: BufferUsage,
     /// `GpuOnly` for device-local data, `CpuToGpu` for per-frame uploads, `GpuToCpu` for
     /// readback.
     pub location: MemoryLocation,
@@ -31,7 +33,7 @@ impl Buffer {
         }
         let info = vk::BufferCreateInfo::default()
             .size(desc.size)
-            .usage(desc.usage)
+            .usage(desc.usage.0)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info.
         let raw = unsafe { ctx.device.create_buffer(&info, None) }.map_err(Error::vk("vkCreateBuffer"))?;
@@ -67,18 +69,13 @@ impl Buffer {
     }
 
     /// A device-local buffer filled with `data` through a staging buffer.
-    pub fn with_data(
-        ctx: &Arc<Context>,
-        name: &str,
-        usage: vk::BufferUsageFlags,
-        data: &[u8],
-    ) -> Result<Buffer> {
+    pub fn with_data(ctx: &Arc<Context>, name: &str, usage: BufferUsage, data: &[u8]) -> Result<Buffer> {
         let buffer = Buffer::new(
             ctx,
             &BufferDesc {
                 name,
                 size: data.len() as u64,
-                usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+                usage: usage | BufferUsage::TRANSFER_DST,
                 location: MemoryLocation::GpuOnly,
             },
         )?;
@@ -145,7 +142,7 @@ impl Buffer {
             &BufferDesc {
                 name: &format!("{}.staging", self.name),
                 size: data.len().max(1) as u64,
-                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                usage: BufferUsage::TRANSFER_SRC,
                 location: MemoryLocation::CpuToGpu,
             },
         )?;
@@ -153,14 +150,14 @@ impl Buffer {
         let region = vk::BufferCopy::default().size(data.len() as u64);
         self.ctx.one_shot(&format!("{}.upload", self.name), |cmd| {
             // SAFETY: both buffers are alive until the one-shot submission has completed.
-            unsafe { self.ctx.device.cmd_copy_buffer(cmd, staging.raw, self.raw, &[region]) }
+            unsafe { self.ctx.device.cmd_copy_buffer(cmd.raw, staging.raw, self.raw, &[region]) }
         })
     }
 
     /// Records filling the whole buffer with zeros (it needs `TRANSFER_DST` usage).
-    pub fn record_zero(&self, cmd: vk::CommandBuffer) {
+    pub fn record_zero(&self, cmd: Cmd) {
         // SAFETY: recording command buffer of this device; the buffer outlives the submission.
-        unsafe { self.ctx.device.cmd_fill_buffer(cmd, self.raw, 0, vk::WHOLE_SIZE, 0) };
+        unsafe { self.ctx.device.cmd_fill_buffer(cmd.raw, self.raw, 0, vk::WHOLE_SIZE, 0) };
     }
 
     /// Reads the whole buffer back to the host (waits for the GPU), into memory reserved
@@ -175,14 +172,14 @@ impl Buffer {
             &BufferDesc {
                 name: &format!("{}.readback", self.name),
                 size: self.size,
-                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                usage: BufferUsage::TRANSFER_DST,
                 location: MemoryLocation::GpuToCpu,
             },
         )?;
         let region = vk::BufferCopy::default().size(self.size);
         self.ctx.one_shot(&format!("{}.readback", self.name), |cmd| {
             // SAFETY: both buffers are alive until the submission has completed.
-            unsafe { self.ctx.device.cmd_copy_buffer(cmd, self.raw, staging.raw, &[region]) }
+            unsafe { self.ctx.device.cmd_copy_buffer(cmd.raw, self.raw, staging.raw, &[region]) }
         })?;
         let mapped = staging
             .mapped()

@@ -13,8 +13,23 @@ const FENCE_TIMEOUT_NS: u64 = 600_000_000_000;
 /// different threads) may then record at the same time.
 pub struct CommandRecorder {
     pool: vk::CommandPool,
-    pub(crate) cmd: vk::CommandBuffer,
+    cmd: vk::CommandBuffer,
     fence: vk::Fence,
+}
+
+impl CommandRecorder {
+    /// The command buffer to record into, between [`Context::begin`] and
+    /// [`Context::submit_and_wait`].
+    pub(crate) fn cmd(&self) -> Cmd {
+        Cmd { raw: self.cmd }
+    }
+}
+
+/// A command buffer being recorded: what passes record into, through the backend's methods
+/// that take it. Only the backend reaches the Vulkan handle inside.
+#[derive(Clone, Copy, Debug)]
+pub struct Cmd {
+    pub(super) raw: vk::CommandBuffer,
 }
 
 impl Context {
@@ -87,11 +102,11 @@ impl Context {
 
     /// Records `record` into a fresh command buffer, submits it and waits; its writes are then
     /// visible to the host.
-    pub fn one_shot(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+    pub fn one_shot(&self, name: &str, record: impl FnOnce(Cmd)) -> Result<()> {
         let recorder = self.create_recorder(name)?;
         let result = self.begin(&recorder).and_then(|()| {
-            record(recorder.cmd);
-            self.host_read_barrier(recorder.cmd);
+            record(recorder.cmd());
+            self.host_read_barrier(recorder.cmd());
             self.submit_and_wait(&recorder)
         });
         // After a failed submission the buffer may still be pending: free it only once idle.
@@ -102,7 +117,7 @@ impl Context {
     }
 
     /// A full memory barrier: everything before finishes and is visible to everything after.
-    pub fn full_barrier(&self, cmd: vk::CommandBuffer) {
+    pub fn full_barrier(&self, cmd: Cmd) {
         self.barrier_to(
             cmd,
             vk::PipelineStageFlags::ALL_COMMANDS,
@@ -113,18 +128,18 @@ impl Context {
     /// Everything before finishes and its writes become visible to host reads once the
     /// submission's fence is waited for (a fence alone does not make device writes visible to
     /// the host: mapped memory needs this HOST-stage dependency, coherent or not).
-    pub fn host_read_barrier(&self, cmd: vk::CommandBuffer) {
+    pub fn host_read_barrier(&self, cmd: Cmd) {
         self.barrier_to(cmd, vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ);
     }
 
-    fn barrier_to(&self, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags, access: vk::AccessFlags) {
+    fn barrier_to(&self, cmd: Cmd, stage: vk::PipelineStageFlags, access: vk::AccessFlags) {
         let barrier = vk::MemoryBarrier::default()
             .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
             .dst_access_mask(access);
         // SAFETY: recording command buffer of this device.
         unsafe {
             self.device.cmd_pipeline_barrier(
-                cmd,
+                cmd.raw,
                 vk::PipelineStageFlags::ALL_COMMANDS,
                 stage,
                 vk::DependencyFlags::empty(),
@@ -136,19 +151,19 @@ impl Context {
     }
 
     /// Opens a debug label (a named region debuggers show) when debug utils are on.
-    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+    pub fn begin_label(&self, cmd: Cmd, name: &str) {
         let Some(debug) = &self.debug else { return };
         let Ok(name) = std::ffi::CString::new(name) else { return };
         let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
         // SAFETY: recording command buffer; the label string outlives the call.
-        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
+        unsafe { debug.cmd_begin_debug_utils_label(cmd.raw, &label) };
     }
 
     /// Closes the label `begin_label` opened.
-    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+    pub fn end_label(&self, cmd: Cmd) {
         if let Some(debug) = &self.debug {
             // SAFETY: matches a begin_label before it in the same command buffer.
-            unsafe { debug.cmd_end_debug_utils_label(cmd) };
+            unsafe { debug.cmd_end_debug_utils_label(cmd.raw) };
         }
     }
 }

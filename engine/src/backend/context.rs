@@ -2,7 +2,7 @@
 use super::device::{self, has_extension, VALIDATION_LAYER};
 use super::validation::{self, ValidationLog};
 use crate::error::{Error, Result};
-use ash::vk;
+use ash::vk::{self, Handle};
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_char, CString};
 use std::mem::ManuallyDrop;
@@ -26,12 +26,14 @@ pub struct ContextDesc {
 /// `shaderStorageImageExtendedFormats` on, from an instance of API version 1.2 or later.
 #[derive(Clone, Copy, Debug)]
 pub struct HostVulkan {
-    pub instance: vk::Instance,
-    pub physical_device: vk::PhysicalDevice,
-    pub device: vk::Device,
+    /// The `VkInstance`, `VkPhysicalDevice`, `VkDevice` and `VkQueue` handles' raw values, as
+    /// a host's own Vulkan gives them.
+    pub instance: u64,
+    pub physical_device: u64,
+    pub device: u64,
     /// A family with graphics and compute; `queue` belongs to it.
     pub queue_family: u32,
-    pub queue: vk::Queue,
+    pub queue: u64,
     /// Whether the instance has `VK_EXT_debug_utils` enabled (Kage then names and labels its
     /// objects and passes).
     pub debug_utils: bool,
@@ -257,17 +259,19 @@ impl Context {
         let layers = unsafe { entry.enumerate_instance_layer_properties() }
             .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
         // SAFETY: the caller promises a valid instance from this loader.
-        let instance = unsafe { ash::Instance::load(entry.static_fn(), host.instance) };
+        let instance =
+            unsafe { ash::Instance::load(entry.static_fn(), vk::Instance::from_raw(host.instance)) };
         let info = device::probe(
             &entry,
             &instance,
-            host.physical_device,
+            vk::PhysicalDevice::from_raw(host.physical_device),
             host.queue_family,
             host.debug_utils,
             &layers,
         )?;
+        let device_handle = vk::Device::from_raw(host.device);
         // SAFETY: the caller promises a valid device of this instance.
-        let device = unsafe { ash::Device::load(instance.fp_v1_0(), host.device) };
+        let device = unsafe { ash::Device::load(instance.fp_v1_0(), device_handle) };
         // A device created without an extension gives no entry points for it (Vulkan 1.3 and
         // Mesa): say which is missing rather than crash at the first draw.
         for (extension, function) in [
@@ -275,7 +279,8 @@ impl Context {
             (ash::khr::push_descriptor::NAME, c"vkCmdPushDescriptorSetKHR"),
         ] {
             // SAFETY: a valid device and a NUL-terminated name.
-            let found = unsafe { (instance.fp_v1_0().get_device_proc_addr)(host.device, function.as_ptr()) };
+            let found =
+                unsafe { (instance.fp_v1_0().get_device_proc_addr)(device_handle, function.as_ptr()) };
             if found.is_none() {
                 return Err(Error::Unsupported(format!(
                     "{} enabled on the host's device",
@@ -288,7 +293,7 @@ impl Context {
         let calibrated = info.has(device::CALIBRATED_TIMESTAMPS)
             && unsafe {
                 (instance.fp_v1_0().get_device_proc_addr)(
-                    host.device,
+                    device_handle,
                     c"vkGetCalibratedTimestampsEXT".as_ptr(),
                 )
             }
@@ -300,10 +305,10 @@ impl Context {
             messenger: vk::DebugUtilsMessengerEXT::null(),
             validation: None,
             debug_utils: host.debug_utils,
-            physical: host.physical_device,
+            physical: vk::PhysicalDevice::from_raw(host.physical_device),
             device,
             queue_family: host.queue_family,
-            queue: host.queue,
+            queue: vk::Queue::from_raw(host.queue),
             info,
             owns_device: false,
             calibrated,

@@ -1,5 +1,6 @@
 //! Descriptors: every pipeline has one set, written with push descriptors at record time, so
 //! there are no pools or set lifetimes to manage. Binding `i` is the i-th entry of the list.
+use super::Cmd;
 use super::{Buffer, Context, Image, Sampler};
 use ash::vk;
 
@@ -61,7 +62,7 @@ pub(crate) fn set_layout_bindings(kinds: &[BindingKind]) -> Vec<vk::DescriptorSe
 /// not match the layout is a programming error that validation reports.
 pub fn push_descriptors(
     ctx: &Context,
-    cmd: vk::CommandBuffer,
+    cmd: Cmd,
     bind_point: vk::PipelineBindPoint,
     layout: vk::PipelineLayout,
     expected: &[BindingKind],
@@ -75,7 +76,7 @@ pub fn push_descriptors(
 /// as the last push left them (push descriptors update only what they write).
 pub fn push_descriptors_from(
     ctx: &Context,
-    cmd: vk::CommandBuffer,
+    cmd: Cmd,
     bind_point: vk::PipelineBindPoint,
     layout: vk::PipelineLayout,
     first: u32,
@@ -126,5 +127,5 @@ pub fn push_descriptors_from(
         .collect();
     // SAFETY: recording command buffer; the writes point at locals alive for the call, and the
     // set layout was created with the push-descriptor flag.
-    unsafe { ctx.push_descriptor.cmd_push_descriptor_set(cmd, bind_point, layout, 0, &writes) };
+    unsafe { ctx.push_descriptor.cmd_push_descriptor_set(cmd.raw, bind_point, layout, 0, &writes) };
 }

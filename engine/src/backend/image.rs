@@ -3,7 +3,9 @@
 //! alone step into the transfer layout drivers prefer and back, inside `record_copy_to`,
 //! `upload` and `upload_rows`.
 use super::buffer::allocation_error;
+use super::Cmd;
 use super::{Buffer, BufferDesc, Context};
+use super::{BufferUsage, Format, ImageUsage};
 use crate::error::{Error, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
@@ -22,8 +24,8 @@ pub struct ImageDesc<'a> {
     pub levels: u32,
     /// Viewed as a 2D array even with one layer (shaders declare `*2DArray`).
     pub array: bool,
-    pub format: vk::Format,
-    pub usage: vk::ImageUsageFlags,
+    pub format: Format,
+    pub usage: ImageUsage,
 }
 
 impl<'a> ImageDesc<'a> {
@@ -32,8 +34,8 @@ impl<'a> ImageDesc<'a> {
         name: &'a str,
         size: u32,
         layers: u32,
-        format: vk::Format,
-        usage: vk::ImageUsageFlags,
+        format: Format,
+        usage: ImageUsage,
     ) -> ImageDesc<'a> {
         ImageDesc { name, width: size, height: size, layers, levels: 1, array: true, format, usage }
     }
@@ -50,29 +52,8 @@ pub struct Image {
     pub height: u32,
     pub layers: u32,
     pub levels: u32,
-    pub format: vk::Format,
+    pub format: Format,
     name: String,
-}
-
-fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
-    match format {
-        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM => vk::ImageAspectFlags::DEPTH,
-        _ => vk::ImageAspectFlags::COLOR,
-    }
-}
-
-/// Bytes per texel of the formats Kage reads back or uploads.
-fn texel_bytes(format: vk::Format) -> Option<u64> {
-    match format {
-        vk::Format::R32G32B32A32_SFLOAT => Some(16),
-        vk::Format::R32G32_SFLOAT | vk::Format::R16G16B16A16_SFLOAT => Some(8),
-        vk::Format::R8G8B8A8_UNORM
-        | vk::Format::R8G8B8A8_SRGB
-        | vk::Format::R32_SFLOAT
-        | vk::Format::R32_UINT
-        | vk::Format::D32_SFLOAT => Some(4),
-        _ => None,
-    }
 }
 
 impl Image {
@@ -83,10 +64,10 @@ impl Image {
         let limits = unsafe {
             ctx.instance.get_physical_device_image_format_properties(
                 ctx.physical,
-                desc.format,
+                desc.format.raw,
                 vk::ImageType::TYPE_2D,
                 vk::ImageTiling::OPTIMAL,
-                desc.usage,
+                desc.usage.0,
                 vk::ImageCreateFlags::empty(),
             )
         }
@@ -120,28 +101,29 @@ impl Image {
                 limits.max_mip_levels
             )));
         }
-        if let Some(texel) = texel_bytes(desc.format) {
-            let bytes = u64::from(desc.width) * u64::from(desc.height) * u64::from(desc.layers) * texel;
-            if bytes > limits.max_resource_size {
-                return Err(Error::OutOfDeviceMemoryFor {
-                    name: desc.name.to_owned(),
-                    bytes,
-                    reason: format!(
-                        "the device's largest image of this format is {} bytes",
-                        limits.max_resource_size
-                    ),
-                });
-            }
+        let bytes = u64::from(desc.width)
+            * u64::from(desc.height)
+            * u64::from(desc.layers)
+            * desc.format.texel_bytes();
+        if bytes > limits.max_resource_size {
+            return Err(Error::OutOfDeviceMemoryFor {
+                name: desc.name.to_owned(),
+                bytes,
+                reason: format!(
+                    "the device's largest image of this format is {} bytes",
+                    limits.max_resource_size
+                ),
+            });
         }
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
-            .format(desc.format)
+            .format(desc.format.raw)
             .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
             .mip_levels(desc.levels)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(desc.usage)
+            .usage(desc.usage.0)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid device and create info.
@@ -189,23 +171,22 @@ impl Image {
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(view_type)
-            .format(desc.format)
+            .format(desc.format.raw)
             .subresource_range(image.range());
         // SAFETY: the image is bound to memory; the view covers its whole range.
         image.view = unsafe { ctx.device.create_image_view(&view_info, None) }
             .map_err(Error::vk("vkCreateImageView"))?;
         ctx.set_name(image.view, &format!("{}.view", desc.name));
 
-        let attachment =
-            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
-        if desc.layers > 1 && desc.usage.intersects(attachment) {
+        let attachment = ImageUsage::COLOR_ATTACHMENT | ImageUsage::DEPTH_ATTACHMENT;
+        if desc.layers > 1 && desc.usage.0.intersects(attachment.0) {
             for layer in 0..desc.layers {
                 let range =
                     vk::ImageSubresourceRange { base_array_layer: layer, layer_count: 1, ..image.range() };
                 let info = vk::ImageViewCreateInfo::default()
                     .image(raw)
                     .view_type(vk::ImageViewType::TYPE_2D)
-                    .format(desc.format)
+                    .format(desc.format.raw)
                     .subresource_range(range);
                 // SAFETY: the image is bound; the view covers one existing layer.
                 let view = unsafe { ctx.device.create_image_view(&info, None) }
@@ -221,7 +202,7 @@ impl Image {
     }
 
     /// Records a layout change of the whole image, ordered after all earlier commands.
-    fn transition(&self, cmd: vk::CommandBuffer, from: vk::ImageLayout, to: vk::ImageLayout) {
+    fn transition(&self, cmd: Cmd, from: vk::ImageLayout, to: vk::ImageLayout) {
         record_layout_barriers(&self.ctx, cmd, &[self.layout_barrier(from, to)]);
     }
 
@@ -241,7 +222,7 @@ impl Image {
 
     pub(crate) fn range(&self) -> vk::ImageSubresourceRange {
         vk::ImageSubresourceRange {
-            aspect_mask: aspect_of(self.format),
+            aspect_mask: self.format.aspect(),
             base_mip_level: 0,
             level_count: self.levels,
             base_array_layer: 0,
@@ -269,20 +250,19 @@ impl Image {
 
     /// Bytes of the whole image in a tightly packed buffer: level after level, each layer after
     /// layer.
-    pub fn byte_size(&self) -> Result<u64> {
-        let texel = texel_bytes(self.format)
-            .ok_or_else(|| Error::Internal(format!("no host copies of {:?} ({})", self.format, self.name)))?;
+    pub fn byte_size(&self) -> u64 {
+        let texel = self.format.texel_bytes();
         let level = |l| {
             let (w, h) = self.level_extent(l);
             texel * w as u64 * h as u64 * self.layers as u64
         };
-        Ok((0..self.levels).map(level).sum())
+        (0..self.levels).map(level).sum()
     }
 
     /// One copy per level between the image and a tightly packed buffer laid out as
     /// [`Image::byte_size`] says.
     pub(crate) fn copy_regions(&self) -> Vec<vk::BufferImageCopy> {
-        let texel = texel_bytes(self.format).unwrap_or(0);
+        let texel = self.format.texel_bytes();
         let mut offset = 0;
         (0..self.levels)
             .map(|level| {
@@ -290,7 +270,7 @@ impl Image {
                 let region = vk::BufferImageCopy::default()
                     .buffer_offset(offset)
                     .image_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: aspect_of(self.format),
+                        aspect_mask: self.format.aspect(),
                         mip_level: level,
                         base_array_layer: 0,
                         layer_count: self.layers,
@@ -303,12 +283,12 @@ impl Image {
     }
 
     /// Records a copy of the whole image into `buffer` (tightly packed, layer after layer).
-    pub fn record_copy_to(&self, cmd: vk::CommandBuffer, buffer: &Buffer) {
+    pub fn record_copy_to(&self, cmd: Cmd, buffer: &Buffer) {
         let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
         self.transition(cmd, vk::ImageLayout::GENERAL, src);
         // SAFETY: recording command buffer; the image was just moved to `src`.
         unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, src, buffer.raw, &self.copy_regions())
+            self.ctx.device.cmd_copy_image_to_buffer(cmd.raw, self.raw, src, buffer.raw, &self.copy_regions())
         }
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
@@ -317,15 +297,9 @@ impl Image {
     /// each from its first texel here to its first texel there, ordered after all earlier
     /// commands on either image and before all later ones (the copies step into the transfer
     /// layouts and back). Destination squares must not overlap.
-    pub fn record_copy_squares(
-        &self,
-        cmd: vk::CommandBuffer,
-        dst: &Image,
-        squares: &[([u32; 2], [u32; 2])],
-        size: u32,
-    ) {
+    pub fn record_copy_squares(&self, cmd: Cmd, dst: &Image, squares: &[([u32; 2], [u32; 2])], size: u32) {
         let layer = vk::ImageSubresourceLayers {
-            aspect_mask: aspect_of(self.format),
+            aspect_mask: self.format.aspect(),
             mip_level: 0,
             base_array_layer: 0,
             layer_count: 1,
@@ -353,7 +327,7 @@ impl Image {
         );
         // SAFETY: recording command buffer; both images are alive until the submission completes
         // and were just moved to the layouts named.
-        unsafe { self.ctx.device.cmd_copy_image(cmd, self.raw, src, dst.raw, to, &regions) }
+        unsafe { self.ctx.device.cmd_copy_image(cmd.raw, self.raw, src, dst.raw, to, &regions) }
         record_layout_barriers(
             &self.ctx,
             cmd,
@@ -363,7 +337,7 @@ impl Image {
 
     /// Fills the image (every level) from tightly packed texels through a staging buffer.
     pub fn upload(&self, data: &[u8]) -> Result<()> {
-        let expected = self.byte_size()?;
+        let expected = self.byte_size();
         if data.len() as u64 != expected {
             return Err(Error::Internal(format!(
                 "upload of {} bytes into image {} of {expected} bytes",
@@ -383,7 +357,7 @@ impl Image {
             &BufferDesc {
                 name: &format!("{}.staging", self.name),
                 size,
-                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                usage: BufferUsage::TRANSFER_SRC,
                 location: MemoryLocation::CpuToGpu,
             },
         )
@@ -395,7 +369,7 @@ impl Image {
             let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
             self.transition(cmd, vk::ImageLayout::GENERAL, dst);
             // SAFETY: both are alive until the one-shot wait returns; the image is in `dst`.
-            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, self.raw, dst, regions) }
+            unsafe { self.ctx.device.cmd_copy_buffer_to_image(cmd.raw, staging.raw, self.raw, dst, regions) }
             self.transition(cmd, dst, vk::ImageLayout::GENERAL);
         })
     }
@@ -411,7 +385,7 @@ impl Image {
                 self.name
             )));
         }
-        let row_bytes = self.byte_size()? / self.height as u64;
+        let row_bytes = self.byte_size() / self.height as u64;
         let band_rows = (STAGING_BAND_BYTES / row_bytes.max(1)).clamp(1, self.height as u64) as u32;
         let mut staging = self.staging(row_bytes * band_rows as u64)?;
         for first in (0..self.height).step_by(band_rows as usize) {
@@ -419,7 +393,7 @@ impl Image {
             fill(first, staging.mapped_mut(row_bytes * rows as u64)?);
             let region = vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: aspect_of(self.format),
+                    aspect_mask: self.format.aspect(),
                     mip_level: 0,
                     base_array_layer: 0,
                     layer_count: 1,
@@ -441,8 +415,8 @@ impl Image {
             &self.ctx,
             &BufferDesc {
                 name: &format!("{}.readback", self.name),
-                size: self.byte_size()?,
-                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                size: self.byte_size(),
+                usage: BufferUsage::TRANSFER_DST,
                 location: MemoryLocation::GpuToCpu,
             },
         )?;
@@ -452,11 +426,11 @@ impl Image {
 }
 
 /// Records `barriers`, each ordered after all earlier commands and before all later ones.
-fn record_layout_barriers(ctx: &Context, cmd: vk::CommandBuffer, barriers: &[vk::ImageMemoryBarrier]) {
+fn record_layout_barriers(ctx: &Context, cmd: Cmd, barriers: &[vk::ImageMemoryBarrier]) {
     // SAFETY: recording command buffer; the images are alive until the submission completes.
     unsafe {
         ctx.device.cmd_pipeline_barrier(
-            cmd,
+            cmd.raw,
             vk::PipelineStageFlags::ALL_COMMANDS,
             vk::PipelineStageFlags::ALL_COMMANDS,
             vk::DependencyFlags::empty(),

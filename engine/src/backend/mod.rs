@@ -7,24 +7,29 @@ mod commands;
 mod context;
 mod descriptor;
 mod device;
+mod format;
 mod image;
 mod pipeline;
 mod reflect;
 mod rendering;
 mod timestamps;
+mod usage;
 mod validation;
+mod vk_error;
 
 pub use buffer::{Buffer, BufferDesc};
-pub use commands::CommandRecorder;
+pub use commands::{Cmd, CommandRecorder};
 pub use context::{Calibration, Context, ContextDesc, DeviceInfo, HostVulkan};
 pub use descriptor::{push_descriptors, Binding, BindingKind};
 pub use device::{CALIBRATED_TIMESTAMPS, FRAGMENT_STORES, GEOMETRY_SHADER};
+pub use format::Format;
 pub use image::{Edge, Image, ImageDesc, Sampler, SamplerDesc, STAGING_BAND_BYTES};
 pub use pipeline::{
-    ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, VertexAttribute, VertexBuffer,
+    ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, Topology, VertexAttribute, VertexBuffer,
 };
 pub use rendering::{Depth, Target};
 pub use timestamps::TimestampPool;
+pub use usage::{BufferUsage, ImageUsage};
 pub use validation::ValidationLog;
 
 pub use ash::vk;

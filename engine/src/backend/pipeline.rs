@@ -1,6 +1,8 @@
 //! Compute and graphics pipelines. Each owns its set layout (push descriptors, set 0) and
 //! pipeline layout, and records its own binds so passes stay short.
 use super::descriptor::{push_descriptors, push_descriptors_from, set_layout_bindings};
+use super::Cmd;
+use super::Format;
 use super::{reflect, Binding, BindingKind, Context};
 use crate::error::{Error, Result};
 use ash::vk;
@@ -81,11 +83,13 @@ impl Drop for Module<'_> {
     }
 }
 
-fn push_bytes(ctx: &Context, cmd: vk::CommandBuffer, layout: &Layout, bytes: &[u8]) {
+fn push_bytes(ctx: &Context, cmd: Cmd, layout: &Layout, bytes: &[u8]) {
     debug_assert_eq!(bytes.len() as u32, layout.push_size, "push constant size mismatch");
     if !bytes.is_empty() {
         // SAFETY: recording command buffer; the range was declared in the layout.
-        unsafe { ctx.device.cmd_push_constants(cmd, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes) };
+        unsafe {
+            ctx.device.cmd_push_constants(cmd.raw, layout.pipeline, vk::ShaderStageFlags::ALL, 0, bytes)
+        };
     }
 }
 
@@ -140,9 +144,9 @@ impl ComputePipeline {
     }
 
     /// Binds the pipeline, its resources and push constants, then dispatches.
-    pub fn dispatch(&self, cmd: vk::CommandBuffer, bindings: &[Binding], push: &[u8], groups: [u32; 3]) {
+    pub fn dispatch(&self, cmd: Cmd, bindings: &[Binding], push: &[u8], groups: [u32; 3]) {
         // SAFETY: recording command buffer of this device.
-        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
+        unsafe { self.ctx.device.cmd_bind_pipeline(cmd.raw, vk::PipelineBindPoint::COMPUTE, self.raw) };
         push_descriptors(
             &self.ctx,
             cmd,
@@ -153,7 +157,7 @@ impl ComputePipeline {
         );
         push_bytes(&self.ctx, cmd, &self.layout, push);
         // SAFETY: pipeline and descriptors bound above.
-        unsafe { self.ctx.device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+        unsafe { self.ctx.device.cmd_dispatch(cmd.raw, groups[0], groups[1], groups[2]) };
     }
 }
 
@@ -169,7 +173,7 @@ impl Drop for ComputePipeline {
 #[derive(Clone, Copy, Debug)]
 pub struct VertexAttribute {
     pub location: u32,
-    pub format: vk::Format,
+    pub format: Format,
     pub offset: u32,
 }
 
@@ -201,6 +205,13 @@ pub enum DepthTest {
     LessOrEqual,
 }
 
+/// What a draw's vertices make.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Topology {
+    Triangles,
+    Points,
+}
+
 pub struct GraphicsDesc<'a> {
     pub name: &'a str,
     pub vertex_spirv: &'a [u8],
@@ -209,9 +220,9 @@ pub struct GraphicsDesc<'a> {
     pub push_size: u32,
     /// Vertex buffers, bound in this order; none means vertices are made in the shader.
     pub vertex_buffers: &'a [VertexBuffer<'a>],
-    pub topology: vk::PrimitiveTopology,
-    pub color_formats: &'a [vk::Format],
-    pub depth_format: Option<vk::Format>,
+    pub topology: Topology,
+    pub color_formats: &'a [Format],
+    pub depth_format: Option<Format>,
     pub depth: DepthTest,
     /// Write the colour targets; false draws depth only into a scope that has colour targets
     /// (the fragment shader's outputs are dropped).
@@ -276,7 +287,7 @@ impl GraphicsPipeline {
                 buffer.attributes.iter().map(move |a| vk::VertexInputAttributeDescription {
                     location: a.location,
                     binding: b as u32,
-                    format: a.format,
+                    format: a.format.raw,
                     offset: a.offset,
                 })
             })
@@ -284,7 +295,11 @@ impl GraphicsPipeline {
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)
             .vertex_attribute_descriptions(&attributes);
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
+        let topology = match desc.topology {
+            Topology::Triangles => vk::PrimitiveTopology::TRIANGLE_LIST,
+            Topology::Points => vk::PrimitiveTopology::POINT_LIST,
+        };
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(topology);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         // Kage's surfaces are two-sided (open meshes such as the teapot show their inside), so
         // nothing is culled; shaders flip normals on back faces.
@@ -313,9 +328,10 @@ impl GraphicsPipeline {
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let color_formats: Vec<vk::Format> = desc.color_formats.iter().map(|f| f.raw).collect();
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(desc.color_formats)
-            .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
+            .color_attachment_formats(&color_formats)
+            .depth_attachment_format(desc.depth_format.map_or(vk::Format::UNDEFINED, |f| f.raw));
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stages)
             .vertex_input_state(&vertex_input)
@@ -346,9 +362,9 @@ impl GraphicsPipeline {
     }
 
     /// Binds the pipeline and its resources (call inside a rendering scope).
-    pub fn bind(&self, cmd: vk::CommandBuffer, bindings: &[Binding]) {
+    pub fn bind(&self, cmd: Cmd, bindings: &[Binding]) {
         // SAFETY: recording command buffer of this device.
-        unsafe { self.ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw) };
+        unsafe { self.ctx.device.cmd_bind_pipeline(cmd.raw, vk::PipelineBindPoint::GRAPHICS, self.raw) };
         push_descriptors(
             &self.ctx,
             cmd,
@@ -363,7 +379,7 @@ impl GraphicsPipeline {
     /// it (a per-draw resource), keeping the others.
     ///
     /// [`bind`]: GraphicsPipeline::bind
-    pub fn rebind(&self, cmd: vk::CommandBuffer, at: u32, binding: Binding) {
+    pub fn rebind(&self, cmd: Cmd, at: u32, binding: Binding) {
         debug_assert_eq!(self.layout.bindings.get(at as usize), Some(&binding.kind()));
         let bind_point = vk::PipelineBindPoint::GRAPHICS;
         push_descriptors_from(&self.ctx, cmd, bind_point, self.layout.pipeline, at, &[binding]);
@@ -374,7 +390,7 @@ impl GraphicsPipeline {
         self.layout.bindings.len() as u32
     }
 
-    pub fn push(&self, cmd: vk::CommandBuffer, bytes: &[u8]) {
+    pub fn push(&self, cmd: Cmd, bytes: &[u8]) {
         push_bytes(&self.ctx, cmd, &self.layout, bytes);
     }
 }

@@ -1,5 +1,6 @@
 //! Dynamic-rendering scopes (no render pass or framebuffer objects): one colour target, an
 //! optional depth target, viewport and scissor covering the target.
+use super::Cmd;
 use super::{Context, Image};
 use ash::vk;
 
@@ -37,7 +38,7 @@ impl Context {
     /// Either may be absent (depth-only shadow maps).
     pub fn begin_rendering(
         &self,
-        cmd: vk::CommandBuffer,
+        cmd: Cmd,
         color: Option<Target>,
         clear: Option<[f32; 4]>,
         depth: Option<Depth>,
@@ -97,38 +98,21 @@ impl Context {
         };
         // SAFETY: recording command buffer; attachments are alive, in GENERAL layout by policy.
         unsafe {
-            self.dynamic_rendering.cmd_begin_rendering(cmd, &info);
-            self.device.cmd_set_viewport(cmd, 0, &[viewport]);
-            self.device.cmd_set_scissor(cmd, 0, &[area]);
+            self.dynamic_rendering.cmd_begin_rendering(cmd.raw, &info);
+            self.device.cmd_set_viewport(cmd.raw, 0, &[viewport]);
+            self.device.cmd_set_scissor(cmd.raw, 0, &[area]);
         }
     }
 
-    /// Restricts drawing to `area` of the targets (viewport and scissor), within a rendering
-    /// scope: several views drawn side by side into one image, such as a probe's cube faces.
-    pub fn set_viewport(&self, cmd: vk::CommandBuffer, area: vk::Rect2D) {
-        let viewport = vk::Viewport {
-            x: area.offset.x as f32,
-            y: area.offset.y as f32,
-            width: area.extent.width as f32,
-            height: area.extent.height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
-        // SAFETY: recording command buffer inside a rendering scope (dynamic viewport and scissor).
-        unsafe {
-            self.device.cmd_set_viewport(cmd, 0, &[viewport]);
-            self.device.cmd_set_scissor(cmd, 0, &[area]);
-        }
-    }
-
-    pub fn end_rendering(&self, cmd: vk::CommandBuffer) {
+    pub fn end_rendering(&self, cmd: Cmd) {
         // SAFETY: closes the scope opened by begin_rendering.
-        unsafe { self.dynamic_rendering.cmd_end_rendering(cmd) };
+        unsafe { self.dynamic_rendering.cmd_end_rendering(cmd.raw) };
     }
 
     /// Restricts the current rendering scope's viewport and scissor to the `side`² texels from
-    /// `origin` (begin_rendering covers the whole target).
-    pub fn restrict_to_square(&self, cmd: vk::CommandBuffer, origin: [u32; 2], side: u32) {
+    /// `origin` (begin_rendering covers the whole target): several views drawn side by side
+    /// into one image, such as a probe's cube faces or ASM's tiles.
+    pub fn restrict_to_square(&self, cmd: Cmd, origin: [u32; 2], side: u32) {
         let (x, y) = (origin[0] as f32, origin[1] as f32);
         let viewport =
             vk::Viewport { x, y, width: side as f32, height: side as f32, min_depth: 0.0, max_depth: 1.0 };
@@ -138,20 +122,14 @@ impl Context {
         };
         // SAFETY: recording command buffer inside a rendering scope.
         unsafe {
-            self.device.cmd_set_viewport(cmd, 0, &[viewport]);
-            self.device.cmd_set_scissor(cmd, 0, &[scissor]);
+            self.device.cmd_set_viewport(cmd.raw, 0, &[viewport]);
+            self.device.cmd_set_scissor(cmd.raw, 0, &[scissor]);
         }
     }
 
     /// Binds vertex buffers (binding i = `vertices[i]`) and a u32 index buffer and draws `count`
     /// indices.
-    pub fn draw_indexed(
-        &self,
-        cmd: vk::CommandBuffer,
-        vertices: &[&super::Buffer],
-        indices: &super::Buffer,
-        count: u32,
-    ) {
+    pub fn draw_indexed(&self, cmd: Cmd, vertices: &[&super::Buffer], indices: &super::Buffer, count: u32) {
         self.draw_indexed_range(cmd, vertices, indices, 0, count);
     }
 
@@ -159,7 +137,7 @@ impl Context {
     /// counts from the first of them).
     pub fn draw_indexed_range(
         &self,
-        cmd: vk::CommandBuffer,
+        cmd: Cmd,
         vertices: &[&super::Buffer],
         indices: &super::Buffer,
         first: u32,
@@ -169,22 +147,22 @@ impl Context {
         let offsets = vec![0; raw.len()];
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {
-            self.device.cmd_bind_vertex_buffers(cmd, 0, &raw, &offsets);
-            self.device.cmd_bind_index_buffer(cmd, indices.raw, 0, vk::IndexType::UINT32);
-            self.device.cmd_draw_indexed(cmd, count, 1, first, 0, 0);
+            self.device.cmd_bind_vertex_buffers(cmd.raw, 0, &raw, &offsets);
+            self.device.cmd_bind_index_buffer(cmd.raw, indices.raw, 0, vk::IndexType::UINT32);
+            self.device.cmd_draw_indexed(cmd.raw, count, 1, first, 0, 0);
         }
     }
 
     /// Binds vertex buffers (binding i = `vertices[i]`, possibly none) and draws `count`
     /// vertices.
-    pub fn draw(&self, cmd: vk::CommandBuffer, vertices: &[&super::Buffer], count: u32) {
+    pub fn draw(&self, cmd: Cmd, vertices: &[&super::Buffer], count: u32) {
         let raw: Vec<vk::Buffer> = vertices.iter().map(|b| b.raw).collect();
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {
             if !raw.is_empty() {
-                self.device.cmd_bind_vertex_buffers(cmd, 0, &raw, &vec![0; raw.len()]);
+                self.device.cmd_bind_vertex_buffers(cmd.raw, 0, &raw, &vec![0; raw.len()]);
             }
-            self.device.cmd_draw(cmd, count, 1, 0, 0);
+            self.device.cmd_draw(cmd.raw, count, 1, 0, 0);
         }
     }
 }

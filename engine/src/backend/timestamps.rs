@@ -1,4 +1,5 @@
 //! A timestamp query pool: two queries per pass, read after the frame's fence.
+use super::Cmd;
 use super::Context;
 use crate::error::{Error, Result};
 use ash::vk;
@@ -25,14 +26,14 @@ impl TimestampPool {
         self.capacity
     }
 
-    pub fn reset(&self, cmd: vk::CommandBuffer, count: u32) {
+    pub fn reset(&self, cmd: Cmd, count: u32) {
         // SAFETY: recording command buffer; count <= capacity (checked by the caller).
-        unsafe { self.ctx.device.cmd_reset_query_pool(cmd, self.raw, 0, count) };
+        unsafe { self.ctx.device.cmd_reset_query_pool(cmd.raw, self.raw, 0, count) };
     }
 
-    pub fn write(&self, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags, index: u32) {
+    pub fn write(&self, cmd: Cmd, stage: vk::PipelineStageFlags, index: u32) {
         // SAFETY: recording command buffer; the query was reset earlier in the same buffer.
-        unsafe { self.ctx.device.cmd_write_timestamp(cmd, stage, self.raw, index) };
+        unsafe { self.ctx.device.cmd_write_timestamp(cmd.raw, stage, self.raw, index) };
     }
 
     /// Reads `count` timestamps (ticks) once the submission that wrote them has completed.

@@ -2,7 +2,7 @@
 use super::args;
 use super::handles;
 use super::result::{boundary, kage_result, Failure};
-use crate::backend::{vk, Context, ContextDesc, HostVulkan};
+use crate::backend::{Context, ContextDesc, HostVulkan};
 use std::ffi::{c_char, c_void};
 use std::sync::Arc;
 
@@ -129,11 +129,11 @@ pub unsafe extern "C" fn kage_context_create_from_vulkan(
             }
         }
         let host = HostVulkan {
-            instance: vk::Handle::from_raw(host.instance as u64),
-            physical_device: vk::Handle::from_raw(host.physical_device as u64),
-            device: vk::Handle::from_raw(host.device as u64),
+            instance: host.instance as u64,
+            physical_device: host.physical_device as u64,
+            device: host.device as u64,
             queue_family: host.queue_family,
-            queue: vk::Handle::from_raw(host.queue as u64),
+            queue: host.queue as u64,
             debug_utils: host.debug_utils,
         };
         // SAFETY: the caller promises live handles created as `kage_vulkan_handles` says.

@@ -1,7 +1,7 @@
 //! The scene's albedo maps on the GPU: one sRGB image with its mipmaps and one sampler per map
 //! (meshes that share a map share them), and map 0, a white texel, for meshes without one. Lit
 //! pipelines end their bindings with the mesh's map (`albedo_map.glsl`), pushed per draw.
-use crate::backend::{vk, Binding, Context, Edge, Image, ImageDesc, Sampler, SamplerDesc};
+use crate::backend::{Binding, Context, Edge, Format, Image, ImageDesc, ImageUsage, Sampler, SamplerDesc};
 use crate::error::Result;
 use crate::scene::albedo_map::{srgb_to_linear, AlbedoMap, Filter, Wrap};
 use crate::scene::Scene;
@@ -58,7 +58,7 @@ impl GpuAlbedoMaps {
 
     /// Device bytes of the maps' images.
     pub fn bytes(&self) -> u64 {
-        self.maps.iter().map(|m| m.image.byte_size().unwrap_or(0)).sum()
+        self.maps.iter().map(|m| m.image.byte_size()).sum()
     }
 }
 
@@ -74,8 +74,8 @@ fn upload(ctx: &Arc<Context>, map: &AlbedoMap) -> Result<GpuAlbedoMap> {
             layers: 1,
             levels: levels.len() as u32,
             array: false,
-            format: vk::Format::R8G8B8A8_SRGB,
-            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+            format: Format::RGBA8_SRGB,
+            usage: ImageUsage::SAMPLED | ImageUsage::TRANSFER_DST,
         },
     )?;
     image.upload(&levels.iter().flatten().flatten().copied().collect::<Vec<u8>>())?;

@@ -2,7 +2,10 @@
 //! colour target and looks up the map along each pixel's view ray.
 use super::environment::GpuEnvironment;
 use super::{FrameInputs, COLOR, ENVIRONMENT, FRAME_UNIFORMS};
-use crate::backend::{vk, Binding, BindingKind, Buffer, Context, DepthTest, GraphicsDesc, GraphicsPipeline};
+use crate::backend::Cmd;
+use crate::backend::{
+    Binding, BindingKind, Buffer, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Topology,
+};
 use crate::error::Result;
 use crate::frame::COLOR_FORMAT;
 use crate::layouts::spirv;
@@ -24,7 +27,7 @@ impl Background {
                 bindings: &[BindingKind::UniformBuffer, BindingKind::SampledImage],
                 push_size: 0,
                 vertex_buffers: &[],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                topology: Topology::Triangles,
                 color_formats: &[COLOR_FORMAT],
                 depth_format: None,
                 depth: DepthTest::Off,
@@ -47,7 +50,7 @@ impl Background {
 
     /// Draws the environment as seen with `uniforms` (`FrameUniforms`) into the current
     /// viewport, inside a rendering scope with a colour target only.
-    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, uniforms: &Buffer, env: &GpuEnvironment) {
+    pub fn draw(&self, ctx: &Context, cmd: Cmd, uniforms: &Buffer, env: &GpuEnvironment) {
         self.pipeline.bind(cmd, &[Binding::Uniform(uniforms), Binding::Sampled(&env.image, &env.sampler)]);
         ctx.draw(cmd, &[], 3);
     }

@@ -1,7 +1,7 @@
 //! The environment map on the GPU, or a table over directions laid out like it (the irradiance
 //! table): an RGBA32F image (alpha unused) and a sampler that wraps in longitude and clamps at
 //! the poles.
-use crate::backend::{vk, Context, Edge, Image, ImageDesc, Sampler};
+use crate::backend::{Context, Edge, Format, Image, ImageDesc, ImageUsage, Sampler};
 use crate::error::Result;
 use crate::scene::EnvMap;
 use std::sync::Arc;
@@ -33,8 +33,8 @@ impl GpuEnvironment {
                 layers: 1,
                 levels: 1,
                 array: false,
-                format: vk::Format::R32G32B32A32_SFLOAT,
-                usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+                format: Format::RGBA32_FLOAT,
+                usage: ImageUsage::SAMPLED | ImageUsage::TRANSFER_DST,
             },
         )?;
         // Row by row: the RGBA copy of a large map never exists whole on the host.

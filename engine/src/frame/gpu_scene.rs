@@ -1,7 +1,10 @@
 //! The scene's geometry on the GPU: one vertex and index buffer per mesh, one transform per
 //! group, the albedo maps, and the vertex layouts the techniques' pipelines read it with.
 use super::albedo_maps::GpuAlbedoMaps;
-use crate::backend::{vk, Binding, Buffer, Context, GraphicsPipeline, VertexAttribute, VertexBuffer};
+use crate::backend::Cmd;
+use crate::backend::{
+    Binding, Buffer, BufferUsage, Context, Format, GraphicsPipeline, VertexAttribute, VertexBuffer,
+};
 use crate::error::Result;
 use crate::scene::clusters::{clustered, Cluster};
 use crate::scene::Scene;
@@ -14,9 +17,9 @@ pub const VERTEX_STRIDE: u32 = 32;
 // The vertex limit of a mesh is what this stride leaves of 4 GiB.
 const _: () = assert!(crate::scene::MAX_MESH_VERTICES as u64 * VERTEX_STRIDE as u64 <= u32::MAX as u64);
 pub const MESH_ATTRIBUTES: [VertexAttribute; 3] = [
-    VertexAttribute { location: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
-    VertexAttribute { location: 1, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
-    VertexAttribute { location: 2, format: vk::Format::R32G32_SFLOAT, offset: 24 },
+    VertexAttribute { location: 0, format: Format::RGB32_FLOAT, offset: 0 },
+    VertexAttribute { location: 1, format: Format::RGB32_FLOAT, offset: 12 },
+    VertexAttribute { location: 2, format: Format::RG32_FLOAT, offset: 24 },
 ];
 pub const MESH_VERTICES: VertexBuffer<'static> =
     VertexBuffer { stride: VERTEX_STRIDE, attributes: &MESH_ATTRIBUTES };
@@ -77,13 +80,13 @@ impl GpuScene {
                     vertices: Buffer::with_data(
                         ctx,
                         &format!("{name}.vertices"),
-                        vk::BufferUsageFlags::VERTEX_BUFFER,
+                        BufferUsage::VERTEX,
                         &vertices,
                     )?,
                     indices: Buffer::with_data(
                         ctx,
                         &format!("{name}.indices"),
-                        vk::BufferUsageFlags::INDEX_BUFFER,
+                        BufferUsage::INDEX,
                         &indices,
                     )?,
                     index_count: mesh.indices.len() as u32,
@@ -108,7 +111,7 @@ impl GpuScene {
 
     /// Binds `mesh`'s albedo map as the last binding of `pipeline`, a lit pipeline
     /// ([`super::scene_pass::lit_bindings`]).
-    pub fn bind_albedo_map(&self, cmd: vk::CommandBuffer, pipeline: &GraphicsPipeline, mesh: &GpuMesh) {
+    pub fn bind_albedo_map(&self, cmd: Cmd, pipeline: &GraphicsPipeline, mesh: &GpuMesh) {
         pipeline.rebind(cmd, pipeline.binding_count() - 1, self.albedo_map(mesh));
     }
 }

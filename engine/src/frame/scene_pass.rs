@@ -14,8 +14,10 @@ use super::gpu_scene::MESH_VERTICES;
 use super::shadow_depth::depth_only_pipeline;
 use super::shadow_depth::SHADOW_MAPS;
 use super::{FrameInputs, COLOR, DEPTH, FRAME_UNIFORMS};
+use crate::backend::Cmd;
+use crate::backend::Topology;
 use crate::backend::{
-    vk, Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
+    Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
 };
 use crate::error::Result;
 use crate::frame::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
@@ -90,7 +92,7 @@ pub fn scene_pipeline_with(
             bindings: &lit_bindings(bindings),
             push_size: push_size as u32,
             vertex_buffers,
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            topology: Topology::Triangles,
             color_formats: &[COLOR_FORMAT],
             depth_format: Some(DEPTH_FORMAT),
             depth,
@@ -124,7 +126,7 @@ pub fn scene_pass<'a, P: Pod>(
 
 /// Binds a lit pipeline with `bindings` and the first mesh's albedo map, which
 /// [`draw_meshes`] replaces per draw.
-pub fn bind_lit(cmd: vk::CommandBuffer, pipeline: &GraphicsPipeline, scene: &GpuScene, bindings: &[Binding]) {
+pub fn bind_lit(cmd: Cmd, pipeline: &GraphicsPipeline, scene: &GpuScene, bindings: &[Binding]) {
     let first = scene.albedo_maps.binding(scene.meshes.first().map_or(0, |m| m.albedo_map));
     let all: Vec<Binding> = bindings.iter().cloned().chain([first]).collect();
     pipeline.bind(cmd, &all);
@@ -135,7 +137,7 @@ pub fn bind_lit(cmd: vk::CommandBuffer, pipeline: &GraphicsPipeline, scene: &Gpu
 /// [`bind_lit`]).
 pub fn draw_meshes<P: Pod>(
     ctx: &Context,
-    cmd: vk::CommandBuffer,
+    cmd: Cmd,
     scene: &GpuScene,
     pipeline: &GraphicsPipeline,
     lit: bool,
@@ -172,7 +174,7 @@ pub fn lighting_pipeline(ctx: &Arc<Context>, name: &str, fragment_spirv: &[u8]) 
 /// albedo map.
 pub fn draw_lit_meshes(
     ctx: &Context,
-    cmd: vk::CommandBuffer,
+    cmd: Cmd,
     pipeline: &GraphicsPipeline,
     scene: &GpuScene,
     albedo: impl Fn(&GpuMesh) -> Option<[f32; 3]>,

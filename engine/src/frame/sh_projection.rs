@@ -4,8 +4,9 @@
 //! environment map (equirectangular; run when the environment changes, not every frame) and a
 //! light probe's cube map ([`Mapping::Cube`]).
 use super::environment::GpuEnvironment;
+use crate::backend::BufferUsage;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Image, MemoryLocation, Sampler,
+    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Image, MemoryLocation, Sampler,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, constants, spirv, ShCoeffs, ShProjectPush};
@@ -81,7 +82,7 @@ impl ShProjection {
         // Below 512 rows, at most 2·(2·512)² cells: no overflow; above, one cell per texel.
         let cells = width * height * mapping.subdivisions().pow(2);
         let groups = cells.div_ceil(texels_per_group);
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let storage = BufferUsage::STORAGE;
         Ok(ShProjection {
             project: ComputePipeline::new(
                 ctx,
@@ -112,9 +113,7 @@ impl ShProjection {
                     name: names.result.0,
                     size: size_of::<ShCoeffs>() as u64,
                     // Read per fragment as uniforms: far cheaper than a storage buffer on CPU drivers.
-                    usage: storage
-                        | vk::BufferUsageFlags::UNIFORM_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_SRC,
+                    usage: storage | BufferUsage::UNIFORM | BufferUsage::TRANSFER_SRC,
                     location: MemoryLocation::GpuOnly,
                 },
             )?,

@@ -4,10 +4,12 @@
 //! (orthographic maps), the shadowmap technique (perspective maps of local lights) and adaptive
 //! shadow maps (its page pool: one tile per layer).
 use super::gpu_scene::MESH_POSITIONS;
+use crate::backend::Cmd;
 use crate::backend::{
-    vk, Binding, BindingKind, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image,
-    ImageDesc, Sampler, Target,
+    Binding, BindingKind, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
+    Sampler, Target,
 };
+use crate::backend::{ImageUsage, Topology};
 use crate::error::Result;
 use crate::frame::{GpuMesh, GpuScene, DEPTH_FORMAT};
 use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
@@ -45,7 +47,7 @@ pub fn depth_only_pipeline(
             bindings,
             push_size: push_size as u32,
             vertex_buffers: &[MESH_POSITIONS],
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            topology: Topology::Triangles,
             color_formats: &[],
             depth_format: Some(DEPTH_FORMAT),
             depth: DepthTest::Less,
@@ -66,9 +68,7 @@ impl ShadowMaps {
             size_of::<ShadowDepthPush>(),
         )?;
         // TRANSFER_SRC: the ASM's scratch tile is copied into its pages.
-        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
-            | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let usage = ImageUsage::DEPTH_ATTACHMENT | ImageUsage::SAMPLED | ImageUsage::TRANSFER_SRC;
         let maps_name = format!("{name}.maps");
         let desc = ImageDesc::square_array(&maps_name, size, layers, DEPTH_FORMAT, usage);
         Ok(ShadowMaps {
@@ -80,7 +80,7 @@ impl ShadowMaps {
     }
 
     /// Bytes of the maps: side² × 4 (D32) per layer.
-    pub fn byte_size(&self) -> Result<u64> {
+    pub fn byte_size(&self) -> u64 {
         self.maps.byte_size()
     }
 
@@ -115,7 +115,7 @@ impl ShadowMaps {
     pub fn record<'m>(
         &self,
         ctx: &Context,
-        cmd: vk::CommandBuffer,
+        cmd: Cmd,
         scene: &GpuScene,
         layer: u32,
         view_proj: &Mat4,
@@ -128,7 +128,7 @@ impl ShadowMaps {
 
     /// Opens a rendering scope that clears map `layer`, with the depth pipeline bound, for
     /// [`ShadowMaps::draw`]s (in parts of it: `Context::restrict_to_square`).
-    pub fn begin(&self, ctx: &Context, cmd: vk::CommandBuffer, layer: u32) {
+    pub fn begin(&self, ctx: &Context, cmd: Cmd, layer: u32) {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear(self.target(layer))));
         self.pipeline.bind(cmd, &[]);
     }
@@ -137,7 +137,7 @@ impl ShadowMaps {
     pub fn draw<'m>(
         &self,
         ctx: &Context,
-        cmd: vk::CommandBuffer,
+        cmd: Cmd,
         scene: &GpuScene,
         view_proj: &Mat4,
         draws: impl IntoIterator<Item = (&'m GpuMesh, u32, u32)>,

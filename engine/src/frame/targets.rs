@@ -1,6 +1,9 @@
 //! The frame's render targets: the colour and depth images every technique draws into, and the
 //! buffer the picture is read back through.
-use crate::backend::{vk, Buffer, BufferDesc, Context, Image, ImageDesc, MemoryLocation};
+use crate::backend::Cmd;
+use crate::backend::{
+    Buffer, BufferDesc, BufferUsage, Context, Format, Image, ImageDesc, ImageUsage, MemoryLocation,
+};
 use crate::error::{Error, Result};
 use crate::host_memory;
 use crate::imageio::RgbaF32Image;
@@ -8,8 +11,8 @@ use std::sync::Arc;
 
 /// Linear radiance, 32-bit float per channel: the picture is compared against the ray-traced
 /// reference pixel by pixel, so no precision is given away before the output file.
-pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+pub const COLOR_FORMAT: Format = Format::RGBA32_FLOAT;
+pub const DEPTH_FORMAT: Format = Format::DEPTH32_FLOAT;
 
 /// The largest image side Kage renders (lavapipe and current GPUs allow 16384; 8192 keeps the
 /// colour target and its readback within 2 GiB).
@@ -40,7 +43,7 @@ impl Targets {
                 levels: 1,
                 array: false,
                 format: COLOR_FORMAT,
-                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                usage: ImageUsage::COLOR_ATTACHMENT | ImageUsage::TRANSFER_SRC,
             },
         )?;
         let depth = Image::new(
@@ -54,15 +57,15 @@ impl Targets {
                 array: false,
                 format: DEPTH_FORMAT,
                 // Sampled: the ASM refinement analysis reads the visible surfaces back.
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                usage: ImageUsage::DEPTH_ATTACHMENT | ImageUsage::SAMPLED,
             },
         )?;
         let readback = Buffer::new(
             ctx,
             &BufferDesc {
                 name: "color.readback",
-                size: color.byte_size()?,
-                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                size: color.byte_size(),
+                usage: BufferUsage::TRANSFER_DST,
                 location: MemoryLocation::GpuToCpu,
             },
         )?;
@@ -70,7 +73,7 @@ impl Targets {
     }
 
     /// Records the copy of the colour target into the readback buffer.
-    pub fn record_readback(&self, cmd: vk::CommandBuffer) {
+    pub fn record_readback(&self, cmd: Cmd) {
         self.color.record_copy_to(cmd, &self.readback)
     }
 

@@ -20,7 +20,7 @@ mod timings;
 
 pub use timings::{frame_ms, median, TimingRow, TimingTable};
 
-use crate::backend::{Context, TimestampPool};
+use crate::backend::{Cmd, Context, TimestampPool};
 use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
@@ -36,7 +36,7 @@ pub struct Pass<'a> {
     pub name: &'static str,
     pub inputs: &'a [Resource],
     pub outputs: &'a [Resource],
-    record: Box<dyn FnOnce(vk::CommandBuffer) + 'a>,
+    record: Box<dyn FnOnce(Cmd) + 'a>,
 }
 
 impl<'a> Pass<'a> {
@@ -44,7 +44,7 @@ impl<'a> Pass<'a> {
         name: &'static str,
         inputs: &'a [Resource],
         outputs: &'a [Resource],
-        record: impl FnOnce(vk::CommandBuffer) + 'a,
+        record: impl FnOnce(Cmd) + 'a,
     ) -> Pass<'a> {
         Pass { name, inputs, outputs, record: Box::new(record) }
     }
@@ -120,7 +120,7 @@ impl FrameExecutor {
             Ok(recorder) => recorder,
             Err(failed) => return Err(failed.error()),
         };
-        let cmd = recorder.cmd;
+        let cmd = recorder.cmd();
         let timestamps = self.timestamps.as_ref().filter(|_| period_ns.is_some());
         self.ctx.begin(recorder)?;
         if let Some(t) = timestamps {

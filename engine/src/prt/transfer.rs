@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use super::{buried, mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
 use crate::backend::MemoryLocation;
-use crate::backend::{vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context};
+use crate::backend::{Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, PrtTransferPush, PrtVertex};
 use crate::pass::{FrameExecutor, Pass, Resource};
@@ -102,14 +102,14 @@ impl<'a> Jobs<'a> {
             .flat_map(|(_, mesh)| mesh.positions.iter().zip(&mesh.normals))
             .map(|(p, n)| PrtVertex { position: [p[0], p[1], p[2], 0.0], normal: [n[0], n[1], n[2], 0.0] })
             .collect();
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let storage = BufferUsage::STORAGE;
         let readback = |name, size| {
             Buffer::new(
                 ctx,
                 &BufferDesc {
                     name,
                     size,
-                    usage: storage | vk::BufferUsageFlags::TRANSFER_SRC,
+                    usage: storage | BufferUsage::TRANSFER_SRC,
                     location: MemoryLocation::GpuOnly,
                 },
             )

@@ -1,9 +1,8 @@
 //! Casts lists of rays on the GPU through bvh.glsl (shaders-glsl/raycast.comp): the test and
 //! benchmark harness of the BVH. Techniques trace their own rays in their own shaders.
 use super::GpuBvh;
-use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, MemoryLocation,
-};
+use crate::backend::BufferUsage;
+use crate::backend::{Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, MemoryLocation};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, CastPush, CastRay, CastResult};
 use crate::pass::{FrameExecutor, Pass, Resource};
@@ -44,18 +43,13 @@ impl GpuRays {
             Error::InvalidArgument(format!("cannot cast {} rays: give 1 to 2^32 - 1", rays.len()))
         })?;
         Ok(GpuRays {
-            rays: Buffer::with_data(
-                ctx,
-                "raycast.rays",
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                bytes_of_slice(rays),
-            )?,
+            rays: Buffer::with_data(ctx, "raycast.rays", BufferUsage::STORAGE, bytes_of_slice(rays))?,
             results: Buffer::new(
                 ctx,
                 &BufferDesc {
                     name: RESULTS.0,
                     size: rays.len() as u64 * size_of::<CastResult>() as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+                    usage: BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
                     location: MemoryLocation::GpuOnly,
                 },
             )?,

@@ -1,6 +1,6 @@
 //! The scene BVH in device-local storage buffers, bound as bvh.glsl declares them.
 use super::SceneBvh;
-use crate::backend::{vk, Binding, BindingKind, Buffer, Context};
+use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of_slice, constants, Pod};
 use crate::pass::Resource;
@@ -83,10 +83,5 @@ impl GpuBvh {
 fn upload<T: Pod + Default>(ctx: &Arc<Context>, name: &str, items: &[T]) -> Result<Buffer> {
     let placeholder = [T::default()];
     let items = if items.is_empty() { &placeholder[..] } else { items };
-    Buffer::with_data(
-        ctx,
-        name,
-        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-        bytes_of_slice(items),
-    )
+    Buffer::with_data(ctx, name, BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC, bytes_of_slice(items))
 }

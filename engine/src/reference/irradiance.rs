@@ -17,7 +17,7 @@
 //! "standard_error": [[r, g, b], ...]}`, in the input's order.
 use super::lighting::{ReferenceLighting, IMPORTS};
 use super::statistics::{accum_buffer, samples_after, Statistics};
-use crate::backend::{vk, BindingKind, Buffer, ComputePipeline, Context};
+use crate::backend::{BindingKind, Buffer, BufferUsage, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, IrradiancePoint, IrradiancePush};
 use crate::pass::{FrameExecutor, Pass, Resource};
@@ -250,14 +250,14 @@ impl IrradianceReference {
             points: Buffer::with_data(
                 ctx,
                 "irradiance_points",
-                vk::BufferUsageFlags::STORAGE_BUFFER,
+                BufferUsage::STORAGE,
                 bytes_of_slice(&gpu_points),
             )?,
             accum: accum_buffer(ctx, "irradiance_accum", points.len())?,
             radiance: Buffer::with_data(
                 ctx,
                 "irradiance_surface_radiance",
-                vk::BufferUsageFlags::STORAGE_BUFFER,
+                BufferUsage::STORAGE,
                 &radiance
                     .filter(|r| !r.is_empty())
                     .unwrap_or(&[[0.0; 4]])

@@ -3,7 +3,7 @@
 //! and what both need besides: the scene's point and spot lights.
 use super::env_sampling::EnvDistribution;
 use super::render::reference_light;
-use crate::backend::{vk, Binding, BindingKind, Buffer, Context};
+use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context};
 use crate::error::Result;
 use crate::frame::environment::GpuEnvironment;
 use crate::frame::ENVIRONMENT;
@@ -37,7 +37,7 @@ impl ReferenceLighting {
         let scene_bvh = SceneBvh::build(scene)?;
         let bvh = GpuBvh::new(ctx, &scene_bvh)?;
         let distribution = EnvDistribution::new(&scene.environment);
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let storage = BufferUsage::STORAGE;
         let upload = |name: &str, values: &[f32]| {
             let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_ne_bytes()).collect();
             Buffer::with_data(ctx, name, storage, &bytes)

@@ -1,6 +1,6 @@
 //! The per-pixel (or per-point) statistics the reference shaders accumulate, read back: the
 //! mean of the samples and the standard error of that mean.
-use crate::backend::{vk, Buffer, BufferDesc, Context, MemoryLocation};
+use crate::backend::{Buffer, BufferDesc, BufferUsage, Context, MemoryLocation};
 use crate::error::{Error, Result};
 use crate::layouts::ReferenceAccum;
 use std::sync::Arc;
@@ -23,7 +23,7 @@ pub fn accum_buffer(ctx: &Arc<Context>, name: &str, items: usize) -> Result<Buff
         &BufferDesc {
             name,
             size: (items * size_of::<ReferenceAccum>()) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+            usage: BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
             location: MemoryLocation::GpuOnly,
         },
     )

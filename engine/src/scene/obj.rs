@@ -55,11 +55,10 @@ pub fn load_obj(path: &Path, albedo: [f32; 3]) -> Result<Vec<Mesh>, SceneError> 
     meshes(models, &name, albedo, &mut map_of).map_err(|e| e.attributed_to(path))
 }
 
-/// The file's models and, where its library could be read, its materials.
-fn models(
-    bytes: &[u8],
-    library: impl Fn(&Path) -> tobj::MTLLoadResult,
-) -> Result<(Vec<tobj::Model>, Result<Vec<tobj::Material>, tobj::LoadError>), SceneError> {
+/// An OBJ file's models and, where its library could be read, its materials.
+type ObjContents = (Vec<tobj::Model>, Result<Vec<tobj::Material>, tobj::LoadError>);
+
+fn models(bytes: &[u8], library: impl Fn(&Path) -> tobj::MTLLoadResult) -> Result<ObjContents, SceneError> {
     tobj::load_obj_buf(&mut Cursor::new(bytes), &tobj::GPU_LOAD_OPTIONS, library)
         .map_err(|e| SceneError::invalid(format!("malformed OBJ: {e}")))
 }

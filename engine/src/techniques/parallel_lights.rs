@@ -20,8 +20,9 @@
 //! `GraphicsDesc` free of a setting only this baseline would use. A small constant depth bias
 //! covers curved surfaces, where the texel's depth varies inside the texel.
 use super::Technique;
+use crate::backend::BufferUsage;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
+    Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::env_rotation;
@@ -94,7 +95,7 @@ impl ParallelLights {
             &BufferDesc {
                 name: "parallel_lights.lights",
                 size: (constants::MAX_PARALLEL_LIGHTS as usize * size_of::<ParallelLight>()) as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                usage: BufferUsage::UNIFORM,
                 location: MemoryLocation::CpuToGpu,
             },
         )?;

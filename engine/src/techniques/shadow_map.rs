@@ -16,8 +16,9 @@
 //! a depth of tan θ per unit of width inside a texel, so the bias grows with tan θ (capped:
 //! grazing surfaces would otherwise detach their shadows entirely).
 use super::{Technique, TechniqueStats};
+use crate::backend::BufferUsage;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
+    Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::scene_sphere;
@@ -105,7 +106,7 @@ impl ShadowMap {
             &BufferDesc {
                 name: "shadow_map.lights",
                 size: (max * size_of::<ShadowLight>()) as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                usage: BufferUsage::UNIFORM,
                 location: MemoryLocation::CpuToGpu,
             },
         )?;
@@ -186,6 +187,6 @@ impl Technique for ShadowMap {
 
     fn stats(&self) -> TechniqueStats {
         // D32 has a texel size, so this never fails.
-        TechniqueStats { shadow_memory_bytes: self.shadow_maps.byte_size().ok(), ..Default::default() }
+        TechniqueStats { shadow_memory_bytes: Some(self.shadow_maps.byte_size()), ..Default::default() }
     }
 }

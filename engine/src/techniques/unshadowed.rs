@@ -1,6 +1,7 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
 use super::Technique;
-use crate::backend::{vk, Binding, Buffer, Context, Depth, GraphicsPipeline};
+use crate::backend::Cmd;
+use crate::backend::{Binding, Buffer, Context, Depth, GraphicsPipeline};
 use crate::error::Result;
 use crate::frame::scene_pass::{bind_lit, draw_lit_meshes, lighting_pipeline};
 use crate::frame::{FrameInputs, FrameState, COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
@@ -48,7 +49,7 @@ impl Unshadowed {
     pub fn draw(
         &self,
         ctx: &Context,
-        cmd: vk::CommandBuffer,
+        cmd: Cmd,
         uniforms: &Buffer,
         sh: &Buffer,
         scene: &GpuScene,

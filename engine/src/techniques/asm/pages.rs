@@ -9,10 +9,12 @@
 //! The polygon-ID test keeps a second atlas and scratch, of IDs, laid out as the depth ones.
 use super::pool::{TilePages, TILE_PAGES};
 use super::tile::TileKey;
+use crate::backend::Cmd;
 use crate::backend::{
-    vk, Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
+    Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
     Target,
 };
+use crate::backend::{Format, ImageUsage, Topology};
 use crate::error::{Error, Result};
 use crate::frame::gpu_scene::MESH_POSITIONS;
 use crate::frame::shadow_depth::ShadowMaps;
@@ -23,7 +25,7 @@ use glam::Mat4;
 use std::sync::Arc;
 
 /// The ID test's polygon IDs.
-const ID_FORMAT: vk::Format = vk::Format::R32_UINT;
+const ID_FORMAT: Format = Format::R32_UINT;
 /// Most pages per atlas row: 16384 texels, the largest image side of lavapipe and NVIDIA.
 const MAX_COLUMNS: u32 = 16384 / ASM_PAGE_TEXELS;
 /// Tiles the scratch holds: renders between two copies into the atlas.
@@ -131,7 +133,7 @@ impl PageStore {
     ) -> Result<PageStore> {
         let layout = AtlasLayout::within(u64::from(most_pages) * page_bytes, page_bytes)?;
         let (width, height) = (layout.columns * ASM_PAGE_TEXELS, layout.rows * ASM_PAGE_TEXELS);
-        let atlas_usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
+        let atlas_usage = ImageUsage::SAMPLED | ImageUsage::TRANSFER_DST;
         let atlas = |name, format| {
             let desc = ImageDesc {
                 name,
@@ -181,7 +183,7 @@ impl PageStore {
     }
 
     /// Records `writes` in order, one debug label each.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, writes: &[TileWrite]) {
+    pub fn record(&self, ctx: &Context, cmd: Cmd, scene: &GpuScene, writes: &[TileWrite]) {
         let half = ASM_PAGE_TEXELS;
         for batch in writes.chunks(SCRATCH_TILES as usize) {
             self.begin_batch(ctx, cmd);
@@ -206,7 +208,7 @@ impl PageStore {
     }
 
     /// Opens the rendering scope of a batch: the scratch cleared, depth and IDs for the ID test.
-    fn begin_batch(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+    fn begin_batch(&self, ctx: &Context, cmd: Cmd) {
         let Some(ids) = &self.ids else { return self.scratch.begin(ctx, cmd, 0) };
         let color = Target { image: &ids.scratch, layer: 0 };
         ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(0))));
@@ -214,7 +216,7 @@ impl PageStore {
     }
 
     /// A tile's draws into the part of the scratch the scope is restricted to.
-    fn draw_tile(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &GpuScene, write: &TileWrite) {
+    fn draw_tile(&self, ctx: &Context, cmd: Cmd, scene: &GpuScene, write: &TileWrite) {
         let draws = write.draws.iter().map(|&(m, first, count)| (&scene.meshes[m], first, count));
         let Some(ids) = &self.ids else {
             return self.scratch.draw(ctx, cmd, scene, &write.view_proj, draws);
@@ -233,7 +235,7 @@ impl PageStore {
     /// Copies squares of the scratch (each with the page it goes to) into the atlases. A page
     /// written twice keeps the later square: a tile's quadrant given back to a child rendered
     /// after it in the same batch, or an evicted tile's page taken by another.
-    fn store(&self, cmd: vk::CommandBuffer, pending: Vec<([u32; 2], u32)>) {
+    fn store(&self, cmd: Cmd, pending: Vec<([u32; 2], u32)>) {
         let mut seen = std::collections::HashSet::new();
         let mut squares: Vec<([u32; 2], [u32; 2])> = pending
             .into_iter()
@@ -254,7 +256,7 @@ impl PageStore {
 
 impl IdPages {
     fn new(ctx: &Arc<Context>, gpu: &GpuScene, atlas: Image) -> Result<IdPages> {
-        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+        let usage = ImageUsage::COLOR_ATTACHMENT | ImageUsage::TRANSFER_SRC;
         let desc = ImageDesc::square_array("asm.id_scratch", SCRATCH_SIDE, 1, ID_FORMAT, usage);
         let tile = GraphicsPipeline::new(
             ctx,
@@ -265,7 +267,7 @@ impl IdPages {
                 bindings: &[],
                 push_size: size_of::<AsmTilePush>() as u32,
                 vertex_buffers: &[MESH_POSITIONS],
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                topology: Topology::Triangles,
                 color_formats: &[ID_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth: DepthTest::Less,

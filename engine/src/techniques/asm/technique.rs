@@ -29,9 +29,10 @@ use super::pages::{PageStore, TileWrite};
 use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{Insert, PageOp, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES, TILE_PAGES};
 use super::tile::TileKey;
+use crate::backend::BufferUsage;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, DepthTest, Edge,
-    GraphicsPipeline, MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
+    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, DepthTest, Edge, GraphicsPipeline,
+    MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::scene_sphere;
@@ -295,30 +296,22 @@ impl Asm {
         )?;
         let buffer =
             |name, size, usage, location| Buffer::new(ctx, &BufferDesc { name, size, usage, location });
-        let records = buffer(
-            "asm.lights",
-            memory::lights_bytes(),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-            MemoryLocation::CpuToGpu,
-        )?;
+        let records =
+            buffer("asm.lights", memory::lights_bytes(), BufferUsage::UNIFORM, MemoryLocation::CpuToGpu)?;
         let table = buffer(
             "asm.page_table",
             page_table::PageTable::buffer_bytes(nodes),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
+            BufferUsage::STORAGE,
             MemoryLocation::CpuToGpu,
         )?;
         let requests = buffer(
             "asm.requests",
             memory::requests_bytes(nodes, edge_capacity),
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            BufferUsage::STORAGE | BufferUsage::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let mut used = buffer(
-            "asm.used",
-            memory::used_bytes(nodes),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let mut used =
+            buffer("asm.used", memory::used_bytes(nodes), BufferUsage::STORAGE, MemoryLocation::GpuToCpu)?;
         // No frame yet: a node the lighting never marked must not read as used last frame.
         used.write(0, &vec![0xFF; memory::used_bytes(nodes) as usize])?;
         let mut asm = Asm {

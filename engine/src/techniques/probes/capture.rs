@@ -24,9 +24,10 @@
 use super::dering::Dering;
 use super::set::ProbeGroups;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, Depth, DepthTest, Edge, GraphicsPipeline, Image,
+    Binding, BindingKind, Buffer, BufferDesc, Context, Depth, DepthTest, Edge, GraphicsPipeline, Image,
     ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
 };
+use crate::backend::{BufferUsage, Format, ImageUsage};
 use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
@@ -165,7 +166,7 @@ pub struct InvalidProbe {
 
 /// Per-vertex radiance as a second vertex buffer (location 1).
 const RADIANCE_ATTRIBUTES: [VertexAttribute; 1] =
-    [VertexAttribute { location: 1, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }];
+    [VertexAttribute { location: 1, format: Format::RGBA32_FLOAT, offset: 0 }];
 const RADIANCE_VERTICES: VertexBuffer<'static> =
     VertexBuffer { stride: 16, attributes: &RADIANCE_ATTRIBUTES };
 
@@ -226,7 +227,7 @@ impl ProbeCapture {
                     &BufferDesc {
                         name: &format!("probe_face{f}.uniforms"),
                         size: size_of::<FrameUniforms>() as u64,
-                        usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                        usage: BufferUsage::UNIFORM,
                         location: MemoryLocation::CpuToGpu,
                     },
                 )
@@ -238,9 +239,9 @@ impl ProbeCapture {
             cube: image(
                 PROBE_CUBE.source.0,
                 COLOR_FORMAT,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                ImageUsage::COLOR_ATTACHMENT | ImageUsage::SAMPLED,
             )?,
-            depth: image("probe_depth", DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?,
+            depth: image("probe_depth", DEPTH_FORMAT, ImageUsage::DEPTH_ATTACHMENT)?,
             // The projection reads texels with texelFetch: the filter never applies.
             sampler: Sampler::new(ctx, "probe_cube.sampler", false, Edge::Clamp, Edge::Clamp)?,
             faces,
@@ -290,17 +291,15 @@ impl ProbeCapture {
         }
         let (ctx, cube, depth, faces, side) =
             (&self.ctx, &self.cube, &self.depth, &self.faces, self.settings.cube_size);
-        let face_area = |f: u32| vk::Rect2D {
-            offset: vk::Offset2D { x: 0, y: (f * side) as i32 },
-            extent: vk::Extent2D { width: side, height: side },
-        };
+        // Face f is the side² square at (0, f × side) of the strip.
+        let face_origin = |f: usize| [0, f as u32 * side];
         let (background, surfaces, env, radiance) =
             (&self.background, &self.surfaces, &self.env, &self.radiance);
         let mut passes = vec![
             Pass::new("probe_background", &[FACES, ENVIRONMENT], &[CUBE], move |cmd| {
                 ctx.begin_rendering(cmd, Some(cube.into()), Some([0.0; 4]), None);
                 for (f, uniforms) in faces.iter().enumerate() {
-                    ctx.set_viewport(cmd, face_area(f as u32));
+                    ctx.restrict_to_square(cmd, face_origin(f), side);
                     background.draw(ctx, cmd, uniforms, env);
                 }
                 ctx.end_rendering(cmd);
@@ -312,7 +311,7 @@ impl ProbeCapture {
                 move |cmd| {
                     ctx.begin_rendering(cmd, Some(cube.into()), None, Some(Depth::Clear(depth.into())));
                     for (f, uniforms) in faces.iter().enumerate() {
-                        ctx.set_viewport(cmd, face_area(f as u32));
+                        ctx.restrict_to_square(cmd, face_origin(f), side);
                         bind_lit(cmd, surfaces, scene, &[Binding::Uniform(uniforms)]);
                         for mesh in scene.meshes.iter().filter(|m| is_static(m.group)) {
                             let Some(Some(r)) = radiance.get(mesh.group).and_then(|g| g.get(mesh.mesh))
@@ -444,7 +443,7 @@ fn static_radiance(
             let name = format!("{}.{}.probe_radiance", group.name, mesh.name);
             meshes.push(
                 (count > 0)
-                    .then(|| Buffer::with_data(ctx, &name, vk::BufferUsageFlags::VERTEX_BUFFER, &bytes))
+                    .then(|| Buffer::with_data(ctx, &name, BufferUsage::VERTEX, &bytes))
                     .transpose()?,
             );
         }

@@ -12,7 +12,9 @@
 //! not the probes'.
 use super::set::{bounds, ProbeGroups, ProbeSet, ProbeSettings, StaticLighting};
 use super::Walker;
-use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, Depth, GraphicsPipeline, MemoryLocation};
+use crate::backend::{
+    Binding, Buffer, BufferDesc, BufferUsage, Context, Depth, GraphicsPipeline, MemoryLocation,
+};
 use crate::error::{Error, Result};
 use crate::frame::scene_pass::{bind_lit, draw_lit_meshes, lighting_pipeline};
 use crate::frame::GpuScene;
@@ -102,7 +104,7 @@ impl ProbeTechnique {
                     &BufferDesc {
                         name: &format!("{}.probe_light", scene.groups[group].name),
                         size: size_of::<ProbeLight>() as u64,
-                        usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                        usage: BufferUsage::UNIFORM,
                         location: MemoryLocation::CpuToGpu,
                     },
                 )?;

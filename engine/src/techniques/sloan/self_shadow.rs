@@ -2,9 +2,10 @@
 //! as points carrying their transfer vectors. It reruns only for groups whose orientation
 //! relative to the light changed since the last frame; other texels keep their values.
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Image,
+    Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Image,
     ImageDesc, MemoryLocation, VertexAttribute, VertexBuffer,
 };
+use crate::backend::{BufferUsage, Format, ImageUsage, Topology};
 use crate::error::{Error, Result};
 use crate::frame::bounds::rotation_of;
 use crate::frame::GpuScene;
@@ -23,8 +24,7 @@ const WIDTH: u32 = constants::SELF_SHADOW_WIDTH;
 
 /// The transfer vectors as vertex attributes: `TRANSFER_VEC4` vec4s per vertex, zero-padded.
 const TRANSFER_ATTRIBUTES: [VertexAttribute; TRANSFER_VEC4] = {
-    let mut a =
-        [VertexAttribute { location: 0, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }; TRANSFER_VEC4];
+    let mut a = [VertexAttribute { location: 0, format: Format::RGBA32_FLOAT, offset: 0 }; TRANSFER_VEC4];
     let mut i = 0;
     while i < TRANSFER_VEC4 {
         a[i].location = i as u32;
@@ -87,7 +87,7 @@ impl SelfShadow {
             buffers.push(Buffer::with_data(
                 ctx,
                 &format!("{}.transfer", mesh.name),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
+                BufferUsage::VERTEX,
                 &bytes,
             )?);
             first_texel.push(next);
@@ -102,8 +102,8 @@ impl SelfShadow {
                 layers: 1,
                 levels: 1,
                 array: false,
-                format: vk::Format::R32G32B32A32_SFLOAT,
-                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                format: Format::RGBA32_FLOAT,
+                usage: ImageUsage::COLOR_ATTACHMENT | ImageUsage::SAMPLED,
             },
         )?;
         let groups = scene.transforms.len();
@@ -112,7 +112,7 @@ impl SelfShadow {
             &BufferDesc {
                 name: "self_shadow.group_lights",
                 size: (groups.max(1) * size_of::<GroupLight>()) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                usage: BufferUsage::STORAGE,
                 location: MemoryLocation::CpuToGpu,
             },
         )?;
@@ -125,8 +125,8 @@ impl SelfShadow {
                 bindings: &[BindingKind::StorageBuffer],
                 push_size: size_of::<SelfShadowPush>() as u32,
                 vertex_buffers: &[VertexBuffer { stride: TRANSFER_STRIDE, attributes: &TRANSFER_ATTRIBUTES }],
-                topology: vk::PrimitiveTopology::POINT_LIST,
-                color_formats: &[vk::Format::R32G32B32A32_SFLOAT],
+                topology: Topology::Points,
+                color_formats: &[Format::RGBA32_FLOAT],
                 depth_format: None,
                 depth: DepthTest::Off,
                 write_color: true,

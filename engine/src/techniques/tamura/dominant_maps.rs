@@ -5,7 +5,7 @@
 //! percentage-closer tap). Shadows between groups take the occlusion layers' path, as the
 //! regions' do, with the light's own angular size for their penumbra.
 use super::dominant::DominantLight;
-use crate::backend::{vk, Binding, Buffer, BufferDesc, Context, MemoryLocation, Sampler};
+use crate::backend::{Binding, Buffer, BufferDesc, BufferUsage, Context, MemoryLocation, Sampler};
 use crate::error::{Error, Result};
 use crate::frame::bounds::{rotation_of, GroupBounds};
 use crate::frame::shadow_depth::ShadowMaps;
@@ -97,7 +97,7 @@ impl DominantMaps {
                 &BufferDesc {
                     name: "dominant.lights",
                     size: size_of::<DominantLights>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    usage: BufferUsage::UNIFORM,
                     location: MemoryLocation::CpuToGpu,
                 },
             )?,

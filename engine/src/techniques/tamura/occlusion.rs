@@ -24,9 +24,10 @@ use super::dominant::DominantLight;
 use super::sheet::Sheet;
 use super::technique::{OcclusionSettings, Penumbra};
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge,
-    GraphicsDesc, GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
+    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge, GraphicsDesc,
+    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
 };
+use crate::backend::{BufferUsage, Format, ImageUsage, Topology};
 use crate::error::Result;
 use crate::frame::bounds::{box_corners, rotation_of, GroupBounds};
 use crate::frame::gpu_scene::MESH_POSITIONS;
@@ -122,11 +123,11 @@ pub struct Occlusion {
 }
 
 /// The masks: coverage, and coverage × occluder height.
-const MASK_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
+const MASK_FORMAT: Format = Format::RG32_FLOAT;
 /// The filtered layers: up to three box widths side by side, and the occluder heights. Half
 /// floats: the scene pass reads one per layer per pixel, and coverage needs no more than their
 /// 2^-10 of relative precision.
-pub const FILTERED_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub const FILTERED_FORMAT: Format = Format::RGBA16_FLOAT;
 // The scene pass reads the layers from a uniform buffer (16 KiB on every device) and keeps one
 // bit per layer in 32-bit words.
 const _: () = assert!(constants::MAX_OCCLUSION_LAYERS as usize * size_of::<OcclusionLayer>() <= 16 * 1024);
@@ -163,13 +164,10 @@ fn layered(
     name: &str,
     size: u32,
     layers: u32,
-    format: vk::Format,
-    usage: vk::ImageUsageFlags,
+    format: Format,
+    usage: ImageUsage,
 ) -> Result<Image> {
-    Image::new(
-        ctx,
-        &ImageDesc::square_array(name, size, layers, format, usage | vk::ImageUsageFlags::SAMPLED),
-    )
+    Image::new(ctx, &ImageDesc::square_array(name, size, layers, format, usage | ImageUsage::SAMPLED))
 }
 
 fn host_buffer(ctx: &Arc<Context>, name: &str, size: usize) -> Result<Buffer> {
@@ -178,7 +176,7 @@ fn host_buffer(ctx: &Arc<Context>, name: &str, size: usize) -> Result<Buffer> {
         &BufferDesc {
             name,
             size: size.max(16) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::UNIFORM_BUFFER,
+            usage: BufferUsage::STORAGE | BufferUsage::UNIFORM,
             location: MemoryLocation::CpuToGpu,
         },
     )
@@ -203,7 +201,7 @@ fn mask_pipeline(ctx: &Arc<Context>, name: &str, occluder: bool) -> Result<Graph
             bindings: &[BindingKind::StorageBuffer],
             push_size: size_of::<MaskPush>() as u32,
             vertex_buffers: &[MESH_POSITIONS],
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            topology: Topology::Triangles,
             color_formats: &[MASK_FORMAT],
             depth_format: Some(DEPTH_FORMAT),
             depth: if occluder { DepthTest::Nearer } else { DepthTest::Less },
@@ -261,7 +259,7 @@ impl Occlusion {
                 resolution,
                 layer_count,
                 MASK_FORMAT,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT,
+                ImageUsage::COLOR_ATTACHMENT,
             )?,
             mask_depth: Image::new(
                 ctx,
@@ -270,7 +268,7 @@ impl Occlusion {
                     resolution,
                     layer_count,
                     DEPTH_FORMAT,
-                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                    ImageUsage::DEPTH_ATTACHMENT,
                 ),
             )?,
             temp: Buffer::new(
@@ -280,7 +278,7 @@ impl Occlusion {
                     size: u64::from(layer_count)
                         * u64::from(resolution * resolution)
                         * size_of::<[u16; 4]>() as u64, // four half floats per texel
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    usage: BufferUsage::STORAGE,
                     location: MemoryLocation::GpuOnly,
                 },
             )?,
@@ -290,7 +288,7 @@ impl Occlusion {
                 resolution,
                 layer_count,
                 FILTERED_FORMAT,
-                vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC,
+                ImageUsage::STORAGE | ImageUsage::TRANSFER_SRC,
             )?,
             sampler: Sampler::new(ctx, "occlusion.sampler", true, Edge::Clamp, Edge::Clamp)?,
             nearest: Sampler::new(ctx, "occlusion.nearest", false, Edge::Clamp, Edge::Clamp)?,

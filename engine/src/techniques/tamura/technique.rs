@@ -6,10 +6,12 @@ use super::dominant_maps::{self, DominantMaps};
 use super::occlusion::OCCLUSION;
 use super::occlusion::{Occlusion, RegionSize};
 use super::sheet::Sheet;
+use crate::backend::Cmd;
 use crate::backend::{
-    vk, Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline,
-    Sampler, VertexBuffer,
+    Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Sampler,
+    VertexBuffer,
 };
+use crate::backend::{BufferUsage, Topology};
 use crate::error::{Error, Result};
 use crate::frame::bounds::{env_rotation, group_bounds};
 use crate::frame::environment::GpuEnvironment;
@@ -218,7 +220,7 @@ impl PrtTechnique {
                         MESH_VERTICES,
                         VertexBuffer { stride: TRANSFER_STRIDE, attributes: &transfer_attributes },
                     ],
-                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                    topology: Topology::Triangles,
                     color_formats: &[COLOR_FORMAT],
                     depth_format: Some(DEPTH_FORMAT),
                     depth: DepthTest::LessOrEqual,
@@ -234,12 +236,7 @@ impl PrtTechnique {
             )?,
             prepass_pipeline: depth_prepass_pipeline(ctx, "prt.depth_prepass", size_of::<PrtDrawPush>())?,
             nearest: Sampler::new(ctx, "self_shadow.sampler", false, Edge::Clamp, Edge::Clamp)?,
-            light_sh: Buffer::with_data(
-                ctx,
-                "prt.light_sh",
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-                bytes_of(&light_sh),
-            )?,
+            light_sh: Buffer::with_data(ctx, "prt.light_sh", BufferUsage::UNIFORM, bytes_of(&light_sh))?,
             irradiance: gpu_irradiance(ctx, settings.pixel_cosine.then_some(residual))?,
         })
     }
@@ -315,7 +312,7 @@ impl PrtTechnique {
 
     /// Records, inside a rendering scope, the meshes of the groups it lights with eq. (15)
     /// (Sloan's PRT where there are no regions).
-    pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, uniforms: &Buffer, scene: &GpuScene) {
+    pub fn record_draws(&self, ctx: &Context, cmd: Cmd, uniforms: &Buffer, scene: &GpuScene) {
         let (occlusion, self_shadow) = (&self.occlusion, &self.self_shadow);
         let [lights, shadow] = self.dominant.bindings();
         bind_lit(
