@@ -5,10 +5,10 @@ use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
 use crate::frame::sh_projection::ShProjection;
-use crate::frame::{FrameInputs, FrameState, GpuScene, Targets, COLOR, ENVIRONMENT, ENV_SH, FRAME_UNIFORMS};
+use crate::frame::{FrameInputs, FrameState, GpuScene, Targets};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
-use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
+use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::progress::Progress;
 use crate::prt::TransferSet;
 use crate::scene::{check_extent, Light, Scene};
@@ -191,30 +191,23 @@ impl Renderer {
             scene: &self.scene,
             targets: &self.targets,
         };
-        let mut imports = vec![FRAME_UNIFORMS, ENVIRONMENT];
-        imports.extend_from_slice(self.technique.persistent());
         let analysis = self.technique.analysis_passes(&inputs);
         let mut timings = Vec::new();
         if analysis.is_empty() {
             drop(analysis);
         } else {
-            // What the analysis wrote stays for the frame (the ASM depth prepass).
-            let written: Vec<Resource> = analysis.iter().flat_map(|p| p.outputs.iter().copied()).collect();
-            timings = self.executor.run(&imports, analysis)?;
-            imports.extend(written);
+            timings = self.executor.run(analysis)?;
             self.technique.analysed()?;
         }
         let mut passes: Vec<Pass> = Vec::new();
         if self.env_dirty {
             passes.extend(self.env_sh.passes(&self.env.image, &self.env.sampler));
-        } else {
-            imports.push(ENV_SH);
         }
         passes.push(self.background.pass(&inputs));
         passes.extend(self.technique.passes(&inputs));
         let targets = &self.targets;
-        passes.push(Pass::new("readback", &[COLOR], &[], move |cmd| targets.record_readback(cmd)));
-        let mut frame = self.executor.run(&imports, passes)?;
+        passes.push(Pass::new("readback", move |cmd| targets.record_readback(cmd)));
+        let mut frame = self.executor.run(passes)?;
         self.technique.timed(&frame);
         // Starts count from the frame's first pass: this submission's follow the analysis's end.
         let analysis_end = crate::pass::frame_ms(&timings).unwrap_or(0.0);

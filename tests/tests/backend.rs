@@ -5,7 +5,6 @@ use kage::backend::{
     MemoryLocation,
 };
 use kage::layouts::{bytes_of, bytes_of_slice, constants, spirv, ShCoeffs, ShProjectPush};
-use kage::pass::Resource;
 use kage::pass::{FrameExecutor, Pass};
 use kage_tests::Validated;
 
@@ -72,17 +71,14 @@ fn compute_shader_result_is_exact() {
     let push = ShProjectPush { size: [count, 0, 0, 0] };
     let mut executor = FrameExecutor::new(&ctx, "exact").unwrap();
     let timings = executor
-        .run(
-            &[Resource("partials")],
-            vec![Pass::new("reduce", &[Resource("partials")], &[Resource("sum")], |cmd| {
-                pipeline.dispatch(
-                    cmd,
-                    &[Binding::Storage(&input), Binding::Storage(&output)],
-                    bytes_of(&push),
-                    [1, 1, 1],
-                )
-            })],
-        )
+        .run(vec![Pass::new("reduce", |cmd| {
+            pipeline.dispatch(
+                cmd,
+                &[Binding::Storage(&input), Binding::Storage(&output)],
+                bytes_of(&push),
+                [1, 1, 1],
+            )
+        })])
         .unwrap();
     assert_eq!(timings.len(), 1);
     assert_eq!(constants::SH_COEFFS, 9);
@@ -101,20 +97,41 @@ fn compute_shader_result_is_exact() {
     }
 }
 
+/// A pass's reads and writes are the buffers it binds, read or written as its shader declares
+/// them (sh_reduce reads its partials `readonly` and writes its result): a pass that reads what
+/// a later pass of the frame writes is refused before anything is submitted, naming both, and
+/// the executor runs the same passes in order afterwards.
 #[test]
 fn frame_with_unordered_passes_is_rejected() {
     let ctx = Validated::new();
+    let one = size_of::<ShCoeffs>() as u64;
+    let storage = BufferUsage::STORAGE;
+    let input = Buffer::with_data(&ctx, "input", storage, bytes_of(&ShCoeffs::default())).unwrap();
+    let buffer = |name| {
+        Buffer::new(&ctx, &BufferDesc { name, size: one, usage: storage, location: MemoryLocation::GpuOnly })
+            .unwrap()
+    };
+    let (middle, result) = (buffer("middle"), buffer("result"));
+    let kinds = [BindingKind::StorageBuffer, BindingKind::StorageBuffer];
+    let push_size = size_of::<ShProjectPush>() as u32;
+    let pipeline = ComputePipeline::new(&ctx, "sh_reduce", spirv::SH_REDUCE_COMP, &kinds, push_size).unwrap();
+    let push = ShProjectPush { size: [1, 0, 0, 0] };
+    let reduce = |name, from: &'static str| {
+        let (from, to) = if from == "input" { (&input, &middle) } else { (&middle, &result) };
+        let pipeline = &pipeline;
+        Pass::new(name, move |cmd| {
+            pipeline.dispatch(
+                cmd,
+                &[Binding::Storage(from), Binding::Storage(to)],
+                bytes_of(&push),
+                [1, 1, 1],
+            )
+        })
+    };
     let mut executor = FrameExecutor::new(&ctx, "order").unwrap();
-    let err = executor
-        .run(
-            &[],
-            vec![
-                Pass::new("consumer", &[Resource("thing")], &[], |_| {}),
-                Pass::new("producer", &[], &[Resource("thing")], |_| {}),
-            ],
-        )
-        .unwrap_err();
-    assert!(err.to_string().contains("pass consumer reads thing"), "{err}");
+    let err = executor.run(vec![reduce("consumer", "middle"), reduce("producer", "input")]).unwrap_err();
+    assert!(err.to_string().contains("pass consumer reads middle before pass producer writes it"), "{err}");
+    executor.run(vec![reduce("producer", "input"), reduce("consumer", "middle")]).unwrap();
 }
 
 /// The canary: a deliberate misuse must reach the collected messages, or every other test's

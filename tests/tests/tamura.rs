@@ -2,14 +2,14 @@
 use exr::prelude::f16;
 use glam::{Mat3, Mat4, Vec3};
 use kage::backend::{
-    Binding, Buffer, BufferDesc, BufferUsage, ComputePipeline, Edge, Format, Image, ImageDesc, ImageUsage,
-    MemoryLocation, Sampler,
+    Binding, Buffer, BufferDesc, BufferUsage, Cmd, ComputePipeline, Edge, Format, Image, ImageDesc,
+    ImageUsage, MemoryLocation, Sampler,
 };
 use kage::frame::bounds::group_bounds;
 use kage::frame::regions::Regions;
 use kage::frame::GpuScene;
 use kage::layouts::{bytes_of, bytes_of_slice, BlurPush, OcclusionLayer};
-use kage::pass::Resource;
+
 use kage::pass::{FrameExecutor, Pass};
 use kage::prt::{transfer, PrtParams, TransferSet};
 use kage::renderer::{RenderOptions, Renderer};
@@ -78,7 +78,7 @@ fn filter_layer(
     let penumbra = if adaptive { Penumbra::Adaptive } else { Penumbra::Fixed };
     let pass = |vertical| filter_pipeline(ctx, penumbra, vertical).unwrap();
     let (horizontal, vertical) = (pass(false), pass(true));
-    let filter = |cmd, blur: &ComputePipeline| {
+    let filter = |cmd: Cmd<'_>, blur: &ComputePipeline| {
         let push = BlurPush { params: [0, size, 1, 0] };
         let bindings = [
             Binding::Storage(&layers),
@@ -90,10 +90,10 @@ fn filter_layer(
     };
     let mut executor = FrameExecutor::new(ctx, "filter").unwrap();
     let passes = vec![
-        Pass::new("horizontal", &[], &[Resource("half")], |cmd| filter(cmd, &horizontal)),
-        Pass::new("vertical", &[Resource("half")], &[], |cmd| filter(cmd, &vertical)),
+        Pass::new("horizontal", |cmd| filter(cmd, &horizontal)),
+        Pass::new("vertical", |cmd| filter(cmd, &vertical)),
     ];
-    executor.run(&[], passes).unwrap();
+    executor.run(passes).unwrap();
     let floats: Vec<f32> =
         filtered.read().unwrap().chunks_exact(2).map(|b| f16::from_ne_bytes([b[0], b[1]]).to_f32()).collect();
     floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
@@ -350,7 +350,7 @@ fn filtered_layers_are_zero_outside_their_footprint() {
             assert!(!layers.is_empty(), "pose {t}: no occlusion layer");
             let mut moved = GpuScene::new(&ctx, &scene).unwrap();
             moved.transforms = transforms;
-            executor.run(&[], occlusion.passes(&ctx, &moved)).unwrap();
+            executor.run(occlusion.passes(&ctx, &moved)).unwrap();
             let bytes = occlusion.filtered.read().unwrap();
             let layer_bytes = (size * size * 8) as usize;
             for (l, layer) in layers.iter().enumerate() {

@@ -23,7 +23,7 @@ pub struct Buffer {
     pub(crate) raw: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
-    name: String,
+    name: Arc<str>,
 }
 
 impl Buffer {
@@ -61,7 +61,7 @@ impl Buffer {
             raw,
             allocation: Some(allocation),
             size: desc.size,
-            name: desc.name.to_owned(),
+            name: desc.name.into(),
         };
         bound.map_err(Error::vk("vkBindBufferMemory"))?;
         ctx.set_name(raw, desc.name);
@@ -89,6 +89,12 @@ impl Buffer {
 
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Logs that the commands recorded into `cmd` use this buffer: read it, or (`writes`) may
+    /// write it.
+    pub(super) fn touched(&self, cmd: Cmd, writes: bool) {
+        cmd.log.add(vk::Handle::as_raw(self.raw), &self.name, writes);
     }
 
     pub fn raw(&self) -> vk::Buffer {
@@ -156,6 +162,7 @@ impl Buffer {
 
     /// Records filling the whole buffer with zeros (it needs `TRANSFER_DST` usage).
     pub fn record_zero(&self, cmd: Cmd) {
+        self.touched(cmd, true);
         // SAFETY: recording command buffer of this device; the buffer outlives the submission.
         unsafe { self.ctx.device.cmd_fill_buffer(cmd.raw, self.raw, 0, vk::WHOLE_SIZE, 0) };
     }

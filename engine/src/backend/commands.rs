@@ -1,6 +1,6 @@
 //! Command buffers and submission. Kage records a frame into one primary command buffer and
 //! waits for its fence; `one_shot` is the same for set-up work (uploads, layout changes).
-use super::Context;
+use super::{AccessLog, Context};
 use crate::error::{Error, Result};
 use ash::vk;
 
@@ -19,17 +19,19 @@ pub struct CommandRecorder {
 
 impl CommandRecorder {
     /// The command buffer to record into, between [`Context::begin`] and
-    /// [`Context::submit_and_wait`].
-    pub(crate) fn cmd(&self) -> Cmd {
-        Cmd { raw: self.cmd }
+    /// [`Context::submit_and_wait`], logging what its commands touch into `log`.
+    pub(crate) fn cmd<'a>(&self, log: &'a AccessLog) -> Cmd<'a> {
+        Cmd { raw: self.cmd, log }
     }
 }
 
 /// A command buffer being recorded: what passes record into, through the backend's methods
-/// that take it. Only the backend reaches the Vulkan handle inside.
-#[derive(Clone, Copy, Debug)]
-pub struct Cmd {
+/// that take it, which log the resources they touch. Only the backend reaches the Vulkan
+/// handle inside.
+#[derive(Clone, Copy)]
+pub struct Cmd<'a> {
     pub(super) raw: vk::CommandBuffer,
+    pub(super) log: &'a AccessLog,
 }
 
 impl Context {
@@ -81,10 +83,16 @@ impl Context {
             .map_err(Error::vk("vkBeginCommandBuffer"))
     }
 
+    /// Ends the recording that [`Context::begin`] began, leaving the buffer ready to submit or
+    /// to begin again.
+    pub(crate) fn end(&self, recorder: &CommandRecorder) -> Result<()> {
+        // SAFETY: recording was begun by `begin`.
+        unsafe { self.device.end_command_buffer(recorder.cmd) }.map_err(Error::vk("vkEndCommandBuffer"))
+    }
+
     /// Ends, submits and waits for the recorder's command buffer.
     pub(crate) fn submit_and_wait(&self, recorder: &CommandRecorder) -> Result<()> {
-        // SAFETY: recording was begun by `begin`.
-        unsafe { self.device.end_command_buffer(recorder.cmd) }.map_err(Error::vk("vkEndCommandBuffer"))?;
+        self.end(recorder)?;
         let cmds = [recorder.cmd];
         let submit = vk::SubmitInfo::default().command_buffers(&cmds);
         {
@@ -104,9 +112,11 @@ impl Context {
     /// visible to the host.
     pub fn one_shot(&self, name: &str, record: impl FnOnce(Cmd)) -> Result<()> {
         let recorder = self.create_recorder(name)?;
+        // Set-up work is one submission of its own: nothing to order it against.
+        let log = AccessLog::default();
         let result = self.begin(&recorder).and_then(|()| {
-            record(recorder.cmd());
-            self.host_read_barrier(recorder.cmd());
+            record(recorder.cmd(&log));
+            self.host_read_barrier(recorder.cmd(&log));
             self.submit_and_wait(&recorder)
         });
         // After a failed submission the buffer may still be pending: free it only once idle.

@@ -1,5 +1,6 @@
 //! Descriptors: every pipeline has one set, written with push descriptors at record time, so
 //! there are no pools or set lifetimes to manage. Binding `i` is the i-th entry of the list.
+use super::pipeline::Layout;
 use super::Cmd;
 use super::{Buffer, Context, Image, Sampler};
 use ash::vk;
@@ -60,28 +61,36 @@ pub(crate) fn set_layout_bindings(kinds: &[BindingKind]) -> Vec<vk::DescriptorSe
 
 /// Binds `bindings` to set 0 of `layout`. Panics are impossible here; a binding list that does
 /// not match the layout is a programming error that validation reports.
-pub fn push_descriptors(
+pub(super) fn push_descriptors(
     ctx: &Context,
     cmd: Cmd,
     bind_point: vk::PipelineBindPoint,
-    layout: vk::PipelineLayout,
-    expected: &[BindingKind],
+    layout: &Layout,
     bindings: &[Binding],
 ) {
-    debug_assert_eq!(expected, bindings.iter().map(Binding::kind).collect::<Vec<_>>().as_slice());
+    debug_assert_eq!(layout.bindings, bindings.iter().map(Binding::kind).collect::<Vec<_>>());
     push_descriptors_from(ctx, cmd, bind_point, layout, 0, bindings);
 }
 
 /// Binds `bindings` to bindings `first`, `first + 1`, … of set 0 of `layout`, leaving the others
 /// as the last push left them (push descriptors update only what they write).
-pub fn push_descriptors_from(
+pub(super) fn push_descriptors_from(
     ctx: &Context,
     cmd: Cmd,
     bind_point: vk::PipelineBindPoint,
-    layout: vk::PipelineLayout,
+    layout: &Layout,
     first: u32,
     bindings: &[Binding],
 ) {
+    for (i, binding) in bindings.iter().enumerate() {
+        let written = layout.written.get(first as usize + i).copied().unwrap_or(false);
+        match binding {
+            Binding::Uniform(buffer) => buffer.touched(cmd, false),
+            Binding::Storage(buffer) => buffer.touched(cmd, written),
+            Binding::Sampled(image, _) => image.touched(cmd, false),
+            Binding::StorageImage(image) => image.touched(cmd, written),
+        }
+    }
     // A push with no writes is invalid (descriptorWriteCount must be at least 1): pipelines
     // without resources, such as the depth-only shadow pass, push nothing.
     if bindings.is_empty() {
@@ -127,5 +136,5 @@ pub fn push_descriptors_from(
         .collect();
     // SAFETY: recording command buffer; the writes point at locals alive for the call, and the
     // set layout was created with the push-descriptor flag.
-    unsafe { ctx.push_descriptor.cmd_push_descriptor_set(cmd.raw, bind_point, layout, 0, &writes) };
+    unsafe { ctx.push_descriptor.cmd_push_descriptor_set(cmd.raw, bind_point, layout.pipeline, 0, &writes) };
 }

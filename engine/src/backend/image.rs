@@ -53,7 +53,7 @@ pub struct Image {
     pub layers: u32,
     pub levels: u32,
     pub format: Format,
-    name: String,
+    name: Arc<str>,
 }
 
 impl Image {
@@ -107,7 +107,7 @@ impl Image {
             * desc.format.texel_bytes();
         if bytes > limits.max_resource_size {
             return Err(Error::OutOfDeviceMemoryFor {
-                name: desc.name.to_owned(),
+                name: desc.name.into(),
                 bytes,
                 reason: format!(
                     "the device's largest image of this format is {} bytes",
@@ -155,7 +155,7 @@ impl Image {
             layers: desc.layers,
             levels: desc.levels,
             format: desc.format,
-            name: desc.name.to_owned(),
+            name: desc.name.into(),
         };
         // SAFETY: the allocation satisfies the image's requirements.
         let bound = unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
@@ -234,6 +234,12 @@ impl Image {
         &self.name
     }
 
+    /// Logs that the commands recorded into `cmd` use this image: read it, or (`writes`) may
+    /// write it.
+    pub(super) fn touched(&self, cmd: Cmd, writes: bool) {
+        cmd.log.add(vk::Handle::as_raw(self.raw), &self.name, writes);
+    }
+
     pub fn view(&self) -> vk::ImageView {
         self.view
     }
@@ -284,6 +290,8 @@ impl Image {
 
     /// Records a copy of the whole image into `buffer` (tightly packed, layer after layer).
     pub fn record_copy_to(&self, cmd: Cmd, buffer: &Buffer) {
+        self.touched(cmd, false);
+        buffer.touched(cmd, true);
         let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
         self.transition(cmd, vk::ImageLayout::GENERAL, src);
         // SAFETY: recording command buffer; the image was just moved to `src`.
@@ -298,6 +306,8 @@ impl Image {
     /// commands on either image and before all later ones (the copies step into the transfer
     /// layouts and back). Destination squares must not overlap.
     pub fn record_copy_squares(&self, cmd: Cmd, dst: &Image, squares: &[([u32; 2], [u32; 2])], size: u32) {
+        self.touched(cmd, false);
+        dst.touched(cmd, true);
         let layer = vk::ImageSubresourceLayers {
             aspect_mask: self.format.aspect(),
             mip_level: 0,

@@ -2,6 +2,7 @@
 //!
 //! Resources hold an `Arc<Context>` and destroy themselves on drop, so a host cannot leak them
 //! or outlive the device. Every object gets a debug name when `VK_EXT_debug_utils` is present.
+mod access;
 mod buffer;
 mod commands;
 mod context;
@@ -17,10 +18,11 @@ mod usage;
 mod validation;
 mod vk_error;
 
+pub use access::{AccessLog, Touch};
 pub use buffer::{Buffer, BufferDesc};
 pub use commands::{Cmd, CommandRecorder};
 pub use context::{Calibration, Context, ContextDesc, DeviceInfo, HostVulkan};
-pub use descriptor::{push_descriptors, Binding, BindingKind};
+pub use descriptor::{Binding, BindingKind};
 pub use device::{CALIBRATED_TIMESTAMPS, FRAGMENT_STORES, GEOMETRY_SHADER};
 pub use format::Format;
 pub use image::{Edge, Image, ImageDesc, Sampler, SamplerDesc, STAGING_BAND_BYTES};

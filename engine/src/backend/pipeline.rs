@@ -8,14 +8,25 @@ use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
 
-struct Layout {
+pub(super) struct Layout {
     set: vk::DescriptorSetLayout,
-    pipeline: vk::PipelineLayout,
-    bindings: Vec<BindingKind>,
+    pub(super) pipeline: vk::PipelineLayout,
+    pub(super) bindings: Vec<BindingKind>,
+    /// Per binding, whether a shader of the pipeline may write it.
+    pub(super) written: Vec<bool>,
     push_size: u32,
 }
 
-fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size: u32) -> Result<Layout> {
+fn create_layout(
+    ctx: &Context,
+    name: &str,
+    bindings: &[BindingKind],
+    modules: &[&Module],
+    push_size: u32,
+) -> Result<Layout> {
+    let written = (0..bindings.len() as u32)
+        .map(|b| modules.iter().flat_map(|m| &m.used).any(|u| u.binding == b && u.written))
+        .collect();
     let set_bindings = set_layout_bindings(bindings);
     let set_info = vk::DescriptorSetLayoutCreateInfo::default()
         .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
@@ -41,7 +52,7 @@ fn create_layout(ctx: &Context, name: &str, bindings: &[BindingKind], push_size:
         }
     };
     ctx.set_name(pipeline, &format!("{name}.layout"));
-    Ok(Layout { set, pipeline, bindings: bindings.to_vec(), push_size })
+    Ok(Layout { set, pipeline, bindings: bindings.to_vec(), written, push_size })
 }
 
 fn destroy_layout(ctx: &Context, layout: &Layout) {
@@ -56,6 +67,7 @@ fn destroy_layout(ctx: &Context, layout: &Layout) {
 struct Module<'a> {
     ctx: &'a Context,
     raw: vk::ShaderModule,
+    used: Vec<reflect::Used>,
 }
 
 impl<'a> Module<'a> {
@@ -64,15 +76,15 @@ impl<'a> Module<'a> {
     fn new(ctx: &'a Context, name: &str, spirv: &[u8], bindings: &[BindingKind]) -> Result<Module<'a>> {
         let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
             .map_err(|e| Error::Internal(format!("SPIR-V of {name}: {e}")))?;
-        reflect::descriptor_bindings(&words)
-            .and_then(|used| reflect::check(name, bindings, &used))
+        let used = reflect::descriptor_bindings(&words)
+            .and_then(|used| reflect::check(name, bindings, &used).map(|()| used))
             .map_err(|e| Error::Internal(format!("shader {name}: {e}")))?;
         let info = vk::ShaderModuleCreateInfo::default().code(&words);
         // SAFETY: the words are SPIR-V compiled by the build script.
         let raw = unsafe { ctx.device.create_shader_module(&info, None) }
             .map_err(Error::vk("vkCreateShaderModule"))?;
         ctx.set_name(raw, name);
-        Ok(Module { ctx, raw })
+        Ok(Module { ctx, raw, used })
     }
 }
 
@@ -121,7 +133,7 @@ impl ComputePipeline {
         constants: &[u32],
     ) -> Result<ComputePipeline> {
         let module = Module::new(ctx, &format!("{name}.comp"), spirv, bindings)?;
-        let layout = create_layout(ctx, name, bindings, push_size)?;
+        let layout = create_layout(ctx, name, bindings, &[&module], push_size)?;
         let (entries, constant_bytes) = specialization_entries(constants);
         let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&constant_bytes);
         let stage = vk::PipelineShaderStageCreateInfo::default()
@@ -147,14 +159,7 @@ impl ComputePipeline {
     pub fn dispatch(&self, cmd: Cmd, bindings: &[Binding], push: &[u8], groups: [u32; 3]) {
         // SAFETY: recording command buffer of this device.
         unsafe { self.ctx.device.cmd_bind_pipeline(cmd.raw, vk::PipelineBindPoint::COMPUTE, self.raw) };
-        push_descriptors(
-            &self.ctx,
-            cmd,
-            vk::PipelineBindPoint::COMPUTE,
-            self.layout.pipeline,
-            &self.layout.bindings,
-            bindings,
-        );
+        push_descriptors(&self.ctx, cmd, vk::PipelineBindPoint::COMPUTE, &self.layout, bindings);
         push_bytes(&self.ctx, cmd, &self.layout, push);
         // SAFETY: pipeline and descriptors bound above.
         unsafe { self.ctx.device.cmd_dispatch(cmd.raw, groups[0], groups[1], groups[2]) };
@@ -254,7 +259,7 @@ impl GraphicsPipeline {
     pub fn new(ctx: &Arc<Context>, desc: &GraphicsDesc) -> Result<GraphicsPipeline> {
         let vs = Module::new(ctx, &format!("{}.vert", desc.name), desc.vertex_spirv, desc.bindings)?;
         let fs = Module::new(ctx, &format!("{}.frag", desc.name), desc.fragment_spirv, desc.bindings)?;
-        let layout = create_layout(ctx, desc.name, desc.bindings, desc.push_size)?;
+        let layout = create_layout(ctx, desc.name, desc.bindings, &[&vs, &fs], desc.push_size)?;
         let (entries, constant_bytes) = specialization_entries(desc.constants);
         let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&constant_bytes);
         let stages = [
@@ -365,14 +370,7 @@ impl GraphicsPipeline {
     pub fn bind(&self, cmd: Cmd, bindings: &[Binding]) {
         // SAFETY: recording command buffer of this device.
         unsafe { self.ctx.device.cmd_bind_pipeline(cmd.raw, vk::PipelineBindPoint::GRAPHICS, self.raw) };
-        push_descriptors(
-            &self.ctx,
-            cmd,
-            vk::PipelineBindPoint::GRAPHICS,
-            self.layout.pipeline,
-            &self.layout.bindings,
-            bindings,
-        );
+        push_descriptors(&self.ctx, cmd, vk::PipelineBindPoint::GRAPHICS, &self.layout, bindings);
     }
 
     /// Binds `binding` at index `at` of the pipeline's bindings in place of what [`bind`] gave
@@ -382,7 +380,7 @@ impl GraphicsPipeline {
     pub fn rebind(&self, cmd: Cmd, at: u32, binding: Binding) {
         debug_assert_eq!(self.layout.bindings.get(at as usize), Some(&binding.kind()));
         let bind_point = vk::PipelineBindPoint::GRAPHICS;
-        push_descriptors_from(&self.ctx, cmd, bind_point, self.layout.pipeline, at, &[binding]);
+        push_descriptors_from(&self.ctx, cmd, bind_point, &self.layout, at, &[binding]);
     }
 
     /// How many resources the pipeline binds.

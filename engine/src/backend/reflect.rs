@@ -2,7 +2,8 @@
 //! pipeline's declared bindings are checked against its shaders when the pipeline is made: a
 //! wrong binding list fails there, naming the shader and the binding, not as a validation
 //! message at draw time. Only what Kage's shaders use is read: set 0, uniform and storage
-//! buffers, combined image samplers and storage images.
+//! buffers, combined image samplers and storage images, and whether the shader may write each
+//! (what a pass that binds it touches: `access.rs`).
 use super::descriptor::BindingKind;
 use std::collections::HashMap;
 
@@ -10,11 +11,14 @@ const OP_TYPE_IMAGE: u32 = 25;
 const OP_TYPE_SAMPLED_IMAGE: u32 = 27;
 const OP_TYPE_ARRAY: u32 = 28;
 const OP_TYPE_RUNTIME_ARRAY: u32 = 29;
+const OP_TYPE_STRUCT: u32 = 30;
 const OP_TYPE_POINTER: u32 = 32;
 const OP_VARIABLE: u32 = 59;
 const OP_DECORATE: u32 = 71;
+const OP_MEMBER_DECORATE: u32 = 72;
 const DECORATION_BLOCK: u32 = 2;
 const DECORATION_BUFFER_BLOCK: u32 = 3;
+const DECORATION_NON_WRITABLE: u32 = 24;
 const DECORATION_BINDING: u32 = 33;
 const DECORATION_DESCRIPTOR_SET: u32 = 34;
 const STORAGE_UNIFORM_CONSTANT: u32 = 0;
@@ -23,10 +27,21 @@ const STORAGE_STORAGE_BUFFER: u32 = 12;
 /// `OpTypeImage`'s "sampled" operand for an image used without a sampler (a storage image).
 const IMAGE_STORAGE: u32 = 2;
 
-/// The (binding, kind) of every descriptor of set 0 the module uses, by binding; `Err` names an
-/// instruction this reader does not know how to classify.
-pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<(u32, BindingKind)>, String> {
+/// A descriptor a shader uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Used {
+    pub binding: u32,
+    pub kind: BindingKind,
+    /// Whether the shader may write it: a storage buffer or image not declared `readonly`.
+    pub written: bool,
+}
+
+/// Every descriptor of set 0 the module uses, by binding; `Err` names an instruction this
+/// reader does not know how to classify.
+pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<Used>, String> {
     let mut decorations: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
+    // Per struct: its member count and how many members are `NonWritable`.
+    let mut members: HashMap<u32, (usize, usize)> = HashMap::new();
     let mut types: HashMap<u32, (u32, Vec<u32>)> = HashMap::new();
     let mut variables = Vec::new();
     let mut at = 5; // past the header
@@ -40,6 +55,12 @@ pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<(u32, BindingKind)>, Str
             OP_DECORATE if operands.len() >= 2 => {
                 let value = operands.get(2).copied().unwrap_or(0);
                 decorations.entry(operands[0]).or_default().push((operands[1], value));
+            }
+            OP_MEMBER_DECORATE if operands.len() >= 3 && operands[2] == DECORATION_NON_WRITABLE => {
+                members.entry(operands[0]).or_default().1 += 1;
+            }
+            OP_TYPE_STRUCT if !operands.is_empty() => {
+                members.entry(operands[0]).or_default().0 = operands.len() - 1
             }
             OP_VARIABLE if operands.len() >= 3 => variables.push((operands[1], operands[0], operands[2])),
             OP_TYPE_IMAGE
@@ -80,16 +101,19 @@ pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<(u32, BindingKind)>, Str
             }
             _ => return Err(format!("binding {binding}: a descriptor of a kind Kage does not use")),
         };
-        found.push((binding, kind));
+        let readonly = has(id, DECORATION_NON_WRITABLE)
+            || members.get(&pointee).is_some_and(|&(count, read_only)| count > 0 && read_only == count);
+        let written = matches!(kind, BindingKind::StorageBuffer | BindingKind::StorageImage) && !readonly;
+        found.push(Used { binding, kind, written });
     }
-    found.sort_by_key(|(b, _)| *b);
+    found.sort_by_key(|u| u.binding);
     Ok(found)
 }
 
 /// Checks that every binding `used` by the shader `shader` is declared in `declared` (the
 /// pipeline's list, in binding order) with the same kind.
-pub fn check(shader: &str, declared: &[BindingKind], used: &[(u32, BindingKind)]) -> Result<(), String> {
-    for &(binding, kind) in used {
+pub fn check(shader: &str, declared: &[BindingKind], used: &[Used]) -> Result<(), String> {
+    for &Used { binding, kind, .. } in used {
         match declared.get(binding as usize) {
             Some(&d) if d == kind => {}
             Some(d) => {
@@ -111,21 +135,36 @@ pub fn check(shader: &str, declared: &[BindingKind], used: &[(u32, BindingKind)]
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layouts::spirv;
+    use crate::layouts::{constants, spirv};
     use BindingKind::{SampledImage, StorageBuffer, StorageImage, UniformBuffer};
 
-    fn used(spirv: &[u8]) -> Vec<(u32, BindingKind)> {
+    fn used(spirv: &[u8]) -> Vec<Used> {
         descriptor_bindings(&ash::util::read_spv(&mut std::io::Cursor::new(spirv)).unwrap()).unwrap()
     }
 
-    /// Each kind, read from Kage's own shaders (their GLSL declares these bindings).
+    fn kinds(spirv: &[u8]) -> Vec<(u32, BindingKind, bool)> {
+        used(spirv).iter().map(|u| (u.binding, u.kind, u.written)).collect()
+    }
+
+    /// Each kind, read from Kage's own shaders (their GLSL declares these bindings), and
+    /// whether the shader writes it: only storage buffers and images not declared `readonly`.
     #[test]
     fn the_shaders_bindings_are_read_with_their_kinds() {
-        assert_eq!(used(spirv::BACKGROUND_FRAG), [(0, UniformBuffer), (1, SampledImage)]);
+        assert_eq!(kinds(spirv::BACKGROUND_FRAG), [(0, UniformBuffer, false), (1, SampledImage, false)]);
         assert_eq!(
-            used(spirv::OCCLUSION_BLUR_COMP),
-            [(0, StorageBuffer), (1, SampledImage), (2, StorageBuffer), (3, StorageImage)]
+            kinds(spirv::OCCLUSION_BLUR_COMP),
+            [
+                (0, StorageBuffer, false),
+                (1, SampledImage, false),
+                (2, StorageBuffer, true),
+                (3, StorageImage, true)
+            ]
         );
+        // The transfer shader reads the BVH and the vertices and writes its sums.
+        let prt = used(spirv::PRT_TRANSFER_COMP);
+        let written: Vec<u32> = prt.iter().filter(|u| u.written).map(|u| u.binding).collect();
+        let first = constants::BVH_BINDINGS;
+        assert_eq!(written, [first + 1, first + 2, first + 3]);
     }
 
     #[test]

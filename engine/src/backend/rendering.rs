@@ -43,6 +43,10 @@ impl Context {
         clear: Option<[f32; 4]>,
         depth: Option<Depth>,
     ) {
+        // Render targets count as written, loaded or cleared.
+        for image in color.map(|t| t.image).into_iter().chain(depth.map(|d| d.target().image)) {
+            image.touched(cmd, true);
+        }
         let color_attachment: Vec<vk::RenderingAttachmentInfo> = color
             .iter()
             .map(|c| {
@@ -143,6 +147,9 @@ impl Context {
         first: u32,
         count: u32,
     ) {
+        for buffer in vertices.iter().chain([&indices]) {
+            buffer.touched(cmd, false);
+        }
         let raw: Vec<vk::Buffer> = vertices.iter().map(|b| b.raw).collect();
         let offsets = vec![0; raw.len()];
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
@@ -156,6 +163,9 @@ impl Context {
     /// Binds vertex buffers (binding i = `vertices[i]`, possibly none) and draws `count`
     /// vertices.
     pub fn draw(&self, cmd: Cmd, vertices: &[&super::Buffer], count: u32) {
+        for buffer in vertices {
+            buffer.touched(cmd, false);
+        }
         let raw: Vec<vk::Buffer> = vertices.iter().map(|b| b.raw).collect();
         // SAFETY: recording command buffer inside a rendering scope with a pipeline bound.
         unsafe {

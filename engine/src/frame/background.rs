@@ -1,10 +1,9 @@
 //! The environment seen directly, behind everything: one full-screen triangle that clears the
 //! colour target and looks up the map along each pixel's view ray.
 use super::environment::GpuEnvironment;
-use super::{FrameInputs, COLOR, ENVIRONMENT, FRAME_UNIFORMS};
-use crate::backend::Cmd;
+use super::FrameInputs;
 use crate::backend::{
-    Binding, BindingKind, Buffer, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Topology,
+    Binding, BindingKind, Buffer, Cmd, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Topology,
 };
 use crate::error::Result;
 use crate::frame::COLOR_FORMAT;
@@ -41,7 +40,7 @@ impl Background {
     pub fn pass<'a>(&'a self, inputs: &FrameInputs<'a>) -> Pass<'a> {
         let (ctx, uniforms, env, color) =
             (inputs.ctx, inputs.uniforms, inputs.environment, &inputs.targets.color);
-        Pass::new("background", &[FRAME_UNIFORMS, ENVIRONMENT], &[COLOR], move |cmd| {
+        Pass::new("background", move |cmd| {
             ctx.begin_rendering(cmd, Some(color.into()), Some([0.0; 4]), None);
             self.draw(ctx, cmd, uniforms, env);
             ctx.end_rendering(cmd);

@@ -1,9 +1,8 @@
 //! The scene's geometry on the GPU: one vertex and index buffer per mesh, one transform per
 //! group, the albedo maps, and the vertex layouts the techniques' pipelines read it with.
 use super::albedo_maps::GpuAlbedoMaps;
-use crate::backend::Cmd;
 use crate::backend::{
-    Binding, Buffer, BufferUsage, Context, Format, GraphicsPipeline, VertexAttribute, VertexBuffer,
+    Binding, Buffer, BufferUsage, Cmd, Context, Format, GraphicsPipeline, VertexAttribute, VertexBuffer,
 };
 use crate::error::Result;
 use crate::scene::clusters::{clustered, Cluster};

@@ -18,22 +18,10 @@ pub use gpu_scene::{GpuMesh, GpuScene};
 pub use targets::{Targets, COLOR_FORMAT, DEPTH_FORMAT, MAX_SIZE};
 
 use crate::backend::{Buffer, Context};
-use crate::pass::Resource;
 use crate::scene::Light;
 use environment::GpuEnvironment;
 use glam::Mat4;
 use std::sync::Arc;
-
-/// The colour target (`Targets::color`).
-pub const COLOR: Resource = Resource("color");
-/// The depth target (`Targets::depth`).
-pub const DEPTH: Resource = Resource("depth");
-/// The frame's `FrameUniforms`.
-pub const FRAME_UNIFORMS: Resource = Resource("frame_uniforms");
-/// The environment map's image.
-pub const ENVIRONMENT: Resource = Resource("environment");
-/// The environment's SH coefficients (`sh_projection`).
-pub const ENV_SH: Resource = Resource("env_sh");
 
 /// What every technique may read while recording a frame.
 pub struct FrameInputs<'a> {

@@ -12,22 +12,18 @@
 //! as long on lavapipe; BENCHMARKS.md).
 use super::gpu_scene::MESH_VERTICES;
 use super::shadow_depth::depth_only_pipeline;
-use super::shadow_depth::SHADOW_MAPS;
-use super::{FrameInputs, COLOR, DEPTH, FRAME_UNIFORMS};
-use crate::backend::Cmd;
-use crate::backend::Topology;
+
+use super::FrameInputs;
 use crate::backend::{
-    Binding, BindingKind, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, VertexBuffer,
+    Binding, BindingKind, Cmd, Context, Depth, DepthTest, GraphicsDesc, GraphicsPipeline, Topology,
+    VertexBuffer,
 };
 use crate::error::Result;
 use crate::frame::{GpuMesh, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::{bytes_of, spirv, DrawPush, Pod};
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 use glam::Mat4;
 use std::sync::Arc;
-
-/// What a shadow-map technique's scene pass after a depth prepass reads.
-pub const PREPASS_SCENE_READS: [Resource; 4] = [FRAME_UNIFORMS, SHADOW_MAPS, COLOR, DEPTH];
 
 /// A lit pipeline's bindings: `bindings`, then the mesh's albedo map, which its fragment shader
 /// declares through `albedo_map.glsl` at binding `bindings.len()` and which
@@ -65,7 +61,7 @@ pub fn depth_prepass<'a, P: Pod>(
     push: impl Fn(&GpuMesh, &Mat4) -> P + 'a,
 ) -> Pass<'a> {
     let (ctx, scene, targets, uniforms) = (frame.ctx, frame.scene, frame.targets, frame.uniforms);
-    Pass::new("depth_prepass", &[FRAME_UNIFORMS], &[DEPTH], move |cmd| {
+    Pass::new("depth_prepass", move |cmd| {
         ctx.begin_rendering(cmd, None, None, Some(Depth::Clear((&targets.depth).into())));
         pipeline.bind(cmd, &[Binding::Uniform(uniforms)]);
         draw_meshes(ctx, cmd, scene, pipeline, false, &|m, t| Some(push(m, t)));
@@ -107,13 +103,12 @@ pub fn scene_pipeline_with(
 /// `Equal`, else into a cleared depth target.
 pub fn scene_pass<'a, P: Pod>(
     frame: &FrameInputs<'a>,
-    reads: &'a [Resource],
     pipeline: &'a GraphicsPipeline,
     bindings: Vec<Binding<'a>>,
     push: impl Fn(&GpuMesh, &Mat4) -> P + 'a,
 ) -> Pass<'a> {
     let (ctx, scene, targets) = (frame.ctx, frame.scene, frame.targets);
-    Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
+    Pass::new("scene", move |cmd| {
         let depth = (&targets.depth).into();
         let depth =
             if pipeline.depth() == DepthTest::Equal { Depth::Keep(depth) } else { Depth::Clear(depth) };

@@ -4,13 +4,13 @@
 //! environment map (equirectangular; run when the environment changes, not every frame) and a
 //! light probe's cube map ([`Mapping::Cube`]).
 use super::environment::GpuEnvironment;
-use crate::backend::BufferUsage;
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Image, MemoryLocation, Sampler,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, Image, MemoryLocation,
+    Sampler,
 };
 use crate::error::Result;
 use crate::layouts::{bytes_of, constants, spirv, ShCoeffs, ShProjectPush};
-use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::pass::{FrameExecutor, Pass};
 use crate::scene::EnvMap;
 use crate::sh::ShRgb9;
 use std::sync::Arc;
@@ -49,20 +49,17 @@ impl Mapping {
     }
 }
 
-/// The resource names of one projection in the pass layer.
+/// The debug names of one projection's buffers.
 #[derive(Clone, Copy, Debug)]
 pub struct ProjectionNames {
-    /// The image projected (a pass input).
-    pub source: Resource,
     /// The partial sums (between the two passes).
-    pub partials: Resource,
-    /// The result (the second pass's output) and its buffer's debug name.
-    pub result: Resource,
+    pub partials: &'static str,
+    /// The result (the second pass's output).
+    pub result: &'static str,
 }
 
 /// The environment's projection as the renderer runs it.
-pub const ENVIRONMENT: ProjectionNames =
-    ProjectionNames { source: super::ENVIRONMENT, partials: Resource("sh_partials"), result: super::ENV_SH };
+pub const ENVIRONMENT: ProjectionNames = ProjectionNames { partials: "sh_partials", result: "env_sh" };
 
 pub struct ShProjection {
     project: ComputePipeline,
@@ -72,7 +69,6 @@ pub struct ShProjection {
     pub coefficients: Buffer,
     groups: u32,
     mapping: Mapping,
-    names: ProjectionNames,
 }
 
 impl ShProjection {
@@ -101,7 +97,7 @@ impl ShProjection {
             partials: Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: names.partials.0,
+                    name: names.partials,
                     size: groups as u64 * size_of::<ShCoeffs>() as u64,
                     usage: storage,
                     location: MemoryLocation::GpuOnly,
@@ -110,7 +106,7 @@ impl ShProjection {
             coefficients: Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: names.result.0,
+                    name: names.result,
                     size: size_of::<ShCoeffs>() as u64,
                     // Read per fragment as uniforms: far cheaper than a storage buffer on CPU drivers.
                     usage: storage | BufferUsage::UNIFORM | BufferUsage::TRANSFER_SRC,
@@ -119,7 +115,6 @@ impl ShProjection {
             )?,
             groups,
             mapping,
-            names,
         })
     }
 
@@ -128,41 +123,30 @@ impl ShProjection {
         ShProjection::new(ctx, Mapping::Equirect { width: map.width(), height: map.height() }, ENVIRONMENT)
     }
 
-    /// The two passes; they read `names.source` (`image`, which must match the mapping's size)
-    /// and write `names.result`.
+    /// The two passes; they read `image` (which must match the mapping's size) and write the
+    /// result buffer.
     pub fn passes<'a>(&'a self, image: &'a Image, sampler: &'a Sampler) -> [Pass<'a>; 2] {
         let [width, height] = self.mapping.size();
         let project_push =
             ShProjectPush { size: [width, height, constants::SH_TEXELS_PER_INVOCATION, self.mapping.id()] };
         let reduce_push = ShProjectPush { size: [self.groups, 0, 0, 0] };
-        let names = &self.names;
         [
-            Pass::new(
-                "sh_project",
-                std::slice::from_ref(&names.source),
-                std::slice::from_ref(&names.partials),
-                move |cmd| {
-                    self.project.dispatch(
-                        cmd,
-                        &[Binding::Sampled(image, sampler), Binding::Storage(&self.partials)],
-                        bytes_of(&project_push),
-                        [self.groups, 1, 1],
-                    )
-                },
-            ),
-            Pass::new(
-                "sh_reduce",
-                std::slice::from_ref(&names.partials),
-                std::slice::from_ref(&names.result),
-                move |cmd| {
-                    self.reduce.dispatch(
-                        cmd,
-                        &[Binding::Storage(&self.partials), Binding::Storage(&self.coefficients)],
-                        bytes_of(&reduce_push),
-                        [1, 1, 1],
-                    )
-                },
-            ),
+            Pass::new("sh_project", move |cmd| {
+                self.project.dispatch(
+                    cmd,
+                    &[Binding::Sampled(image, sampler), Binding::Storage(&self.partials)],
+                    bytes_of(&project_push),
+                    [self.groups, 1, 1],
+                )
+            }),
+            Pass::new("sh_reduce", move |cmd| {
+                self.reduce.dispatch(
+                    cmd,
+                    &[Binding::Storage(&self.partials), Binding::Storage(&self.coefficients)],
+                    bytes_of(&reduce_push),
+                    [1, 1, 1],
+                )
+            }),
         ]
     }
 
@@ -185,6 +169,6 @@ pub fn project(ctx: &Arc<Context>, map: &EnvMap) -> Result<ShRgb9> {
     let env = GpuEnvironment::new(ctx, map)?;
     let sh = ShProjection::environment(ctx, map)?;
     let mut executor = FrameExecutor::new(ctx, "sh_projection")?;
-    executor.run(&[ENVIRONMENT.source], sh.passes(&env.image, &env.sampler).into())?;
+    executor.run(sh.passes(&env.image, &env.sampler).into())?;
     sh.read()
 }

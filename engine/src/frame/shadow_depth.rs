@@ -4,19 +4,15 @@
 //! (orthographic maps), the shadowmap technique (perspective maps of local lights) and adaptive
 //! shadow maps (its page pool: one tile per layer).
 use super::gpu_scene::MESH_POSITIONS;
-use crate::backend::Cmd;
 use crate::backend::{
-    Binding, BindingKind, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
-    Sampler, Target,
+    Binding, BindingKind, Cmd, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image,
+    ImageDesc, ImageUsage, Sampler, Target, Topology,
 };
-use crate::backend::{ImageUsage, Topology};
 use crate::error::Result;
 use crate::frame::{GpuMesh, GpuScene, DEPTH_FORMAT};
 use crate::layouts::{bytes_of, spirv, ShadowDepthPush};
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 
-/// The shadow maps of the depth-map techniques (and the adaptive shadow map's atlas).
-pub const SHADOW_MAPS: Resource = Resource("shadow_maps");
 use glam::Mat4;
 use std::sync::Arc;
 
@@ -101,7 +97,7 @@ impl ShadowMaps {
 
     /// The `shadow_maps` pass: layer i from `view_projs[i]`.
     pub fn pass<'a>(&'a self, ctx: &'a Context, scene: &'a GpuScene) -> Pass<'a> {
-        Pass::new("shadow_maps", &[], &[SHADOW_MAPS], move |cmd| {
+        Pass::new("shadow_maps", move |cmd| {
             for (layer, view_proj) in self.view_projs.iter().enumerate() {
                 let whole = scene.meshes.iter().map(|m| (m, 0, m.index_count));
                 self.record(ctx, cmd, scene, layer as u32, view_proj, whole);

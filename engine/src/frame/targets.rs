@@ -1,8 +1,7 @@
 //! The frame's render targets: the colour and depth images every technique draws into, and the
 //! buffer the picture is read back through.
-use crate::backend::Cmd;
 use crate::backend::{
-    Buffer, BufferDesc, BufferUsage, Context, Format, Image, ImageDesc, ImageUsage, MemoryLocation,
+    Buffer, BufferDesc, BufferUsage, Cmd, Context, Format, Image, ImageDesc, ImageUsage, MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::host_memory;

@@ -13,40 +13,31 @@
 //!   reads, submitted and waited for on its fence before `run` returns, so the host may read or
 //!   rewrite any resource afterwards (readbacks, the ASM analysis' counts).
 //!
-//! The declared inputs and outputs are checked before recording: a pass may only read what an
-//! earlier pass of the frame wrote or what the frame imports (persistent resources), which
-//! catches passes recorded in the wrong order.
+//! A pass's reads and writes are the resources its commands use: the backend logs every buffer
+//! and image a recording method touches (bound, drawn from, rendered into, copied) and whether
+//! it may write it (`backend/access.rs`). Before submitting, the executor checks the frame's
+//! order by them: no pass only reads a resource that a later pass of the same frame writes and
+//! no earlier one did, which catches passes recorded in the wrong order. A resource no pass of
+//! the frame writes is persistent (uploaded by the host, or written by an earlier frame).
 mod timings;
 
 pub use timings::{frame_ms, median, TimingRow, TimingTable};
 
-use crate::backend::{Cmd, Context, TimestampPool};
+use crate::backend::{AccessLog, Cmd, Context, TimestampPool, Touch};
 use crate::error::{Error, Result};
 use ash::vk;
+use std::collections::HashMap;
 use std::sync::Arc;
 
-/// A resource passes read and write (a GPU buffer or image), named once as a constant beside
-/// what makes it (`frame::COLOR`, `techniques::tamura::occlusion::OCCLUSION`), so that a
-/// misspelt resource is a compile error; the executor checks a frame's order by them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Resource(pub &'static str);
-
-/// One pass of a frame.
+/// One pass of a frame: its name and the function that records it.
 pub struct Pass<'a> {
     pub name: &'static str,
-    pub inputs: &'a [Resource],
-    pub outputs: &'a [Resource],
-    record: Box<dyn FnOnce(Cmd) + 'a>,
+    record: Box<dyn FnOnce(Cmd<'_>) + 'a>,
 }
 
 impl<'a> Pass<'a> {
-    pub fn new(
-        name: &'static str,
-        inputs: &'a [Resource],
-        outputs: &'a [Resource],
-        record: impl FnOnce(Cmd) + 'a,
-    ) -> Pass<'a> {
-        Pass { name, inputs, outputs, record: Box::new(record) }
+    pub fn new(name: &'static str, record: impl FnOnce(Cmd<'_>) + 'a) -> Pass<'a> {
+        Pass { name, record: Box::new(record) }
     }
 }
 
@@ -108,8 +99,7 @@ impl FrameExecutor {
     }
 
     /// Runs `passes` in order as one submission and returns each pass's GPU time.
-    pub fn run(&mut self, imports: &[Resource], passes: Vec<Pass<'_>>) -> Result<Vec<PassTiming>> {
-        check_data_flow(imports, &passes)?;
+    pub fn run(&mut self, passes: Vec<Pass<'_>>) -> Result<Vec<PassTiming>> {
         let count = 2 * passes.len() as u32;
         let period_ns = self.ctx.info().timestamp_period_ns;
         if period_ns.is_some() && self.timestamps.as_ref().is_none_or(|t| t.capacity() < count) {
@@ -120,13 +110,17 @@ impl FrameExecutor {
             Ok(recorder) => recorder,
             Err(failed) => return Err(failed.error()),
         };
-        let cmd = recorder.cmd();
         let timestamps = self.timestamps.as_ref().filter(|_| period_ns.is_some());
+        // What the executor's own commands touch (none of them a resource) goes here; each
+        // pass's touches go to a log of its own.
+        let frame_log = AccessLog::default();
+        let cmd = recorder.cmd(&frame_log);
         self.ctx.begin(recorder)?;
         if let Some(t) = timestamps {
             t.reset(cmd, count);
         }
         let names: Vec<&'static str> = passes.iter().map(|p| p.name).collect();
+        let mut touches = Vec::with_capacity(passes.len());
         for (i, pass) in passes.into_iter().enumerate() {
             if i > 0 {
                 self.ctx.full_barrier(cmd);
@@ -135,13 +129,20 @@ impl FrameExecutor {
             if let Some(t) = timestamps {
                 t.write(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, 2 * i as u32);
             }
-            (pass.record)(cmd);
+            let log = AccessLog::default();
+            (pass.record)(recorder.cmd(&log));
+            touches.push(log.take());
             if let Some(t) = timestamps {
                 t.write(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * i as u32 + 1);
             }
             self.ctx.end_label(cmd);
         }
         self.ctx.host_read_barrier(cmd);
+        if let Err(e) = check_order(&names, &touches) {
+            // Recorded but never submitted: the buffer is ended, ready to begin again.
+            self.ctx.end(recorder)?;
+            return Err(e);
+        }
         if let Err(e) = self.ctx.submit_and_wait(recorder) {
             // The command buffer may still be pending after a timeout or device loss: never
             // reuse it.
@@ -181,16 +182,24 @@ impl Drop for FrameExecutor {
     }
 }
 
-fn check_data_flow(imports: &[Resource], passes: &[Pass<'_>]) -> Result<()> {
-    let mut available: Vec<Resource> = imports.to_vec();
-    for pass in passes {
-        if let Some(missing) = pass.inputs.iter().find(|i| !available.contains(i)) {
-            return Err(Error::Internal(format!(
-                "pass {} reads {}, which no earlier pass writes and the frame does not import",
-                pass.name, missing.0
-            )));
+/// No pass only reads a resource that a later pass writes and no earlier pass (nor itself)
+/// did: such a pass would see the previous frame's content, a pass recorded out of order.
+fn check_order(names: &[&'static str], touches: &[Vec<Touch>]) -> Result<()> {
+    let mut first_writer: HashMap<u64, usize> = HashMap::new();
+    for (i, pass) in touches.iter().enumerate() {
+        for touch in pass.iter().filter(|t| t.writes) {
+            first_writer.entry(touch.id).or_insert(i);
         }
-        available.extend_from_slice(pass.outputs);
+    }
+    for (i, pass) in touches.iter().enumerate() {
+        for touch in pass.iter().filter(|t| !t.writes) {
+            if let Some(&writer) = first_writer.get(&touch.id).filter(|&&w| w > i) {
+                return Err(Error::Internal(format!(
+                    "pass {} reads {} before pass {} writes it: the passes are recorded out of order",
+                    names[i], touch.name, names[writer]
+                )));
+            }
+        }
     }
     Ok(())
 }
@@ -199,17 +208,26 @@ fn check_data_flow(imports: &[Resource], passes: &[Pass<'_>]) -> Result<()> {
 mod tests {
     use super::*;
 
+    fn touch(id: u64, name: &str, writes: bool) -> Touch {
+        Touch { id, name: name.into(), writes }
+    }
+
     #[test]
-    fn a_pass_reading_what_nothing_wrote_is_an_internal_error() {
-        const A: Resource = Resource("a");
-        const B: Resource = Resource("b");
-        let passes = [Pass::new("first", &[A], &[B], |_| {}), Pass::new("second", &[B], &[], |_| {})];
-        assert!(check_data_flow(&[A], &passes).is_ok());
-        let passes = [Pass::new("second", &[B], &[], |_| {})];
-        let error = check_data_flow(&[A], &passes).unwrap_err();
+    fn a_pass_reading_what_a_later_pass_writes_is_an_internal_error() {
+        let produce = vec![touch(1, "uniforms", false), touch(2, "masks", true)];
+        let consume = vec![touch(2, "masks", false), touch(3, "color", true)];
+        let names = ["produce", "consume"];
+        assert!(check_order(&names, &[produce.clone(), consume.clone()]).is_ok());
+        // Read and written by the same pass, or by no pass of the frame: in order.
+        let persistent = vec![touch(1, "uniforms", false), touch(2, "masks", false), touch(2, "masks", true)];
+        assert!(check_order(&["a", "b"], &[persistent, consume.clone()]).is_ok());
+        let error = check_order(&["consume", "produce"], &[consume, produce]).unwrap_err();
         // Kage's own bug, not the caller's: the C ABI gives it KAGE_RESULT_INTERNAL.
         assert_eq!(error.fault(), crate::error::Fault::Internal);
-        assert!(error.to_string().contains("pass second reads b, which no earlier pass writes"), "{error}");
+        assert!(
+            error.to_string().contains("pass consume reads masks before pass produce writes it"),
+            "{error}"
+        );
     }
 
     /// Lavapipe cannot lose its device on demand, so the answer to the frames after a failure

@@ -7,13 +7,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::{buried, mesh_layout, MeshTransfer, PrtParams, TransferSet, Visibility};
-use crate::backend::MemoryLocation;
-use crate::backend::{Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context};
+use crate::backend::{
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, MemoryLocation,
+};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, PrtTransferPush, PrtVertex};
-use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::pass::{FrameExecutor, Pass};
 use crate::progress::Progress;
-use crate::raycast::BVH;
+
 use crate::raycast::{GpuBvh, SceneBvh};
 use crate::scene::Scene;
 
@@ -166,7 +167,7 @@ impl<'a> Jobs<'a> {
             Binding::Storage(&self.back_hits),
         ]);
         let ctx = self.ctx;
-        let pass = Pass::new("prt_transfer", &[BVH], &[Resource("prt_transfer")], |cmd| {
+        let pass = Pass::new("prt_transfer", |cmd| {
             for first_ray in (first..first + rays).step_by(RAYS_PER_DISPATCH as usize) {
                 // Each dispatch adds to the sums the previous one wrote.
                 if first_ray > first {
@@ -181,7 +182,7 @@ impl<'a> Jobs<'a> {
             }
         });
         let start = Instant::now();
-        self.executor.run(&[BVH], vec![pass])?;
+        self.executor.run(vec![pass])?;
         Ok(start.elapsed().as_secs_f64())
     }
 

@@ -1,14 +1,13 @@
 //! Casts lists of rays on the GPU through bvh.glsl (shaders-glsl/raycast.comp): the test and
 //! benchmark harness of the BVH. Techniques trace their own rays in their own shaders.
 use super::GpuBvh;
-use crate::backend::BufferUsage;
-use crate::backend::{Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, MemoryLocation};
+use crate::backend::{
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, MemoryLocation,
+};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, CastPush, CastRay, CastResult};
-use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::pass::{FrameExecutor, Pass};
 
-/// The hits of a batch of rays.
-pub const RESULTS: Resource = Resource("raycast.results");
 use std::sync::Arc;
 
 /// What to ask of each ray.
@@ -47,7 +46,7 @@ impl GpuRays {
             results: Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: RESULTS.0,
+                    name: "raycast.results",
                     size: rays.len() as u64 * size_of::<CastResult>() as u64,
                     usage: BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
                     location: MemoryLocation::GpuOnly,
@@ -126,23 +125,20 @@ impl RayCaster {
             Query::PacketObjectSpace { .. } => &self.packet_pipeline,
             _ => &self.pipeline,
         };
-        let timings = self.executor.run(
-            &[],
-            vec![Pass::new("raycast", &[], &[RESULTS], move |cmd| {
-                let mut bindings: Vec<Binding> = bvh.bindings().into();
-                bindings.extend([Binding::Storage(&rays.rays), Binding::Storage(&rays.results)]);
-                for first in (0..rays.count).step_by(per_dispatch as usize) {
-                    let push = CastPush { params: [rays.count, mode, instance, first] };
-                    let n = (rays.count - first).min(per_dispatch);
-                    pipeline.dispatch(
-                        cmd,
-                        &bindings,
-                        bytes_of(&push),
-                        [n.div_ceil(constants::RAYCAST_GROUP), 1, 1],
-                    );
-                }
-            })],
-        )?;
+        let timings = self.executor.run(vec![Pass::new("raycast", move |cmd| {
+            let mut bindings: Vec<Binding> = bvh.bindings().into();
+            bindings.extend([Binding::Storage(&rays.rays), Binding::Storage(&rays.results)]);
+            for first in (0..rays.count).step_by(per_dispatch as usize) {
+                let push = CastPush { params: [rays.count, mode, instance, first] };
+                let n = (rays.count - first).min(per_dispatch);
+                pipeline.dispatch(
+                    cmd,
+                    &bindings,
+                    bytes_of(&push),
+                    [n.div_ceil(constants::RAYCAST_GROUP), 1, 1],
+                );
+            }
+        })])?;
         Ok(timings[0].gpu_ms)
     }
 }

@@ -3,13 +3,10 @@ use super::SceneBvh;
 use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of_slice, constants, Pod};
-use crate::pass::Resource;
+
 use std::sync::Arc;
 
 const BINDINGS: usize = constants::BVH_BINDINGS as usize;
-
-/// The BVH's storage buffers, read by the passes that trace rays.
-pub const BVH: Resource = Resource("bvh");
 
 pub struct GpuBvh {
     blas_pairs: Buffer,

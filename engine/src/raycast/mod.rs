@@ -41,8 +41,8 @@ mod triangle;
 
 pub use aabb::Aabb;
 pub use brute_force::{closest_hit_brute_force, edge_distance, occluded_object_space_brute_force};
-pub use caster::{GpuRays, Query, RayCaster, RESULTS};
-pub use gpu::{GpuBvh, BVH};
+pub use caster::{GpuRays, Query, RayCaster};
+pub use gpu::GpuBvh;
 pub use scene_bvh::{SceneBvh, TriangleOrigin};
 pub use traverse::Hit;
 pub use triangle::{offset_ray_origin, WatertightRay};

@@ -15,12 +15,12 @@
 //! Input file: `{"points": [{"position": [x, y, z], "normal": [x, y, z]}, ...]}` (normals are
 //! normalised; unknown fields are errors). Output: `{"irradiance": [[r, g, b], ...], "spp": N,
 //! "standard_error": [[r, g, b], ...]}`, in the input's order.
-use super::lighting::{ReferenceLighting, IMPORTS};
+use super::lighting::ReferenceLighting;
 use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{BindingKind, Buffer, BufferUsage, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, IrradiancePoint, IrradiancePush};
-use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::pass::{FrameExecutor, Pass};
 use crate::scene::Scene;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
@@ -290,11 +290,11 @@ impl IrradianceReference {
             };
             let bindings =
                 lighting.bindings(&[accum, points, &lighting.lights, radiance, &lighting.triangle_vertices]);
-            Pass::new("reference_irradiance", &IMPORTS, &[Resource("irradiance_accum")], move |cmd| {
+            Pass::new("reference_irradiance", move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
             })
         });
-        self.executor.run(&IMPORTS, passes)?;
+        self.executor.run(passes)?;
         self.samples = after;
         Ok(())
     }

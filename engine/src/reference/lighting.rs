@@ -6,15 +6,12 @@ use super::render::reference_light;
 use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context};
 use crate::error::Result;
 use crate::frame::environment::GpuEnvironment;
-use crate::frame::ENVIRONMENT;
+
 use crate::layouts::{bytes_of_slice, ReferenceLight};
-use crate::pass::Resource;
-use crate::raycast::{GpuBvh, SceneBvh, BVH};
+
+use crate::raycast::{GpuBvh, SceneBvh};
 use crate::scene::Scene;
 use std::sync::Arc;
-
-/// Resources the passes import: written before the first batch, read by every batch.
-pub const IMPORTS: [Resource; 3] = [BVH, ENVIRONMENT, Resource("env_distribution")];
 
 pub struct ReferenceLighting {
     bvh: GpuBvh,

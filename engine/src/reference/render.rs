@@ -4,7 +4,7 @@
 //! Same camera and pixel grid as the renderer: the camera's view and
 //! projection matrices and one primary ray through each pixel centre ((i + ½) / width, row 0 at
 //! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
-use super::lighting::{ReferenceLighting, IMPORTS};
+use super::lighting::ReferenceLighting;
 use super::metrics::EdgeTies;
 use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{BindingKind, Buffer, ComputePipeline, Context};
@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::frame::MAX_SIZE;
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, constants, spirv, ReferenceLight, ReferencePush};
-use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::pass::{FrameExecutor, Pass};
 use crate::scene::{Camera, Light, Scene};
 use std::sync::Arc;
 
@@ -96,11 +96,11 @@ impl ReferenceRenderer {
             let push =
                 ReferencePush { inv_view_proj, camera_pos, frame: [width, height, first, count], params };
             let bindings = lighting.bindings(&[accum, lights]);
-            Pass::new("reference_render", &IMPORTS, &[Resource("reference_accum")], move |cmd| {
+            Pass::new("reference_render", move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
             })
         });
-        self.executor.run(&IMPORTS, passes)?;
+        self.executor.run(passes)?;
         self.samples = after;
         Ok(())
     }

@@ -11,17 +11,12 @@ pub mod unshadowed;
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, FrameState};
-use crate::pass::{Pass, PassTiming, Resource};
+use crate::pass::{Pass, PassTiming};
 
 /// A lighting technique: host-side updates, then the passes that draw the scene over the
 /// background (the colour target is cleared and holds the environment when they start).
 pub trait Technique {
     fn update(&mut self, state: &FrameState) -> Result<()>;
-    /// Resources the technique keeps from frame to frame, which its passes may read without a
-    /// pass of the same frame writing them.
-    fn persistent(&self) -> &'static [Resource] {
-        &[]
-    }
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>>;
     /// Passes submitted and waited for before the frame's own, whose results the host reads in
     /// [`Technique::analysed`] before [`Technique::passes`] records the frame: the adaptive

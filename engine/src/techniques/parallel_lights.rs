@@ -20,17 +20,15 @@
 //! `GraphicsDesc` free of a setting only this baseline would use. A small constant depth bias
 //! covers curved surfaces, where the texel's depth varies inside the texel.
 use super::Technique;
-use crate::backend::BufferUsage;
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Context, DepthTest, GraphicsPipeline,
+    MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::env_rotation;
 use crate::frame::bounds::{group_bounds, scene_sphere, GroupBounds};
 use crate::frame::regions::Regions;
-use crate::frame::scene_pass::{
-    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
-};
+use crate::frame::scene_pass::{depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline};
 use crate::frame::shadow_depth::ShadowMaps;
 use crate::frame::{FrameInputs, FrameState, GpuMesh};
 use crate::layouts::{bytes_of_slice, constants, spirv, ParallelDrawPush, ParallelLight};
@@ -170,7 +168,7 @@ impl Technique for ParallelLights {
         };
         // Its fragments test q shadow maps each: a depth prepass shades each pixel once.
         let prepass = depth_prepass(inputs, &self.prepass_pipeline, push);
-        let scene_pass = scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, push);
+        let scene_pass = scene_pass(inputs, &self.scene_pipeline, bindings, push);
         vec![shadow_maps, prepass, scene_pass]
     }
 }

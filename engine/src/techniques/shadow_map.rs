@@ -16,16 +16,14 @@
 //! a depth of tan θ per unit of width inside a texel, so the bias grows with tan θ (capped:
 //! grazing surfaces would otherwise detach their shadows entirely).
 use super::{Technique, TechniqueStats};
-use crate::backend::BufferUsage;
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsPipeline, MemoryLocation,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Context, DepthTest, GraphicsPipeline,
+    MemoryLocation,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::scene_sphere;
 use crate::frame::bounds::{group_bounds, GroupBounds};
-use crate::frame::scene_pass::{
-    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
-};
+use crate::frame::scene_pass::{depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline};
 use crate::frame::shadow_depth::ShadowMaps;
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuMesh, MAX_SIZE};
@@ -181,7 +179,7 @@ impl Technique for ShadowMap {
             bias: DEPTH_BIAS,
         };
         let prepass = depth_prepass(inputs, &self.prepass_pipeline, push);
-        let scene_pass = scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, push);
+        let scene_pass = scene_pass(inputs, &self.scene_pipeline, bindings, push);
         vec![shadow_maps, prepass, scene_pass]
     }
 

@@ -1,10 +1,9 @@
 //! Diffuse surfaces lit by the environment's SH irradiance, no shadows: L = albedo / π · E(n).
 use super::Technique;
-use crate::backend::Cmd;
-use crate::backend::{Binding, Buffer, Context, Depth, GraphicsPipeline};
+use crate::backend::{Binding, Buffer, Cmd, Context, Depth, GraphicsPipeline};
 use crate::error::Result;
 use crate::frame::scene_pass::{bind_lit, draw_lit_meshes, lighting_pipeline};
-use crate::frame::{FrameInputs, FrameState, COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
+use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuMesh, GpuScene};
 use crate::layouts::spirv;
 use crate::pass::Pass;
@@ -28,7 +27,7 @@ impl Technique for Unshadowed {
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, env_sh, scene, targets) =
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
-        vec![Pass::new("scene", &[FRAME_UNIFORMS, ENV_SH, COLOR], &[COLOR, DEPTH], move |cmd| {
+        vec![Pass::new("scene", move |cmd| {
             ctx.begin_rendering(
                 cmd,
                 Some((&targets.color).into()),

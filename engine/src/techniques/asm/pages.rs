@@ -9,12 +9,10 @@
 //! The polygon-ID test keeps a second atlas and scratch, of IDs, laid out as the depth ones.
 use super::pool::{TilePages, TILE_PAGES};
 use super::tile::TileKey;
-use crate::backend::Cmd;
 use crate::backend::{
-    Binding, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
-    Target,
+    Binding, Cmd, Context, Depth, DepthTest, Edge, Format, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
+    ImageUsage, Sampler, Target, Topology,
 };
-use crate::backend::{Format, ImageUsage, Topology};
 use crate::error::{Error, Result};
 use crate::frame::gpu_scene::MESH_POSITIONS;
 use crate::frame::shadow_depth::ShadowMaps;

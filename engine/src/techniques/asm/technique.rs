@@ -29,23 +29,20 @@ use super::pages::{PageStore, TileWrite};
 use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{Insert, PageOp, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES, TILE_PAGES};
 use super::tile::TileKey;
-use crate::backend::BufferUsage;
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, DepthTest, Edge, GraphicsPipeline,
-    MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, DepthTest, Edge,
+    GraphicsPipeline, MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::scene_sphere;
 use crate::frame::bounds::{box_corners, group_bounds, GroupBounds};
-use crate::frame::scene_pass::{
-    depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline, PREPASS_SCENE_READS,
-};
-use crate::frame::shadow_depth::SHADOW_MAPS;
+use crate::frame::scene_pass::{depth_prepass, depth_prepass_pipeline, scene_pass, scene_pipeline};
+
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuMesh, GpuScene};
-use crate::frame::{DEPTH, FRAME_UNIFORMS};
+
 use crate::layouts::{bytes_of, constants, spirv, AsmAnalysisPush, LocalDrawPush, ShadowLight};
-use crate::pass::{FrameExecutor, Pass, PassTiming, Resource};
+use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::scene::clusters::{runs, Cluster};
 use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
@@ -385,12 +382,12 @@ impl Asm {
             let passes = renders
                 .iter()
                 .map(|t| {
-                    Pass::new("asm_calibration", &[], &[Resource("asm_calibration")], move |cmd| {
+                    Pass::new("asm_calibration", move |cmd| {
                         self.pages.record(ctx, cmd, gpu, std::slice::from_ref(t))
                     })
                 })
                 .collect();
-            let timings = executor.run(&[], passes)?;
+            let timings = executor.run(passes)?;
             if round == 1 {
                 for (t, timing) in renders.iter().zip(timings) {
                     samples.push((draw_triangles(&t.draws), timing.gpu_ms.unwrap_or(0.0)));
@@ -589,40 +586,35 @@ impl Technique for Asm {
 
     fn analysis_passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene, targets, uniforms) = (inputs.ctx, inputs.scene, inputs.targets, inputs.uniforms);
-        let refresh = Pass::new("asm_refresh", &[], &[SHADOW_MAPS], move |cmd| {
+        let refresh = Pass::new("asm_refresh", move |cmd| {
             self.pages.record(ctx, cmd, scene, &self.refresh);
         });
         // The eye view the analysis reads is the lighting pass' depth prepass.
         let eye_depth = depth_prepass(inputs, &self.prepass_pipeline, self.draw_push());
         let (width, height) = (targets.depth.width, targets.depth.height);
-        let analysis = Pass::new(
-            "asm_analysis",
-            &[FRAME_UNIFORMS, SHADOW_MAPS, DEPTH],
-            &[Resource("asm_requests")],
-            move |cmd| {
-                self.requests.record_zero(cmd);
-                ctx.full_barrier(cmd);
-                let push = AsmAnalysisPush {
-                    size: [width, height, self.pool.max_tiles(), self.edge_capacity],
-                    phase: [(self.frame % 4) as u32, 0, 0, 0],
-                    bias: DEPTH_BIAS,
-                };
-                let group = constants::ASM_ANALYSIS_GROUP;
-                self.analysis.dispatch(
-                    cmd,
-                    &[
-                        Binding::Uniform(uniforms),
-                        Binding::Uniform(&self.records),
-                        self.pages.depth_binding(),
-                        Binding::Storage(&self.table),
-                        Binding::Sampled(&targets.depth, &self.nearest),
-                        Binding::Storage(&self.requests),
-                    ],
-                    bytes_of(&push),
-                    [width.div_ceil(2 * group), height.div_ceil(2 * group), 1],
-                );
-            },
-        );
+        let analysis = Pass::new("asm_analysis", move |cmd| {
+            self.requests.record_zero(cmd);
+            ctx.full_barrier(cmd);
+            let push = AsmAnalysisPush {
+                size: [width, height, self.pool.max_tiles(), self.edge_capacity],
+                phase: [(self.frame % 4) as u32, 0, 0, 0],
+                bias: DEPTH_BIAS,
+            };
+            let group = constants::ASM_ANALYSIS_GROUP;
+            self.analysis.dispatch(
+                cmd,
+                &[
+                    Binding::Uniform(uniforms),
+                    Binding::Uniform(&self.records),
+                    self.pages.depth_binding(),
+                    Binding::Storage(&self.table),
+                    Binding::Sampled(&targets.depth, &self.nearest),
+                    Binding::Storage(&self.requests),
+                ],
+                bytes_of(&push),
+                [width.div_ceil(2 * group), height.div_ceil(2 * group), 1],
+            );
+        });
         vec![refresh, eye_depth, analysis]
     }
 
@@ -678,7 +670,7 @@ impl Technique for Asm {
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene) = (inputs.ctx, inputs.scene);
-        let tiles = Pass::new("asm_tiles", &[], &[SHADOW_MAPS], move |cmd| {
+        let tiles = Pass::new("asm_tiles", move |cmd| {
             self.pages.record(ctx, cmd, scene, &self.render);
         });
         let mut bindings = vec![
@@ -689,8 +681,7 @@ impl Technique for Asm {
             Binding::Storage(&self.used),
         ];
         bindings.extend(self.pages.id_binding());
-        let lighting =
-            scene_pass(inputs, &PREPASS_SCENE_READS, &self.scene_pipeline, bindings, self.draw_push());
+        let lighting = scene_pass(inputs, &self.scene_pipeline, bindings, self.draw_push());
         vec![tiles, lighting]
     }
 

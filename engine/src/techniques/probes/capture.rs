@@ -24,28 +24,21 @@
 use super::dering::Dering;
 use super::set::ProbeGroups;
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, Context, Depth, DepthTest, Edge, GraphicsPipeline, Image,
-    ImageDesc, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Context, Depth, DepthTest, Edge, Format,
+    GraphicsPipeline, Image, ImageDesc, ImageUsage, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
 };
-use crate::backend::{BufferUsage, Format, ImageUsage};
 use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
 use crate::frame::gpu_scene::MESH_POSITIONS_UVS;
 use crate::frame::scene_pass::{bind_lit, scene_pipeline_with};
 use crate::frame::sh_projection::{Mapping, ProjectionNames, ShProjection};
-use crate::frame::ENVIRONMENT;
+
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::ReferenceLight;
 use crate::layouts::{bytes_of, spirv, DrawPush, FrameUniforms};
-use crate::pass::{FrameExecutor, Pass, Resource};
+use crate::pass::{FrameExecutor, Pass};
 
-/// The cube faces' view matrices.
-const FACES: Resource = Resource("probe_faces");
-/// The static surfaces' radiance per vertex.
-const RADIANCE: Resource = Resource("probe_radiance");
-/// The captured cube map.
-const CUBE: Resource = Resource("probe_cube");
 use crate::raycast::SceneBvh;
 use crate::reference::{irradiance::check_bounces, surface_radiance};
 use crate::scene::{Camera, Scene};
@@ -170,12 +163,7 @@ const RADIANCE_ATTRIBUTES: [VertexAttribute; 1] =
 const RADIANCE_VERTICES: VertexBuffer<'static> =
     VertexBuffer { stride: 16, attributes: &RADIANCE_ATTRIBUTES };
 
-const PROBE_CUBE: ProjectionNames =
-    ProjectionNames { source: CUBE, partials: Resource("probe_sh_partials"), result: Resource("probe_sh") };
-/// What every capture reads without writing it: the faces' cameras, the environment and the
-/// walls' radiance.
-const IMPORTS: [Resource; 3] = [FACES, ENVIRONMENT, RADIANCE];
-
+const PROBE_CUBE: ProjectionNames = ProjectionNames { partials: "probe_sh_partials", result: "probe_sh" };
 /// Captures probes of one scene, one after another, reusing its cube map and pipelines.
 pub struct ProbeCapture {
     ctx: Arc<Context>,
@@ -236,11 +224,7 @@ impl ProbeCapture {
         Ok(ProbeCapture {
             ctx: ctx.clone(),
             settings,
-            cube: image(
-                PROBE_CUBE.source.0,
-                COLOR_FORMAT,
-                ImageUsage::COLOR_ATTACHMENT | ImageUsage::SAMPLED,
-            )?,
+            cube: image("probe_cube", COLOR_FORMAT, ImageUsage::COLOR_ATTACHMENT | ImageUsage::SAMPLED)?,
             depth: image("probe_depth", DEPTH_FORMAT, ImageUsage::DEPTH_ATTACHMENT)?,
             // The projection reads texels with texelFetch: the filter never applies.
             sampler: Sampler::new(ctx, "probe_cube.sampler", false, Edge::Clamp, Edge::Clamp)?,
@@ -296,7 +280,7 @@ impl ProbeCapture {
         let (background, surfaces, env, radiance) =
             (&self.background, &self.surfaces, &self.env, &self.radiance);
         let mut passes = vec![
-            Pass::new("probe_background", &[FACES, ENVIRONMENT], &[CUBE], move |cmd| {
+            Pass::new("probe_background", move |cmd| {
                 ctx.begin_rendering(cmd, Some(cube.into()), Some([0.0; 4]), None);
                 for (f, uniforms) in faces.iter().enumerate() {
                     ctx.restrict_to_square(cmd, face_origin(f), side);
@@ -304,35 +288,29 @@ impl ProbeCapture {
                 }
                 ctx.end_rendering(cmd);
             }),
-            Pass::new(
-                "probe_surfaces",
-                &[FACES, RADIANCE, CUBE],
-                &[CUBE, Resource("probe_depth")],
-                move |cmd| {
-                    ctx.begin_rendering(cmd, Some(cube.into()), None, Some(Depth::Clear(depth.into())));
-                    for (f, uniforms) in faces.iter().enumerate() {
-                        ctx.restrict_to_square(cmd, face_origin(f), side);
-                        bind_lit(cmd, surfaces, scene, &[Binding::Uniform(uniforms)]);
-                        for mesh in scene.meshes.iter().filter(|m| is_static(m.group)) {
-                            let Some(Some(r)) = radiance.get(mesh.group).and_then(|g| g.get(mesh.mesh))
-                            else {
-                                continue;
-                            };
-                            let push = DrawPush {
-                                model: scene.transforms[mesh.group].to_cols_array_2d(),
-                                albedo: [0.0; 4],
-                            };
-                            scene.bind_albedo_map(cmd, surfaces, mesh);
-                            surfaces.push(cmd, bytes_of(&push));
-                            ctx.draw_indexed(cmd, &[&mesh.vertices, r], &mesh.indices, mesh.index_count);
-                        }
+            Pass::new("probe_surfaces", move |cmd| {
+                ctx.begin_rendering(cmd, Some(cube.into()), None, Some(Depth::Clear(depth.into())));
+                for (f, uniforms) in faces.iter().enumerate() {
+                    ctx.restrict_to_square(cmd, face_origin(f), side);
+                    bind_lit(cmd, surfaces, scene, &[Binding::Uniform(uniforms)]);
+                    for mesh in scene.meshes.iter().filter(|m| is_static(m.group)) {
+                        let Some(Some(r)) = radiance.get(mesh.group).and_then(|g| g.get(mesh.mesh)) else {
+                            continue;
+                        };
+                        let push = DrawPush {
+                            model: scene.transforms[mesh.group].to_cols_array_2d(),
+                            albedo: [0.0; 4],
+                        };
+                        scene.bind_albedo_map(cmd, surfaces, mesh);
+                        surfaces.push(cmd, bytes_of(&push));
+                        ctx.draw_indexed(cmd, &[&mesh.vertices, r], &mesh.indices, mesh.index_count);
                     }
-                    ctx.end_rendering(cmd);
-                },
-            ),
+                }
+                ctx.end_rendering(cmd);
+            }),
         ];
         passes.extend(self.projection.passes(&self.cube, &self.sampler));
-        self.executor.run(&IMPORTS, passes)?;
+        self.executor.run(passes)?;
         let mut sh = self.projection.read()?;
         for light in &self.lights {
             self.add_light(&mut sh, light, position);

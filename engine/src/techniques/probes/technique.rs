@@ -19,14 +19,14 @@ use crate::error::{Error, Result};
 use crate::frame::scene_pass::{bind_lit, draw_lit_meshes, lighting_pipeline};
 use crate::frame::GpuScene;
 use crate::frame::{FrameInputs, FrameState};
-use crate::frame::{COLOR, DEPTH, ENV_SH, FRAME_UNIFORMS};
+
 use crate::layouts::{bytes_of, spirv, ProbeLight};
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 use crate::progress::Progress;
 use crate::prt::TransferSet;
 use crate::scene::Scene;
 use crate::techniques::sloan;
-use crate::techniques::sloan::self_shadow::SELF_SHADOW;
+
 use crate::techniques::tamura::technique::PrtTechnique;
 use crate::techniques::unshadowed::Unshadowed;
 use crate::techniques::{Technique, TechniqueStats};
@@ -138,21 +138,14 @@ impl Technique for ProbeTechnique {
         Ok(())
     }
 
-    fn persistent(&self) -> &'static [Resource] {
-        match &self.statics {
-            Statics::Unshadowed(_) => &[],
-            Statics::Sloan(prt) => prt.persistent(),
-        }
-    }
-
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, env_sh, scene, targets) =
             (inputs.ctx, inputs.uniforms, inputs.env_sh, inputs.scene, inputs.targets);
-        let (mut passes, reads): (Vec<Pass>, &'static [Resource]) = match &self.statics {
-            Statics::Unshadowed(_) => (Vec::new(), &[FRAME_UNIFORMS, ENV_SH, COLOR]),
-            Statics::Sloan(prt) => (prt.prepasses(ctx, scene), &[FRAME_UNIFORMS, SELF_SHADOW, COLOR]),
+        let mut passes = match &self.statics {
+            Statics::Unshadowed(_) => Vec::new(),
+            Statics::Sloan(prt) => prt.prepasses(ctx, scene),
         };
-        passes.push(Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
+        passes.push(Pass::new("scene", move |cmd| {
             ctx.begin_rendering(
                 cmd,
                 Some((&targets.color).into()),

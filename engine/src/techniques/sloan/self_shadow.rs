@@ -2,18 +2,15 @@
 //! as points carrying their transfer vectors. It reruns only for groups whose orientation
 //! relative to the light changed since the last frame; other texels keep their values.
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, Context, DepthTest, GraphicsDesc, GraphicsPipeline, Image,
-    ImageDesc, MemoryLocation, VertexAttribute, VertexBuffer,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Context, DepthTest, Format, GraphicsDesc,
+    GraphicsPipeline, Image, ImageDesc, ImageUsage, MemoryLocation, Topology, VertexAttribute, VertexBuffer,
 };
-use crate::backend::{BufferUsage, Format, ImageUsage, Topology};
 use crate::error::{Error, Result};
 use crate::frame::bounds::rotation_of;
 use crate::frame::GpuScene;
 use crate::layouts::{bytes_of, constants, spirv, GroupLight, SelfShadowPush};
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 
-/// The self-shadowed light L_s, one texel per vertex.
-pub const SELF_SHADOW: Resource = Resource("self_shadow");
 use crate::prt::TransferSet;
 use crate::sh::rotation;
 use glam::{Mat3, Mat4};
@@ -180,7 +177,7 @@ impl SelfShadow {
         }
         // Every group at once (first frame, a turned light): clear, so no texel is undefined.
         let clear = self.dirty.iter().all(|&d| d).then_some([0.0; 4]);
-        Some(Pass::new("self_shadow", &[], &[SELF_SHADOW], move |cmd| {
+        Some(Pass::new("self_shadow", move |cmd| {
             ctx.begin_rendering(cmd, Some((&self.texture).into()), clear, None);
             self.pipeline.bind(cmd, &[Binding::Storage(&self.lights)]);
             for (i, mesh) in scene.meshes.iter().enumerate().filter(|(_, m)| self.dirty[m.group]) {

@@ -11,10 +11,8 @@ use crate::frame::bounds::{rotation_of, GroupBounds};
 use crate::frame::shadow_depth::ShadowMaps;
 use crate::frame::GpuScene;
 use crate::layouts::{self, bytes_of, constants, DominantLights, DominantMap};
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 
-/// The groups' depth maps along the dominant lights.
-pub const DOMINANT_MAPS: Resource = Resource("dominant_maps");
 use glam::{Mat3, Mat4, Vec3};
 use std::sync::Arc;
 
@@ -163,7 +161,7 @@ impl DominantMaps {
         if !self.stale.iter().any(|&s| s) {
             return None;
         }
-        Some(Pass::new("dominant_maps", &[], &[DOMINANT_MAPS], move |cmd| {
+        Some(Pass::new("dominant_maps", move |cmd| {
             let groups: Vec<usize> = (0..self.slots.len()).filter(|&g| self.slots[g].is_some()).collect();
             for (m, view_proj) in self.maps.view_projs.iter().enumerate().filter(|&(m, _)| self.stale[m]) {
                 let g = groups[m % groups.len()];

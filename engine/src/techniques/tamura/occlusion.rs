@@ -24,10 +24,10 @@ use super::dominant::DominantLight;
 use super::sheet::Sheet;
 use super::technique::{OcclusionSettings, Penumbra};
 use crate::backend::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Context, Depth, DepthTest, Edge, GraphicsDesc,
-    GraphicsPipeline, Image, ImageDesc, MemoryLocation, Sampler, Target,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Cmd, ComputePipeline, Context, Depth, DepthTest,
+    Edge, Format, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, ImageUsage, MemoryLocation, Sampler,
+    Target, Topology,
 };
-use crate::backend::{BufferUsage, Format, ImageUsage, Topology};
 use crate::error::Result;
 use crate::frame::bounds::{box_corners, rotation_of, GroupBounds};
 use crate::frame::gpu_scene::MESH_POSITIONS;
@@ -36,15 +36,9 @@ use crate::frame::{GpuScene, DEPTH_FORMAT};
 use crate::layouts::{
     bytes_of, bytes_of_slice, constants, spirv, BlurPush, MaskPush, OcclusionLayer, RegionBasis,
 };
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 use crate::scene::clusters::{runs, Cluster};
 
-/// The occluder masks before filtering.
-pub const MASKS: Resource = Resource("occlusion_masks");
-/// The masks after the horizontal filter pass.
-pub const HALF_FILTERED: Resource = Resource("occlusion_half");
-/// The filtered masks V_o the scene pass reads.
-pub const OCCLUSION: Resource = Resource("occlusion");
 use crate::sh;
 use glam::{Mat3, Mat4, Vec3};
 use std::sync::Arc;
@@ -499,7 +493,7 @@ impl Occlusion {
         }
         let count = self.in_use.len() as u32;
         let groups = [self.resolution.div_ceil(constants::BLUR_GROUP), count, 1];
-        let blur = move |cmd, pipeline: &ComputePipeline| {
+        let blur = move |cmd: Cmd<'_>, pipeline: &ComputePipeline| {
             let push = BlurPush { params: [0, self.resolution, count, 0] };
             pipeline.dispatch(
                 cmd,
@@ -513,7 +507,7 @@ impl Occlusion {
                 groups,
             );
         };
-        let draw = move |cmd, pipeline: &GraphicsPipeline, l: usize, group: usize, role: u32| {
+        let draw = move |cmd: Cmd<'_>, pipeline: &GraphicsPipeline, l: usize, group: usize, role: u32| {
             let layer = &self.in_use[l];
             let bias = CONTACT_BIAS_TEXELS / (layer.centre[3] * self.resolution as f32);
             pipeline.bind(cmd, &[Binding::Storage(&self.layers)]);
@@ -537,7 +531,7 @@ impl Occlusion {
             }
         };
         vec![
-            Pass::new("occluder_masks", &[], &[MASKS], move |cmd| {
+            Pass::new("occluder_masks", move |cmd| {
                 for (l, (layer, &receiver)) in self.in_use.iter().zip(&self.receivers).enumerate() {
                     let target = Target { image: &self.mask, layer: l as u32 };
                     let depth = Depth::Clear(Target { image: &self.mask_depth, layer: l as u32 });
@@ -547,8 +541,8 @@ impl Occlusion {
                     ctx.end_rendering(cmd);
                 }
             }),
-            Pass::new("blur_horizontal", &[MASKS], &[HALF_FILTERED], move |cmd| blur(cmd, &self.blur[0])),
-            Pass::new("blur_vertical", &[HALF_FILTERED], &[OCCLUSION], move |cmd| blur(cmd, &self.blur[1])),
+            Pass::new("blur_horizontal", move |cmd| blur(cmd, &self.blur[0])),
+            Pass::new("blur_vertical", move |cmd| blur(cmd, &self.blur[1])),
         ]
     }
 }

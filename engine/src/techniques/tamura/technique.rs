@@ -1,17 +1,15 @@
 //! The PRT scene technique: self-shadowed radiance per vertex (Sloan et al.), minus, with
 //! regions, the light other groups block (Tamura et al. eq. (15)).
 use super::dominant;
-use super::dominant_maps::DOMINANT_MAPS;
+
 use super::dominant_maps::{self, DominantMaps};
-use super::occlusion::OCCLUSION;
+
 use super::occlusion::{Occlusion, RegionSize};
 use super::sheet::Sheet;
-use crate::backend::Cmd;
 use crate::backend::{
-    Binding, BindingKind, Buffer, Context, Depth, DepthTest, Edge, GraphicsDesc, GraphicsPipeline, Sampler,
-    VertexBuffer,
+    Binding, BindingKind, Buffer, BufferUsage, Cmd, Context, Depth, DepthTest, Edge, GraphicsDesc,
+    GraphicsPipeline, Sampler, Topology, VertexBuffer,
 };
-use crate::backend::{BufferUsage, Topology};
 use crate::error::{Error, Result};
 use crate::frame::bounds::{env_rotation, group_bounds};
 use crate::frame::environment::GpuEnvironment;
@@ -21,12 +19,12 @@ use crate::frame::regions::Regions;
 use crate::frame::scene_pass::{bind_lit, depth_prepass, depth_prepass_pipeline, lit_bindings};
 use crate::frame::{FrameInputs, FrameState};
 use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
-use crate::frame::{COLOR, DEPTH, FRAME_UNIFORMS};
+
 use crate::layouts::{bytes_of, constants, spirv, PrtDrawPush, ShCoeffs};
-use crate::pass::{Pass, Resource};
+use crate::pass::Pass;
 use crate::prt::TransferSet;
 use crate::scene::Scene;
-use crate::techniques::sloan::self_shadow::SELF_SHADOW;
+
 use crate::techniques::sloan::self_shadow::{transfer_vertex_buffer, SelfShadow, TRANSFER_STRIDE};
 use crate::techniques::{Technique, TechniqueStats};
 use glam::Mat4;
@@ -258,24 +256,14 @@ impl Technique for PrtTechnique {
         self.occlusion.update(state.transforms, env)
     }
 
-    fn persistent(&self) -> &'static [Resource] {
-        &[SELF_SHADOW, DOMINANT_MAPS]
-    }
-
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, uniforms, scene, targets) = (inputs.ctx, inputs.uniforms, inputs.scene, inputs.targets);
         let mut passes = self.prepasses(ctx, scene);
-        // What the scene pass reads: the filtered layers where an earlier pass wrote them.
-        let reads: &'static [Resource] = if passes.iter().any(|p| p.outputs.contains(&OCCLUSION)) {
-            &[FRAME_UNIFORMS, SELF_SHADOW, OCCLUSION, DOMINANT_MAPS, COLOR, DEPTH]
-        } else {
-            &[FRAME_UNIFORMS, SELF_SHADOW, DOMINANT_MAPS, COLOR, DEPTH]
-        };
         passes.push(depth_prepass(inputs, &self.prepass_pipeline, move |_, model: &Mat4| PrtDrawPush {
             model: model.to_cols_array_2d(),
             ..Default::default()
         }));
-        passes.push(Pass::new("scene", reads, &[COLOR, DEPTH], move |cmd| {
+        passes.push(Pass::new("scene", move |cmd| {
             ctx.begin_rendering(
                 cmd,
                 Some((&targets.color).into()),
