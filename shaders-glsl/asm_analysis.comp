@@ -20,6 +20,8 @@ layout(set = 0, binding = 1) uniform Lights { ShadowLight lights[KAGE_MAX_LOCAL_
 layout(set = 0, binding = 4) uniform sampler2D eye_depth;
 layout(std430, set = 0, binding = 5) buffer Requests { uint requests[]; };
 layout(push_constant) uniform Push { AsmAnalysisPush push; };
+// Levels asked for beyond the eye pixel's (`AsmSettings::extra_levels`).
+layout(constant_id = 0) const uint EXTRA_LEVELS = KAGE_ASM_EXTRA_LEVELS;
 
 #include "asm_lookup.glsl"
 
@@ -94,12 +96,12 @@ void main() {
     if (level >= uint(KAGE_ASM_MAX_LEVEL)) return;
     // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
     // level L has texels of 1 / (TILE 2^L) a side, so it matches the pixel where
-    // 2^L = 1 / (TILE sqrt(area)); KAGE_ASM_EXTRA_LEVELS finer.
+    // 2^L = 1 / (TILE sqrt(area)); EXTRA_LEVELS finer.
     vec4 mx = shadow_map_coords(s, p + dx), my = shadow_map_coords(s, p + dy);
     vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
     float area = abs(ux.x * uy.y - ux.y * uy.x);
     float needed = area > 0.0 ? -log2(float(KAGE_ASM_TILE_TEXELS) * sqrt(area)) : float(KAGE_ASM_MAX_LEVEL);
-    needed += float(KAGE_ASM_EXTRA_LEVELS);
+    needed += float(EXTRA_LEVELS);
     float missing = min(ceil(needed), float(KAGE_ASM_MAX_LEVEL)) - float(level);
     if (missing < 1.0) return;
     // On a shadow edge: the receiver's visibility against its texel and the 8 around it

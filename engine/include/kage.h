@@ -652,6 +652,11 @@ typedef struct {
    * default 512.
    */
   uint32_t light_map_size;
+  /**
+   * Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
+   * whose texels match the eye pixel, 0 to 8; default 4.
+   */
+  uint32_t asm_extra_levels;
 } kage_technique_desc;
 
 /**

@@ -99,8 +99,8 @@
 // The deepest quadtree level: 2^17 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 17
-// Levels the ASM refinement asks for beyond the one whose texels match the eye pixel's
-// footprint: a reconstructed edge lies within a fraction of a texel of the true one, so texels a
+// Levels the ASM refinement asks for by default (`AsmSettings::extra_levels`) beyond the one
+// whose texels match the eye pixel's footprint: a reconstructed edge lies within a fraction of a texel of the true one, so texels a
 // sixteenth of the pixel keep the lit/shadowed state of pixel centres right but near an edge
 // (with 128² tiles an eighth, 3, was as good as 4: the pages they took ran out first).
 #define KAGE_ASM_EXTRA_LEVELS 4

@@ -140,6 +140,14 @@ static void check_scene_lights(kage_context *context) {
     CHECK(kage_technique_desc_default(techniques[t], &renderer_desc.technique));
     renderer_desc.technique.shadow_map_size = 64;
     kage_renderer *renderer = NULL;
+    if (techniques[t] == KAGE_TECHNIQUE_ASM) {
+      /* Beyond the 8 extra levels a setting may ask for: refused, naming the limit. */
+      renderer_desc.technique.asm_extra_levels = 9;
+      EXPECT(kage_renderer_create(context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_VALUE);
+      CHECK(kage_last_error_message(text, sizeof text, NULL));
+      REQUIRE(strstr(text, "9 extra ASM levels: at most 8") != NULL);
+      renderer_desc.technique.asm_extra_levels = 5;
+    }
     CHECK(kage_renderer_create(context, scene, &renderer_desc, &renderer));
     snprintf(path, sizeof path, "%s/frame.png", dir);
     EXPECT(kage_renderer_write_image(renderer, path, 1.0f), KAGE_RESULT_INVALID_VALUE); /* no frame yet */

@@ -27,7 +27,12 @@ fn close_up(index: usize) -> Scene {
 
 fn settings(budget_bytes: u64, test: AsmTest) -> AsmSettings {
     // A generous time budget: these tests count tiles, not milliseconds.
-    AsmSettings { budget_mb: budget_bytes as f64 / MB as f64, time_ms: 1000.0, test }
+    AsmSettings {
+        budget_mb: budget_bytes as f64 / MB as f64,
+        time_ms: 1000.0,
+        test,
+        ..AsmSettings::default()
+    }
 }
 
 fn renderer(ctx: &Validated, scene: &Scene, technique: TechniqueDesc) -> Renderer {
@@ -50,6 +55,28 @@ fn mismatches(r: &mut Renderer, truth: &RgbaF32Image, frames: usize) -> Vec<kage
             shadow_mismatch(&r.image().unwrap(), truth, SHADOW_THRESHOLD, None).unwrap()
         })
         .collect()
+}
+
+/// The extra levels a setting asks for reach the analysis shader: the refinement at shadow
+/// edges stops that many levels below the level whose texels match the eye pixel, so with a
+/// budget that never runs out the deepest resident tile moves by the difference in the setting.
+#[test]
+fn extra_levels_deepen_the_refinement_by_as_many_levels() {
+    let ctx = Validated::new();
+    let scene = close_up(1);
+    let deepest = |extra_levels| {
+        let asm = AsmSettings { extra_levels, ..settings(256 * MB, AsmTest::Bias) };
+        let mut r = renderer(&ctx, &scene, TechniqueDesc::Asm(asm));
+        for _ in 0..8 {
+            r.render().unwrap();
+        }
+        let stats = r.stats().asm.unwrap();
+        assert!(stats.bytes_used < stats.budget_bytes / 2, "the budget ran short: {stats:?}");
+        stats.deepest_level
+    };
+    let (two, four) = (deepest(2), deepest(4));
+    eprintln!("deepest level with 2 extra levels {two}, with 4 {four}");
+    assert_eq!(four, two + 2);
 }
 
 /// Refinement on the grating close-up: the mismatch falls as tiles arrive, the pool stays

@@ -8,7 +8,7 @@ use kage::pass::TimingTable;
 use kage::prt::PrtParams;
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{animation, Scene};
-use kage::techniques::asm::technique::{AsmTest, MB};
+use kage::techniques::asm::technique::MB;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
 use kage::techniques::probes::{
@@ -45,17 +45,8 @@ pub struct RenderArgs {
     /// Side of a shadow map, texels: parallel-lights 16 to 2048, shadowmap 16 to 8192.
     #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
-    /// Adaptive shadow maps: the page pool's budget, MB (MiB); never exceeded.
-    #[arg(long, default_value_t = AsmSettings::default().budget_mb)]
-    asm_budget_mb: f64,
-    /// Adaptive shadow maps: tile rendering time per frame, ms, as the start-up calibration
-    /// predicts it.
-    #[arg(long, default_value_t = AsmSettings::default().time_ms)]
-    asm_time_ms: f64,
-    /// Adaptive shadow maps: the shadow test, `id` (the paper's polygon IDs, depth with bias
-    /// as fallback; pages take twice the bytes) or `bias` (depth with slope-scaled bias).
-    #[arg(long, value_enum, default_value_t = AsmSettings::default().test)]
-    asm_test: AsmTest,
+    #[command(flatten)]
+    asm: AsmSettings,
     /// Light probes (technique `probes`): `grid:NX,NY,NZ` (cell centres over the static groups'
     /// bounding box, 2 to 64 each), `scene` (the scene file's `probes`), a file
     /// `{"positions": [[x,y,z], ...]}`, or `auto`, `auto:TOL` or `auto:TOL:NX,NY,NZ` (candidates
@@ -189,8 +180,7 @@ impl TechniqueParams for Flags<'_> {
         })
     }
     fn asm(&self) -> Result<AsmSettings> {
-        let args = self.args;
-        Ok(AsmSettings { budget_mb: args.asm_budget_mb, time_ms: args.asm_time_ms, test: args.asm_test })
+        Ok(self.args.asm)
     }
 }
 

@@ -121,6 +121,9 @@ pub struct kage_technique_desc {
     /// Tamura: side of a group's depth map along a dominant light in texels, 16 to 4096;
     /// default 512.
     pub light_map_size: u32,
+    /// Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
+    /// whose texels match the eye pixel, 0 to 8; default 4.
+    pub asm_extra_levels: u32,
 }
 
 impl kage_technique_desc {
@@ -226,6 +229,7 @@ impl TechniqueParams for HostParams<'_> {
             budget_mb: self.0.asm_budget_mb,
             time_ms: self.0.asm_time_ms,
             test: args::enumeration(self.0.asm_test, "asm_test", AsmTest::from_repr)?,
+            extra_levels: self.0.asm_extra_levels,
         })
     }
 }
@@ -272,6 +276,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_statics: probes.statics as u32,
             dominant_lights: occlusion.dominant_lights as u32,
             light_map_size: occlusion.light_map_size,
+            asm_extra_levels: asm.extra_levels,
         };
         // An unknown technique is reported here already, not at the first use.
         // SAFETY: the default places no probes at positions.

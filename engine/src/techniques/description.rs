@@ -422,6 +422,8 @@ mod tests {
         assert!(invalid(asm(0.01, 8.0)).contains("holds no tile"));
         assert!(invalid(asm(f64::INFINITY, 8.0)).contains("finite number of MB"));
         assert!(invalid(asm(16.0, 0.0)).contains("time budget"));
+        let levels = TechniqueDesc::Asm(AsmSettings { extra_levels: 9, ..Default::default() });
+        assert!(invalid(levels).contains("9 extra ASM levels: at most 8"));
         // Parallel lights and shadow maps are checked here too, before anything is built.
         let parallel = |regions, shadow_map_size| TechniqueDesc::ParallelLights { regions, shadow_map_size };
         assert!(invalid(parallel(129, 512)).contains("q = 129 regions, must be 1 to 128"));

@@ -86,21 +86,44 @@ impl AsmTest {
     }
 }
 
-/// The technique's parameters.
+/// Most levels of refinement [`AsmSettings::extra_levels`] may ask for beyond an eye pixel's.
+pub const MAX_EXTRA_LEVELS: u32 = 8;
+
+/// The technique's parameters, each defined here once: the command line takes them as its
+/// `--asm-*` options (these comments are their help) and the C ABI as `kage_technique_desc`'s
+/// `asm_*` fields.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct AsmSettings {
-    /// The page pool's budget, MB: it never holds more tiles than fit.
+    /// Adaptive shadow maps: the page pool's budget, MB (MiB); never exceeded.
+    #[cfg_attr(feature = "clap", arg(long = "asm-budget-mb", value_name = "MB", default_value_t = AsmSettings::default().budget_mb))]
     pub budget_mb: f64,
-    /// Per-frame time budget of tile rendering, ms, against the calibrated cost model.
+    /// Adaptive shadow maps: tile rendering time per frame, ms, as the start-up calibration
+    /// predicts it.
+    #[cfg_attr(feature = "clap", arg(long = "asm-time-ms", value_name = "MS", default_value_t = AsmSettings::default().time_ms))]
     pub time_ms: f64,
+    /// Adaptive shadow maps: the shadow test, `id` (the paper's polygon IDs, depth with bias
+    /// as fallback; pages take twice the bytes) or `bias` (depth with slope-scaled bias).
+    #[cfg_attr(feature = "clap", arg(long = "asm-test", value_enum, default_value_t = AsmSettings::default().test))]
     pub test: AsmTest,
+    /// Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
+    /// whose texels match the eye pixel, 0 to 8: each halves the edge's texels and may take up
+    /// to four times their pages (BENCHMARKS.md: 5 is better than 4 at 256 MiB, no better at
+    /// 16 MiB, where the pages run out first).
+    #[cfg_attr(feature = "clap", arg(long = "asm-extra-levels", value_name = "LEVELS", default_value_t = AsmSettings::default().extra_levels))]
+    pub extra_levels: u32,
 }
 
 impl Default for AsmSettings {
     fn default() -> Self {
         // 32 ms: some 30 64² tiles per frame on lavapipe, with the scene's 5,000 triangles; at
         // 8 ms the walkthrough of BENCHMARKS.md misclassified 17 % more pixels at 16 MiB.
-        AsmSettings { budget_mb: 16.0, time_ms: 32.0, test: AsmTest::default() }
+        AsmSettings {
+            budget_mb: 16.0,
+            time_ms: 32.0,
+            test: AsmTest::default(),
+            extra_levels: constants::ASM_EXTRA_LEVELS,
+        }
     }
 }
 
@@ -125,6 +148,12 @@ impl AsmSettings {
             return Err(Error::InvalidArgument(format!(
                 "the ASM time budget {} ms must be positive",
                 self.time_ms
+            )));
+        }
+        if self.extra_levels > MAX_EXTRA_LEVELS {
+            return Err(Error::InvalidArgument(format!(
+                "{} extra ASM levels: at most {MAX_EXTRA_LEVELS}",
+                self.extra_levels
             )));
         }
         Ok(self)
@@ -277,7 +306,7 @@ impl Asm {
             size_of::<LocalDrawPush>(),
             DepthTest::Equal,
         )?;
-        let analysis = ComputePipeline::new(
+        let analysis = ComputePipeline::specialized(
             ctx,
             "asm_analysis",
             spirv::ASM_ANALYSIS_COMP,
@@ -290,6 +319,7 @@ impl Asm {
                 BindingKind::StorageBuffer,
             ],
             size_of::<AsmAnalysisPush>() as u32,
+            &[settings.extra_levels],
         )?;
         let buffer =
             |name, size, usage, location| Buffer::new(ctx, &BufferDesc { name, size, usage, location });
