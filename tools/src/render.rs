@@ -15,7 +15,7 @@ use kage::techniques::probes::{
     CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
     DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
-use kage::techniques::tamura::technique::{OcclusionSettings, Penumbra};
+use kage::techniques::tamura::technique::OcclusionSettings;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -25,23 +25,8 @@ pub struct RenderArgs {
     /// (its PRT transfer is computed first, in seconds, and cached).
     #[arg(long, value_enum, default_value_t = TechniqueKind::Tamura)]
     technique: TechniqueKind,
-    /// Environment regions q of the Tamura technique (1 to 64) or of parallel-lights (1 to 128).
-    #[arg(long, default_value_t = OcclusionSettings::default().regions)]
-    regions: usize,
-    /// Penumbra of the Tamura shadows: `fixed` (the paper's box width per group pair) or
-    /// `adaptive` (a width per pixel from its distance to the occluder).
-    #[arg(long, value_enum, default_value_t = OcclusionSettings::default().penumbra)]
-    penumbra: Penumbra,
-    /// Side of a Tamura occlusion mask layer, texels.
-    #[arg(long, default_value_t = OcclusionSettings::default().mask_size)]
-    mask_size: u32,
-    /// Most dominant lights (small, bright parts of the map: a sun, lamps) Tamura takes out of
-    /// the map and lights per pixel with soft shadows, 0 to 8; they count among the regions.
-    #[arg(long, default_value_t = OcclusionSettings::default().dominant_lights)]
-    dominant_lights: usize,
-    /// Side of a group's depth map along a dominant light, texels (16 to 4096).
-    #[arg(long, default_value_t = OcclusionSettings::default().light_map_size)]
-    light_map_size: u32,
+    #[command(flatten)]
+    occlusion: OcclusionSettings,
     /// Side of a shadow map, texels: parallel-lights 16 to 2048, shadowmap 16 to 8192.
     #[arg(long, visible_alias = "shadowmap-size", default_value_t = kage::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE)]
     shadow_map_size: u32,
@@ -145,21 +130,13 @@ impl TechniqueParams for Flags<'_> {
         self.args.prt.params()
     }
     fn regions(&self) -> usize {
-        self.args.regions
+        self.args.occlusion.regions
     }
     fn mask_size(&self) -> u32 {
-        self.args.mask_size
+        self.args.occlusion.mask_size
     }
     fn occlusion(&self) -> Result<OcclusionSettings> {
-        let args = self.args;
-        Ok(OcclusionSettings {
-            regions: args.regions,
-            mask_size: args.mask_size,
-            penumbra: args.penumbra,
-            dominant_lights: args.dominant_lights,
-            light_map_size: args.light_map_size,
-            ..OcclusionSettings::default()
-        })
+        Ok(self.args.occlusion)
     }
     fn shadow_map_size(&self) -> u32 {
         self.args.shadow_map_size

@@ -45,26 +45,40 @@ pub enum Penumbra {
     Adaptive = 1,
 }
 
-/// Settings of the occlusion between groups.
+/// Settings of the occlusion between groups, each defined here once: the command line takes
+/// those it exposes as options (these comments are their help), the C ABI as
+/// `kage_technique_desc` fields.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct OcclusionSettings {
-    /// q: environment regions (0: Sloan's PRT, self-shadowing only).
+    /// Environment regions q of the Tamura technique (1 to 64) or of parallel-lights (1 to 128).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = OcclusionSettings::default().regions))]
     pub regions: usize,
-    /// Side of a mask layer, texels.
+    /// Side of a Tamura occlusion mask layer, texels.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = OcclusionSettings::default().mask_size))]
     pub mask_size: u32,
     /// Most layers filtered per frame.
+    #[cfg_attr(feature = "clap", arg(skip = OcclusionSettings::default().max_layers))]
     pub max_layers: u32,
+    /// Penumbra of the Tamura shadows: `fixed` (the paper's box width per group pair) or
+    /// `adaptive` (a width per pixel from its distance to the occluder).
+    #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = OcclusionSettings::default().penumbra))]
     pub penumbra: Penumbra,
     /// Which solid angle sets a region's box width.
+    #[cfg_attr(feature = "clap", arg(skip = OcclusionSettings::default().size))]
     pub size: RegionSize,
-    /// Most dominant lights taken out of the map and lit per pixel (0: the paper's technique;
-    /// they count among the q regions).
+    /// Most dominant lights (small, bright parts of the map: a sun, lamps) Tamura takes out of
+    /// the map and lights per pixel with soft shadows, 0 to 8; they count among the regions
+    /// (0: the paper's technique).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = OcclusionSettings::default().dominant_lights))]
     pub dominant_lights: usize,
-    /// Side of a group's depth map along a dominant light, texels.
+    /// Side of a group's depth map along a dominant light, texels (16 to 4096).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = OcclusionSettings::default().light_map_size))]
     pub light_map_size: u32,
     /// The unshadowed light per pixel, from the exact irradiance of L_s's map (`frame::irradiance`),
     /// only what the group hides of it interpolated from the vertices (beyond the paper, whose
     /// L_s is per vertex and in 3-band SH).
+    #[cfg_attr(feature = "clap", arg(skip = OcclusionSettings::default().pixel_cosine))]
     pub pixel_cosine: bool,
 }
 
