@@ -10,12 +10,8 @@ use std::sync::Arc;
 
 #[derive(Args, Clone, Debug)]
 pub struct PrtArgs {
-    /// Visibility rays per vertex of the PRT precomputation.
-    #[arg(long, default_value_t = PrtParams::DEFAULT.rays)]
-    pub rays: u32,
-    /// SH bands of the PRT transfer, 2 to 5 (bands² coefficients per vertex).
-    #[arg(long, default_value_t = PrtParams::DEFAULT.bands)]
-    pub bands: u32,
+    #[command(flatten)]
+    pub params: PrtParams,
     /// Cache folder (default: $KAGE_CACHE_DIR, else $XDG_CACHE_HOME/kage, else ~/.cache/kage).
     #[arg(long)]
     pub cache: Option<PathBuf>,
@@ -37,7 +33,7 @@ pub enum Origin {
 
 impl PrtArgs {
     pub fn params(&self) -> Result<PrtParams> {
-        Ok(PrtParams { bands: self.bands, rays: self.rays, ..PrtParams::DEFAULT }.validated()?)
+        Ok(self.params.validated()?)
     }
 
     /// The transfer of `scene` with `params` (this struct's bands and rays, the visibility the

@@ -48,13 +48,19 @@ pub enum Visibility {
     Scene = 1,
 }
 
-/// What to precompute.
+/// What to precompute, each parameter defined here once: the command line takes the bands and
+/// rays as options (these comments are their help), the C ABI as `kage_technique_desc` fields.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct PrtParams {
-    /// SH bands, [`MIN_BANDS`]..=[`MAX_BANDS`]; `bands²` coefficients per vertex.
+    /// SH bands of the PRT transfer, 2 to 5 (bands² coefficients per vertex).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = PrtParams::DEFAULT.bands))]
     pub bands: u32,
-    /// Visibility rays per vertex.
+    /// Visibility rays per vertex of the PRT precomputation.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = PrtParams::DEFAULT.rays))]
     pub rays: u32,
+    /// Against what visibility is tested: set by the technique that needs the transfer.
+    #[cfg_attr(feature = "clap", arg(skip = PrtParams::DEFAULT.visibility))]
     pub visibility: Visibility,
 }
 

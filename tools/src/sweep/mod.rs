@@ -302,8 +302,7 @@ fn run_prt(args: &SweepArgs) -> Result<()> {
     for params in settings.iter().filter_map(|s| s.precomputation()) {
         let params = PrtParams { rays: args.rays, ..params };
         if !transfers.iter().any(|(p, _)| *p == params) {
-            let source =
-                PrtArgs { rays: args.rays, bands: params.bands, cache: args.cache.clone(), force: false };
+            let source = PrtArgs { params, cache: args.cache.clone(), force: false };
             let (transfer, _) = source.obtain(&ctx, &scene, params)?;
             transfers.push((params, Arc::new(transfer)));
         }
