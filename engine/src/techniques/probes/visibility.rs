@@ -1,5 +1,6 @@
-//! Visibility-aware interpolation: a probe that the lookup point cannot see through the static
-//! geometry gets no weight, and the others' weights are renormalised. Without it a tetrahedron
+//! Visibility-aware interpolation: a probe keeps only the part of its weight that the lookup
+//! point sees of it through the static geometry (none behind a wall), and the weights are
+//! renormalised. Without it a tetrahedron
 //! (or grid cell) spanning a wall blends the light of both sides: in `two-rooms` the dim room's
 //! path took 45–280 times its own irradiance from the sunlit room's probes (BENCHMARKS.md).
 //!
@@ -47,8 +48,8 @@ pub enum ProbeVisibility {
 /// sphere.
 pub const RAYS_PER_PROBE: usize = 9;
 /// The free sphere's radius as a fraction of the nearest surface hit over 14 directions (axes
-/// and diagonals): a plane's nearest point lies within 30° of one of them, so the first hit
-/// is at most 1/cos 30° = 1.155 times its distance, and 0.8 of it stays inside.
+/// and diagonals): a plane's nearest point lies within 36.3° of one of them, so the first hit
+/// is at most 1/cos 36.3° = 1.24 times its distance, and 0.8 of it (0.99) stays inside.
 pub const FREE_FRACTION: f64 = 0.8;
 /// The free sphere's radius as a fraction of the probe's distance to the point, at most: seen
 /// from the point it spans at most about 15° on each side.
@@ -116,10 +117,6 @@ impl Visibility {
     pub fn new(occluders: Arc<Occluders>, positions: &[DVec3]) -> Visibility {
         let free = positions.iter().map(|&q| occluders.free_radius(q)).collect();
         Visibility { occluders, free }
-    }
-
-    pub fn occluders(&self) -> &Arc<Occluders> {
-        &self.occluders
     }
 
     /// The fraction of the [`RAYS_PER_PROBE`] rays from `p` to probe `probe` at `q` that no
@@ -323,7 +320,7 @@ mod tests {
         assert_eq!((seen, inside), (Seen::Nearest, [(4, 1.0), (4, 0.0)]));
         // Inside the sealed box with no probe in it: no probe seen, the weights as they were.
         let outside = [PROBES[0], PROBES[1], PROBES[2], PROBES[3]];
-        let visibility = Visibility::new(visibility.occluders().clone(), &outside);
+        let visibility = Visibility::new(walled(), &outside);
         let mut kept = [(2, 0.5), (3, 0.5)];
         let seen = weigh_by_visibility(&mut kept, DVec3::new(0.2, 0.0, 5.0), &outside, &visibility);
         counts.count(seen);
