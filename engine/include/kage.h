@@ -313,6 +313,32 @@ typedef uint32_t kage_static_lighting;
 #endif // __cplusplus
 
 /**
+ * Whether a lookup weighs probes by whether the point sees them.
+ */
+enum kage_probe_visibility
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Every probe of the cell keeps its weight: light leaks through walls.
+   */
+  KAGE_PROBE_VISIBILITY_OFF = 0,
+  /**
+   * Rays from the point to each probe of its cell and around it: each keeps the fraction of
+   * its weight the point sees, a probe behind a wall none.
+   */
+  KAGE_PROBE_VISIBILITY_RAYS = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum kage_probe_visibility kage_probe_visibility;
+#else
+typedef uint32_t kage_probe_visibility;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * Pixel formats of `kage_renderer_read_pixels`.
  */
 enum kage_pixel_format
@@ -652,6 +678,11 @@ typedef struct {
    * default 512.
    */
   uint32_t light_map_size;
+  /**
+   * A `kage_probe_visibility` value: whether a moving group's probe lookup leaves out the
+   * probes its centre cannot see through the static groups; default rays.
+   */
+  uint32_t probe_visibility;
   /**
    * Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
    * whose texels match the eye pixel, 0 to 8; default 4.

@@ -821,7 +821,7 @@ fn c_abi_catches_bad_values_and_calls_after_free() {
 fn c_abi_places_probes_and_reports_them() {
     use capi::technique::{kage_probe_dering, kage_probe_placement};
     use kage::techniques::description::TechniqueKind;
-    use kage::techniques::probes::{CapturedLight, ProbeInterpolation, StaticLighting};
+    use kage::techniques::probes::{CapturedLight, ProbeInterpolation, ProbeVisibility, StaticLighting};
     let c = CHost::new();
     // Around the triangles (the scene's static group is the upper one): a tetrahedralization
     // needs probes in 3D.
@@ -857,6 +857,13 @@ fn c_abi_places_probes_and_reports_them() {
         assert_eq!(capi::renderer::kage_renderer_destroy(renderer), kage_result::Ok);
     }
     assert_eq!((stats.probes, stats.probe_candidates, stats.probes_inside_geometry), (5, 5, 0));
+    // Lookups weigh probes by visibility unless the host turns it off.
+    assert_eq!(probes.probe_visibility, ProbeVisibility::Rays as u32);
+    let off = ProbeVisibility::Off as u32;
+    let (code, renderer) = create(capi::technique::kage_technique_desc { probe_visibility: off, ..probes });
+    assert_eq!(code, kage_result::Ok, "{}", last_error());
+    // SAFETY: a live renderer.
+    unsafe { assert_eq!(capi::renderer::kage_renderer_destroy(renderer), kage_result::Ok) };
 
     let hanning = kage_probe_dering::Hanning as u32;
     let trilinear = ProbeInterpolation::Trilinear as u32;
@@ -894,6 +901,11 @@ fn c_abi_places_probes_and_reports_them() {
             capi::technique::kage_technique_desc { probe_statics: 7, ..probes },
             kage_result::InvalidValue,
             "probe_statics",
+        ),
+        (
+            capi::technique::kage_technique_desc { probe_visibility: 2, ..probes },
+            kage_result::InvalidValue,
+            "probe_visibility",
         ),
         (
             capi::technique::kage_technique_desc { probe_statics: StaticLighting::Sloan as u32, ..probes },

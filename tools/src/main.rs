@@ -87,8 +87,10 @@ enum Command {
     /// `grid:3,2,3`, cell centres, 2 to 64 a side), at the scene file's `probes` or at the
     /// positions of a probe file; cube faces of 8 to 256 texels (default 128); the moving groups
     /// (those with keyframes; without any, the first group, with a note) each take their irradiance
-    /// from the probes at their own centre, the others are captured by the probes and lit as by
-    /// `unshadowed` (`--probe-statics sloan`: Sloan's PRT)
+    /// from the probes at their own centre, leaving out the probes it cannot see through the
+    /// static groups (`--probe-visibility off`: every probe of the cell weighs, light leaks
+    /// through walls), the others are captured by the probes and lit as by `unshadowed`
+    /// (`--probe-statics sloan`: Sloan's PRT)
     ///
     /// kage render ... --technique probes --probes auto[:TOL[:NX,NY,NZ]] [--probe-interpolation
     /// tetrahedral|trilinear] [--probe-statics unshadowed|sloan]: automatic placement (see

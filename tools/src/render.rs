@@ -12,8 +12,8 @@ use kage::techniques::asm::technique::MB;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
 use kage::techniques::probes::{
-    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, StaticLighting,
-    DEFAULT_GRID, DEFAULT_TOLERANCE,
+    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, ProbeVisibility,
+    StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
 use kage::techniques::tamura::technique::OcclusionSettings;
 use std::path::PathBuf;
@@ -42,6 +42,10 @@ pub struct RenderArgs {
     /// How the light between probes is found: `trilinear` needs a `grid:` placement.
     #[arg(long, value_enum, default_value_t = ProbeSettings::default().interpolation)]
     probe_interpolation: ProbeInterpolation,
+    /// Whether a moving group's lookup leaves out the probes its centre cannot see through the
+    /// static groups (`rays`), so that no light comes through walls.
+    #[arg(long, value_enum, default_value_t = ProbeSettings::default().visibility)]
+    probe_visibility: ProbeVisibility,
     /// How the probes technique lights the static groups beside the probe-lit moving ones.
     #[arg(long, value_enum, default_value_t = ProbeSettings::default().statics)]
     probe_statics: StaticLighting,
@@ -153,6 +157,7 @@ impl TechniqueParams for Flags<'_> {
                 dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
             },
             interpolation: args.probe_interpolation,
+            visibility: args.probe_visibility,
             statics: args.probe_statics,
         })
     }
@@ -298,6 +303,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             stats.refreshed.len() + stats.rendered.len(),
             stats.cost.0,
             stats.cost.1
+        );
+    }
+    if let Some(c) = renderer.stats().probe_lookups {
+        println!(
+            "probe lookups: {}; a probe hidden from the group's centre in {}; none of the cell's seen, the nearest seen probe in {}; no probe seen, unweighted, in {}",
+            c.lookups, c.renormalised, c.nearest, c.unweighted
         );
     }
     if dropped > 0 {

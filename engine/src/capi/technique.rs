@@ -12,7 +12,7 @@ use crate::techniques::description::{TechniqueDesc, TechniqueKind, TechniquePara
 use crate::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use crate::techniques::probes::{
     self, CaptureSettings, CapturedLight, Dering, ProbeInterpolation, ProbePlacement, ProbeSettings,
-    StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
+    ProbeVisibility, StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
 };
 use crate::techniques::tamura::technique::{OcclusionSettings, Penumbra};
 use glam::DVec3;
@@ -121,6 +121,9 @@ pub struct kage_technique_desc {
     /// Tamura: side of a group's depth map along a dominant light in texels, 16 to 4096;
     /// default 512.
     pub light_map_size: u32,
+    /// A `kage_probe_visibility` value: whether a moving group's probe lookup leaves out the
+    /// probes its centre cannot see through the static groups; default rays.
+    pub probe_visibility: u32,
     /// Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
     /// whose texels match the eye pixel, 0 to 8; default 4.
     pub asm_extra_levels: u32,
@@ -186,6 +189,11 @@ impl kage_technique_desc {
                 self.probe_interpolation,
                 "probe_interpolation",
                 ProbeInterpolation::from_repr,
+            )?,
+            visibility: args::enumeration(
+                self.probe_visibility,
+                "probe_visibility",
+                ProbeVisibility::from_repr,
             )?,
             statics: args::enumeration(self.probe_statics, "probe_statics", StaticLighting::from_repr)?,
         })
@@ -276,6 +284,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_statics: probes.statics as u32,
             dominant_lights: occlusion.dominant_lights as u32,
             light_map_size: occlusion.light_map_size,
+            probe_visibility: probes.visibility as u32,
             asm_extra_levels: asm.extra_levels,
         };
         // An unknown technique is reported here already, not at the first use.

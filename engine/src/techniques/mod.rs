@@ -52,4 +52,6 @@ pub struct TechniqueStats {
     pub asm: Option<asm::AsmStats>,
     /// The light probes placed and kept.
     pub probes: Option<probes::ProbeCounts>,
+    /// The probe lookups since the technique was built, by what their visibility test did.
+    pub probe_lookups: Option<probes::LookupCounts>,
 }

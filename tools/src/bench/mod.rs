@@ -3,6 +3,7 @@
 //! `probe_count` (probe error against count) and `scale` (costs as the scene grows).
 pub mod asm;
 pub mod probe_count;
+mod probe_score;
 pub mod probes;
 pub mod rays;
 mod rng;
@@ -53,12 +54,14 @@ pub enum BenchCommand {
     ///
     /// kage bench probe-count [--scene probe-room,atrium] [--grids 2,3,4,6,8,12] [--candidates
     /// LEVEL] [--tolerances ...] [--probe-light sky] [--test-region path|box] [--points N]
-    /// [--normals N] [--spp N] [--probe-cube-size N] [--target E] [--cache DIR]: interpolated
+    /// [--normals N] [--spp N] [--probe-cube-size N] [--visibility rays,off] [--closed-room]
+    /// [--target E] [--cache DIR]: interpolated
     /// irradiance against the ray-cast truth at points along the moving group's path (`box`:
     /// anywhere in the static groups' box, probes over the box only), for trilinear grids of
     /// growing size and automatic placement at falling tolerance (candidates: grid level LEVEL's
-    /// probes, by default the finest grid's; each step measured: reduced, fitted, relocated), with
-    /// the fewest probes each needs for a target error (BENCHMARKS.md)
+    /// probes, by default the finest grid's; each step measured: reduced, fitted, relocated), each
+    /// with and without the visibility test (and against its closed room, with the leaked
+    /// fraction), with the fewest probes each needs for a target error (BENCHMARKS.md)
     ProbeCount(probe_count::ProbeCountArgs),
     /// Costs as the scene grows: BVH build, PRT precomputation, device memory and frame time
     /// per technique at 1k to 1M triangles of one scene family, with their log-log slopes.

@@ -8,6 +8,9 @@
 //! (every moving group moved far away, as the probes leave them out), cached. Error: the RMS of |E_probes − E| over points, normals and channels
 //! divided by the RMS of E (a relative error that dark normals cannot blow up).
 //!
+//! Each set is scored with the visibility test and without (`--visibility`, [`probe_score`]),
+//! and with `--closed-room` against its closed room, with its leaked fraction.
+//!
 //! Captures are shared: the grid levels are captured once each, and automatic placement's
 //! candidates are one level's probes outside solids (`--candidates`, by default the finest
 //! grid's), placed at each tolerance on the host. Automatic placement is measured step by step:
@@ -15,6 +18,7 @@
 //! every candidate's; and, as the engine runs it, relocated before the fit. Each grid is also
 //! measured fitted to the same candidates, to tell the fit's gain from the placement's.
 use crate::args::GpuArgs;
+use crate::bench::probe_score::{squared_error, Frames, LookupCost, Score, Scorer, NORMALS};
 use crate::bench::Pcg32;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
@@ -27,8 +31,8 @@ use kage::reference::IrradianceReference;
 use kage::scene::Scene;
 use kage::sh::ShRgb9;
 use kage::techniques::probes::{
-    bounds, capture_at, grid_lattice, CaptureSettings, Lattice, ProbeGroups, ProbeSet, Solids, Walker,
-    MAX_GRID,
+    bounds, capture_at, grid_lattice, reduce, CaptureSettings, Lattice, Occluders, ProbeGroups, ProbeSet,
+    ProbeVisibility, Solids, MAX_GRID,
 };
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -81,6 +85,21 @@ pub struct ProbeCountArgs {
     /// changes.
     #[arg(long, value_enum, default_value_t = kage::techniques::probes::CapturedLight::Sky)]
     probe_light: kage::techniques::probes::CapturedLight,
+    /// Lookups measured: `rays` leaves out the probes a test point cannot see through the
+    /// static groups (as `kage render` does by default), `off` weighs every probe of the cell
+    /// (methods named "..., no visibility").
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [ProbeVisibility::Rays, ProbeVisibility::Off])]
+    visibility: Vec<ProbeVisibility>,
+    /// Also measure each set's closed room (its probes that the path's centre sees, alone: in
+    /// a convex room, the room's own) and the leaked fraction (the share of the interpolated
+    /// irradiance from the probes the path's centre does not see).
+    #[arg(long)]
+    closed_room: bool,
+    /// Also follow the moving group's centre over this many frames of its motion and report
+    /// each set's largest frame-to-frame irradiance jump (6 axis normals), against the
+    /// reference's and a probe captured at each frame's point (0: not measured).
+    #[arg(long, default_value_t = 0)]
+    path_frames: usize,
     /// The relative error a method must reach; default: each grid level's own error.
     #[arg(long)]
     target: Option<f64>,
@@ -98,6 +117,29 @@ pub struct Row {
     pub setting: Setting,
     pub probes: usize,
     pub error: f64,
+    /// The leaked fraction (with `--closed-room`).
+    pub leaked: Option<f64>,
+    /// The largest frame-to-frame jump (with `--path-frames`).
+    pub jump: Option<f64>,
+}
+
+impl Row {
+    fn new(method: String, setting: Setting, probes: usize, score: Score) -> Row {
+        Row { method, setting, probes, error: score.error, leaked: score.leaked, jump: score.jump }
+    }
+}
+
+/// The largest frame-to-frame jumps along the moving group's path that the sets' are measured
+/// against (relative to the RMS of the truth there).
+#[derive(Clone, Copy, Debug)]
+pub struct FrameJumps {
+    pub frames: usize,
+    /// The reference's, noise included.
+    pub reference: f64,
+    /// The RMS jump the reference's noise alone makes: √2 σ.
+    pub reference_noise: f64,
+    /// A probe captured at each frame's point: the light as the probes capture it, no noise.
+    pub captured: f64,
 }
 
 /// What a row's method was given: a grid's counts, or automatic placement's tolerance (or all
@@ -142,6 +184,10 @@ pub struct Measurement {
     pub capture_floor: f64,
     pub capture_ms_per_probe: f64,
     pub reference_seconds: f64,
+    /// Lookups without and with the visibility test.
+    pub lookups_off: LookupCost,
+    pub lookups_rays: LookupCost,
+    pub jumps: Option<FrameJumps>,
 }
 
 pub struct Params<'a> {
@@ -155,6 +201,11 @@ pub struct Params<'a> {
     pub spp: u32,
     pub capture: CaptureSettings,
     pub cache: Option<&'a Path>,
+    /// Each set is measured with each of these lookups.
+    pub visibility: &'a [ProbeVisibility],
+    pub closed_room: bool,
+    /// Frames of the moving group's motion whose jumps are measured; 0: none.
+    pub path_frames: usize,
 }
 
 pub fn run(args: &ProbeCountArgs) -> Result<()> {
@@ -169,6 +220,9 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         spp: args.spp,
         capture: CaptureSettings { cube_size: args.cube_size, light: args.probe_light, ..Default::default() },
         cache: Some(&args.cache),
+        visibility: &args.visibility,
+        closed_room: args.closed_room,
+        path_frames: args.path_frames,
     };
     println!(
         "probe count against error: {} test positions x {} normals ({}), reference {} spp, cube faces {}², capture {:?}, {}",
@@ -186,12 +240,32 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
             m.reference_seconds,
             m.capture_ms_per_probe
         );
+        if let Some(j) = m.jumps {
+            println!(
+                "largest frame-to-frame jump over {} frames: reference {:.4} (its noise alone: {:.4} RMS), a probe captured at each frame's point {:.4}",
+                j.frames, j.reference, j.reference_noise, j.captured
+            );
+        }
+        for (name, cost) in [("without visibility", m.lookups_off), ("with visibility", m.lookups_rays)] {
+            let c = cost.counts;
+            if c.lookups > 0 {
+                println!(
+                    "lookups {name}: {:.2} µs each; of {}, {} renormalised, {} the nearest probe seen, {} unweighted (no probe seen)",
+                    cost.micros(), c.lookups, c.renormalised, c.nearest, c.unweighted
+                );
+            }
+        }
         println!(
-            "path region {:.2?} to {:.2?}\n{:<40} {:>12} {:>8} {:>10}",
-            m.path.0, m.path.1, "method", "setting", "probes", "rel. RMS"
+            "path region {:.2?} to {:.2?}\n{:<52} {:>12} {:>8} {:>10} {:>8} {:>8}",
+            m.path.0, m.path.1, "method", "setting", "probes", "rel. RMS", "leaked", "jump"
         );
         for row in &m.rows {
-            println!("{:<40} {:>12} {:>8} {:>10.4}", row.method, row.setting, row.probes, row.error);
+            let leaked = row.leaked.map_or(String::new(), |l| format!("{:.2} %", 100.0 * l));
+            let jump = row.jump.map_or(String::new(), |j| format!("{j:.4}"));
+            println!(
+                "{:<52} {:>12} {:>8} {:>10.4} {leaked:>8} {jump:>8}",
+                row.method, row.setting, row.probes, row.error
+            );
         }
         // Like for like (each region's grid against automatic placement in it), and the
         // paper's comparison: a grid over the whole box against probes where objects move.
@@ -249,6 +323,20 @@ fn compare(rows: &[Row], grid: &str, tetra: &str, target: Option<f64>) {
         ratios.len(),
         ratios.len() - reached.len()
     );
+}
+
+/// `name` measured with `visibility`: the engine's default, with visibility, keeps the plain
+/// name.
+fn named(name: &str, visibility: ProbeVisibility) -> String {
+    match visibility {
+        ProbeVisibility::Rays => name.to_string(),
+        ProbeVisibility::Off => format!("{name}, no visibility"),
+    }
+}
+
+/// `name`'s closed room (see [`probe_score`](super::probe_score)).
+fn closed(name: &str) -> String {
+    format!("{name}, closed room")
 }
 
 const TRILINEAR: &str = "grid, trilinear";
@@ -340,24 +428,55 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
     let unit = grid_lattice(scene, [1; 3])?;
     let static_box = ((unit.first - 0.5 * unit.step).as_vec3(), (unit.first + 0.5 * unit.step).as_vec3());
     let points = test_points(scene, &solids, params, static_box)?;
-    let (truth, noise, reference_seconds) = reference(ctx, scene, &points, params)?;
+    let region = format!("{:?}", params.test_region).to_lowercase();
+    let (truth, noise, reference_seconds) = reference(ctx, scene, &points, params, &region)?;
 
     // The probes leave the moving groups out of their captures; they stay where they are.
     let gpu = GpuScene::new(ctx, scene)?;
-    let rms_truth = (truth.iter().flatten().map(|&e| e * e).sum::<f64>() / (3 * truth.len()) as f64).sqrt();
-    let error = |set: &ProbeSet| -> Result<f64> {
-        let mut walker = Walker::default();
-        let mut sum = 0.0;
-        for (point, exact) in points.iter().zip(&truth) {
-            let sh = set.interpolate(&mut walker, Vec3::from(point.position))?;
-            sum += squared_error(&sh, point, exact);
-        }
-        Ok((sum / (3 * truth.len()) as f64).sqrt() / rms_truth)
-    };
-
     let path = path_bounds(&scene.groups[moving_group(scene)?], static_box)
         .filter(|(lo, hi)| (*hi - *lo).min_element() > 0.0)
         .context("the moving group's path has no volume inside the static box")?;
+    let occluders = Arc::new(Occluders::of_static(scene)?);
+    let room = params.closed_room.then(|| ((path.0 + path.1) * 0.5).as_dvec3());
+    let frame_points = match params.path_frames {
+        0 => Vec::new(),
+        frames => frame_points(scene, frames)?,
+    };
+    let (frame_truth, frame_noise, _) = match params.path_frames {
+        0 => (Vec::new(), 0.0, 0.0),
+        _ => reference(ctx, scene, &frame_points, params, "frames")?,
+    };
+    let frames = (params.path_frames > 0).then_some(Frames { points: &frame_points, truth: &frame_truth });
+    let mut scorer = Scorer::new(&points, &truth, &occluders, room, frames);
+    let rms_truth = scorer.rms_truth();
+    // Each set scored with each visibility, then its closed room (that of the set built for
+    // visibility). `build` makes the set, given the occluders its fit and relocation see; a set
+    // that neither fits nor relocates (`fits` false) is built once, without.
+    let mut record = |rows: &mut Vec<Row>,
+                      name: &str,
+                      (region, setting): (Region, Setting),
+                      fits: bool,
+                      build: &dyn Fn(Option<Arc<Occluders>>) -> Result<ProbeSet>| {
+        let once = if fits { None } else { Some(build(None)?) };
+        let mut room_set = None;
+        for &visibility in params.visibility {
+            let built = match &once {
+                Some(_) => None,
+                None => Some(build((visibility == ProbeVisibility::Rays).then(|| occluders.clone()))?),
+            };
+            let set = once.as_ref().or(built.as_ref()).expect("built once or now");
+            let score = scorer.score(set, visibility)?;
+            rows.push(Row::new(method(&named(name, visibility), region), setting, set.probe_count(), score));
+            if room_set.is_none() || visibility == ProbeVisibility::Rays {
+                room_set = built;
+            }
+        }
+        if let Some(room) = once.or(room_set).and_then(|set| scorer.closed_room(&set)) {
+            let score = scorer.score(&room, ProbeVisibility::Off)?;
+            rows.push(Row::new(method(&closed(name), region), setting, room.probe_count(), score));
+        }
+        anyhow::Ok(())
+    };
 
     let mut rows = Vec::new();
     let mut captured = 0usize;
@@ -371,18 +490,18 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
             let lattice = Lattice::cell_centres(lo, hi, counts);
             let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
             captured += sh.len();
-            let (setting, probes) = (Setting::Grid(counts), sh.len());
-            let tetra = ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?;
-            let trilinear = ProbeSet::trilinear(lattice, sh)?;
-            rows.push(Row { method: method(TRILINEAR, region), setting, probes, error: error(&trilinear)? });
-            rows.push(Row { method: method(GRID_TETRA, region), setting, probes, error: error(&tetra)? });
-            levels.push((level, lattice, trilinear));
+            let at = (region, Setting::Grid(counts));
+            record(&mut rows, TRILINEAR, at, false, &|_| Ok(ProbeSet::trilinear(lattice, sh.clone())?))?;
+            record(&mut rows, GRID_TETRA, at, false, &|_| {
+                Ok(ProbeSet::tetrahedral(&lattice.positions(), sh.clone())?)
+            })?;
+            levels.push((level, lattice, sh));
         }
         // The candidates: a measured level's captures, or their own.
         let level = params.candidates.unwrap_or(finest);
         let lattice = Lattice::cell_centres(lo, hi, grid_counts(hi - lo, level));
         let sh = match levels.iter().find(|(l, ..)| *l == level) {
-            Some((.., set)) => set.sh.clone(),
+            Some((.., sh)) => sh.clone(),
             None => {
                 let sh = capture_at(ctx, scene, &gpu, params.capture, &lattice.positions())?;
                 captured += sh.len();
@@ -393,28 +512,26 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
             lattice.positions().into_iter().zip(sh).filter(|(p, _)| !solids.contains(p.as_vec3())).unzip();
         // Each grid fitted to the same captures as automatic placement: how much of its gain
         // is the fit and how much the placement.
-        for (_, lattice, trilinear) in levels {
-            let fitted = trilinear.fitted(&positions, &sh)?;
-            let (setting, probes) = (Setting::Grid(lattice.counts), fitted.probe_count());
-            rows.push(Row { method: method(GRID_FITTED, region), setting, probes, error: error(&fitted)? });
+        let (positions, sh) = (&positions, &sh);
+        for (_, lattice, own) in levels {
+            let fitted = |seen: Option<Arc<Occluders>>| {
+                Ok(ProbeSet::trilinear(lattice, own.clone())?.seeing(seen).fitted(positions, sh)?)
+            };
+            record(&mut rows, GRID_FITTED, (region, Setting::Grid(lattice.counts)), true, &fitted)?;
         }
         for &tolerance in params.tolerances {
-            let set = ProbeSet::reduced(&positions, &sh, tolerance)?;
-            let (setting, probes) = (Setting::Tolerance(tolerance), set.probe_count());
-            rows.push(Row { method: method(AUTO_CAPTURED, region), setting, probes, error: error(&set)? });
-            let fitted = set.fitted(&positions, &sh)?;
-            rows.push(Row { method: method(AUTO_UNMOVED, region), setting, probes, error: error(&fitted)? });
-            let placed = ProbeSet::placed(&positions, &sh, tolerance)?;
-            rows.push(Row { method: method(AUTO, region), setting, probes, error: error(&placed)? });
+            let at = (region, Setting::Tolerance(tolerance));
+            let kept = reduce(positions, sh, tolerance)?;
+            let reduced = || ProbeSet::kept(positions, sh, &kept);
+            record(&mut rows, AUTO_CAPTURED, at, false, &|_| Ok(reduced()?))?;
+            let unmoved = |seen: Option<Arc<Occluders>>| Ok(reduced()?.seeing(seen).fitted(positions, sh)?);
+            record(&mut rows, AUTO_UNMOVED, at, true, &unmoved)?;
+            let placed = |seen| Ok(ProbeSet::placed(positions, sh, tolerance, seen)?);
+            record(&mut rows, AUTO, at, true, &placed)?;
         }
         // Every candidate kept: each probe is its own capture, which the fit leaves as it is.
-        let all = ProbeSet::tetrahedral(&positions, sh)?;
-        rows.push(Row {
-            method: method(AUTO, region),
-            setting: Setting::AllCandidates,
-            probes: all.probe_count(),
-            error: error(&all)?,
-        });
+        let all = |_| Ok(ProbeSet::tetrahedral(positions, sh.clone())?);
+        record(&mut rows, AUTO, (region, Setting::AllCandidates), false, &all)?;
     }
 
     // A probe at every test point: what interpolation cannot improve on.
@@ -424,6 +541,24 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
     let capture_ms_per_probe = start.elapsed().as_secs_f64() * 1e3 / captured as f64;
     let floor =
         points.iter().zip(&truth).zip(&direct).map(|((p, e), sh)| squared_error(sh, p, e)).sum::<f64>();
+    let jumps = match &scorer.frames {
+        None => None,
+        Some(f) => {
+            let centres: Vec<DVec3> =
+                frame_points.chunks(NORMALS.len()).map(|c| Vec3::from(c[0].position).as_dvec3()).collect();
+            let captured = capture_at(ctx, scene, &gpu, params.capture, &centres)?;
+            let values: Vec<[f64; 3]> = captured
+                .iter()
+                .flat_map(|sh| NORMALS.map(|n| sh.irradiance(n).map(|e| f64::from(e.max(0.0)))))
+                .collect();
+            Some(FrameJumps {
+                frames: params.path_frames,
+                reference: f.largest_jump(&frame_truth),
+                reference_noise: 2f64.sqrt() * frame_noise / f.rms(),
+                captured: f.largest_jump(&values),
+            })
+        }
+    };
     Ok(Measurement {
         rows,
         path,
@@ -432,13 +567,29 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
         capture_floor: (floor / (3 * truth.len()) as f64).sqrt() / rms_truth,
         capture_ms_per_probe,
         reference_seconds,
+        lookups_off: scorer.off,
+        lookups_rays: scorer.rays,
+        jumps,
     })
 }
 
-/// Σ over channels of (E_sh(n), clamped at 0 as the renderer does, − E)².
-fn squared_error(sh: &ShRgb9, point: &Point, exact: &[f64; 3]) -> f64 {
-    let e = sh.irradiance(Vec3::from(point.normal));
-    (0..3).map(|k| (f64::from(e[k].max(0.0)) - exact[k]).powi(2)).sum()
+/// The moving group's centre (its bounding box's, where the technique looks its light up) at
+/// `frames` + 1 times evenly over its motion, each with the axis normals ([`NORMALS`]).
+fn frame_points(scene: &Scene, frames: usize) -> Result<Vec<Point>> {
+    let group = &scene.groups[moving_group(scene)?];
+    let corners = group.meshes.iter().flat_map(|m| m.positions.iter().map(|p| Vec3::from(*p)));
+    let (lo, hi) = bounds(corners).context("the moving group has no vertices")?;
+    let duration = group.motion.as_ref().map_or(0.0, |m| m.duration());
+    if duration <= 0.0 {
+        bail!("--path-frames: the moving group of scene {} has no motion to follow", scene.name);
+    }
+    let centre = (lo + hi) * 0.5;
+    Ok((0..=frames)
+        .flat_map(|k| {
+            let at = group.pose_at(duration * k as f32 / frames as f32).matrix().transform_point3(centre);
+            NORMALS.map(|n| Point { position: at.to_array(), normal: n.to_array() })
+        })
+        .collect())
 }
 
 /// The moving group whose path the test points follow: the first of the probes' moving groups
@@ -505,18 +656,18 @@ struct Cached {
     irradiance: IrradianceFile,
 }
 
-/// The reference irradiance at `points` (from the cache when it holds these points at this
-/// spp), the RMS of its standard error, and the seconds it took (0 when cached).
+/// The reference irradiance at `points` (from the cache, under `label`, when it holds these
+/// points at this spp), the RMS of its standard error, and the seconds it took (0 when cached).
 fn reference(
     ctx: &Arc<Context>,
     scene: &Scene,
     points: &[Point],
     params: &Params,
+    label: &str,
 ) -> Result<(Vec<[f64; 3]>, f64, f64)> {
-    let path = params.cache.map(|dir| {
-        let region = format!("{:?}", params.test_region).to_lowercase();
-        dir.join(format!("{}-{region}-{}-{}spp.json", scene.name, points.len(), params.spp))
-    });
+    let path = params
+        .cache
+        .map(|dir| dir.join(format!("{}-{label}-{}-{}spp.json", scene.name, points.len(), params.spp)));
     let cached = path.as_ref().and_then(|p| files::read(p, files::JSON).ok()).and_then(|bytes| {
         serde_json::from_slice::<Cached>(&bytes).ok().filter(|c| c.scene == scene.name && c.points == points)
     });
@@ -578,6 +729,9 @@ mod tests {
             spp: 1,
             capture: CaptureSettings::default(),
             cache: None,
+            visibility: &[ProbeVisibility::Rays],
+            closed_room: false,
+            path_frames: 0,
         };
         let static_box = (Vec3::new(-1.0, 0.0, -2.0), Vec3::new(5.0, 3.0, 2.0));
         let points = test_points(&scene, &solids, &params, static_box).unwrap();
@@ -605,17 +759,32 @@ mod tests {
             spp: 64,
             capture: CaptureSettings { cube_size: 8, light: CapturedLight::Sky, ..Default::default() },
             cache: None,
+            visibility: &[ProbeVisibility::Rays, ProbeVisibility::Off],
+            closed_room: true,
+            path_frames: 4,
         };
         let m = measure(&ctx, &scene, &params).unwrap();
         assert_eq!(m.test_points, 4);
         let rows: Vec<_> = m.rows.iter().map(|r| (r.method.as_str(), r.probes)).collect();
         let (tri, tet) = (method(TRILINEAR, Region::Box), method(GRID_TETRA, Region::Box));
+        let tri_off = method(&named(TRILINEAR, ProbeVisibility::Off), Region::Box);
+        let tri_closed = method(&closed(TRILINEAR), Region::Box);
+        // Each set with visibility, without, then its closed room. probe-room is one convex
+        // room: its path's centre sees every probe, so the closed room is the whole set.
+        assert_eq!(&rows[..3], &[(tri.as_str(), 8), (tri_off.as_str(), 8), (tri_closed.as_str(), 8)]);
+        assert_eq!(rows[3], (tet.as_str(), 8));
         // probe-room's box is 4 × 2.5 × 4: level 4 is 4 × 3 × 4.
-        assert_eq!(
-            &rows[..4],
-            &[(tri.as_str(), 8), (tet.as_str(), 8), (tri.as_str(), 48), (tet.as_str(), 48)]
-        );
+        assert_eq!(rows[6], (tri.as_str(), 48));
         assert!(m.rows.iter().all(|r| r.error.is_finite() && r.error >= 0.0));
+        // Nothing hides a probe from the path's centre: no light leaked, visibility or not; and
+        // no test point was sealed off from every probe.
+        assert!(m.rows.iter().all(|r| r.leaked == Some(0.0)), "{:?}", m.rows);
+        assert_eq!(m.lookups_rays.counts.unweighted, 0);
+        // Four frames of the hop: every set's largest jump, the reference's and the captures'.
+        assert!(m.rows.iter().all(|r| r.jump.is_some_and(|j| j.is_finite() && j >= 0.0)));
+        let jumps = m.jumps.unwrap();
+        assert!(jumps.frames == 4 && jumps.reference > 0.0 && jumps.captured > 0.0, "{jumps:?}");
+        assert!(m.lookups_rays.counts.lookups > 0 && m.lookups_off.counts.lookups > 0);
         for region in [Region::Box, Region::Path] {
             let auto: Vec<_> = m.rows.iter().filter(|r| r.method == method(AUTO, region)).collect();
             assert_eq!(auto.len(), 2);

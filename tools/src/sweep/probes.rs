@@ -13,7 +13,7 @@ use crate::chart::Axes;
 use anyhow::{bail, Context as _, Result};
 use kage::sh::ShRgb9;
 use kage::techniques::probes::CaptureSettings;
-use kage::techniques::probes::CapturedLight;
+use kage::techniques::probes::{CapturedLight, ProbeVisibility};
 use std::fmt::Write as _;
 
 /// Tolerances over the whole box, where the kept set grows from 4 probes to 57 between
@@ -50,6 +50,10 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         spp,
         capture: CaptureSettings { cube_size: CUBE_SIZE, light: CapturedLight::Sky, ..Default::default() },
         cache: Some(&cache),
+        // As `kage render` looks probes up by default.
+        visibility: &[ProbeVisibility::Rays],
+        closed_room: false,
+        path_frames: 0,
     };
     let m = measure(&ctx, &scene, &params).with_context(|| format!("scene {}", scene.name))?;
     println!(

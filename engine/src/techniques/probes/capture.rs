@@ -23,6 +23,7 @@
 //! one just behind a single-sided wall sees its back over about half the sphere.
 use super::dering::Dering;
 use super::set::ProbeGroups;
+use super::visibility::Occluders;
 use crate::backend::{
     Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Context, Depth, DepthTest, Edge, Format,
     GraphicsPipeline, Image, ImageDesc, ImageUsage, MemoryLocation, Sampler, VertexAttribute, VertexBuffer,
@@ -318,6 +319,12 @@ impl ProbeCapture {
         Ok(self.settings.dering.apply(&sh))
     }
 
+    /// The static groups as occluders of the probes ([`Occluders`]), from the BVH the
+    /// capture built for its own shadow rays.
+    pub fn occluders(&self) -> Occluders {
+        Occluders::from_bvh(self.statics.clone())
+    }
+
     /// The fraction of [`BACK_FACE_RAYS`] directions from `p` whose first static surface is
     /// met from behind.
     pub fn back_faces(&self, p: Vec3) -> f32 {
@@ -385,7 +392,7 @@ impl ProbeCapture {
 
 /// A copy of `scene` without the meshes of its moving groups (each stays, empty, so that group
 /// indices do not change).
-fn static_scene(scene: &Scene) -> Scene {
+pub(super) fn static_scene(scene: &Scene) -> Scene {
     let groups = ProbeGroups::of(scene);
     let mut statics = scene.clone();
     for (g, group) in statics.groups.iter_mut().enumerate() {

@@ -126,7 +126,7 @@ pub fn fit(rows: &[Vec<(usize, f64)>], captured: &[ShRgb9], own: &[ShRgb9]) -> R
 
 #[cfg(test)]
 mod tests {
-    use super::super::reduce::blend;
+    use super::super::reduce::{blend, reduce};
     use super::super::{Lattice, ProbeSet, Walker};
     use super::*;
     use glam::{DVec3, Vec3};
@@ -223,7 +223,7 @@ mod tests {
             sh
         };
         let sh: Vec<ShRgb9> = positions.iter().map(|&p| field(p)).collect();
-        let captured = ProbeSet::reduced(&positions, &sh, 0.3).unwrap();
+        let captured = ProbeSet::kept(&positions, &sh, &reduce(&positions, &sh, 0.3).unwrap()).unwrap();
         let kept = captured.probe_count();
         assert!(kept < positions.len(), "{kept} kept");
         let before = set_residual(&captured, &positions, &sh);

@@ -18,6 +18,8 @@
 //! grids); a [`Walker`] finds the tetrahedron that holds a point by walking from the previous
 //! one, and gives the barycentric weights of its four probes. Outside the convex hull the weights
 //! are those of the hull's nearest point ([`Location::extrapolated`]), continuous across the hull.
+//! With [`ProbeVisibility::Rays`] (the default) the probes the point cannot see through the
+//! static groups lose their weight ([`Occluders`]): no light through walls.
 //!
 //! Duplicate positions are merged, keeping the first ([`TetMesh::merged`]); fewer than four
 //! distinct positions, or all of them in one plane, is an error
@@ -42,6 +44,7 @@ pub mod technique;
 mod tests;
 mod tetmesh;
 mod trilinear;
+mod visibility;
 
 pub use capture::{
     CaptureSettings, CapturedLight, InvalidProbe, ProbeCapture, BACK_FACE_RAYS, CUBE_SIZES,
@@ -53,9 +56,12 @@ pub use lookup::{Location, Walker};
 pub use reduce::reduce;
 pub use relocate::relocate;
 pub use set::{
-    bounds, capture_at, grid_lattice, ProbeCounts, ProbeGroups, ProbeInterpolation, ProbePlacement, ProbeSet,
-    ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID,
+    bounds, capture_at, grid_lattice, Lookup, ProbeCounts, ProbeGroups, ProbeInterpolation, ProbePlacement,
+    ProbeSet, ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID,
 };
 pub use solids::{Hit, Solids};
 pub use tetmesh::{Across, TetMesh};
 pub use trilinear::Lattice;
+pub use visibility::{
+    LookupCounts, Occluders, ProbeVisibility, Seen, Visibility, NEAREST_TRIES, RAYS_PER_PROBE,
+};

@@ -7,6 +7,7 @@ use super::reduce::{blend, reduce};
 use super::relocate::relocate;
 use super::solids::Solids;
 use super::trilinear::Lattice;
+use super::visibility::{weigh_by_visibility, Occluders, ProbeVisibility, Seen, Visibility};
 use super::{TetMesh, Walker};
 use crate::backend::Context;
 use crate::error::{Error, Result};
@@ -137,6 +138,7 @@ pub struct ProbeSettings {
     pub placement: ProbePlacement,
     pub capture: CaptureSettings,
     pub interpolation: ProbeInterpolation,
+    pub visibility: ProbeVisibility,
     pub statics: StaticLighting,
 }
 
@@ -274,6 +276,17 @@ pub struct ProbeSet {
     /// The probes left out because they are inside geometry ([`ProbeCapture::keep_valid`]): the
     /// mesh holds the others, in their order.
     pub invalid: Vec<InvalidProbe>,
+    /// What hides probes from a lookup point ([`ProbeVisibility::Rays`]); `None`: every probe
+    /// of the cell weighs.
+    pub visibility: Option<Visibility>,
+}
+
+/// The interpolation's weights at a point and what its visibility test did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lookup {
+    /// (probe, weight) pairs: a grid cell's eight, or a tetrahedron's four and four of weight 0.
+    pub weights: [(usize, f64); 8],
+    pub seen: Seen,
 }
 
 impl ProbeSet {
@@ -315,8 +328,11 @@ impl ProbeSet {
         if !progress(candidates, candidates + 1) {
             return Err(cancelled());
         }
-        let mut set = match (&settings.placement, settings.interpolation) {
-            (ProbePlacement::Auto { tolerance, .. }, _) => ProbeSet::placed(&positions, &sh, *tolerance)?,
+        let occluders = (settings.visibility == ProbeVisibility::Rays).then(|| Arc::new(capture.occluders()));
+        let set = match (&settings.placement, settings.interpolation) {
+            (ProbePlacement::Auto { tolerance, .. }, _) => {
+                ProbeSet::placed(&positions, &sh, *tolerance, occluders.clone())?
+            }
             (ProbePlacement::Grid(counts), ProbeInterpolation::Trilinear) => {
                 // A lattice needs every corner: a probe left out leaves a hole no weight fills.
                 if let Some(probe) = invalid.first() {
@@ -329,6 +345,7 @@ impl ProbeSet {
             }
             _ => ProbeSet::tetrahedral(&positions, sh)?,
         };
+        let mut set = set.seeing(occluders);
         set.candidates = candidates;
         set.invalid = invalid;
         progress(candidates + 1, candidates + 1);
@@ -344,6 +361,7 @@ impl ProbeSet {
             trilinear: None,
             candidates,
             invalid: Vec::new(),
+            visibility: None,
         })
     }
 
@@ -354,22 +372,24 @@ impl ProbeSet {
         Ok(set)
     }
 
-    /// Tetrahedral interpolation of those of the SH captured at `positions` that the reduction
-    /// keeps at `tolerance` ([`reduce`]), where it left them and each with its own capture: the
-    /// first step of [`ProbeSet::placed`], measured alone by `kage bench probe-count`.
-    pub fn reduced(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<ProbeSet> {
-        ProbeSet::kept(positions, sh, &reduce(positions, sh, tolerance)?)
-    }
-
     /// Automatic placement at `tolerance` from the SH captured at `positions`, as the engine
-    /// runs it: the probes [`reduce`] keeps, moved by [`relocate`], their SH fitted to `sh`.
-    pub fn placed(positions: &[DVec3], sh: &[ShRgb9], tolerance: f32) -> Result<ProbeSet> {
-        let kept = relocate(positions, sh, reduce(positions, sh, tolerance)?)?;
-        ProbeSet::kept(positions, sh, &kept)?.fitted(positions, sh)
+    /// runs it: the probes [`reduce`] keeps, moved by [`relocate`], their SH fitted to `sh`;
+    /// with `occluders`, the relocation and the fit weigh probes by visibility as the set's
+    /// lookups then do (the reduction does not yet).
+    pub fn placed(
+        positions: &[DVec3],
+        sh: &[ShRgb9],
+        tolerance: f32,
+        occluders: Option<Arc<Occluders>>,
+    ) -> Result<ProbeSet> {
+        let kept = relocate(positions, sh, reduce(positions, sh, tolerance)?, occluders.as_ref())?;
+        ProbeSet::kept(positions, sh, &kept)?.seeing(occluders).fitted(positions, sh)
     }
 
-    /// Tetrahedral interpolation of the SH captured at those of `positions` that `kept` indexes.
-    fn kept(positions: &[DVec3], sh: &[ShRgb9], kept: &[usize]) -> Result<ProbeSet> {
+    /// Tetrahedral interpolation of the SH captured at those of `positions` that `kept` indexes:
+    /// with the indices [`reduce`] keeps, the first step of [`ProbeSet::placed`], measured alone
+    /// by `kage bench probe-count`.
+    pub fn kept(positions: &[DVec3], sh: &[ShRgb9], kept: &[usize]) -> Result<ProbeSet> {
         let points: Vec<DVec3> = kept.iter().map(|&i| positions[i]).collect();
         let mut set = ProbeSet::tetrahedral(&points, kept.iter().map(|&i| sh[i]).collect())?;
         set.candidates = positions.len();
@@ -377,10 +397,18 @@ impl ProbeSet {
     }
 
     /// The set with its probes' SH fitted by least squares to `captured`, the SH captured at
-    /// each of `positions` (see [`super::fit`]).
+    /// each of `positions` (see [`super::fit`]), with the weights its lookups give (by
+    /// visibility when it has occluders).
     pub fn fitted(self, positions: &[DVec3], captured: &[ShRgb9]) -> Result<ProbeSet> {
         let rows = self.rows(positions)?;
         self.fitted_by(&rows, captured)
+    }
+
+    /// The set whose lookups weigh probes by how much of them the point sees through
+    /// `occluders` (`None`: not at all).
+    pub fn seeing(mut self, occluders: Option<Arc<Occluders>>) -> ProbeSet {
+        self.visibility = occluders.map(|o| Visibility::new(o, self.mesh.positions()));
+        self
     }
 
     /// The interpolation's (probe, weight) pairs of weight other than 0 at each of `positions`.
@@ -388,7 +416,10 @@ impl ProbeSet {
         let mut walker = Walker::default();
         positions
             .iter()
-            .map(|&p| Ok(self.weights(&mut walker, p)?.into_iter().filter(|&(_, w)| w != 0.0).collect()))
+            .map(|&p| {
+                let weights = self.lookup(&mut walker, p)?.weights;
+                Ok(weights.into_iter().filter(|&(_, w)| w != 0.0).collect())
+            })
             .collect()
     }
 
@@ -412,12 +443,38 @@ impl ProbeSet {
         }
     }
 
-    /// The SH at `p`: the probes' SH weighted by the trilinear weights of the grid, or by the
-    /// tetrahedral (outside the hull, extrapolation) weights that `walker` finds from where it
-    /// last stopped.
+    /// The SH at `p`: [`ProbeSet::blend`] of the [`ProbeSet::lookup`] there.
     pub fn interpolate(&self, walker: &mut Walker, p: Vec3) -> Result<ShRgb9> {
-        let weights = self.weights(walker, p.as_dvec3())?;
-        Ok(blend(weights.iter().map(|&(probe, w)| (&self.sh[probe], w))))
+        Ok(self.blend(&self.lookup(walker, p.as_dvec3())?.weights))
+    }
+
+    /// The probes' SH weighted by `weights` (probe, weight).
+    pub fn blend(&self, weights: &[(usize, f64)]) -> ShRgb9 {
+        blend(weights.iter().map(|&(probe, w)| (&self.sh[probe], w)))
+    }
+
+    /// The weights at `p`: the trilinear weights of the grid, or the tetrahedral (outside the
+    /// hull, extrapolation) weights that `walker` finds from where it last stopped; with
+    /// [`ProbeSet::visibility`], those of the probes `p` does not see moved to the others
+    /// ([`Visibility`]).
+    pub fn lookup(&self, walker: &mut Walker, p: DVec3) -> Result<Lookup> {
+        self.lookup_with(walker, p, self.visibility.as_ref())
+    }
+
+    /// [`ProbeSet::lookup`] with `visibility` in place of the set's own (`None`: every probe
+    /// weighs), to measure the set both ways.
+    pub fn lookup_with(
+        &self,
+        walker: &mut Walker,
+        p: DVec3,
+        visibility: Option<&Visibility>,
+    ) -> Result<Lookup> {
+        let mut weights = self.weights(walker, p)?;
+        let seen = match visibility {
+            Some(visibility) => weigh_by_visibility(&mut weights, p, self.mesh.positions(), visibility),
+            None => Seen::All,
+        };
+        Ok(Lookup { weights, seen })
     }
 
     /// The interpolation's (probe, weight) pairs at `p`: a grid cell's eight, or a

@@ -3,7 +3,8 @@
 //! irradiance from the probes, E(n) = nᵀMn (Ramamoorthi & Hanrahan 2001) with M from the SH
 //! interpolated at that group's centre by its own walker, which starts where its last frame's
 //! lookup ended (one lookup per moving group per frame, on the host; with trilinear
-//! interpolation, from the grid cell instead), written to its own `ProbeLight` uniform buffer
+//! interpolation, from the grid cell instead; by default without the probes that centre cannot
+//! see, [`super::ProbeVisibility`]), written to its own `ProbeLight` uniform buffer
 //! and bound for its draws; negative irradiance is clamped; times albedo / π. The static groups
 //! keep their own lighting in the same frame and depth buffer: the unshadowed technique's
 //! (environment SH, no shadows) or Sloan's PRT (self-shadowed among the static groups: walls
@@ -11,7 +12,7 @@
 //! environment unrotated: turning the environment afterwards turns the static groups' light,
 //! not the probes'.
 use super::set::{bounds, ProbeGroups, ProbeSet, ProbeSettings, StaticLighting};
-use super::Walker;
+use super::{LookupCounts, Walker};
 use crate::backend::{
     Binding, Buffer, BufferDesc, BufferUsage, Context, Depth, GraphicsPipeline, MemoryLocation,
 };
@@ -58,6 +59,8 @@ pub struct ProbeTechnique {
     groups: ProbeGroups,
     /// One per moving group, in the scene's order.
     lit: Vec<Lit>,
+    /// Every lookup since the technique was built, by what its visibility test did.
+    lookups: LookupCounts,
 }
 
 impl ProbeTechnique {
@@ -118,6 +121,7 @@ impl ProbeTechnique {
             set,
             groups,
             lit,
+            lookups: LookupCounts::default(),
         })
     }
 }
@@ -131,7 +135,9 @@ impl Technique for ProbeTechnique {
             let (Some(centre), Some(transform)) = (lit.centre, state.transforms.get(lit.group)) else {
                 continue;
             };
-            let sh = self.set.interpolate(&mut lit.walker, transform.transform_point3(centre))?;
+            let lookup = self.set.lookup(&mut lit.walker, transform.transform_point3(centre).as_dvec3())?;
+            self.lookups.count(lookup.seen);
+            let sh = self.set.blend(&lookup.weights);
             let [red, green, blue] = sh.irradiance_matrix().map(|m| m.to_cols_array_2d());
             lit.light.write(0, bytes_of(&ProbeLight { red, green, blue }))?;
         }
@@ -177,6 +183,10 @@ impl Technique for ProbeTechnique {
     }
 
     fn stats(&self) -> TechniqueStats {
-        TechniqueStats { probes: Some(self.set.counts()), ..Default::default() }
+        TechniqueStats {
+            probes: Some(self.set.counts()),
+            probe_lookups: Some(self.lookups),
+            ..Default::default()
+        }
     }
 }

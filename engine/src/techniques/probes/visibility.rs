@@ -1,0 +1,348 @@
+//! Visibility-aware interpolation: a probe keeps only the part of its weight that the lookup
+//! point sees of it through the static geometry (none behind a wall), and the weights are
+//! renormalised. Without it a tetrahedron
+//! (or grid cell) spanning a wall blends the light of both sides: in `two-rooms` the dim room's
+//! path took 45–280 times its own irradiance from the sunlit room's probes (BENCHMARKS.md).
+//!
+//! The test, on the host, once per moving group per frame: for each probe of nonzero weight (4
+//! for a tetrahedron, 8 for a grid cell), [`RAYS_PER_PROBE`] rays from the point through the
+//! static groups' BVH, to the probe and to the corners of a cube inscribed in its **free
+//! sphere** (the probe's distance to the nearest surface, [`FREE_FRACTION`] of the first hit
+//! over 14 directions, at most [`SPREAD`] of its distance to the point); the probe keeps the
+//! fraction of its weight whose rays arrive. A wall between point and probe stops every ray,
+//! since the free sphere lies on the probe's side of it; a column stops some. A single ray to
+//! the probe (tried first) cut a probe off behind any thin column and made the atrium's coarse
+//! sets worse (BENCHMARKS.md). Considered and not built: DDGI's per-probe depth moments with a
+//! Chebyshev test (a depth cube per probe, approximate, and made to be read per pixel on the
+//! GPU, which the per-object lookup does not need); a visibility bit per tetrahedron corner
+//! precomputed from the tetrahedron's centre (wrong for a point across a wall inside the
+//! tetrahedron, the leak's own case).
+//!
+//! When the point sees none of its cell's probes, the nearest probe it sees among the
+//! [`NEAREST_TRIES`] nearest takes all the weight ([`Seen::Nearest`]); when it sees none of
+//! those either (it is inside a solid, or sealed off from every probe), the weights stay as they
+//! were ([`Seen::Unweighted`]). Each outcome is counted ([`LookupCounts`]). Never a division by
+//! zero: the weights renormalised sum to more than [`MIN_SEEN_WEIGHT`].
+use super::capture::static_scene;
+use super::solids::directions;
+use crate::error::Result;
+use crate::raycast::SceneBvh;
+use crate::scene::Scene;
+use glam::DVec3;
+use std::sync::Arc;
+
+/// Whether a lookup weighs probes by whether the point sees them.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, strum::FromRepr)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum ProbeVisibility {
+    /// Every probe of the cell keeps its weight: light leaks through walls.
+    Off = 0,
+    /// Rays from the point to each probe of its cell and around it: each keeps the fraction of
+    /// its weight the point sees, a probe behind a wall none.
+    #[default]
+    Rays = 1,
+}
+
+/// Rays from the point to each probe: to its centre and to the 8 corners of a cube in its free
+/// sphere.
+pub const RAYS_PER_PROBE: usize = 9;
+/// The free sphere's radius as a fraction of the nearest surface hit over 14 directions (axes
+/// and diagonals): a plane's nearest point lies within 36.3° of one of them, so the first hit
+/// is at most 1/cos 36.3° = 1.24 times its distance, and 0.8 of it (0.99) stays inside.
+pub const FREE_FRACTION: f64 = 0.8;
+/// The free sphere's radius as a fraction of the probe's distance to the point, at most: seen
+/// from the point it spans at most about 15° on each side.
+pub const SPREAD: f64 = 0.25;
+
+/// The probes nearest a point that sees none of its cell's probes tried, nearest first, before
+/// the lookup gives up and keeps the weights as they were.
+pub const NEAREST_TRIES: usize = 32;
+
+/// The weight the seen probes must hold to be renormalised: below it they are a rounding's
+/// remainder, and the point counts as seeing none.
+pub const MIN_SEEN_WEIGHT: f64 = 1e-9;
+
+/// The static groups' surfaces, which hide probes from a point.
+#[derive(Clone, Debug)]
+pub struct Occluders {
+    bvh: SceneBvh,
+}
+
+impl Occluders {
+    /// The static groups of `scene` (those [`super::ProbeGroups`] does not move).
+    pub fn of_static(scene: &Scene) -> Result<Occluders> {
+        Ok(Occluders { bvh: SceneBvh::build(&static_scene(scene))? })
+    }
+
+    /// Occluders from the static groups' BVH.
+    pub(super) fn from_bvh(bvh: SceneBvh) -> Occluders {
+        Occluders { bvh }
+    }
+
+    /// The distance from `q` to the nearest static surface, times [`FREE_FRACTION`] (see
+    /// there); infinite in open space.
+    fn free_radius(&self, q: DVec3) -> f64 {
+        let q = q.as_vec3();
+        let nearest = directions()
+            .iter()
+            .filter_map(|&d| self.bvh.closest_hit(q, d, f32::INFINITY))
+            .map(|hit| f64::from(hit.t))
+            .fold(f64::INFINITY, f64::min);
+        FREE_FRACTION * nearest
+    }
+
+    /// Whether no static surface lies between `p` and `q`. A surface within a millionth of the
+    /// distance of `q` does not hide it: a probe placed on a wall sees the room it faces.
+    pub fn sees(&self, p: DVec3, q: DVec3) -> bool {
+        let d = q - p;
+        if d == DVec3::ZERO {
+            return true;
+        }
+        // The BVH measures t in units of the direction: t = 1 is q.
+        !self.bvh.occluded(p.as_vec3(), d.as_vec3(), 1.0 - 1e-6)
+    }
+}
+
+/// The occluders and each probe's free sphere: what a set's lookups test visibility with.
+#[derive(Clone, Debug)]
+pub struct Visibility {
+    occluders: Arc<Occluders>,
+    /// Each probe's free radius ([`Occluders::free_radius`]), in the order of its positions.
+    free: Vec<f64>,
+}
+
+impl Visibility {
+    /// For probes at `positions` (14 rays each).
+    pub fn new(occluders: Arc<Occluders>, positions: &[DVec3]) -> Visibility {
+        let free = positions.iter().map(|&q| occluders.free_radius(q)).collect();
+        Visibility { occluders, free }
+    }
+
+    /// The fraction of the [`RAYS_PER_PROBE`] rays from `p` to probe `probe` at `q` that no
+    /// static surface stops.
+    fn seen_fraction(&self, p: DVec3, probe: usize, q: DVec3) -> f64 {
+        let radius = self.free[probe].min(SPREAD * p.distance(q)) / 3f64.sqrt();
+        let corner = |k: usize| DVec3::new(bit(k, 1), bit(k, 2), bit(k, 4)) * radius;
+        let seen = std::iter::once(q)
+            .chain((0..RAYS_PER_PROBE - 1).map(|k| q + corner(k)))
+            .filter(|&target| self.occluders.sees(p, target))
+            .count();
+        seen as f64 / RAYS_PER_PROBE as f64
+    }
+}
+
+/// ±1 by bit `mask` of `k`: the cube corners.
+fn bit(k: usize, mask: usize) -> f64 {
+    if k & mask == 0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// What a lookup's visibility test did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Seen {
+    /// The point sees every probe of nonzero weight (or visibility is off).
+    All,
+    /// Some were hidden, wholly or partly: the weights times the fractions seen, renormalised.
+    Some,
+    /// None was seen: the nearest probe it sees alone.
+    Nearest,
+    /// No probe among the [`NEAREST_TRIES`] nearest is seen: the weights as they were.
+    Unweighted,
+}
+
+/// Lookups counted by what their visibility test did (see [`Seen`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LookupCounts {
+    pub lookups: u64,
+    /// Lookups where some probe was hidden, wholly or partly, and the weights renormalised.
+    pub renormalised: u64,
+    /// Lookups that fell back to the nearest probe seen.
+    pub nearest: u64,
+    /// Lookups that saw no probe and kept the weights as they were.
+    pub unweighted: u64,
+}
+
+impl LookupCounts {
+    pub fn count(&mut self, seen: Seen) {
+        self.lookups += 1;
+        match seen {
+            Seen::All => {}
+            Seen::Some => self.renormalised += 1,
+            Seen::Nearest => self.nearest += 1,
+            Seen::Unweighted => self.unweighted += 1,
+        }
+    }
+}
+
+/// Multiplies the weight of each probe of `weights` (index into `positions`, weight) by the
+/// fraction of it that `p` sees and renormalises them (see the module documentation for the
+/// fallbacks).
+pub(super) fn weigh_by_visibility<const N: usize>(
+    weights: &mut [(usize, f64); N],
+    p: DVec3,
+    positions: &[DVec3],
+    visibility: &Visibility,
+) -> Seen {
+    let mut seen_weight = 0.0;
+    let mut hidden = false;
+    let before = *weights;
+    for (probe, w) in weights.iter_mut().filter(|(_, w)| *w != 0.0) {
+        let seen = visibility.seen_fraction(p, *probe, positions[*probe]);
+        *w *= seen;
+        seen_weight += *w;
+        hidden |= seen < 1.0;
+    }
+    if !hidden {
+        return Seen::All;
+    }
+    if seen_weight > MIN_SEEN_WEIGHT {
+        weights.iter_mut().for_each(|(_, w)| *w /= seen_weight);
+        return Seen::Some;
+    }
+    match nearest_seen(p, positions, &visibility.occluders) {
+        Some(probe) => {
+            *weights = [(probe, 0.0); N];
+            weights[0].1 = 1.0;
+            Seen::Nearest
+        }
+        None => {
+            *weights = before;
+            Seen::Unweighted
+        }
+    }
+}
+
+/// The nearest of the [`NEAREST_TRIES`] probes nearest `p` that `p` sees.
+fn nearest_seen(p: DVec3, positions: &[DVec3], occluders: &Occluders) -> Option<usize> {
+    let mut near: Vec<(f64, usize)> = positions.iter().map(|q| (q - p).length_squared()).zip(0..).collect();
+    let cmp = |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    if near.len() > NEAREST_TRIES {
+        near.select_nth_unstable_by(NEAREST_TRIES, cmp);
+        near.truncate(NEAREST_TRIES);
+    }
+    near.sort_unstable_by(cmp);
+    near.into_iter().map(|(_, i)| i).find(|&i| occluders.sees(p, positions[i]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::motion::Key;
+    use crate::scene::{shapes, Camera, EnvMap, Group, Motion, Transform};
+    use glam::Vec3;
+
+    /// A wall 0.1 thick at x = 0 (y and z within ±2), a sealed box around (0, 0, 5), a pole 4 cm
+    /// thick along Y through (2, y, 0), and a moving ball far away (so that the rest is static).
+    fn walled() -> Arc<Occluders> {
+        let wall = shapes::boxes(
+            "wall",
+            &[([-0.05, -2.0, -2.0], [0.05, 2.0, 2.0]), ([1.98, -2.0, -0.02], [2.02, 2.0, 0.02])],
+            [0.5; 3],
+        )
+        .unwrap();
+        let sealed = shapes::boxes("sealed", &[([-0.5, -0.5, 4.5], [0.5, 0.5, 5.5])], [0.5; 3]).unwrap();
+        let ball = shapes::boxes("ball", &[([-0.1; 3], [0.1; 3])], [0.5; 3]).unwrap();
+        let at = Transform { translation: Vec3::splat(50.0), ..Transform::default() };
+        let motion = Motion { keys: vec![Key::posed(0.0, at)], loop_seconds: None };
+        let scene = Scene {
+            name: "walled".into(),
+            groups: vec![
+                Group { motion: Some(motion), ..Group::new("ball", vec![ball], at) },
+                Group::new("walls", vec![wall, sealed], Transform::default()),
+            ],
+            environment: EnvMap::constant([1.0; 3]),
+            lights: vec![],
+            walkthrough: vec![],
+            probes: vec![],
+            exposure: 1.0,
+            camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        };
+        Arc::new(Occluders::of_static(&scene).unwrap())
+    }
+
+    /// Probes 0 and 1 west of the wall, 2 and 3 east of it, 4 inside the sealed box.
+    const PROBES: [DVec3; 5] = [
+        DVec3::new(-1.0, 0.0, -1.0),
+        DVec3::new(-1.0, 0.0, 1.0),
+        DVec3::new(1.0, 0.0, -1.0),
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(0.0, 0.0, 5.0),
+    ];
+
+    #[test]
+    fn the_wall_hides_what_is_behind_it_and_nothing_else() {
+        let occluders = walled();
+        let east = DVec3::new(0.3, 0.0, 0.0);
+        assert!(occluders.sees(east, PROBES[2]) && occluders.sees(east, PROBES[3]));
+        assert!(!occluders.sees(east, PROBES[0]) && !occluders.sees(PROBES[1], east));
+        // Above the wall's top nothing hides the other side.
+        assert!(occluders.sees(DVec3::new(0.3, 2.5, 0.0), DVec3::new(-1.0, 2.5, 0.0)));
+        // A probe on the wall's east face is seen from the east.
+        assert!(occluders.sees(east, DVec3::new(0.05, 0.0, 0.5)));
+    }
+
+    #[test]
+    fn hidden_probes_lose_their_weight_and_the_others_are_renormalised() {
+        let visibility = Visibility::new(walled(), &PROBES);
+        let mut weights = [(0, 0.2), (1, 0.2), (2, 0.36), (3, 0.24)];
+        let seen = weigh_by_visibility(&mut weights, DVec3::new(0.3, 0.0, 0.0), &PROBES, &visibility);
+        assert_eq!(seen, Seen::Some);
+        // 0.36 and 0.24 of 0.6, to rounding.
+        let expected = [0.0, 0.0, 0.6, 0.4];
+        assert!(weights.iter().zip(expected).all(|(w, e)| (w.1 - e).abs() < 1e-12), "{weights:?}");
+        // All seen: unchanged.
+        let mut same = [(2, 0.5), (3, 0.5)];
+        assert_eq!(
+            weigh_by_visibility(&mut same, DVec3::new(0.5, 0.0, 0.0), &PROBES, &visibility),
+            Seen::All
+        );
+        assert_eq!(same, [(2, 0.5), (3, 0.5)]);
+    }
+
+    #[test]
+    fn a_point_seeing_none_of_its_probes_takes_the_nearest_it_sees_or_keeps_its_weights() {
+        let visibility = Visibility::new(walled(), &PROBES);
+        let mut counts = LookupCounts::default();
+        // East of the wall, weighted on the west probes only: the nearest east probe, 2.
+        let mut weights = [(0, 0.5), (1, 0.5)];
+        let seen = weigh_by_visibility(&mut weights, DVec3::new(0.9, 0.0, -0.5), &PROBES, &visibility);
+        counts.count(seen);
+        assert_eq!((seen, weights), (Seen::Nearest, [(2, 1.0), (2, 0.0)]));
+        // Inside the sealed box, weighted on the outside probes: it sees only probe 4, which
+        // is not among the weighted ones, so it falls back to it.
+        let mut inside = [(2, 0.5), (3, 0.5)];
+        let seen = weigh_by_visibility(&mut inside, DVec3::new(0.2, 0.0, 5.0), &PROBES, &visibility);
+        counts.count(seen);
+        assert_eq!((seen, inside), (Seen::Nearest, [(4, 1.0), (4, 0.0)]));
+        // Inside the sealed box with no probe in it: no probe seen, the weights as they were.
+        let outside = [PROBES[0], PROBES[1], PROBES[2], PROBES[3]];
+        let visibility = Visibility::new(walled(), &outside);
+        let mut kept = [(2, 0.5), (3, 0.5)];
+        let seen = weigh_by_visibility(&mut kept, DVec3::new(0.2, 0.0, 5.0), &outside, &visibility);
+        counts.count(seen);
+        assert_eq!((seen, kept), (Seen::Unweighted, [(2, 0.5), (3, 0.5)]));
+        assert_eq!(counts, LookupCounts { lookups: 3, renormalised: 0, nearest: 2, unweighted: 1 });
+    }
+
+    #[test]
+    fn a_thin_pole_hides_part_of_a_probe_and_a_wall_all_of_it() {
+        let occluders = walled();
+        // The pole stops the ray to the probe's centre, not those to its free sphere's corners
+        // (0.5 from it at most: its distance to the point times SPREAD; the pole is 0.98 away).
+        let (p, behind_pole) = (DVec3::new(1.0, 0.0, 0.0), DVec3::new(3.0, 0.0, 0.0));
+        let probes = [behind_pole, DVec3::new(-1.0, 0.0, 0.0)];
+        let visibility = Visibility::new(occluders, &probes);
+        let fraction = (RAYS_PER_PROBE as f64 - 1.0) / RAYS_PER_PROBE as f64;
+        assert_eq!(visibility.seen_fraction(p, 0, probes[0]), fraction);
+        assert_eq!(visibility.seen_fraction(p, 1, probes[1]), 0.0);
+        // The probe behind the pole keeps its weight (renormalised: all of it) where a single
+        // ray to its centre would have cut it off; the one behind the wall loses its.
+        let mut weights = [(0, 0.5), (1, 0.5)];
+        assert_eq!(weigh_by_visibility(&mut weights, p, &probes, &visibility), Seen::Some);
+        assert!((weights[0].1 - 1.0).abs() < 1e-12 && weights[1].1 == 0.0, "{weights:?}");
+    }
+}
