@@ -23,7 +23,7 @@ use std::path::Path;
 
 pub mod albedo_map;
 pub mod animation;
-mod builtin;
+pub(crate) mod builtin;
 mod camera;
 pub mod clusters;
 pub mod envmap;

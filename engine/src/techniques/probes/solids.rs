@@ -125,4 +125,57 @@ mod tests {
         assert!((hit.distance - 1.0).abs() < 1e-6 && !hit.back, "{hit:?}");
         assert!(solids.first_hit(Vec3::new(0.5, 1.0, 0.5), Vec3::X).unwrap().back);
     }
+
+    /// The built-in atrium as the probes see it (its dimensions from the scene's module).
+    mod atrium {
+        use super::super::Solids;
+        use crate::scene::builtin::atrium::{BUNNY_HEIGHT, COLUMN, COLUMN_SPACING, COURT, GALLERY, SPRING};
+        use crate::scene::Scene;
+        use glam::Vec3;
+
+        #[test]
+        fn the_camera_sees_the_sky() {
+            let scene = Scene::builtin("atrium").unwrap();
+            let solids = Solids::of_static(&scene);
+            let c = scene.camera.position;
+            assert!(!solids.contains(c) && solids.first_hit(c, Vec3::Y).is_none(), "the camera sees the sky");
+        }
+
+        #[test]
+        fn the_bunny_moves_from_the_sun_into_the_shade_through_the_open_arch() {
+            let scene = Scene::builtin("atrium").unwrap();
+            let solids = Solids::of_static(&scene);
+            let bunny = &scene.groups[0];
+            let above = |t: f32| {
+                let top = bunny.pose_at(t).matrix().transform_point3(Vec3::new(0.0, BUNNY_HEIGHT, 0.0));
+                solids.first_hit(top, Vec3::Y)
+            };
+            // At a quarter cycle it is 90 cm into the gallery (+X), under the roof; at three
+            // quarters 90 cm into the courtyard, under the sky.
+            assert!(above(0.25).is_some_and(|h| !h.back), "in the gallery, the roof above");
+            assert!(above(0.75).is_none(), "in the courtyard, nothing above");
+            // Along the whole path its middle is in free space and not in a column: the arch's
+            // opening is wider than the bunny.
+            for s in 0..32 {
+                let t = s as f32 / 32.0;
+                let middle =
+                    bunny.pose_at(t).matrix().transform_point3(Vec3::new(0.0, 0.5 * BUNNY_HEIGHT, 0.0));
+                assert!(!solids.contains(middle), "t = {t}: {middle}");
+                assert!(middle.z.abs() < 0.5 * (COLUMN_SPACING - COLUMN), "{middle}");
+            }
+        }
+
+        #[test]
+        fn arches_close_the_arcade_above_the_springs_and_leave_it_open_below() {
+            let scene = Scene::builtin("atrium").unwrap();
+            let solids = Solids::of_static(&scene);
+            // Across the arch at z = 0 (mid-span): open under the crown, closed above it.
+            let crown = SPRING + 0.5 * (COLUMN_SPACING - COLUMN);
+            let from_court = |y: f32| solids.first_hit(Vec3::new(0.0, y, 0.0), Vec3::X).map(|h| h.distance);
+            assert!(from_court(crown - 0.05).unwrap() > GALLERY, "under the crown the gallery's wall is met");
+            assert!((from_court(crown + 0.05).unwrap() - (COURT - 0.5 * COLUMN)).abs() < 1e-4);
+            // Inside a column is solid.
+            assert!(solids.contains(Vec3::new(COURT, 1.0, 1.0)));
+        }
+    }
 }
