@@ -89,7 +89,7 @@ impl Hull {
 }
 
 /// The barycentric weights of the point of triangle t nearest p, and the squared distance.
-fn closest_on_triangle(p: DVec3, t: [DVec3; 3]) -> ([f64; 3], f64) {
+pub(super) fn closest_on_triangle(p: DVec3, t: [DVec3; 3]) -> ([f64; 3], f64) {
     let [a, b, c] = t;
     let n = (b - a).cross(c - a);
     let area2 = n.length_squared();

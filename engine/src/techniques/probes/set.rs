@@ -281,11 +281,13 @@ pub struct ProbeSet {
     pub visibility: Option<Visibility>,
 }
 
+/// (probe, weight) pairs: a grid cell's eight, or a tetrahedron's four and four of weight 0.
+pub type Weights = [(usize, f64); 8];
+
 /// The interpolation's weights at a point and what its visibility test did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lookup {
-    /// (probe, weight) pairs: a grid cell's eight, or a tetrahedron's four and four of weight 0.
-    pub weights: [(usize, f64); 8],
+    pub weights: Weights,
     pub seen: Seen,
 }
 
@@ -469,28 +471,32 @@ impl ProbeSet {
         p: DVec3,
         visibility: Option<&Visibility>,
     ) -> Result<Lookup> {
-        let mut weights = self.weights(walker, p)?;
+        let (mut weights, tet) = self.weights(walker, p)?;
         let seen = match visibility {
-            Some(visibility) => weigh_by_visibility(&mut weights, p, self.mesh.positions(), visibility),
+            Some(visibility) => {
+                let cell = tet.map(|tet| (&self.mesh, tet));
+                weigh_by_visibility(&mut weights, p, self.mesh.positions(), visibility, cell)
+            }
             None => Seen::All,
         };
         Ok(Lookup { weights, seen })
     }
 
     /// The interpolation's (probe, weight) pairs at `p`: a grid cell's eight, or a
-    /// tetrahedron's four and four of weight 0.
-    fn weights(&self, walker: &mut Walker, p: DVec3) -> Result<[(usize, f64); 8]> {
+    /// tetrahedron's four and four of weight 0, with the tetrahedron.
+    fn weights(&self, walker: &mut Walker, p: DVec3) -> Result<(Weights, Option<u32>)> {
         if let Some(lattice) = &self.trilinear {
-            return Ok(lattice.weights(p).map(|(probe, w)| (probe as usize, w)));
+            return Ok((lattice.weights(p).map(|(probe, w)| (probe as usize, w)), None));
         }
         let location = walker.locate(&self.mesh, p)?;
-        Ok(std::array::from_fn(|k| {
+        let weights = std::array::from_fn(|k| {
             if k < 4 {
                 (location.probes[k] as usize, location.weights[k])
             } else {
                 (0, 0.0)
             }
-        }))
+        });
+        Ok((weights, Some(location.tet)))
     }
 }
 

@@ -18,13 +18,23 @@
 //! precomputed from the tetrahedron's centre (wrong for a point across a wall inside the
 //! tetrahedron, the leak's own case).
 //!
+//! A tetrahedron across a wall keeps only its 1–3 corners on the point's side, and their
+//! renormalised weights are coarser than the room's own tetrahedra (1.41 times the error of the
+//! dim room's probes alone in `two-rooms`'s 16-probe grid): when a corner is wholly hidden, the
+//! weights are instead those of the nearest point on the nearest face, among the tetrahedra
+//! within [`FACE_SEARCH_STEPS`], whose three corners the point sees ([`nearest_seen_face`]), as
+//! the hull's nearest point stands in outside the hull (1.00 times, BENCHMARKS.md).
+//!
 //! When the point sees none of its cell's probes, the nearest probe it sees among the
 //! [`NEAREST_TRIES`] nearest takes all the weight ([`Seen::Nearest`]); when it sees none of
 //! those either (it is inside a solid, or sealed off from every probe), the weights stay as they
 //! were ([`Seen::Unweighted`]). Each outcome is counted ([`LookupCounts`]). Never a division by
 //! zero: the weights renormalised sum to more than [`MIN_SEEN_WEIGHT`].
 use super::capture::static_scene;
+use super::delaunay::opposite;
+use super::extrapolate::closest_on_triangle;
 use super::solids::directions;
+use super::tetmesh::{Across, TetMesh};
 use crate::error::Result;
 use crate::raycast::SceneBvh;
 use crate::scene::Scene;
@@ -54,6 +64,10 @@ pub const FREE_FRACTION: f64 = 0.8;
 /// The free sphere's radius as a fraction of the probe's distance to the point, at most: seen
 /// from the point it spans at most about 15° on each side.
 pub const SPREAD: f64 = 0.25;
+
+/// Steps through neighbouring tetrahedra within which a tetrahedron with a corner wholly hidden
+/// looks for the nearest face whose corners the point sees.
+pub const FACE_SEARCH_STEPS: usize = 2;
 
 /// The probes nearest a point that sees none of its cell's probes tried, nearest first, before
 /// the lookup gives up and keeps the weights as they were.
@@ -180,24 +194,37 @@ impl LookupCounts {
 
 /// Multiplies the weight of each probe of `weights` (index into `positions`, weight) by the
 /// fraction of it that `p` sees and renormalises them (see the module documentation for the
-/// fallbacks).
+/// fallbacks). With `cell`, the tetrahedral mesh and tetrahedron the weights come from: when a
+/// corner is wholly hidden, the weights are instead those of the nearest face p sees
+/// ([`nearest_seen_face`]).
 pub(super) fn weigh_by_visibility<const N: usize>(
     weights: &mut [(usize, f64); N],
     p: DVec3,
     positions: &[DVec3],
     visibility: &Visibility,
+    cell: Option<(&TetMesh, u32)>,
 ) -> Seen {
     let mut seen_weight = 0.0;
-    let mut hidden = false;
+    let (mut hidden, mut wholly) = (false, false);
     let before = *weights;
+    let mut fractions = Vec::with_capacity(N);
     for (probe, w) in weights.iter_mut().filter(|(_, w)| *w != 0.0) {
         let seen = visibility.seen_fraction(p, *probe, positions[*probe]);
+        fractions.push((*probe, seen));
         *w *= seen;
         seen_weight += *w;
         hidden |= seen < 1.0;
+        wholly |= seen == 0.0;
     }
     if !hidden {
         return Seen::All;
+    }
+    if let (true, Some((mesh, tet))) = (wholly, cell) {
+        if let Some(face) = nearest_seen_face(mesh, tet, p, visibility, &mut fractions) {
+            *weights = [(face[0].0, 0.0); N];
+            weights[..3].copy_from_slice(&face);
+            return Seen::Some;
+        }
     }
     if seen_weight > MIN_SEEN_WEIGHT {
         weights.iter_mut().for_each(|(_, w)| *w /= seen_weight);
@@ -214,6 +241,66 @@ pub(super) fn weigh_by_visibility<const N: usize>(
             Seen::Unweighted
         }
     }
+}
+
+/// The weights of the point nearest `p` on the faces of the tetrahedra within
+/// [`FACE_SEARCH_STEPS`] of `tet` whose three corners `p` sees, each weight times the fraction
+/// seen, renormalised; `None` when there is no such face. A tetrahedron across a wall keeps
+/// only its 1–3 corners on `p`'s side, whose renormalised weights are coarser than the room's
+/// own tetrahedra: the nearest face wholly in the room stands for those, as the hull's nearest
+/// point does outside the hull. `fractions`: the fractions known so far, (probe, fraction).
+fn nearest_seen_face(
+    mesh: &TetMesh,
+    tet: u32,
+    p: DVec3,
+    visibility: &Visibility,
+    fractions: &mut Vec<(usize, f64)>,
+) -> Option<[(usize, f64); 3]> {
+    let positions = mesh.positions();
+    let mut tets = vec![tet];
+    let mut reached = 0;
+    for _ in 0..FACE_SEARCH_STEPS {
+        let end = tets.len();
+        for t in reached..end {
+            for across in mesh.neighbours()[tets[t] as usize] {
+                if let Across::Tet(next) = across {
+                    if !tets.contains(&next) {
+                        tets.push(next);
+                    }
+                }
+            }
+        }
+        reached = end;
+    }
+    let mut fraction = |probe: usize| match fractions.iter().find(|(i, _)| *i == probe) {
+        Some(&(_, f)) => f,
+        None => {
+            let f = visibility.seen_fraction(p, probe, positions[probe]);
+            fractions.push((probe, f));
+            f
+        }
+    };
+    let mut best: Option<(f64, [(usize, f64); 3])> = None;
+    for &t in &tets {
+        for slot in 0..4 {
+            let face = opposite(mesh.tets()[t as usize], slot).map(|i| i as usize);
+            let seen = face.map(&mut fraction);
+            if seen.contains(&0.0) {
+                continue;
+            }
+            let (w, distance2) = closest_on_triangle(p, face.map(|i| positions[i]));
+            if best.is_none_or(|(d, _)| distance2 < d) {
+                best = Some((distance2, std::array::from_fn(|k| (face[k], w[k] * seen[k]))));
+            }
+        }
+    }
+    let (_, mut face) = best?;
+    let sum: f64 = face.iter().map(|w| w.1).sum();
+    if sum <= MIN_SEEN_WEIGHT {
+        return None;
+    }
+    face.iter_mut().for_each(|w| w.1 /= sum);
+    Some(face)
 }
 
 /// The nearest of the [`NEAREST_TRIES`] probes nearest `p` that `p` sees.
@@ -289,7 +376,7 @@ mod tests {
     fn hidden_probes_lose_their_weight_and_the_others_are_renormalised() {
         let visibility = Visibility::new(walled(), &PROBES);
         let mut weights = [(0, 0.2), (1, 0.2), (2, 0.36), (3, 0.24)];
-        let seen = weigh_by_visibility(&mut weights, DVec3::new(0.3, 0.0, 0.0), &PROBES, &visibility);
+        let seen = weigh_by_visibility(&mut weights, DVec3::new(0.3, 0.0, 0.0), &PROBES, &visibility, None);
         assert_eq!(seen, Seen::Some);
         // 0.36 and 0.24 of 0.6, to rounding.
         let expected = [0.0, 0.0, 0.6, 0.4];
@@ -297,7 +384,7 @@ mod tests {
         // All seen: unchanged.
         let mut same = [(2, 0.5), (3, 0.5)];
         assert_eq!(
-            weigh_by_visibility(&mut same, DVec3::new(0.5, 0.0, 0.0), &PROBES, &visibility),
+            weigh_by_visibility(&mut same, DVec3::new(0.5, 0.0, 0.0), &PROBES, &visibility, None),
             Seen::All
         );
         assert_eq!(same, [(2, 0.5), (3, 0.5)]);
@@ -309,20 +396,20 @@ mod tests {
         let mut counts = LookupCounts::default();
         // East of the wall, weighted on the west probes only: the nearest east probe, 2.
         let mut weights = [(0, 0.5), (1, 0.5)];
-        let seen = weigh_by_visibility(&mut weights, DVec3::new(0.9, 0.0, -0.5), &PROBES, &visibility);
+        let seen = weigh_by_visibility(&mut weights, DVec3::new(0.9, 0.0, -0.5), &PROBES, &visibility, None);
         counts.count(seen);
         assert_eq!((seen, weights), (Seen::Nearest, [(2, 1.0), (2, 0.0)]));
         // Inside the sealed box, weighted on the outside probes: it sees only probe 4, which
         // is not among the weighted ones, so it falls back to it.
         let mut inside = [(2, 0.5), (3, 0.5)];
-        let seen = weigh_by_visibility(&mut inside, DVec3::new(0.2, 0.0, 5.0), &PROBES, &visibility);
+        let seen = weigh_by_visibility(&mut inside, DVec3::new(0.2, 0.0, 5.0), &PROBES, &visibility, None);
         counts.count(seen);
         assert_eq!((seen, inside), (Seen::Nearest, [(4, 1.0), (4, 0.0)]));
         // Inside the sealed box with no probe in it: no probe seen, the weights as they were.
         let outside = [PROBES[0], PROBES[1], PROBES[2], PROBES[3]];
         let visibility = Visibility::new(walled(), &outside);
         let mut kept = [(2, 0.5), (3, 0.5)];
-        let seen = weigh_by_visibility(&mut kept, DVec3::new(0.2, 0.0, 5.0), &outside, &visibility);
+        let seen = weigh_by_visibility(&mut kept, DVec3::new(0.2, 0.0, 5.0), &outside, &visibility, None);
         counts.count(seen);
         assert_eq!((seen, kept), (Seen::Unweighted, [(2, 0.5), (3, 0.5)]));
         assert_eq!(counts, LookupCounts { lookups: 3, renormalised: 0, nearest: 2, unweighted: 1 });
@@ -342,7 +429,27 @@ mod tests {
         // The probe behind the pole keeps its weight (renormalised: all of it) where a single
         // ray to its centre would have cut it off; the one behind the wall loses its.
         let mut weights = [(0, 0.5), (1, 0.5)];
-        assert_eq!(weigh_by_visibility(&mut weights, p, &probes, &visibility), Seen::Some);
+        assert_eq!(weigh_by_visibility(&mut weights, p, &probes, &visibility, None), Seen::Some);
         assert!((weights[0].1 - 1.0).abs() < 1e-12 && weights[1].1 == 0.0, "{weights:?}");
+    }
+
+    #[test]
+    fn a_tetrahedron_across_the_wall_takes_the_nearest_face_on_the_points_side() {
+        // A cube of probes across the wall: every tetrahedron holding a point east of it has
+        // west corners, wholly hidden.
+        let positions: Vec<DVec3> = (0..8).map(|k| DVec3::new(bit(k, 1), bit(k, 2), bit(k, 4))).collect();
+        let mesh = TetMesh::build(&positions).unwrap();
+        let visibility = Visibility::new(walled(), &positions);
+        let p = DVec3::new(0.3, 0.2, -0.4);
+        let location = super::super::Walker::default().locate(&mesh, p).unwrap();
+        let mut weights: [(usize, f64); 4] =
+            std::array::from_fn(|k| (location.probes[k] as usize, location.weights[k]));
+        let seen = weigh_by_visibility(&mut weights, p, &positions, &visibility, Some((&mesh, location.tet)));
+        assert_eq!(seen, Seen::Some);
+        // All the weight on the east face x = 1, reproducing p's projection onto it (1, 0.2,
+        // −0.4), as the east probes alone would extrapolate it; rounding of a few operations.
+        let at: DVec3 = weights.iter().map(|&(i, w)| positions[i] * w).sum();
+        assert!(weights.iter().all(|&(i, w)| w == 0.0 || positions[i].x == 1.0), "{weights:?}");
+        assert!(at.abs_diff_eq(DVec3::new(1.0, 0.2, -0.4), 1e-12), "{at}");
     }
 }
