@@ -862,8 +862,7 @@ fn c_abi_places_probes_and_reports_them() {
     let off = ProbeVisibility::Off as u32;
     let (code, renderer) = create(capi::technique::kage_technique_desc { probe_visibility: off, ..probes });
     assert_eq!(code, kage_result::Ok, "{}", last_error());
-    // SAFETY: a live renderer.
-    unsafe { assert_eq!(capi::renderer::kage_renderer_destroy(renderer), kage_result::Ok) };
+    assert_eq!(capi::renderer::kage_renderer_destroy(renderer), kage_result::Ok);
 
     let hanning = kage_probe_dering::Hanning as u32;
     let trilinear = ProbeInterpolation::Trilinear as u32;

@@ -252,14 +252,10 @@ fn a_scene_file_takes_its_geometry_from_gltf() {
 
     let named = Scene::load(&write("named.json", r#", "gltf_camera": "camera""#)).unwrap();
     assert_eq!(named.camera, from_gltf.camera, "the camera's node is named \"camera\"");
-    for (file, extra, expected) in [(
-        "missing.json",
-        r#", "gltf_camera": "nobody""#,
-        "no camera named \"nobody\" (its cameras and their nodes: \"camera\")",
-    )] {
-        let message = Scene::load(&write(file, extra)).unwrap_err().to_string();
-        assert!(message.contains(file) && message.contains(expected), "{message}");
-    }
+    let message =
+        Scene::load(&write("missing.json", r#", "gltf_camera": "nobody""#)).unwrap_err().to_string();
+    let expected = "no camera named \"nobody\" (its cameras and their nodes: \"camera\")";
+    assert!(message.contains("missing.json") && message.contains(expected), "{message}");
     let lone = dir.join("lone.json");
     std::fs::write(&lone, r#"{"gltf_camera": "camera", "environment": {"constant": [1, 1, 1]}, "camera": {"position": [0, 0, 1], "target": [0, 0, 0], "fov_y_deg": 40}}"#).unwrap();
     let message = Scene::load(&lone).unwrap_err().to_string();
