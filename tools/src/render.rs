@@ -11,10 +11,7 @@ use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::MB;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
-use kage::techniques::probes::{
-    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSettings, ProbeVisibility,
-    StaticLighting, DEFAULT_GRID, DEFAULT_TOLERANCE,
-};
+use kage::techniques::probes::{ProbePlacement, ProbeSettings, DEFAULT_GRID, DEFAULT_TOLERANCE};
 use kage::techniques::tamura::technique::OcclusionSettings;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -39,33 +36,8 @@ pub struct RenderArgs {
     /// irradiance error TOL, default 0.05, dropped).
     #[arg(long, default_value_t = format!("grid:{},{},{}", DEFAULT_GRID[0], DEFAULT_GRID[1], DEFAULT_GRID[2]))]
     probes: String,
-    /// How the light between probes is found: `trilinear` needs a `grid:` placement.
-    #[arg(long, value_enum, default_value_t = ProbeSettings::default().interpolation)]
-    probe_interpolation: ProbeInterpolation,
-    /// Whether a moving group's lookup leaves out the probes its centre cannot see through the
-    /// static groups (`rays`), so that no light comes through walls.
-    #[arg(long, value_enum, default_value_t = ProbeSettings::default().visibility)]
-    probe_visibility: ProbeVisibility,
-    /// How the probes technique lights the static groups beside the probe-lit moving ones.
-    #[arg(long, value_enum, default_value_t = ProbeSettings::default().statics)]
-    probe_statics: StaticLighting,
-    /// Texels per side of a probe's cube-map face, 8 to 256.
-    #[arg(long, default_value_t = CaptureSettings::default().cube_size)]
-    probe_cube_size: u32,
-    /// What the probes capture besides the sky they see.
-    #[arg(long, value_enum, default_value_t = CaptureSettings::default().light)]
-    probe_light: CapturedLight,
-    /// Reflections of the walls' light the probes capture: 1 (walls lit directly) or 2 (and
-    /// by each other once).
-    #[arg(long, default_value_t = CaptureSettings::default().bounces)]
-    probe_bounces: u32,
-    /// Monte Carlo samples per wall vertex and bounce for the probes' capture.
-    #[arg(long, default_value_t = CaptureSettings::default().samples)]
-    probe_samples: u32,
-    /// Window on the probes' SH against ringing: off, nonnegative (irradiance never negative),
-    /// hanning:W or lanczos:W (Sloan 2008).
-    #[arg(long, default_value = "off")]
-    probe_dering: String,
+    #[command(flatten)]
+    probe: ProbeSettings,
     /// Turn the environment about +Y by this many degrees (counter-clockwise from above).
     #[arg(long, default_value_t = 0.0)]
     env_rotation: f32,
@@ -146,19 +118,9 @@ impl TechniqueParams for Flags<'_> {
         self.args.shadow_map_size
     }
     fn probes(&self) -> Result<ProbeSettings> {
-        let args = self.args;
         Ok(ProbeSettings {
-            placement: probe_placement(&args.probes, self.scene)?,
-            capture: CaptureSettings {
-                cube_size: args.probe_cube_size,
-                light: args.probe_light,
-                bounces: args.probe_bounces,
-                samples: args.probe_samples,
-                dering: kage::techniques::probes::Dering::parse(&args.probe_dering)?,
-            },
-            interpolation: args.probe_interpolation,
-            visibility: args.probe_visibility,
-            statics: args.probe_statics,
+            placement: probe_placement(&self.args.probes, self.scene)?,
+            ..self.args.probe.clone()
         })
     }
     fn asm(&self) -> Result<AsmSettings> {

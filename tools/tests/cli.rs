@@ -995,13 +995,18 @@ fn probe_capture_options_are_checked() {
     let probes = ["render", "--technique", "probes", "--width", "8", "--height", "8"];
     let with =
         |extra: &[&'static str]| -> Vec<&'static str> { probes.iter().chain(extra).copied().collect() };
-    let (dering, scene, bounces) = (
-        with(&["--scene", "probe-room", "--probe-dering", "gauss:2"]),
-        with(&["--probes", "scene"]),
-        with(&["--scene", "probe-room", "--probe-bounces", "3"]),
+    let (scene, bounces) =
+        (with(&["--probes", "scene"]), with(&["--scene", "probe-room", "--probe-bounces", "3"]));
+    // The window is parsed with the options (the engine's parser behind the setting), so a bad
+    // one is a usage error naming the option, before anything runs.
+    let out = kage(&with(&["--scene", "probe-room", "--probe-dering", "gauss:2"]));
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(
+        all.contains("'--probe-dering <WINDOW>'") && all.contains("deringing window \"gauss:2\""),
+        "{all}"
     );
-    let cases: [(&[&str], &str); 5] = [
-        (&dering, "deringing window \"gauss:2\""),
+    let cases: [(&[&str], &str); 4] = [
         (&scene, "places no probes"),
         (&bounces, "3 bounces: at most 2"),
         (&["probes", "capture-image", "/nonexistent/photo.exr"], "/nonexistent/photo.exr"),

@@ -83,18 +83,27 @@ pub enum CapturedLight {
     SkyAndWalls = 0,
 }
 
+/// How the probes are captured, each setting defined here once: the command line's
+/// `--probe-*` capture options (these comments are their help), the C ABI's `probe_*` fields.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct CaptureSettings {
-    /// Texels per side of a cube face, within [`CUBE_SIZES`].
+    /// Texels per side of a probe's cube-map face, 8 to 256.
+    #[cfg_attr(feature = "clap", arg(long = "probe-cube-size", default_value_t = CaptureSettings::default().cube_size))]
     pub cube_size: u32,
+    /// What the probes capture besides the sky they see.
+    #[cfg_attr(feature = "clap", arg(long = "probe-light", value_enum, default_value_t = CaptureSettings::default().light))]
     pub light: CapturedLight,
-    /// With [`CapturedLight::SkyAndWalls`]: how many times light reaching the probe from the
-    /// walls has reflected, 1 (the walls lit directly) or 2 (and by each other once, the
-    /// default); the reference's `--bounces`.
+    /// Reflections of the walls' light the probes capture: 1 (walls lit directly) or 2 (and
+    /// by each other once); the reference's `--bounces`.
+    #[cfg_attr(feature = "clap", arg(long = "probe-bounces", default_value_t = CaptureSettings::default().bounces))]
     pub bounces: u32,
-    /// Monte Carlo samples per wall vertex and bounce.
+    /// Monte Carlo samples per wall vertex and bounce for the probes' capture.
+    #[cfg_attr(feature = "clap", arg(long = "probe-samples", default_value_t = CaptureSettings::default().samples))]
     pub samples: u32,
-    /// The window applied to each probe's SH ([`Dering`]; off by default).
+    /// Window on the probes' SH against ringing: off, nonnegative (irradiance never negative),
+    /// hanning:W or lanczos:W (Sloan 2008).
+    #[cfg_attr(feature = "clap", arg(long = "probe-dering", value_name = "WINDOW", default_value = "off", value_parser = Dering::parse))]
     pub dering: Dering,
 }
 

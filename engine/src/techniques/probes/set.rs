@@ -132,13 +132,26 @@ pub enum StaticLighting {
     Sloan = 1,
 }
 
-/// The probes' placement and capture, and the static groups' lighting beside them.
+/// The probes' placement and capture, and the static groups' lighting beside them, each
+/// setting defined here once: the command line's `--probe-*` options (these comments are
+/// their help; the placement is `kage render --probes`, resolved against the scene), the C
+/// ABI's `probe_*` fields.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct ProbeSettings {
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub placement: ProbePlacement,
+    #[cfg_attr(feature = "clap", command(flatten))]
     pub capture: CaptureSettings,
+    /// How the light between probes is found: `trilinear` needs a `grid:` placement.
+    #[cfg_attr(feature = "clap", arg(long = "probe-interpolation", value_enum, default_value_t = ProbeInterpolation::default()))]
     pub interpolation: ProbeInterpolation,
+    /// Whether a moving group's lookup leaves out the probes its centre cannot see through the
+    /// static groups (`rays`), so that no light comes through walls.
+    #[cfg_attr(feature = "clap", arg(long = "probe-visibility", value_enum, default_value_t = ProbeVisibility::default()))]
     pub visibility: ProbeVisibility,
+    /// How the probes technique lights the static groups beside the probe-lit moving ones.
+    #[cfg_attr(feature = "clap", arg(long = "probe-statics", value_enum, default_value_t = StaticLighting::default()))]
     pub statics: StaticLighting,
 }
 
