@@ -49,16 +49,7 @@ impl Drop for Validated {
 
 /// A scene of one group holding `mesh`, under `environment`, seen by `camera`.
 pub fn single_mesh_scene(mesh: Mesh, environment: EnvMap, camera: Camera) -> Scene {
-    Scene {
-        name: "test".into(),
-        groups: vec![Group::new("object", vec![mesh], Transform::default())],
-        environment,
-        lights: vec![],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera,
-    }
+    Scene::new("test", vec![Group::new("object", vec![mesh], Transform::default())], environment, camera)
 }
 
 /// A fresh, empty folder under the system temp folder, unique per call: tests of one binary run

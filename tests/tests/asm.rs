@@ -225,24 +225,23 @@ fn grazing_light_with_the_id_and_the_bias_test() {
     let floor = shapes::plane("floor", [8.0, 8.0], [9, 9], [0.6; 3]).unwrap();
     let group = |name: &str, mesh| Group::new(name, vec![mesh], Transform::default());
     let scene = Scene {
-        name: "grazing".into(),
-        groups: vec![group("box", cube), group("floor", floor)],
-        environment: EnvMap::constant([0.0; 3]),
         lights: vec![Light::Spot {
             position: Vec3::new(-3.5, 0.4, 0.0),
             direction: Vec3::new(1.0, -0.08, 0.0),
             fov_deg: 100.0,
             intensity: [20.0; 3],
         }],
-        walkthrough: vec![],
-        probes: vec![],
-        exposure: 1.0,
-        camera: Camera {
-            position: Vec3::new(0.0, 3.0, 3.0),
-            target: Vec3::new(1.0, 0.0, 0.0),
-            up: Vec3::Y,
-            fov_y_deg: 50.0,
-        },
+        ..Scene::new(
+            "grazing",
+            vec![group("box", cube), group("floor", floor)],
+            EnvMap::constant([0.0; 3]),
+            Camera {
+                position: Vec3::new(0.0, 3.0, 3.0),
+                target: Vec3::new(1.0, 0.0, 0.0),
+                up: Vec3::Y,
+                fov_y_deg: 50.0,
+            },
+        )
     };
     let truth = reference(&ctx, &scene);
     let mut leaks = Vec::new();

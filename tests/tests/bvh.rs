@@ -48,21 +48,12 @@ impl Rng {
 }
 
 fn scene(groups: Vec<Group>) -> Scene {
-    Scene {
-        name: "bvh-test".into(),
+    Scene::new(
+        "bvh-test",
         groups,
-        environment: EnvMap::constant([1.0; 3]),
-        lights: vec![],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: Camera {
-            position: Vec3::new(0.0, 0.0, 5.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 45.0,
-        },
-    }
+        EnvMap::constant([1.0; 3]),
+        Camera { position: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
+    )
 }
 
 fn random_transform(rng: &mut Rng) -> Transform {

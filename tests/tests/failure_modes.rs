@@ -51,16 +51,7 @@ fn spot() -> Light {
 }
 
 fn scene(groups: Vec<Group>) -> Scene {
-    Scene {
-        name: "failure".into(),
-        groups,
-        environment: EnvMap::constant([1.0; 3]),
-        lights: vec![spot()],
-        walkthrough: vec![],
-        probes: vec![],
-        exposure: 1.0,
-        camera: camera(),
-    }
+    Scene { lights: vec![spot()], ..Scene::new("failure", groups, EnvMap::constant([1.0; 3]), camera()) }
 }
 
 fn group(name: &str, meshes: Vec<Mesh>, translation: Vec3) -> Group {

@@ -20,16 +20,12 @@ fn sky_and_walls() -> CaptureSettings {
 fn constant_environment_with_no_walls_captures_its_own_sh() {
     let ctx = Validated::new();
     let radiance = [0.5, 1.0, 2.0];
-    let scene = Scene {
-        name: "empty".into(),
-        groups: vec![],
-        environment: EnvMap::constant(radiance),
-        lights: vec![],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
-    };
+    let scene = Scene::new(
+        "empty",
+        vec![],
+        EnvMap::constant(radiance),
+        Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+    );
     let gpu = GpuScene::new(&ctx, &scene).unwrap();
     let settings = sky_and_walls();
     let mut capture = ProbeCapture::new(&ctx, &scene, settings).unwrap();

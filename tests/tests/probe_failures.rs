@@ -28,19 +28,15 @@ fn sun_scene() -> Scene {
             Transform { translation: Vec3::new(0.0, y, 0.0), ..Transform::default() },
         )
     };
-    Scene {
-        name: "sun".into(),
-        groups: vec![
+    Scene::new(
+        "sun",
+        vec![
             group("ball", shapes::sphere("ball", 0.5, 16, [0.8; 3]).unwrap(), 1.0),
             group("floor", shapes::plane("floor", [4.0, 4.0], [3, 3], [0.5; 3]).unwrap(), 0.0),
         ],
-        environment: sun_map(),
-        lights: vec![],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: Camera { position: Vec3::new(0.0, 1.0, 3.0), target: Vec3::Y, up: Vec3::Y, fov_y_deg: 40.0 },
-    }
+        sun_map(),
+        Camera { position: Vec3::new(0.0, 1.0, 3.0), target: Vec3::Y, up: Vec3::Y, fov_y_deg: 40.0 },
+    )
 }
 
 /// Probes around the ball: a tetrahedron's corners and its centre.

@@ -274,21 +274,17 @@ fn card(name: &str, at: Vec3, moves: bool) -> Group {
 }
 
 fn shelter_scene(groups: Vec<Group>) -> Scene {
-    Scene {
-        name: "shelter".into(),
+    Scene::new(
+        "shelter",
         groups,
-        environment: EnvMap::constant([1.0; 3]),
-        lights: vec![],
-        walkthrough: vec![],
-        probes: vec![],
-        exposure: 1.0,
-        camera: Camera {
+        EnvMap::constant([1.0; 3]),
+        Camera {
             position: Vec3::new(0.0, 0.6, 4.5),
             target: Vec3::new(0.0, 0.6, 0.0),
             up: Vec3::Y,
             fov_y_deg: 50.0,
         },
-    }
+    )
 }
 
 /// 2 × 2 × 2 probes over the shelter's box (x = ±1.25, y = 0.25 and 0.95, z = ±0.75), sky only.

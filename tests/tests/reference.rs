@@ -108,16 +108,12 @@ fn tilted_planes_under_a_real_map_match_cpu_integration() {
         let n = normal.normalize();
         let transform = Transform { rotation: Quat::from_rotation_arc(Vec3::Y, n), ..Transform::default() };
         let up = if n.y.abs() > 0.9 { Vec3::Z } else { Vec3::Y };
-        let scene = Scene {
-            name: "tilted".into(),
-            groups: vec![group("plane", plane(4.0), transform)],
-            environment: map.clone(),
-            lights: vec![],
-            walkthrough: vec![],
-            probes: Vec::new(),
-            exposure: 1.0,
-            camera: Camera { position: 2.0 * n, target: Vec3::ZERO, up, fov_y_deg: 40.0 },
-        };
+        let scene = Scene::new(
+            "tilted",
+            vec![group("plane", plane(4.0), transform)],
+            map.clone(),
+            Camera { position: 2.0 * n, target: Vec3::ZERO, up, fov_y_deg: 40.0 },
+        );
         let stats = render(&ctx, &scene, 16, LightMode::Environment, 10 + k as u32, 256);
         let expected = f64::from(RHO) / PI * cpu_irradiance(&map, n)[0];
         let (mean, se) = mean_over_pixels(&stats);
@@ -175,19 +171,12 @@ fn a_blocker_darkens_the_floor_by_its_form_factor() {
     let ctx = Validated::new();
     let (s, h) = (0.5f32, 0.5f32);
     let blocker = Transform { translation: Vec3::new(0.0, h, 0.0), ..Transform::default() };
-    let scene = Scene {
-        name: "blocker".into(),
-        groups: vec![
-            group("floor", plane(20.0), Transform::default()),
-            group("blocker", plane(2.0 * s), blocker),
-        ],
-        environment: EnvMap::constant([1.0; 3]),
-        lights: vec![],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: side_camera(),
-    };
+    let scene = Scene::new(
+        "blocker",
+        vec![group("floor", plane(20.0), Transform::default()), group("blocker", plane(2.0 * s), blocker)],
+        EnvMap::constant([1.0; 3]),
+        side_camera(),
+    );
     let size = 33;
     let stats = render(&ctx, &scene, size, LightMode::Environment, 5, 2048);
     let (got, se) = centre(&stats, size);
@@ -203,17 +192,10 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
     let ctx = Validated::new();
     let (height, intensity) = (2.0f32, [5.0f32, 2.0, 1.0]);
     let lights = vec![Light::Point { position: Vec3::new(0.0, height, 0.0), intensity }];
-    let mut scene = Scene {
-        name: "point light".into(),
-        groups: vec![group("floor", plane(20.0), Transform::default())],
-        // Ignored in local mode: the environment contributes nothing.
-        environment: EnvMap::constant([1.0; 3]),
-        lights,
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: side_camera(),
-    };
+    // The environment is ignored in local mode: it contributes nothing.
+    let floor = vec![group("floor", plane(20.0), Transform::default())];
+    let mut scene =
+        Scene { lights, ..Scene::new("point light", floor, EnvMap::constant([1.0; 3]), side_camera()) };
     let size = 33;
     let centre_rgb = |stats: &Statistics| stats.mean[((size / 2) * size + size / 2) as usize];
     let lit = render(&ctx, &scene, size, LightMode::Local, 0, 1);
@@ -247,14 +229,13 @@ fn spot_light_lights_only_inside_its_cone() {
     let mut values = Vec::new();
     for direction in [Vec3::NEG_Y, Vec3::X] {
         let scene = Scene {
-            name: "spot".into(),
-            groups: vec![group("floor", plane(20.0), Transform::default())],
-            environment: EnvMap::constant([1.0; 3]),
             lights: vec![spot(direction).validated().unwrap()],
-            walkthrough: vec![],
-            probes: Vec::new(),
-            exposure: 1.0,
-            camera: side_camera(),
+            ..Scene::new(
+                "spot",
+                vec![group("floor", plane(20.0), Transform::default())],
+                EnvMap::constant([1.0; 3]),
+                side_camera(),
+            )
         };
         let stats = render(&ctx, &scene, size, LightMode::Local, 0, 1);
         values.push(centre(&stats, size).0);

@@ -28,19 +28,13 @@ fn box_over_floor_lit_from(light: Vec3) -> Scene {
     let floor = shapes::plane("floor", [6.0, 6.0], [2, 2], [0.6; 3]).unwrap();
     let group = |name: &str, mesh| Group::new(name, vec![mesh], Transform::default());
     Scene {
-        name: "box-over-floor".into(),
-        groups: vec![group("box", cube), group("floor", floor)],
-        environment: EnvMap::constant([0.0; 3]),
         lights: vec![spot_at(light)],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: Camera {
-            position: Vec3::new(0.0, 2.5, 3.5),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 45.0,
-        },
+        ..Scene::new(
+            "box-over-floor",
+            vec![group("box", cube), group("floor", floor)],
+            EnvMap::constant([0.0; 3]),
+            Camera { position: Vec3::new(0.0, 2.5, 3.5), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
+        )
     }
 }
 
@@ -330,27 +324,26 @@ fn a_cube_resting_on_the_floor_has_no_dotted_line_along_its_base() {
     let turn = glam::Quat::from_rotation_y(20f32.to_radians());
     let light = Vec3::new(0.5, 3.2, 3.5);
     let scene = Scene {
-        name: "contact".into(),
-        groups: vec![
-            Group::new("cube", vec![cube], Transform { rotation: turn, ..Transform::default() }),
-            Group::new("floor", vec![floor], Transform::default()),
-        ],
-        environment: EnvMap::constant([0.0; 3]),
         lights: vec![Light::Spot {
             position: light,
             direction: Vec3::new(-0.15, -0.707, -0.707),
             fov_deg: 70.0,
             intensity: [20.0; 3],
         }],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: Camera {
-            position: Vec3::new(1.2, 2.2, 4.5),
-            target: Vec3::new(0.0, 0.3, 0.0),
-            up: Vec3::Y,
-            fov_y_deg: 35.0,
-        },
+        ..Scene::new(
+            "contact",
+            vec![
+                Group::new("cube", vec![cube], Transform { rotation: turn, ..Transform::default() }),
+                Group::new("floor", vec![floor], Transform::default()),
+            ],
+            EnvMap::constant([0.0; 3]),
+            Camera {
+                position: Vec3::new(1.2, 2.2, 4.5),
+                target: Vec3::new(0.0, 0.3, 0.0),
+                up: Vec3::Y,
+                fov_y_deg: 35.0,
+            },
+        )
     };
     let options = ReferenceOptions { width: SIZE, height: SIZE, light: LightMode::Local, seed: 1 };
     let mut reference = ReferenceRenderer::new(&ctx, &scene, &options).unwrap();

@@ -188,15 +188,13 @@ fn two_overlapping_occluders_never_go_negative_and_over_darken_boundedly() {
         Transform::default(),
     );
     let base = Scene::builtin("teapot").unwrap();
-    let scene_of = |name: &str, spheres: Vec<Group>| Scene {
-        name: name.into(),
-        groups: spheres.into_iter().chain([floor.clone()]).collect(),
-        environment: EnvMap::constant([1.0; 3]),
-        lights: vec![],
-        walkthrough: vec![],
-        probes: Vec::new(),
-        exposure: 1.0,
-        camera: base.camera,
+    let scene_of = |name: &str, spheres: Vec<Group>| {
+        Scene::new(
+            name,
+            spheres.into_iter().chain([floor.clone()]).collect(),
+            EnvMap::constant([1.0; 3]),
+            base.camera,
+        )
     };
     let lower = sphere_group("lower", radius, Vec3::new(0.0, low, 0.0));
     let upper = sphere_group("upper", radius, Vec3::new(0.0, high, 0.0));

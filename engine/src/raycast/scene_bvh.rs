@@ -269,16 +269,12 @@ mod tests {
                 Transform { translation: Vec3::new(x, 0.0, 0.0), ..Transform::default() },
             )
         };
-        Scene {
-            name: "spheres".into(),
-            groups: vec![sphere("a", -2.0), sphere("b", 2.0)],
-            environment: EnvMap::constant([1.0; 3]),
-            lights: vec![],
-            walkthrough: vec![],
-            probes: Vec::new(),
-            exposure: 1.0,
-            camera: Camera { position: Vec3::Z * 5.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
-        }
+        Scene::new(
+            "spheres",
+            vec![sphere("a", -2.0), sphere("b", 2.0)],
+            EnvMap::constant([1.0; 3]),
+            Camera { position: Vec3::Z * 5.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 },
+        )
     }
 
     #[test]

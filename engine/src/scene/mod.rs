@@ -84,6 +84,23 @@ pub struct Scene {
     pub exposure: f32,
 }
 
+impl Scene {
+    /// A scene of `groups` under `environment` seen from `camera`, with no lights, walkthrough
+    /// or hand-placed probes, at exposure 1 (change those fields with struct update syntax).
+    pub fn new(name: impl Into<String>, groups: Vec<Group>, environment: EnvMap, camera: Camera) -> Scene {
+        Scene {
+            name: name.into(),
+            groups,
+            environment,
+            lights: Vec::new(),
+            camera,
+            walkthrough: Vec::new(),
+            probes: Vec::new(),
+            exposure: 1.0,
+        }
+    }
+}
+
 /// Meshes that move together.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Group {

@@ -540,16 +540,12 @@ mod tests {
     }
 
     fn scene(groups: Vec<Group>) -> Scene {
-        Scene {
-            name: "boxes".into(),
+        Scene::new(
+            "boxes",
             groups,
-            environment: EnvMap::constant([1.0; 3]),
-            lights: vec![],
-            walkthrough: vec![],
-            probes: vec![],
-            exposure: 1.0,
-            camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
-        }
+            EnvMap::constant([1.0; 3]),
+            Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        )
     }
 
     #[test]

@@ -102,16 +102,12 @@ mod tests {
             motion,
         };
         let held = Motion { keys: vec![Key::posed(0.0, Transform::default())], loop_seconds: None };
-        Scene {
-            name: "column".into(),
-            groups: vec![group("column", column, None), group("mover", moving, Some(held))],
-            environment: EnvMap::constant([1.0; 3]),
-            lights: vec![],
-            walkthrough: vec![],
-            probes: vec![],
-            exposure: 1.0,
-            camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
-        }
+        Scene::new(
+            "column",
+            vec![group("column", column, None), group("mover", moving, Some(held))],
+            EnvMap::constant([1.0; 3]),
+            Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        )
     }
 
     #[test]

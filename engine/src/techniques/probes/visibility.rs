@@ -335,19 +335,15 @@ mod tests {
         let ball = shapes::boxes("ball", &[([-0.1; 3], [0.1; 3])], [0.5; 3]).unwrap();
         let at = Transform { translation: Vec3::splat(50.0), ..Transform::default() };
         let motion = Motion { keys: vec![Key::posed(0.0, at)], loop_seconds: None };
-        let scene = Scene {
-            name: "walled".into(),
-            groups: vec![
+        let scene = Scene::new(
+            "walled",
+            vec![
                 Group { motion: Some(motion), ..Group::new("ball", vec![ball], at) },
                 Group::new("walls", vec![wall, sealed], Transform::default()),
             ],
-            environment: EnvMap::constant([1.0; 3]),
-            lights: vec![],
-            walkthrough: vec![],
-            probes: vec![],
-            exposure: 1.0,
-            camera: Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
-        };
+            EnvMap::constant([1.0; 3]),
+            Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        );
         Arc::new(Occluders::of_static(&scene).unwrap())
     }
 
