@@ -1,21 +1,10 @@
 //! Kage (影): a real-time lighting engine on raw Vulkan.
 //!
-//! Layers, bottom to top (each a folder; a module imports only from layers below it):
-//! - [`backend`]: a thin layer over ash: device, memory, buffers, images, pipelines,
-//!   descriptors, timestamps, validation.
-//! - [`pass`]: named passes with inputs, outputs and a record function, each wrapped in a debug
-//!   label and a GPU timestamp pair.
-//! - [`frame`]: what several techniques share: the GPU scene, targets, environment, background,
-//!   scene draws, shadow depth, group bounds.
-//! - [`raycast`], then [`reference`](mod@reference) and [`prt`] over it: the BVH, the ground
-//!   truth, the PRT precomputation.
-//! - [`techniques`]: one per file or folder, named and built by [`techniques::description`].
-//! - [`renderer`]: the frame loop; then [`capi`] (and the command line, outside this crate).
-//!
-//! Beside the layers, imported by any of them: [`scene`] (what a scene holds and its file
-//! format), [`sh`], [`layouts`] (the GPU/host structs), [`error`], [`imageio`], [`files`]
-//! (opening what a user names), [`image_size`] (image headers checked before decoding) and
-//! [`host_memory`] (allocations a caller sized, made fallibly).
+//! Layers, bottom to top: [`backend`] (the thin Vulkan layer), [`pass`], [`frame`] (what
+//! several techniques share), [`raycast`], [`reference`](mod@reference) and [`prt`],
+//! [`techniques`], [`renderer`], [`capi`]; beneath them the modules every layer uses ([`scene`],
+//! [`sh`], [`error`], [`layouts`], [`imageio`], [`files`], ...). README's "Architecture" places
+//! every module and is checked against the imports (`tests/tests/layers.rs`).
 //!
 //! Conventions: right-handed, +Y up; equirectangular maps map direction (x, y, z) to
 //! u = atan2(x, -z) / 2π wrapped into \[0, 1), v = acos(y) / π, row 0 at the top (+Y).

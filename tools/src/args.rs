@@ -1,7 +1,12 @@
 //! The arguments and helpers every command shares: the GPU (`--validate`, `--device`), the
-//! scene (`--scene`, `--keyframe`, `--env`) and "x,y,z" values.
+//! scene (`--scene`, `--keyframe`, `--env`), "x,y,z" values and `--probes` with probe files.
 use anyhow::{bail, Context as _, Result};
+use glam::DVec3;
 use kage::backend::{Context, ContextDesc};
+use kage::files;
+use kage::scene::Scene;
+use kage::techniques::probes::{positions_file, ProbePlacement, DEFAULT_TOLERANCE};
+use std::path::Path;
 use std::sync::Arc;
 
 /// Options every GPU command takes.
@@ -109,4 +114,48 @@ where
         [x, y, z] if parts.iter().all(|&v| v.into().is_finite()) => Ok([x, y, z]),
         _ => Err(format!("expected three finite numbers x,y,z, got {s:?}")),
     }
+}
+
+/// `--probes`: `grid:NX,NY,NZ`, `auto[:TOL[:NX,NY,NZ]]`, `scene` or a probe file.
+pub fn probe_placement(arg: &str, scene: &Scene) -> Result<ProbePlacement> {
+    if arg == "scene" {
+        if scene.probes.is_empty() {
+            anyhow::bail!(
+                "--probes scene: scene \"{}\" places no probes (its file has no \"probes\")",
+                scene.name
+            );
+        }
+        let positions: Vec<glam::DVec3> = scene.probes.iter().map(|p| p.position.as_dvec3()).collect();
+        return Ok(ProbePlacement::Positions(positions.into()));
+    }
+    let counts = |text: &str, form: &str| -> Result<[u32; 3]> {
+        let counts: Vec<u32> = text
+            .split(',')
+            .map(|n| n.trim().parse())
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("--probes {arg}: expected {form} with whole numbers"))?;
+        counts.try_into().map_err(|_| anyhow::anyhow!("--probes {arg}: expected three counts, {form}"))
+    };
+    if let Some(grid) = arg.strip_prefix("grid:") {
+        return Ok(ProbePlacement::Grid(counts(grid, "grid:NX,NY,NZ")?));
+    }
+    if arg == "auto" || arg.starts_with("auto:") {
+        let mut parts = arg.splitn(3, ':').skip(1);
+        let tolerance = match parts.next() {
+            Some(t) => t
+                .trim()
+                .parse()
+                .with_context(|| format!("--probes {arg}: expected auto:TOL with TOL a number"))?,
+            None => DEFAULT_TOLERANCE,
+        };
+        let candidates = parts.next().map(|c| counts(c, "auto:TOL:NX,NY,NZ")).transpose()?;
+        return Ok(ProbePlacement::Auto { tolerance, candidates });
+    }
+    Ok(ProbePlacement::Positions(read_positions(std::path::Path::new(arg))?.into()))
+}
+
+/// The positions of a probe file.
+pub fn read_positions(path: &Path) -> Result<Vec<DVec3>> {
+    let bytes = files::read(path, files::JSON).with_context(|| format!("reading {}", path.display()))?;
+    positions_file::parse(&bytes).with_context(|| path.display().to_string())
 }

@@ -7,7 +7,6 @@ mod env_cmd;
 mod info;
 mod outputs;
 mod precompute;
-mod probe_image;
 mod probes;
 mod progress;
 mod reference;

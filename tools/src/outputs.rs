@@ -73,3 +73,14 @@ pub fn check(path: &Path, flag: &str, extensions: &[&str]) -> Result<()> {
         Err(e) => bail!("{flag} {}: cannot write in the folder {}: {e}", path.display(), folder.display()),
     }
 }
+
+/// The 9×3 coefficients as `kage sh` prints them, one line per coefficient after a header.
+pub fn print_coefficients(sh: &kage::sh::ShRgb9) {
+    println!("# real SH, index = l*(l+1)+m, orthonormal basis (see README, \"SH basis\")");
+    println!("# {:>5} {:>3} {:>3} {:>14} {:>14} {:>14}", "index", "l", "m", "red", "green", "blue");
+    for (i, c) in sh.c.iter().enumerate() {
+        let l = (i as f64).sqrt() as i32;
+        let m = i as i32 - l * (l + 1);
+        println!("  {i:>5} {l:>3} {m:>3} {:>14.6e} {:>14.6e} {:>14.6e}", c[0], c[1], c[2]);
+    }
+}

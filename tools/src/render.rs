@@ -11,7 +11,7 @@ use kage::scene::{animation, Scene};
 use kage::techniques::asm::technique::MB;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
-use kage::techniques::probes::{ProbePlacement, ProbeSettings, DEFAULT_GRID, DEFAULT_TOLERANCE};
+use kage::techniques::probes::{ProbeSettings, DEFAULT_GRID};
 use kage::techniques::tamura::technique::OcclusionSettings;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -119,7 +119,7 @@ impl TechniqueParams for Flags<'_> {
     }
     fn probes(&self) -> Result<ProbeSettings> {
         Ok(ProbeSettings {
-            placement: probe_placement(&self.args.probes, self.scene)?,
+            placement: crate::args::probe_placement(&self.args.probes, self.scene)?,
             ..self.args.probe.clone()
         })
     }
@@ -312,42 +312,4 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         trace.write(path, &ctx.info().name)?;
     }
     args.gpu.finish(&ctx)
-}
-
-/// `--probes`: `grid:NX,NY,NZ`, `auto[:TOL[:NX,NY,NZ]]`, `scene` or a probe file.
-pub fn probe_placement(arg: &str, scene: &Scene) -> Result<ProbePlacement> {
-    if arg == "scene" {
-        if scene.probes.is_empty() {
-            anyhow::bail!(
-                "--probes scene: scene \"{}\" places no probes (its file has no \"probes\")",
-                scene.name
-            );
-        }
-        let positions: Vec<glam::DVec3> = scene.probes.iter().map(|p| p.position.as_dvec3()).collect();
-        return Ok(ProbePlacement::Positions(positions.into()));
-    }
-    let counts = |text: &str, form: &str| -> Result<[u32; 3]> {
-        let counts: Vec<u32> = text
-            .split(',')
-            .map(|n| n.trim().parse())
-            .collect::<Result<_, _>>()
-            .with_context(|| format!("--probes {arg}: expected {form} with whole numbers"))?;
-        counts.try_into().map_err(|_| anyhow::anyhow!("--probes {arg}: expected three counts, {form}"))
-    };
-    if let Some(grid) = arg.strip_prefix("grid:") {
-        return Ok(ProbePlacement::Grid(counts(grid, "grid:NX,NY,NZ")?));
-    }
-    if arg == "auto" || arg.starts_with("auto:") {
-        let mut parts = arg.splitn(3, ':').skip(1);
-        let tolerance = match parts.next() {
-            Some(t) => t
-                .trim()
-                .parse()
-                .with_context(|| format!("--probes {arg}: expected auto:TOL with TOL a number"))?,
-            None => DEFAULT_TOLERANCE,
-        };
-        let candidates = parts.next().map(|c| counts(c, "auto:TOL:NX,NY,NZ")).transpose()?;
-        return Ok(ProbePlacement::Auto { tolerance, candidates });
-    }
-    Ok(ProbePlacement::Positions(crate::probes::read_positions(std::path::Path::new(arg))?.into()))
 }

@@ -25,7 +25,7 @@ pub fn run(args: &ShArgs) -> Result<()> {
     crate::args::report_clamped(&map);
     let ctx = args.gpu.context()?;
     let sh = kage::frame::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
-    print_coefficients(&sh);
+    crate::outputs::print_coefficients(&sh);
     if let Some(n) = args.irradiance {
         if n.length_squared() == 0.0 {
             anyhow::bail!("--irradiance needs a non-zero normal");
@@ -38,15 +38,4 @@ pub fn run(args: &ShArgs) -> Result<()> {
         );
     }
     args.gpu.finish(&ctx)
-}
-
-/// The 9×3 coefficients as `kage sh` prints them, one line per coefficient after a header.
-pub fn print_coefficients(sh: &kage::sh::ShRgb9) {
-    println!("# real SH, index = l*(l+1)+m, orthonormal basis (see README, \"SH basis\")");
-    println!("# {:>5} {:>3} {:>3} {:>14} {:>14} {:>14}", "index", "l", "m", "red", "green", "blue");
-    for (i, c) in sh.c.iter().enumerate() {
-        let l = (i as f64).sqrt() as i32;
-        let m = i as i32 - l * (l + 1);
-        println!("  {i:>5} {l:>3} {m:>3} {:>14.6e} {:>14.6e} {:>14.6e}", c[0], c[1], c[2]);
-    }
 }

@@ -50,7 +50,7 @@ pub fn run(args: &CaptureImageArgs) -> Result<()> {
     let ctx = args.gpu.context()?;
     let sh = kage::frame::sh_projection::project(&ctx, &map).context("projecting on the GPU")?;
     let sh: ShRgb9 = dering.apply(&sh);
-    crate::sh_cmd::print_coefficients(&sh);
+    crate::outputs::print_coefficients(&sh);
     let irradiance: Vec<(&str, [f32; 3])> = AXES.iter().map(|&(name, n)| (name, sh.irradiance(n))).collect();
     for (name, e) in &irradiance {
         println!("irradiance at {name}: {:.6e} {:.6e} {:.6e}", e[0], e[1], e[2]);

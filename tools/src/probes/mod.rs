@@ -1,9 +1,10 @@
 //! `kage probes tetrahedralize` and `kage probes lookup`: the probe set's tetrahedra, and the
 //! tetrahedron and weights of one point; `kage probes place`: automatic placement in a scene.
+mod capture_image;
+
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
 use glam::DVec3;
-use kage::files;
 use kage::frame::GpuScene;
 use kage::techniques::probes::{
     positions_file, CaptureSettings, ProbePlacement, ProbeSet, ProbeSettings, TetMesh, Walker,
@@ -34,7 +35,7 @@ pub enum ProbesCommand {
     /// equirectangular photo or HDR image (as the paper captured street-view panoramas): its 9×3 SH
     /// coefficients (the projection of `kage sh`, identical) and the irradiance at the six axis
     /// normals; `--out` writes `{"sh": [[r,g,b] × 9], "irradiance": {"+x": [r,g,b], ...}}`
-    CaptureImage(crate::probe_image::CaptureImageArgs),
+    CaptureImage(capture_image::CaptureImageArgs),
     /// Automatic placement: candidates on a grid over the scene's static groups (those inside
     /// solids dropped) are captured, the redundant ones dropped; the kept positions are written
     /// as a probe file for `kage render --probes FILE`.
@@ -98,13 +99,13 @@ pub fn run(command: &ProbesCommand) -> Result<()> {
         ProbesCommand::Tetrahedralize(args) => tetrahedralize(args),
         ProbesCommand::Lookup(args) => lookup(args),
         ProbesCommand::Place(args) => place(args),
-        ProbesCommand::CaptureImage(args) => crate::probe_image::run(args),
+        ProbesCommand::CaptureImage(args) => capture_image::run(args),
     }
 }
 
 fn place(args: &PlaceArgs) -> Result<()> {
     let scene = crate::args::read_scene(&args.scene, false)?;
-    let placement = crate::render::probe_placement(&args.probes, &scene)?;
+    let placement = crate::args::probe_placement(&args.probes, &scene)?;
     if !matches!(placement, ProbePlacement::Auto { .. }) {
         anyhow::bail!("--probes {}: expected auto, auto:TOL or auto:TOL:NX,NY,NZ", args.probes);
     }
@@ -138,15 +139,9 @@ fn place(args: &PlaceArgs) -> Result<()> {
     args.gpu.finish(&ctx)
 }
 
-/// The positions of a probe file.
-pub fn read_positions(path: &Path) -> Result<Vec<DVec3>> {
-    let bytes = files::read(path, files::JSON).with_context(|| format!("reading {}", path.display()))?;
-    positions_file::parse(&bytes).with_context(|| path.display().to_string())
-}
-
 /// Reads and tetrahedralizes a probe file, warning about merged duplicates.
 fn load(path: &Path) -> Result<TetMesh> {
-    let positions = read_positions(path)?;
+    let positions = crate::args::read_positions(path)?;
     let mesh = TetMesh::build(&positions).with_context(|| format!("tetrahedralizing {}", path.display()))?;
     if !mesh.merged().is_empty() {
         let pairs: Vec<String> =
