@@ -138,7 +138,8 @@ void main() {
         for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
             uint j = cell * KAGE_BVH_PACKET + uint(r);
             dirs[r] = ray_direction(hammersley_index(min(j, rays - 1u), rays), rays, shift, n, tangent, bitangent);
-            hits[r] = RayHit(1e30, KAGE_NO_HIT, 0u, vec2(0.0));
+            // A negative tmax: the packet does not cast it.
+            hits[r] = RayHit(j < end ? 1e30 : -1.0, KAGE_NO_HIT, 0u, vec2(0.0));
             if (j < end) cast_rays |= 1u << r;
         }
         if (TRACE && WHOLE_SCENE) {
@@ -146,7 +147,7 @@ void main() {
                 if ((cast_rays & (1u << r)) != 0u) bvh_traverse(world_origin, normalize(mat3(to_world) * dirs[r]), false, hits[r]);
             }
         } else if (TRACE) {
-            bvh_closest_hits_packet(group, origin, dirs, cast_rays, hits);
+            bvh_closest_hits_packet(group, origin, dirs, hits);
         }
         for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
             if ((cast_rays & (1u << r)) == 0u) continue;

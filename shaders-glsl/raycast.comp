@@ -30,10 +30,12 @@ void cast_packet(uint first) {
     for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
         uint i = min(first + uint(r), p.params.x - 1u);
         dirs[r] = rays[i].direction.xyz;
-        hits[r] = RayHit(rays[i].origin.w, KAGE_NO_HIT, 0u, vec2(0.0));
-        if (first + uint(r) < p.params.x) in_list |= 1u << r;
+        bool listed = first + uint(r) < p.params.x;
+        // A negative tmax: the packet does not cast it.
+        hits[r] = RayHit(listed ? rays[i].origin.w : -1.0, KAGE_NO_HIT, 0u, vec2(0.0));
+        if (listed) in_list |= 1u << r;
     }
-    bvh_closest_hits_packet(p.params.z, rays[first].origin.xyz, dirs, in_list, hits);
+    bvh_closest_hits_packet(p.params.z, rays[first].origin.xyz, dirs, hits);
     for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
         if ((in_list & (1u << r)) == 0u) continue;
         results[first + uint(r)].hit = vec4(hits[r].t, hits[r].barycentric, 0.0);

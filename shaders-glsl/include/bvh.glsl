@@ -242,12 +242,13 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
 }
 
 // Closest hits of KAGE_BVH_PACKET rays from one origin through one bottom-level tree, in
-// object space: the rays whose bit is set in `rays` (hits[r].t each ray's running tmax). The
+// object space (hits[r].t each ray's running tmax; a ray given a negative one is not cast: it
+// enters no box and hits no triangle, with no mask to test in the loops below). The
 // packet walks the tree once, entering a child where any of its rays does, so each pair and
 // triangle is read once for all of them: on a CPU driver a read is a gather over the SIMD
 // lanes, the largest cost of a step, and rays from one point in neighbouring directions (the
 // PRT's) enter nearly the same nodes.
-void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACKET], uint rays,
+void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACKET],
                              inout RayHit hits[KAGE_BVH_PACKET]) {
     vec3 inv_dirs[KAGE_BVH_PACKET];
     WatertightRay wrays[KAGE_BVH_PACKET];
@@ -260,7 +261,7 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
     float stack_enter[KAGE_BVH_STACK];
     int top = 0;
     uint next = bvh_instances[instance].info.w;
-    bool live = rays != 0u;
+    bool live = true;
     while (live) {
         while ((next & KAGE_BVH_LEAF) == 0u) {
             BvhPair pair = bvh_blas_pairs[next];
@@ -273,10 +274,8 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
             right_hi -= origin;
             float enter_left = 1.0 / 0.0, enter_right = 1.0 / 0.0;
             for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
-                if ((rays & (1u << r)) != 0u) {
-                    enter_left = min(enter_left, bvh_enter_from(left_lo, left_hi, inv_dirs[r], hits[r].t));
-                    enter_right = min(enter_right, bvh_enter_from(right_lo, right_hi, inv_dirs[r], hits[r].t));
-                }
+                enter_left = min(enter_left, bvh_enter_from(left_lo, left_hi, inv_dirs[r], hits[r].t));
+                enter_right = min(enter_right, bvh_enter_from(right_lo, right_hi, inv_dirs[r], hits[r].t));
             }
             bool left_first;
             int entered = bvh_pair_order(pair, enter_left, enter_right, left_first);
@@ -295,16 +294,14 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
             for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
                 float t;
                 vec2 bary;
-                if ((rays & (1u << r)) != 0u && bvh_intersect(wrays[r], v, hits[r].t, t, bary)) {
+                if (bvh_intersect(wrays[r], v, hits[r].t, t, bary)) {
                     hits[r] = RayHit(t, instance, tri, bary);
                 }
             }
         }
         // Pop the next entry some ray still reaches.
         float reach = 0.0;
-        for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
-            if ((rays & (1u << r)) != 0u) reach = max(reach, hits[r].t);
-        }
+        for (int r = 0; r < KAGE_BVH_PACKET; ++r) reach = max(reach, hits[r].t);
         live = false;
         while (top > 0) {
             --top;

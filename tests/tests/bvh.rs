@@ -335,8 +335,10 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
     );
 
     // The same rays by packets as the PRT casts them: 8 directions from each origin, closest
-    // hits in object space, against brute force over the group alone.
-    let packets: Vec<(Vec3, Vec3, f32)> = rays
+    // hits in object space, against brute force over the group alone. The last packet is
+    // short: the shader casts its missing rays with a negative tmax, which must leave the
+    // others' hits alone.
+    let mut packets: Vec<(Vec3, Vec3, f32)> = rays
         .iter()
         .step_by(constants::BVH_PACKET as usize)
         .flat_map(|&(o, _, tmax)| {
@@ -344,6 +346,7 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
             dirs.into_iter().map(move |d| (o, d, tmax))
         })
         .collect();
+    packets.truncate(packets.len() - 3);
     let hits = cast(&ctx, &mut caster, &gpu, &packets, Query::PacketObjectSpace { instance: 0 });
     let (mut compared, mut found) = (0, 0);
     for (i, &(o, d, tmax)) in packets.iter().enumerate() {
