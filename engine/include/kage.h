@@ -798,6 +798,37 @@ typedef struct {
 } kage_renderer_stats;
 
 /**
+ * The probes technique's lookups since the renderer was made (one per moving group and frame),
+ * counted by what the visibility test (`kage_technique_desc.probe_visibility`) did; all 0 for
+ * the other techniques. The host sets `size`; Kage fills the rest.
+ */
+typedef struct {
+  /**
+   * `sizeof(kage_probe_lookups)` as the host's kage.h declares it: checked.
+   */
+  uint32_t size;
+  /**
+   * Lookups made.
+   */
+  uint64_t lookups;
+  /**
+   * Lookups where the point did not see some probe of its cell, whose weight went to the
+   * others.
+   */
+  uint64_t renormalised;
+  /**
+   * Lookups where the point saw none of its cell's probes and the nearest probe it sees took
+   * all the weight.
+   */
+  uint64_t nearest;
+  /**
+   * Lookups where the point saw no probe among its 32 nearest (inside a solid, or sealed
+   * off) and kept its cell's weights.
+   */
+  uint64_t unweighted;
+} kage_probe_lookups;
+
+/**
  * The GPU time of one pass in the last frame.
  */
 typedef struct {
@@ -1077,6 +1108,15 @@ kage_result kage_renderer_set_time(kage_renderer *renderer, float seconds);
  * `stats` NULL or writable.
  */
 kage_result kage_renderer_get_stats(const kage_renderer *renderer, kage_renderer_stats *stats);
+
+/**
+ * Writes the probes technique's lookup counts to `*lookups`, whose `size` the host set.
+ *
+ * # Safety
+ * `lookups` NULL or readable and writable.
+ */
+kage_result kage_renderer_get_probe_lookups(const kage_renderer *renderer,
+                                            kage_probe_lookups *lookups);
 
 /**
  * Renders one frame and waits for it; then `kage_renderer_read_pixels` and

@@ -507,6 +507,19 @@ static void check_bad_arguments(kage_context *context) {
   EXPECT(kage_renderer_get_stats(no_renderer, &stats), KAGE_RESULT_INVALID_HANDLE);
   CHECK(kage_renderer_get_stats(renderer, &stats));
   REQUIRE(stats.gpu_bytes > 0 && stats.dropped_layers == 0);
+  {
+    /* Not the probes technique: no lookups. A size from another kage.h is refused. */
+    kage_probe_lookups lookups = {sizeof(kage_probe_lookups), 9, 9, 9, 9};
+    EXPECT(kage_renderer_get_probe_lookups(NULL, &lookups), KAGE_RESULT_NULL_ARGUMENT);
+    EXPECT(kage_renderer_get_probe_lookups(renderer, NULL), KAGE_RESULT_NULL_ARGUMENT);
+    EXPECT(kage_renderer_get_probe_lookups(no_renderer, &lookups), KAGE_RESULT_INVALID_HANDLE);
+    lookups.size = 8;
+    EXPECT(kage_renderer_get_probe_lookups(renderer, &lookups), KAGE_RESULT_INVALID_VALUE);
+    REQUIRE(lookups.lookups == 9);
+    lookups.size = sizeof(kage_probe_lookups);
+    CHECK(kage_renderer_get_probe_lookups(renderer, &lookups));
+    REQUIRE(lookups.lookups == 0 && lookups.renormalised == 0 && lookups.nearest == 0 && lookups.unweighted == 0);
+  }
 
   uint8_t pixels[8 * 8 * 16];
   size_t passes = 99;
@@ -674,6 +687,12 @@ static void check_renderer_progress(kage_context *context) {
   /* probe-room's bunny hops: any instant of its motion renders; a time must be finite. */
   CHECK(kage_renderer_set_time(renderer, 0.25f));
   CHECK(kage_renderer_render(renderer));
+  /* One lookup per frame for the one moving group, the bunny. */
+  {
+    kage_probe_lookups lookups = {sizeof(kage_probe_lookups), 0, 0, 0, 0};
+    CHECK(kage_renderer_get_probe_lookups(renderer, &lookups));
+    REQUIRE(lookups.lookups == 2);
+  }
   EXPECT(kage_renderer_set_time(renderer, NAN), KAGE_RESULT_INVALID_VALUE);
   EXPECT(kage_renderer_set_time(NULL, 0.0f), KAGE_RESULT_NULL_ARGUMENT);
   CHECK(kage_renderer_destroy(renderer));

@@ -54,6 +54,19 @@ pub(crate) unsafe fn out<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, Fa
     unsafe { ptr.as_mut() }.ok_or_else(|| null(name))
 }
 
+/// Where to write a result struct whose first field is its `size`, which the host set (see
+/// [`check_size`]).
+///
+/// # Safety
+/// `ptr` must be NULL or valid for reads and writes of the host's version of `T`, whose first
+/// field is its size as a `u32`.
+pub(crate) unsafe fn sized_out<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, Failure> {
+    // SAFETY: the caller's promise: `sized` reads only the size before checking it.
+    unsafe { sized(ptr.cast_const(), name) }?;
+    // SAFETY: the host's struct has this library's size, so it is this library's `T`.
+    unsafe { out(ptr, name) }
+}
+
 /// Where to write a new handle; set to NULL at once, so that the host finds NULL there after
 /// any failure.
 ///

@@ -268,6 +268,51 @@ pub unsafe extern "C" fn kage_renderer_get_stats(
     })
 }
 
+/// The probes technique's lookups since the renderer was made (one per moving group and frame),
+/// counted by what the visibility test (`kage_technique_desc.probe_visibility`) did; all 0 for
+/// the other techniques. The host sets `size`; Kage fills the rest.
+#[repr(C)]
+pub struct kage_probe_lookups {
+    /// `sizeof(kage_probe_lookups)` as the host's kage.h declares it: checked.
+    pub size: u32,
+    /// Lookups made.
+    pub lookups: u64,
+    /// Lookups where the point did not see some probe of its cell, whose weight went to the
+    /// others.
+    pub renormalised: u64,
+    /// Lookups where the point saw none of its cell's probes and the nearest probe it sees took
+    /// all the weight.
+    pub nearest: u64,
+    /// Lookups where the point saw no probe among its 32 nearest (inside a solid, or sealed
+    /// off) and kept its cell's weights.
+    pub unweighted: u64,
+}
+
+/// Writes the probes technique's lookup counts to `*lookups`, whose `size` the host set.
+///
+/// # Safety
+/// `lookups` NULL or readable and writable.
+#[no_mangle]
+pub unsafe extern "C" fn kage_renderer_get_probe_lookups(
+    renderer: *const kage_renderer,
+    lookups: *mut kage_probe_lookups,
+) -> kage_result {
+    boundary(|| {
+        let r = handles::get(renderer, "renderer")?;
+        // SAFETY: the caller promises NULL or a readable and writable struct.
+        let out = unsafe { args::sized_out(lookups, "lookups") }?;
+        let counts = r.renderer.stats().probe_lookups.unwrap_or_default();
+        *out = kage_probe_lookups {
+            size: out.size,
+            lookups: counts.lookups,
+            renormalised: counts.renormalised,
+            nearest: counts.nearest,
+            unweighted: counts.unweighted,
+        };
+        Ok(())
+    })
+}
+
 /// Renders one frame and waits for it; then `kage_renderer_read_pixels` and
 /// `kage_renderer_timings` give its picture and pass timings.
 #[no_mangle]
