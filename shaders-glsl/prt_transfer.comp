@@ -125,7 +125,7 @@ void main() {
 
     vec4 s0 = vec4(0.0), s1 = vec4(0.0), s2 = vec4(0.0), s3 = vec4(0.0), s4 = vec4(0.0),
          s5 = vec4(0.0), s6 = vec4(0.0);
-    mat4 to_world = bvh_instances[group].object_to_world;
+    mat4 to_world = bvh_object_to_world(group);
     vec3 world_origin = (to_world * vec4(origin, 1.0)).xyz;
     uint first = p.params.x;
     uint end = casting ? first + p.params.y : first;
@@ -160,7 +160,7 @@ void main() {
                 vec3 normal = w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz;
                 vec3 ray_dir = dirs[r];
                 if (WHOLE_SCENE) {
-                    normal = mat3(bvh_instances[hit.instance].object_to_world) * normal;
+                    normal = mat3(bvh_object_to_world(hit.instance)) * normal;
                     ray_dir = mat3(to_world) * ray_dir;
                 }
                 if (dot(normal, ray_dir) > 0.0) ++back;

@@ -35,8 +35,8 @@ vec3 surface_irradiance_sample(vec3 position, vec3 n, inout Rng rng) {
     vec3 dir = sample_cosine(n, vec2(rng_next(rng), rng_next(rng)));
     RayHit hit = bvh_closest_hit(offset_ray_origin(position, n), dir, REFERENCE_FAR);
     if (hit.instance == KAGE_NO_HIT) return vec3(0.0);
-    BvhTriangle v = bvh_triangles[hit.triangle];
-    vec3 face = mat3(bvh_instances[hit.instance].object_to_world)
+    BvhTriangle v = bvh_triangle(hit.triangle);
+    vec3 face = mat3(bvh_object_to_world(hit.instance))
         * cross(v.v1.xyz - v.v0.xyz, v.v2.xyz - v.v0.xyz);
     if (dot(face, dir) >= 0.0) return vec3(0.0);
     uvec4 ids = triangle_vertices[hit.triangle];

@@ -11,10 +11,14 @@
 #include "constants.glsl"
 #include "layouts.glsl"
 
-layout(set = 0, binding = 0, std430) readonly buffer BvhBlasPairs { BvhPair bvh_blas_pairs[]; };
-layout(set = 0, binding = 1, std430) readonly buffer BvhTlasNodes { BvhNode bvh_tlas_nodes[]; };
-layout(set = 0, binding = 2, std430) readonly buffer BvhInstances { BvhInstance bvh_instances[]; };
-layout(set = 0, binding = 3, std430) readonly buffer BvhTriangles { BvhTriangle bvh_triangles[]; };
+// What the traversal reads (pairs, top-level nodes, instances, triangles) are texel buffers of
+// uvec4s, read through the accessors below: llvmpipe gathers a texel fetch over the SIMD lanes
+// without branching, where it reads a storage buffer one lane and word at a time
+// (vendor-notes.md). What only a hit reads stays in storage buffers.
+layout(set = 0, binding = 0) uniform usamplerBuffer bvh_blas_pairs;
+layout(set = 0, binding = 1) uniform usamplerBuffer bvh_tlas_nodes;
+layout(set = 0, binding = 2) uniform usamplerBuffer bvh_instances;
+layout(set = 0, binding = 3) uniform usamplerBuffer bvh_triangles;
 layout(set = 0, binding = 4, std430) readonly buffer BvhAttributes {
     BvhTriangleAttributes bvh_attributes[];
 };
@@ -22,6 +26,39 @@ layout(set = 0, binding = 4, std430) readonly buffer BvhAttributes {
 // sRGB packed little-endian, row after row from the top.
 layout(set = 0, binding = 5, std430) readonly buffer BvhAlbedoMaps { BvhAlbedoMap bvh_albedo_maps[]; };
 layout(set = 0, binding = 6, std430) readonly buffer BvhAlbedoTexels { BvhTexel bvh_albedo_texels[]; };
+
+// Pair `index` of the bottom-level trees.
+BvhPair bvh_pair(uint index) {
+    int texel = KAGE_BVH_PAIR_TEXELS * int(index);
+    return BvhPair(uintBitsToFloat(texelFetch(bvh_blas_pairs, texel)), texelFetch(bvh_blas_pairs, texel + 1),
+                   texelFetch(bvh_blas_pairs, texel + 2));
+}
+
+// Node `index` of the top-level tree.
+BvhNode bvh_tlas_node(uint index) {
+    int texel = KAGE_BVH_NODE_TEXELS * int(index);
+    return BvhNode(uintBitsToFloat(texelFetch(bvh_tlas_nodes, texel)),
+                   uintBitsToFloat(texelFetch(bvh_tlas_nodes, texel + 1)));
+}
+
+// The matrix of instance `index` that starts at texel `first` of its record (0: object to
+// world, 4: world to object), and its info.
+mat4 bvh_instance_matrix(uint index, int first) {
+    int texel = KAGE_BVH_INSTANCE_TEXELS * int(index) + first;
+    return mat4(uintBitsToFloat(texelFetch(bvh_instances, texel)), uintBitsToFloat(texelFetch(bvh_instances, texel + 1)),
+                uintBitsToFloat(texelFetch(bvh_instances, texel + 2)), uintBitsToFloat(texelFetch(bvh_instances, texel + 3)));
+}
+mat4 bvh_object_to_world(uint index) { return bvh_instance_matrix(index, 0); }
+mat4 bvh_world_to_object(uint index) { return bvh_instance_matrix(index, 4); }
+uvec4 bvh_instance_info(uint index) { return texelFetch(bvh_instances, KAGE_BVH_INSTANCE_TEXELS * int(index) + 8); }
+
+// Triangle `index` of the triangle buffer.
+BvhTriangle bvh_triangle(uint index) {
+    int texel = KAGE_BVH_TRIANGLE_TEXELS * int(index);
+    return BvhTriangle(uintBitsToFloat(texelFetch(bvh_triangles, texel)),
+                       uintBitsToFloat(texelFetch(bvh_triangles, texel + 1)),
+                       uintBitsToFloat(texelFetch(bvh_triangles, texel + 2)));
+}
 
 // instance == KAGE_NO_HIT on a miss; triangle indexes the BVH triangle buffer; barycentric holds
 // the weights of the triangle's v1 and v2 (v0's is 1 - x - y).
@@ -96,7 +133,7 @@ bool bvh_intersect(WatertightRay r, BvhTriangle v, float tmax, out float t, out 
 
 // The same against triangle `tri` of the triangle buffer.
 bool bvh_intersect_triangle(WatertightRay r, uint tri, float tmax, out float t, out vec2 bary) {
-    return bvh_intersect(r, bvh_triangles[tri], tmax, t, bary);
+    return bvh_intersect(r, bvh_triangle(tri), tmax, t, bary);
 }
 
 // Entry distance of a ray into the box lo .. hi given relative to the ray's origin, or +inf
@@ -194,12 +231,12 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
     int top = 0;
     // What the ray visits next: a pair, or a leaf (KAGE_BVH_LEAF set). The root pair's own
     // box is not tested: its children's are.
-    uint next = bvh_instances[instance].info.w;
+    uint next = bvh_instance_info(instance).w;
     bool live = true;
     while (live) {
         // Down through pairs while a child is entered.
         while ((next & KAGE_BVH_LEAF) == 0u) {
-            BvhPair pair = bvh_blas_pairs[next];
+            BvhPair pair = bvh_pair(next);
             vec3 left_lo, left_hi, right_lo, right_hi;
             bvh_pair_boxes(pair, left_lo, left_hi, right_lo, right_hi);
             float enter_left = bvh_enter(left_lo, left_hi, origin, inv_dir, hit.t);
@@ -260,11 +297,11 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
     // The nearest entry of any ray into each stacked child.
     float stack_enter[KAGE_BVH_STACK];
     int top = 0;
-    uint next = bvh_instances[instance].info.w;
+    uint next = bvh_instance_info(instance).w;
     bool live = true;
     while (live) {
         while ((next & KAGE_BVH_LEAF) == 0u) {
-            BvhPair pair = bvh_blas_pairs[next];
+            BvhPair pair = bvh_pair(next);
             vec3 left_lo, left_hi, right_lo, right_hi;
             bvh_pair_boxes(pair, left_lo, left_hi, right_lo, right_hi);
             // The rays share their origin: the corners relative to it once, as bvh_enter has them.
@@ -290,7 +327,7 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
         uint count = bvh_leaf_count(next);
         uint first = bvh_leaf_first(next);
         for (uint tri = first; tri < first + count; ++tri) {
-            BvhTriangle v = bvh_triangles[tri];
+            BvhTriangle v = bvh_triangle(tri);
             for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
                 float t;
                 vec2 bary;
@@ -320,12 +357,12 @@ bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
     bool found = false;
     uint stack[KAGE_BVH_STACK];
     int top = 0;
-    BvhNode node = bvh_tlas_nodes[0u];
+    BvhNode node = bvh_tlas_node(0u);
     if (bvh_enter_box(node, origin, inv_dir, hit.t) == 1.0 / 0.0) return false;
     while (true) {
         uint index = bvh_node_index(node);
         if (bvh_node_count(node) > 0u) {
-            mat4 to_object = bvh_instances[index].world_to_object;
+            mat4 to_object = bvh_world_to_object(index);
             vec3 o = (to_object * vec4(origin, 1.0)).xyz;
             vec3 d = mat3(to_object) * dir;
             if (bvh_traverse_blas(index, o, d, any_hit, hit)) {
@@ -334,13 +371,13 @@ bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
             }
         } else {
             uint pushed;
-            int entered = bvh_children(bvh_tlas_nodes[index], bvh_tlas_nodes[index + 1u], index, origin, inv_dir, hit.t, node, pushed);
+            int entered = bvh_children(bvh_tlas_node(index), bvh_tlas_node(index + 1u), index, origin, inv_dir, hit.t, node, pushed);
             if (entered == 2) stack[top++] = pushed;
             if (entered > 0) continue;
         }
         bool next = false;
         while (top > 0) {
-            node = bvh_tlas_nodes[stack[--top]];
+            node = bvh_tlas_node(stack[--top]);
             if (bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0) {
                 next = true;
                 break;
@@ -419,9 +456,9 @@ vec3 bvh_hit_texel(RayHit hit) {
 // together with the geometric one, as the rasterizer's gl_FrontFacing does. Its albedo is the
 // mesh's times its albedo map's texel there.
 SurfacePoint bvh_surface(RayHit hit, vec3 ray_dir) {
-    BvhTriangle v = bvh_triangles[hit.triangle];
+    BvhTriangle v = bvh_triangle(hit.triangle);
     BvhTriangleAttributes a = bvh_attributes[hit.triangle];
-    mat4 to_world = bvh_instances[hit.instance].object_to_world;
+    mat4 to_world = bvh_object_to_world(hit.instance);
     vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
     vec3 p = w.x * v.v0.xyz + w.y * v.v1.xyz + w.z * v.v2.xyz;
     // The scale is uniform, so the rotation part carries normals too.

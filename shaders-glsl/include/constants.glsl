@@ -22,7 +22,7 @@
 // 1.18 and 7.07 for pi); with 512 rows the midpoint rule's error, O((pi / rows)^2), is ~1e-5.
 #define KAGE_SH_MIN_ROWS 512
 
-// Storage buffers that bvh.glsl declares at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1; a shader
+// The buffers that bvh.glsl declares at set 0, bindings 0 .. KAGE_BVH_BINDINGS - 1; a shader
 // that includes it numbers its own bindings from here.
 #define KAGE_BVH_BINDINGS 7
 // How an albedo map reads beyond [0, 1] (BvhAlbedoMap.info.w): repeat, mirrored repeat, clamp.
@@ -34,8 +34,16 @@
 // A BvhPair child reference with this bit set is a leaf: its count in bits 28-30, its first
 // triangle in bits 0-27.
 #define KAGE_BVH_LEAF 2147483648u
-// Rays traced together by bvh_closest_hits_packet (one Hammersley cell of the PRT).
-#define KAGE_BVH_PACKET 8
+// Rays traced together by bvh_closest_hits_packet (one Hammersley cell of the PRT): 4 measured
+// faster than 2 or 8 once the BVH was read through texel buffers (BENCHMARKS.md).
+#define KAGE_BVH_PACKET 4
+// The uvec4 texels of one record in the BVH's texel buffers (bvh.glsl's accessors; sizes checked
+// against layouts.glsl's structs by engine/src/raycast/gpu.rs): a BvhPair, a BvhNode, a
+// BvhInstance (object to world at texel 0, world to object at 4, info at 8) and a BvhTriangle.
+#define KAGE_BVH_PAIR_TEXELS 3
+#define KAGE_BVH_NODE_TEXELS 2
+#define KAGE_BVH_INSTANCE_TEXELS 9
+#define KAGE_BVH_TRIANGLE_TEXELS 3
 // Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.
 #define KAGE_BVH_STACK 32
 // Invocations per workgroup of the ray casting test and benchmark shader.

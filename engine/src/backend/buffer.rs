@@ -101,6 +101,10 @@ impl Buffer {
         self.raw
     }
 
+    pub(super) fn ctx(&self) -> &Arc<Context> {
+        &self.ctx
+    }
+
     fn mapped(&self) -> Option<&[u8]> {
         self.allocation.as_ref()?.mapped_slice().map(|s| &s[..self.size as usize])
     }

@@ -69,6 +69,8 @@ pub struct DeviceInfo {
     pub timestamp_period_ns: Option<f64>,
     /// `subPixelPrecisionBits`: the rasterizer places vertices to 1 / 2^bits of a pixel.
     pub sub_pixel_precision_bits: u32,
+    /// `maxTexelBufferElements`: the most texels one texel buffer (the BVH's) may hold.
+    pub max_texel_buffer_elements: u32,
     /// Every optional feature or extension Kage looks at, and whether it is there.
     pub features: Vec<(&'static str, bool)>,
 }

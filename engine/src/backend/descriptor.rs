@@ -2,7 +2,7 @@
 //! there are no pools or set lifetimes to manage. Binding `i` is the i-th entry of the list.
 use super::pipeline::Layout;
 use super::Cmd;
-use super::{Buffer, Context, Image, Sampler};
+use super::{Buffer, Context, Image, Sampler, TexelBuffer};
 use ash::vk;
 
 /// What a shader binding is; the pipeline's set layout is built from a list of these.
@@ -12,6 +12,7 @@ pub enum BindingKind {
     StorageBuffer,
     SampledImage,
     StorageImage,
+    TexelBuffer,
 }
 
 impl BindingKind {
@@ -21,6 +22,7 @@ impl BindingKind {
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            BindingKind::TexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
         }
     }
 }
@@ -32,6 +34,7 @@ pub enum Binding<'a> {
     Storage(&'a Buffer),
     Sampled(&'a Image, &'a Sampler),
     StorageImage(&'a Image),
+    Texel(&'a TexelBuffer),
 }
 
 impl Binding<'_> {
@@ -41,6 +44,7 @@ impl Binding<'_> {
             Binding::Storage(_) => BindingKind::StorageBuffer,
             Binding::Sampled(..) => BindingKind::SampledImage,
             Binding::StorageImage(_) => BindingKind::StorageImage,
+            Binding::Texel(_) => BindingKind::TexelBuffer,
         }
     }
 }
@@ -89,6 +93,7 @@ pub(super) fn push_descriptors_from(
             Binding::Storage(buffer) => buffer.touched(cmd, written),
             Binding::Sampled(image, _) => image.touched(cmd, false),
             Binding::StorageImage(image) => image.touched(cmd, written),
+            Binding::Texel(texels) => texels.buffer().touched(cmd, false),
         }
     }
     // A push with no writes is invalid (descriptorWriteCount must be at least 1): pipelines
@@ -121,6 +126,13 @@ pub(super) fn push_descriptors_from(
             _ => [vk::DescriptorImageInfo::default()],
         })
         .collect();
+    let texel_views: Vec<[vk::BufferView; 1]> = bindings
+        .iter()
+        .map(|b| match b {
+            Binding::Texel(texels) => [texels.view],
+            _ => [vk::BufferView::null()],
+        })
+        .collect();
     let writes: Vec<vk::WriteDescriptorSet> = bindings
         .iter()
         .enumerate()
@@ -130,7 +142,8 @@ pub(super) fn push_descriptors_from(
                 .descriptor_type(b.kind().descriptor_type());
             match b {
                 Binding::Uniform(_) | Binding::Storage(_) => write.buffer_info(&buffer_infos[i]),
-                _ => write.image_info(&image_infos[i]),
+                Binding::Texel(_) => write.texel_buffer_view(&texel_views[i]),
+                Binding::Sampled(..) | Binding::StorageImage(_) => write.image_info(&image_infos[i]),
             }
         })
         .collect();

@@ -81,6 +81,7 @@ pub(crate) fn probe(
         api_version: version_string(props.api_version),
         timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
         sub_pixel_precision_bits: props.limits.sub_pixel_precision_bits,
+        max_texel_buffer_elements: props.limits.max_texel_buffer_elements,
         features: vec![
             (
                 "VK_KHR_dynamic_rendering (required)",

@@ -13,6 +13,7 @@ mod image;
 mod pipeline;
 mod reflect;
 mod rendering;
+mod texel_buffer;
 mod timestamps;
 mod usage;
 mod validation;
@@ -30,6 +31,7 @@ pub use pipeline::{
     ComputePipeline, DepthTest, GraphicsDesc, GraphicsPipeline, Topology, VertexAttribute, VertexBuffer,
 };
 pub use rendering::{Depth, Target};
+pub use texel_buffer::TexelBuffer;
 pub use timestamps::TimestampPool;
 pub use usage::{BufferUsage, ImageUsage};
 pub use validation::ValidationLog;

@@ -2,7 +2,7 @@
 //! pipeline's declared bindings are checked against its shaders when the pipeline is made: a
 //! wrong binding list fails there, naming the shader and the binding, not as a validation
 //! message at draw time. Only what Kage's shaders use is read: set 0, uniform and storage
-//! buffers, combined image samplers and storage images, and whether the shader may write each
+//! buffers, combined image samplers, texel buffers and storage images, and whether the shader may write each
 //! (what a pass that binds it touches: `access.rs`).
 use super::descriptor::BindingKind;
 use std::collections::HashMap;
@@ -26,6 +26,8 @@ const STORAGE_UNIFORM: u32 = 2;
 const STORAGE_STORAGE_BUFFER: u32 = 12;
 /// `OpTypeImage`'s "sampled" operand for an image used without a sampler (a storage image).
 const IMAGE_STORAGE: u32 = 2;
+/// `OpTypeImage`'s dimensionality of a texel buffer.
+const DIM_BUFFER: u32 = 5;
 
 /// A descriptor a shader uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,7 +97,14 @@ pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<Used>, String> {
             (STORAGE_STORAGE_BUFFER, _) => BindingKind::StorageBuffer,
             (STORAGE_UNIFORM, _) if has(pointee, DECORATION_BUFFER_BLOCK) => BindingKind::StorageBuffer,
             (STORAGE_UNIFORM, _) if has(pointee, DECORATION_BLOCK) => BindingKind::UniformBuffer,
-            (STORAGE_UNIFORM_CONSTANT, Some((OP_TYPE_SAMPLED_IMAGE, _))) => BindingKind::SampledImage,
+            (STORAGE_UNIFORM_CONSTANT, Some((OP_TYPE_SAMPLED_IMAGE, ops))) => {
+                match ops.first().and_then(|image| types.get(image)) {
+                    Some((OP_TYPE_IMAGE, image)) if image.get(1) == Some(&DIM_BUFFER) => {
+                        BindingKind::TexelBuffer
+                    }
+                    _ => BindingKind::SampledImage,
+                }
+            }
             (STORAGE_UNIFORM_CONSTANT, Some((OP_TYPE_IMAGE, ops))) if ops.get(5) == Some(&IMAGE_STORAGE) => {
                 BindingKind::StorageImage
             }
@@ -136,7 +145,7 @@ pub fn check(shader: &str, declared: &[BindingKind], used: &[Used]) -> Result<()
 mod tests {
     use super::*;
     use crate::layouts::{constants, spirv};
-    use BindingKind::{SampledImage, StorageBuffer, StorageImage, UniformBuffer};
+    use BindingKind::{SampledImage, StorageBuffer, StorageImage, TexelBuffer, UniformBuffer};
 
     fn used(spirv: &[u8]) -> Vec<Used> {
         descriptor_bindings(&ash::util::read_spv(&mut std::io::Cursor::new(spirv)).unwrap()).unwrap()
@@ -158,6 +167,22 @@ mod tests {
                 (1, SampledImage, false),
                 (2, StorageBuffer, true),
                 (3, StorageImage, true)
+            ]
+        );
+        // The ray caster reads the BVH's traversal data as texel buffers, its hit data and rays
+        // as storage buffers, and writes only its results.
+        assert_eq!(
+            kinds(spirv::RAYCAST_COMP),
+            [
+                (0, TexelBuffer, false),
+                (1, TexelBuffer, false),
+                (2, TexelBuffer, false),
+                (3, TexelBuffer, false),
+                (4, StorageBuffer, false),
+                (5, StorageBuffer, false),
+                (6, StorageBuffer, false),
+                (7, StorageBuffer, false),
+                (8, StorageBuffer, true)
             ]
         );
         // The transfer shader reads the BVH and the vertices and writes its sums.

@@ -1,5 +1,5 @@
-//! Ray casting through a BVH held in storage buffers (no ray-query extension): built on the
-//! CPU, traversed by compute shaders (shaders-glsl/include/bvh.glsl).
+//! Ray casting through a BVH held in GPU buffers (no ray-query extension): built on the CPU,
+//! traversed by compute shaders (shaders-glsl/include/bvh.glsl).
 //!
 //! # Structure
 //! Two levels. Each scene group has a bottom-level BVH (binned SAH, leaves of at most 4
@@ -10,6 +10,10 @@
 //! without renormalising the direction, so t is the same world-space distance in both spaces.
 //!
 //! # GPU layout (bindings 0 .. `KAGE_BVH_BINDINGS` - 1, structs in layouts.glsl)
+//! Bindings 0-3, what the traversal reads, are texel buffers of `uvec4`s read through
+//! bvh.glsl's accessors (`bvh_pair`, `bvh_tlas_node`, `bvh_instance_info`, `bvh_triangle`, ...):
+//! llvmpipe reads a storage buffer one lane and word at a time, and texel fetches made the
+//! traversal 1.6-3.5x faster there (BENCHMARKS.md, "Ray casting"). 4-6 are storage buffers.
 //! 0. `BvhPair[]`, the bottom-level trees of every group as the GPU reads them, one pair per
 //!    interior node holding its two children's quantized boxes and references (see `raycast/pairs.rs`),
 //!    each group's from its root pair (`BvhInstance.info.w`); 1. `BvhNode[]`, the top level,
