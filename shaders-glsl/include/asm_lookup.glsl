@@ -10,19 +10,24 @@
 #define ASM_DIRECTORY_SIDE (1u << KAGE_ASM_DIRECTORY_LEVEL)
 
 layout(set = 0, binding = 2) uniform sampler2D asm_pool;
-// The directory (rows of ASM_DIRECTORY_SIDE entries: node index | level << 24, the finest
-// resident tile at or above the directory's level over each of its tiles), then the nodes.
-layout(std430, set = 0, binding = 3) readonly buffer PageTable {
-    uint asm_directory[ASM_DIRECTORY_SIDE * ASM_DIRECTORY_SIDE];
-    AsmNode asm_nodes[];
-};
+// The page table as uvec4 texels: the directory (rows of ASM_DIRECTORY_SIDE entries, four to a
+// texel: node index | level << 24, the finest resident tile at or above the directory's level
+// over each of its tiles), then the nodes (an AsmNode is three texels: children, pages, tile).
+// A texel buffer because llvmpipe gathers texel fetches and reads storage buffers lane by lane
+// (vendor-notes.md).
+layout(set = 0, binding = 3) uniform usamplerBuffer asm_table;
+#define ASM_DIRECTORY_TEXELS int(ASM_DIRECTORY_SIDE * ASM_DIRECTORY_SIDE / 4u)
+
+uint asm_directory(uint entry) { return texelFetch(asm_table, int(entry >> 2))[entry & 3u]; }
+// Texel `field` (0: children, 1: pages, 2: tile) of node `node`.
+uvec4 asm_node(uint node, int field) { return texelFetch(asm_table, ASM_DIRECTORY_TEXELS + 3 * int(node) + field); }
 
 // The node of the finest resident tile holding light uv `uv`: the directory's tile, then into
 // the child holding uv while it is resident. A missing tile so falls back to its nearest
 // resident ancestor, at worst the root, never to "lit".
 uint asm_descend(vec2 uv) {
     uvec2 entry_cell = min(uvec2(uv * float(ASM_DIRECTORY_SIDE)), uvec2(ASM_DIRECTORY_SIDE - 1u));
-    uint entry = asm_directory[entry_cell.y * ASM_DIRECTORY_SIDE + entry_cell.x];
+    uint entry = asm_directory(entry_cell.y * ASM_DIRECTORY_SIDE + entry_cell.x);
     uint at = entry & 0xffffffu;
     // A tile above the directory's level has no resident child over uv: the directory would
     // name that child.
@@ -30,7 +35,7 @@ uint asm_descend(vec2 uv) {
     for (uint level = uint(KAGE_ASM_DIRECTORY_LEVEL) + 1u; level <= uint(KAGE_ASM_MAX_LEVEL); ++level) {
         uint n = 1u << level;
         uvec2 cell = min(uvec2(uv * float(n)), uvec2(n - 1u));
-        uint next = asm_nodes[at].children[2u * (cell.y & 1u) + (cell.x & 1u)];
+        uint next = asm_node(at, 0)[2u * (cell.y & 1u) + (cell.x & 1u)];
         if (next == 0u) break;
         at = next;
     }
@@ -57,9 +62,9 @@ vec2 asm_texel_coords(uvec3 tile, vec2 uv) {
 // The page of node `node`'s quadrant holding uv: the node is the finest resident tile there
 // (asm_descend), so no resident child covers that quadrant and its page is stored.
 AsmPage asm_page(uint node, vec2 uv) {
-    uvec3 tile = asm_nodes[node].tile.xyz;
+    uvec3 tile = asm_node(node, 2).xyz;
     ivec2 q = ivec2(clamp(asm_texel_coords(tile, uv) / float(KAGE_ASM_PAGE_TEXELS), vec2(0.0), vec2(1.0)));
-    return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_nodes[node].pages[2 * q.y + q.x]));
+    return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_node(node, 1)[2 * q.y + q.x]));
 }
 
 // Tile texel `texel` kept in the page's quadrant (the texels beyond it are in other pages, or in

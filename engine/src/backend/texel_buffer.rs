@@ -3,14 +3,16 @@
 //! Why not storage buffers: llvmpipe (Mesa 22.3) reads a storage buffer at a per-lane address
 //! one lane and one word at a time, each behind a branch on the lane's mask and the buffer's
 //! bound, while a texel fetch gathers all lanes' 16-byte texels without branching
-//! (vendor-notes.md). The BVH's traversal reads most of its time away, so its data lives here.
-use super::{Buffer, BufferUsage, Context};
+//! (vendor-notes.md). The BVH's traversal and ASM's page-table descent read most of their time
+//! away, so their data lives here.
+use super::{Buffer, BufferDesc, BufferUsage, Context};
 use crate::error::{Error, Result};
 use ash::vk;
+use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
 /// Bytes per texel: one `uvec4` of `texelFetch`.
-const TEXEL_BYTES: usize = 16;
+const TEXEL_BYTES: u64 = 16;
 
 pub struct TexelBuffer {
     buffer: Buffer,
@@ -18,26 +20,26 @@ pub struct TexelBuffer {
 }
 
 impl TexelBuffer {
-    /// A device-local texel buffer holding `data`, whose length must be a whole number of
-    /// texels and at most the device's `maxTexelBufferElements` of them.
-    pub fn with_data(ctx: &Arc<Context>, name: &str, data: &[u8]) -> Result<TexelBuffer> {
-        if data.is_empty() || data.len() % TEXEL_BYTES != 0 {
+    /// A texel buffer of `bytes` (a whole, nonzero number of texels, at most the device's
+    /// `maxTexelBufferElements` of them) in `location`: `GpuOnly` for data uploaded once,
+    /// `CpuToGpu` for data the host rewrites ([`TexelBuffer::write`]).
+    pub fn new(ctx: &Arc<Context>, name: &str, bytes: u64, location: MemoryLocation) -> Result<TexelBuffer> {
+        if bytes == 0 || bytes % TEXEL_BYTES != 0 {
             return Err(Error::Internal(format!(
-                "texel buffer {name}: {} bytes is not a whole, nonzero number of {TEXEL_BYTES}-byte texels",
-                data.len()
+                "texel buffer {name}: {bytes} bytes is not a whole, nonzero number of {TEXEL_BYTES}-byte texels"
             )));
         }
-        let texels = (data.len() / TEXEL_BYTES) as u64;
-        let max = ctx.info().max_texel_buffer_elements as u64;
+        let texels = bytes / TEXEL_BYTES;
+        let max = u64::from(ctx.info().max_texel_buffer_elements);
         if texels > max {
             return Err(Error::OutOfDeviceMemoryFor {
                 name: name.into(),
-                bytes: data.len() as u64,
+                bytes,
                 reason: format!("{texels} texels, more than the device's maxTexelBufferElements ({max})"),
             });
         }
-        let buffer =
-            Buffer::with_data(ctx, name, BufferUsage::UNIFORM_TEXEL | BufferUsage::TRANSFER_SRC, data)?;
+        let usage = BufferUsage::UNIFORM_TEXEL | BufferUsage::TRANSFER_SRC | BufferUsage::TRANSFER_DST;
+        let buffer = Buffer::new(ctx, &BufferDesc { name, size: bytes, usage, location })?;
         let info = vk::BufferViewCreateInfo::default()
             .buffer(buffer.raw)
             .format(vk::Format::R32G32B32A32_UINT)
@@ -49,6 +51,18 @@ impl TexelBuffer {
             unsafe { ctx.device.create_buffer_view(&info, None) }.map_err(Error::vk("vkCreateBufferView"))?;
         ctx.set_name(view, &format!("{name}.view"));
         Ok(TexelBuffer { buffer, view })
+    }
+
+    /// A device-local texel buffer holding `data`.
+    pub fn with_data(ctx: &Arc<Context>, name: &str, data: &[u8]) -> Result<TexelBuffer> {
+        let texels = TexelBuffer::new(ctx, name, data.len() as u64, MemoryLocation::GpuOnly)?;
+        texels.buffer.upload(data)?;
+        Ok(texels)
+    }
+
+    /// Writes into a host-visible texel buffer at `offset` (bytes).
+    pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
+        self.buffer.write(offset, data)
     }
 
     /// The buffer under the view: its size, name and contents.

@@ -1,8 +1,8 @@
 //! The page table the GPU lookup descends: the resident tiles as a tree of `AsmNode` records
-//! in a buffer, the root at index 0 and every node's children after it (breadth first). A child
-//! index of 0 means "not resident" (the root is no one's child), so the lookup stops there and
-//! uses the last node's page of that quadrant: the finest resident tile over the point, which
-//! stores every quadrant no resident child covers (`pool`).
+//! in a texel buffer, the root at index 0 and every node's children after it (breadth first).
+//! A child index of 0 means "not resident" (the root is no one's child), so the lookup stops
+//! there and uses the last node's page of that quadrant: the finest resident tile over the
+//! point, which stores every quadrant no resident child covers (`pool`).
 //!
 //! A directory comes first in the buffer: one entry per tile of level
 //! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
@@ -81,6 +81,17 @@ mod tests {
     use super::*;
     use crate::techniques::asm::pool::DEPTH_PAGE_BYTES as PAGE_BYTES;
     const LAYOUT: AtlasLayout = AtlasLayout { columns: 16, rows: 16 };
+
+    /// asm_lookup.glsl reads the table as 16-byte texels: the directory four entries to a
+    /// texel, each node three (children, pages, tile).
+    #[test]
+    fn the_table_is_whole_texels_as_the_shader_reads_it() {
+        assert_eq!(DIRECTORY_BYTES % 16, 0);
+        assert_eq!(size_of::<AsmNode>(), 3 * 16);
+        assert_eq!(std::mem::offset_of!(AsmNode, children), 0);
+        assert_eq!(std::mem::offset_of!(AsmNode, pages), 16);
+        assert_eq!(std::mem::offset_of!(AsmNode, tile), 32);
+    }
 
     fn key_of(node: &AsmNode) -> TileKey {
         let [level, x, y, _] = node.tile;

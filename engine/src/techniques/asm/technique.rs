@@ -31,7 +31,7 @@ use super::pool::{Insert, PageOp, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES, TIL
 use super::tile::TileKey;
 use crate::backend::{
     Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, DepthTest, Edge,
-    GraphicsPipeline, MemoryLocation, Sampler, FRAGMENT_STORES, GEOMETRY_SHADER,
+    GraphicsPipeline, MemoryLocation, Sampler, TexelBuffer, FRAGMENT_STORES, GEOMETRY_SHADER,
 };
 use crate::error::{Error, Result};
 use crate::frame::bounds::scene_sphere;
@@ -211,7 +211,7 @@ pub struct Asm {
     /// `ShadowLight` records (the light in record 0), as the shadowmap technique's.
     records: Buffer,
     /// The page table (page_table::PageTable): the directory, then `AsmNode` per resident tile.
-    table: Buffer,
+    table: TexelBuffer,
     /// What `asm_analysis` writes (see `AsmAnalysisPush`), read by `analysed`.
     requests: Buffer,
     /// The bytes of every buffer and image above, part by part.
@@ -288,7 +288,7 @@ impl Asm {
             BindingKind::UniformBuffer,
             BindingKind::UniformBuffer,
             BindingKind::SampledImage,
-            BindingKind::StorageBuffer,
+            BindingKind::TexelBuffer,
             BindingKind::StorageBuffer,
         ];
         let fragment = match settings.test {
@@ -314,7 +314,7 @@ impl Asm {
                 BindingKind::UniformBuffer,
                 BindingKind::UniformBuffer,
                 BindingKind::SampledImage,
-                BindingKind::StorageBuffer,
+                BindingKind::TexelBuffer,
                 BindingKind::SampledImage,
                 BindingKind::StorageBuffer,
             ],
@@ -325,10 +325,10 @@ impl Asm {
             |name, size, usage, location| Buffer::new(ctx, &BufferDesc { name, size, usage, location });
         let records =
             buffer("asm.lights", memory::lights_bytes(), BufferUsage::UNIFORM, MemoryLocation::CpuToGpu)?;
-        let table = buffer(
+        let table = TexelBuffer::new(
+            ctx,
             "asm.page_table",
             page_table::PageTable::buffer_bytes(nodes),
-            BufferUsage::STORAGE,
             MemoryLocation::CpuToGpu,
         )?;
         let requests = buffer(
@@ -637,7 +637,7 @@ impl Technique for Asm {
                     Binding::Uniform(uniforms),
                     Binding::Uniform(&self.records),
                     self.pages.depth_binding(),
-                    Binding::Storage(&self.table),
+                    Binding::Texel(&self.table),
                     Binding::Sampled(&targets.depth, &self.nearest),
                     Binding::Storage(&self.requests),
                 ],
@@ -707,7 +707,7 @@ impl Technique for Asm {
             Binding::Uniform(inputs.uniforms),
             Binding::Uniform(&self.records),
             self.pages.depth_binding(),
-            Binding::Storage(&self.table),
+            Binding::Texel(&self.table),
             Binding::Storage(&self.used),
         ];
         bindings.extend(self.pages.id_binding());
