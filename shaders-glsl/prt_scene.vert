@@ -14,7 +14,9 @@
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D self_shadow;
-layout(set = 0, binding = 2, std430) readonly buffer Basis { RegionBasis region_basis[]; };
+// Each region's RegionBasis as KAGE_TRANSFER_VEC4 texels, group after group (a texel buffer:
+// llvmpipe reads a storage buffer lane by lane, vendor-notes.md).
+layout(set = 0, binding = 2) uniform usamplerBuffer region_basis;
 layout(set = 0, binding = 3, std140) uniform Energy { vec4 region_energy[KAGE_MAX_REGIONS]; };
 // The SH of the light L_s is made of (the map less its dominant lights), in the map's frame.
 layout(set = 0, binding = 5, std140) uniform Layers { OcclusionLayer layers[KAGE_MAX_OCCLUSION_LAYERS]; };
@@ -61,8 +63,10 @@ void main() {
         [[unroll]] for (uint c = 0u; c < 4u; ++c) {
             uint i = 4u * k + c;
             if (i < regions) {
-                RegionBasis b = region_basis[first + i];
-                [[unroll]] for (uint j = 0u; j < BASIS_VEC4; ++j) t[c] += dot(transfer[j], b.y[j]);
+                int basis = int((first + i) * uint(KAGE_TRANSFER_VEC4));
+                [[unroll]] for (uint j = 0u; j < BASIS_VEC4; ++j) {
+                    t[c] += dot(transfer[j], uintBitsToFloat(texelFetch(region_basis, basis + int(j))));
+                }
                 bool gone = (draw.covered[i / 32u] & (1u << (i % 32u))) != 0u;
                 hidden += gone ? region_energy[i].rgb * max(t[c], 0.0) : vec3(0.0);
             }

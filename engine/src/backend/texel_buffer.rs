@@ -3,8 +3,8 @@
 //! Why not storage buffers: llvmpipe (Mesa 22.3) reads a storage buffer at a per-lane address
 //! one lane and one word at a time, each behind a branch on the lane's mask and the buffer's
 //! bound, while a texel fetch gathers all lanes' 16-byte texels without branching
-//! (vendor-notes.md). The BVH's traversal and ASM's page-table descent read most of their time
-//! away, so their data lives here.
+//! (vendor-notes.md). What hot loops read at such addresses lives here: the BVH's traversal
+//! data, ASM's page table, Tamura's per-region SH basis.
 use super::{Buffer, BufferDesc, BufferUsage, Context};
 use crate::error::{Error, Result};
 use ash::vk;

@@ -26,7 +26,7 @@ use super::technique::{OcclusionSettings, Penumbra};
 use crate::backend::{
     Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Cmd, ComputePipeline, Context, Depth, DepthTest,
     Edge, Format, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, ImageUsage, MemoryLocation, Sampler,
-    Target, Topology,
+    Target, TexelBuffer, Topology,
 };
 use crate::error::Result;
 use crate::frame::bounds::{box_corners, rotation_of, GroupBounds};
@@ -101,8 +101,9 @@ pub struct Occlusion {
     pub layers: Buffer,
     /// B_i per region (rgb).
     pub energy: Buffer,
-    /// `RegionBasis` per group and region.
-    pub region_basis: Buffer,
+    /// `RegionBasis` per group and region, as texels: the scene pass's vertex shader reads
+    /// every region's for every vertex (a texel buffer: vendor-notes.md).
+    pub region_basis: TexelBuffer,
     /// Per receiver group: its first layer and layer count.
     pub ranges: Vec<(u32, u32)>,
     /// Per receiver group, bit s: an occluder sheet hides source s from the whole group, which
@@ -290,7 +291,12 @@ impl Occlusion {
             size,
             layers: host_buffer(ctx, "occlusion.layers", layer_count as usize * size_of::<OcclusionLayer>())?,
             energy,
-            region_basis: host_buffer(ctx, "occlusion.region_basis", groups * q * size_of::<RegionBasis>())?,
+            region_basis: TexelBuffer::new(
+                ctx,
+                "occlusion.region_basis",
+                (groups * q).max(1) as u64 * size_of::<RegionBasis>() as u64,
+                MemoryLocation::CpuToGpu,
+            )?,
             ranges: vec![(0, 0); groups],
             covered: vec![[0; 4]; groups],
             in_use: Vec::new(),

@@ -218,7 +218,7 @@ impl PrtTechnique {
                     bindings: &lit_bindings(&[
                         BindingKind::UniformBuffer,
                         BindingKind::SampledImage,
-                        BindingKind::StorageBuffer,
+                        BindingKind::TexelBuffer,
                         BindingKind::UniformBuffer,
                         BindingKind::SampledImage,
                         BindingKind::UniformBuffer,
@@ -324,7 +324,7 @@ impl PrtTechnique {
             &[
                 Binding::Uniform(uniforms),
                 Binding::Sampled(&self_shadow.texture, &self.nearest),
-                Binding::Storage(&occlusion.region_basis),
+                Binding::Texel(&occlusion.region_basis),
                 Binding::Uniform(&occlusion.energy),
                 Binding::Sampled(&occlusion.filtered, &occlusion.sampler),
                 Binding::Uniform(&occlusion.layers),
