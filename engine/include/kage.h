@@ -688,6 +688,12 @@ typedef struct {
    * whose texels match the eye pixel, 0 to 8; default 4.
    */
   uint32_t asm_extra_levels;
+  /**
+   * Adaptive shadow maps: tile rendering time per frame as a share of the GPU time of the
+   * frame's other passes, above 0 and at most 100 (the lesser of this and `asm_time_ms`
+   * bounds the tiles); default 1.
+   */
+  double asm_time_share;
 } kage_technique_desc;
 
 /**

@@ -208,13 +208,13 @@ impl Renderer {
         let targets = &self.targets;
         passes.push(Pass::new("readback", move |cmd| targets.record_readback(cmd)));
         let mut frame = self.executor.run(passes)?;
-        self.technique.timed(&frame);
         // Starts count from the frame's first pass: this submission's follow the analysis's end.
         let analysis_end = crate::pass::frame_ms(&timings).unwrap_or(0.0);
         for t in &mut frame {
             t.start_ms = t.start_ms.map(|ms| ms + analysis_end);
         }
         timings.extend(frame);
+        self.technique.timed(&timings);
         self.env_dirty = false;
         Ok(timings)
     }

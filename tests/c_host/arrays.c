@@ -147,6 +147,12 @@ static void check_scene_lights(kage_context *context) {
       CHECK(kage_last_error_message(text, sizeof text, NULL));
       REQUIRE(strstr(text, "9 extra ASM levels: at most 8") != NULL);
       renderer_desc.technique.asm_extra_levels = 5;
+      /* A tile budget of no share of the frame: refused, naming the setting. */
+      renderer_desc.technique.asm_time_share = 0.0;
+      EXPECT(kage_renderer_create(context, scene, &renderer_desc, &renderer), KAGE_RESULT_INVALID_VALUE);
+      CHECK(kage_last_error_message(text, sizeof text, NULL));
+      REQUIRE(strstr(text, "ASM time share 0 must be above 0") != NULL);
+      renderer_desc.technique.asm_time_share = 0.5;
     }
     CHECK(kage_renderer_create(context, scene, &renderer_desc, &renderer));
     snprintf(path, sizeof path, "%s/frame.png", dir);

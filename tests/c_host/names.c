@@ -113,6 +113,9 @@ static size_t touch_kage_technique_desc(kage_technique_desc *d) {
   bytes += sizeof d->probe_statics;
   bytes += sizeof d->dominant_lights;
   bytes += sizeof d->light_map_size;
+  bytes += sizeof d->probe_visibility;
+  bytes += sizeof d->asm_extra_levels;
+  bytes += sizeof d->asm_time_share;
   return bytes;
 }
 

@@ -9,7 +9,7 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{Light, Scene};
 use kage::techniques::asm::memory::{edge_records, AsmMemory};
 use kage::techniques::asm::pool::{DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
-use kage::techniques::asm::technique::{AsmTest, MB};
+use kage::techniques::asm::technique::{AsmTest, AsmTimeBudget, MAX_TIME_SHARE, MB};
 use kage::techniques::asm::tile::TileKey;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::TechniqueDesc;
@@ -29,7 +29,7 @@ fn settings(budget_bytes: u64, test: AsmTest) -> AsmSettings {
     // A generous time budget: these tests count tiles, not milliseconds.
     AsmSettings {
         budget_mb: budget_bytes as f64 / MB as f64,
-        time_ms: 1000.0,
+        time: AsmTimeBudget { time_ms: 1000.0, time_share: MAX_TIME_SHARE },
         test,
         ..AsmSettings::default()
     }
@@ -277,7 +277,8 @@ fn a_fast_camera_turn_keeps_the_churn_per_frame_within_the_time_budget() {
     let ctx = Validated::new();
     let scene = close_up(1);
     let (budget, time_ms) = (MB, 2.0);
-    let technique = TechniqueDesc::Asm(AsmSettings { time_ms, ..settings(budget, AsmTest::Bias) });
+    let time = AsmTimeBudget { time_ms, time_share: MAX_TIME_SHARE };
+    let technique = TechniqueDesc::Asm(AsmSettings { time, ..settings(budget, AsmTest::Bias) });
     let mut r = renderer(&ctx, &scene, technique);
     for _ in 0..10 {
         r.render().unwrap();
@@ -304,6 +305,52 @@ fn a_fast_camera_turn_keeps_the_churn_per_frame_within_the_time_budget() {
     }
     eprintln!("after the turn: {differing:?}");
     assert!(differing.last() < differing.first(), "the turned view does not refine: {differing:?}");
+}
+
+/// The share bound: with `time_share` s, a frame's planned tiles fit in s times the GPU time
+/// the frame before spent outside tile renders (each tile costs at least b ms by the model, so
+/// a frame renders at most 1 + s·other/b tiles), whatever `time_ms` allows; with the share at
+/// its largest the same camera turn renders over twice the tiles (measured: 4 against 120 over
+/// four frames), so the share is what binds.
+#[test]
+fn a_camera_turn_renders_tiles_within_the_share_of_the_frame() {
+    let ctx = Validated::new();
+    let tile_passes = ["asm_refresh", "asm_tiles"];
+    let turn = |time_share: f64| {
+        let time = AsmTimeBudget { time_ms: 1000.0, time_share };
+        let technique = TechniqueDesc::Asm(AsmSettings { time, ..settings(MB, AsmTest::Bias) });
+        let mut r = renderer(&ctx, &close_up(1), technique);
+        let mut timings = Vec::new();
+        for _ in 0..3 {
+            timings = r.render().unwrap();
+        }
+        r.set_camera(close_up(3).camera).unwrap();
+        let mut counts = Vec::new();
+        for _ in 0..4 {
+            let other: f64 = timings
+                .iter()
+                .filter(|t| !tile_passes.contains(&t.name))
+                .map(|t| t.gpu_ms.expect("lavapipe has timestamps"))
+                .sum();
+            timings = r.render().unwrap();
+            let stats = r.stats().asm.unwrap();
+            let most = 1 + (time_share * other / stats.cost.1).floor() as usize;
+            assert!(
+                stats.rendered.len() <= most,
+                "share {time_share}: {} tiles, at most {most}",
+                stats.rendered.len()
+            );
+            counts.push(stats.rendered.len());
+        }
+        counts
+    };
+    let (small, large) = (turn(0.05), turn(MAX_TIME_SHARE));
+    eprintln!("tiles per frame after the turn: share 0.05 {small:?}, largest share {large:?}");
+    let total = |counts: &[usize]| counts.iter().sum::<usize>();
+    assert!(
+        2 * total(&small) < total(&large),
+        "the share does not bound the turn's tiles: {small:?} against {large:?}"
+    );
 }
 
 /// The light inside the view: from low in a corner the camera looks up at the spot light on

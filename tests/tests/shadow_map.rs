@@ -4,6 +4,7 @@ use glam::Vec3;
 use kage::reference::{shadow_mismatch, LightMode, ReferenceOptions, ReferenceRenderer, SHADOW_THRESHOLD};
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{shapes, Camera, EnvMap, Group, Light, Scene, Transform};
+use kage::techniques::asm::technique::{AsmTimeBudget, MAX_TIME_SHARE};
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::TechniqueDesc;
 use kage_tests::Validated;
@@ -374,7 +375,8 @@ fn a_cube_resting_on_the_floor_has_no_dotted_line_along_its_base() {
     let threshold = 1e-4 * truth.pixels.iter().map(|p| f64::from(p[1])).fold(0.0, f64::max);
     let lit = |p: &[f32; 4]| f64::from(p[1]) > threshold;
     let ties: Vec<bool> = edges.ties(threshold).collect();
-    let asm = AsmSettings { budget_mb: 16.0, time_ms: 1000.0, ..AsmSettings::default() };
+    let time = AsmTimeBudget { time_ms: 1000.0, time_share: MAX_TIME_SHARE };
+    let asm = AsmSettings { budget_mb: 16.0, time, ..AsmSettings::default() };
     for (name, technique, frames) in [
         ("shadowmap 2048²", TechniqueDesc::ShadowMap { size: 2048 }, 1),
         ("asm 16 MiB", TechniqueDesc::Asm(asm), 12),

@@ -7,7 +7,7 @@ use super::scene::kage_scene;
 use crate::host_memory;
 use crate::prt::{cache, transfer, PrtParams};
 use crate::techniques::asm::technique::AsmTest;
-use crate::techniques::asm::AsmSettings;
+use crate::techniques::asm::{AsmSettings, AsmTimeBudget};
 use crate::techniques::description::{TechniqueDesc, TechniqueKind, TechniqueParams};
 use crate::techniques::parallel_lights::DEFAULT_SHADOW_MAP_SIZE;
 use crate::techniques::probes::{
@@ -127,6 +127,10 @@ pub struct kage_technique_desc {
     /// Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
     /// whose texels match the eye pixel, 0 to 8; default 4.
     pub asm_extra_levels: u32,
+    /// Adaptive shadow maps: tile rendering time per frame as a share of the GPU time of the
+    /// frame's other passes, above 0 and at most 100 (the lesser of this and `asm_time_ms`
+    /// bounds the tiles); default 1.
+    pub asm_time_share: f64,
 }
 
 impl kage_technique_desc {
@@ -235,7 +239,7 @@ impl TechniqueParams for HostParams<'_> {
     fn asm(&self) -> Result<AsmSettings, Failure> {
         Ok(AsmSettings {
             budget_mb: self.0.asm_budget_mb,
-            time_ms: self.0.asm_time_ms,
+            time: AsmTimeBudget { time_ms: self.0.asm_time_ms, time_share: self.0.asm_time_share },
             test: args::enumeration(self.0.asm_test, "asm_test", AsmTest::from_repr)?,
             extra_levels: self.0.asm_extra_levels,
         })
@@ -269,7 +273,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             probe_cube_size: probes.capture.cube_size,
             probe_light: probes.capture.light as u32,
             asm_budget_mb: asm.budget_mb,
-            asm_time_ms: asm.time_ms,
+            asm_time_ms: asm.time.time_ms,
             asm_test: asm.test as u32,
             probe_placement: kage_probe_placement::Grid as u32,
             probe_candidates: [0; 3],
@@ -286,6 +290,7 @@ pub unsafe extern "C" fn kage_technique_desc_default(
             light_map_size: occlusion.light_map_size,
             probe_visibility: probes.visibility as u32,
             asm_extra_levels: asm.extra_levels,
+            asm_time_share: asm.time.time_share,
         };
         // An unknown technique is reported here already, not at the first use.
         // SAFETY: the default places no probes at positions.

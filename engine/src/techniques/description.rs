@@ -334,6 +334,7 @@ impl TechniqueDesc {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::techniques::asm::AsmTimeBudget;
     use crate::techniques::probes::ProbePlacement;
 
     fn transfer(bands: u32, visibility: Visibility) -> Option<Arc<TransferSet>> {
@@ -417,11 +418,18 @@ mod tests {
         probes = ProbeSettings::default();
         probes.capture.cube_size = 512;
         assert!(invalid(desc(probes)).contains("cube map size 512"));
-        let asm =
-            |budget_mb, time_ms| TechniqueDesc::Asm(AsmSettings { budget_mb, time_ms, ..Default::default() });
+        let asm = |budget_mb, time_ms| {
+            let time = AsmTimeBudget { time_ms, ..Default::default() };
+            TechniqueDesc::Asm(AsmSettings { budget_mb, time, ..Default::default() })
+        };
         assert!(invalid(asm(0.01, 8.0)).contains("holds no tile"));
         assert!(invalid(asm(f64::INFINITY, 8.0)).contains("finite number of MB"));
         assert!(invalid(asm(16.0, 0.0)).contains("time budget"));
+        for time_share in [0.0, 101.0, f64::NAN] {
+            let time = AsmTimeBudget { time_share, ..Default::default() };
+            let share = TechniqueDesc::Asm(AsmSettings { time, ..Default::default() });
+            assert!(invalid(share).contains("ASM time share"));
+        }
         let levels = TechniqueDesc::Asm(AsmSettings { extra_levels: 9, ..Default::default() });
         assert!(invalid(levels).contains("9 extra ASM levels: at most 8"));
         // Parallel lights and shadow maps are checked here too, before anything is built.

@@ -29,8 +29,8 @@ pub trait Technique {
     fn analysed(&mut self) -> Result<()> {
         Ok(())
     }
-    /// The GPU times of the frame's own passes, after it completed (the adaptive shadow map
-    /// scales its tile cost model by them).
+    /// The GPU times of the frame's passes (its analysis passes included), after it completed:
+    /// the adaptive shadow map scales its tile cost model and budget by them.
     fn timed(&mut self, _timings: &[PassTiming]) {}
     /// What the technique reports of its last frame besides the pass timings.
     fn stats(&self) -> TechniqueStats {

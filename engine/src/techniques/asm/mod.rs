@@ -28,4 +28,4 @@ pub mod pool;
 pub mod technique;
 pub mod tile;
 
-pub use technique::{AsmSettings, AsmStats};
+pub use technique::{AsmSettings, AsmStats, AsmTimeBudget};

@@ -88,6 +88,14 @@ impl AsmTest {
 
 /// Most levels of refinement [`AsmSettings::extra_levels`] may ask for beyond an eye pixel's.
 pub const MAX_EXTRA_LEVELS: u32 = 8;
+/// The passes that render tiles: the resident tiles a moving group made stale, then the planned
+/// ones.
+const REFRESH_PASS: &str = "asm_refresh";
+const TILES_PASS: &str = "asm_tiles";
+const TILE_PASSES: [&str; 2] = [REFRESH_PASS, TILES_PASS];
+
+/// Largest [`AsmTimeBudget::time_share`]: tile renders up to a hundred times the rest of a frame.
+pub const MAX_TIME_SHARE: f64 = 100.0;
 
 /// The technique's parameters, each defined here once: the command line takes them as its
 /// `--asm-*` options (these comments are their help) and the C ABI as `kage_technique_desc`'s
@@ -98,10 +106,8 @@ pub struct AsmSettings {
     /// Adaptive shadow maps: the page pool's budget, MB (MiB); never exceeded.
     #[cfg_attr(feature = "clap", arg(long = "asm-budget-mb", value_name = "MB", default_value_t = AsmSettings::default().budget_mb))]
     pub budget_mb: f64,
-    /// Adaptive shadow maps: tile rendering time per frame, ms, as the start-up calibration
-    /// predicts it.
-    #[cfg_attr(feature = "clap", arg(long = "asm-time-ms", value_name = "MS", default_value_t = AsmSettings::default().time_ms))]
-    pub time_ms: f64,
+    #[cfg_attr(feature = "clap", command(flatten))]
+    pub time: AsmTimeBudget,
     /// Adaptive shadow maps: the shadow test, `id` (the paper's polygon IDs, depth with bias
     /// as fallback; pages take twice the bytes) or `bias` (depth with slope-scaled bias).
     #[cfg_attr(feature = "clap", arg(long = "asm-test", value_enum, default_value_t = AsmSettings::default().test))]
@@ -114,13 +120,38 @@ pub struct AsmSettings {
     pub extra_levels: u32,
 }
 
-impl Default for AsmSettings {
+/// How long the tile renders of a frame may take: the lesser of a time and a share of the rest
+/// of the frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct AsmTimeBudget {
+    /// Adaptive shadow maps: tile rendering time per frame, ms, as the start-up calibration
+    /// predicts it; at most, with `--asm-time-share`.
+    #[cfg_attr(feature = "clap", arg(long = "asm-time-ms", value_name = "MS", default_value_t = AsmTimeBudget::default().time_ms))]
+    pub time_ms: f64,
+    /// Adaptive shadow maps: tile rendering time per frame as a share of the GPU time of the
+    /// frame's other passes (as the frame before took them), so that tile renders make a frame
+    /// at most 1 + SHARE times as long; the lesser of this and `--asm-time-ms` (that alone on a
+    /// device without timestamps, and in the first frame). Above 0, at most 100.
+    #[cfg_attr(feature = "clap", arg(long = "asm-time-share", value_name = "SHARE", default_value_t = AsmTimeBudget::default().time_share))]
+    pub time_share: f64,
+}
+
+impl Default for AsmTimeBudget {
     fn default() -> Self {
         // 32 ms: some 30 64² tiles per frame on lavapipe, with the scene's 5,000 triangles; at
-        // 8 ms the walkthrough of BENCHMARKS.md misclassified 17 % more pixels at 16 MiB.
+        // 8 ms the walkthrough of BENCHMARKS.md misclassified 17 % more pixels at 16 MiB. A
+        // share of 1: tiles at most double a frame; less costs the slow walkthrough at 256²
+        // its 5x (0.5: 4.7x at 16 MiB), BENCHMARKS.md "Tile time as a share of the frame".
+        AsmTimeBudget { time_ms: 32.0, time_share: 1.0 }
+    }
+}
+
+impl Default for AsmSettings {
+    fn default() -> Self {
         AsmSettings {
             budget_mb: 16.0,
-            time_ms: 32.0,
+            time: AsmTimeBudget::default(),
             test: AsmTest::default(),
             extra_levels: constants::ASM_EXTRA_LEVELS,
         }
@@ -144,10 +175,13 @@ impl AsmSettings {
                 least / 1024
             )));
         }
-        if !(self.time_ms > 0.0 && self.time_ms.is_finite()) {
+        let AsmTimeBudget { time_ms, time_share } = self.time;
+        if !(time_ms > 0.0 && time_ms.is_finite()) {
+            return Err(Error::InvalidArgument(format!("the ASM time budget {time_ms} ms must be positive")));
+        }
+        if !(time_share > 0.0 && time_share <= MAX_TIME_SHARE) {
             return Err(Error::InvalidArgument(format!(
-                "the ASM time budget {} ms must be positive",
-                self.time_ms
+                "the ASM time share {time_share} must be above 0 and at most {MAX_TIME_SHARE}"
             )));
         }
         if self.extra_levels > MAX_EXTRA_LEVELS {
@@ -228,6 +262,9 @@ pub struct Asm {
     cost_scale: f64,
     /// What `cost` predicts for this frame's planned tiles, ms.
     planned_ms: f64,
+    /// GPU ms of the last frame's passes other than tile renders (`time_share` of it is the
+    /// tile budget), once a frame has been timed.
+    other_ms: Option<f64>,
     frame: u64,
     /// The light record, group transforms, group and cluster (per mesh) light-uv bounds of the
     /// frame.
@@ -362,6 +399,7 @@ impl Asm {
             cost: CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 },
             cost_scale: 1.0,
             planned_ms: 0.0,
+            other_ms: None,
             frame: 0,
             record: None,
             transforms: Vec::new(),
@@ -442,6 +480,13 @@ impl Asm {
     fn writes(&self, ops: Vec<PageOp>) -> Vec<TileWrite> {
         let view_proj = self.view_proj();
         ops.into_iter().map(|op| tile_write(op, &view_proj, &self.clusters, &self.cluster_rects)).collect()
+    }
+
+    /// This frame's tile rendering time: `time_ms`, or `time_share` of the other passes' time
+    /// in the frame before where that is less.
+    fn time_budget_ms(&self) -> f64 {
+        let AsmTimeBudget { time_ms, time_share } = self.settings.time;
+        time_ms.min(self.other_ms.map_or(f64::INFINITY, |ms| time_share * ms))
     }
 
     /// World to the light map's clip space this frame.
@@ -616,7 +661,7 @@ impl Technique for Asm {
 
     fn analysis_passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene, targets, uniforms) = (inputs.ctx, inputs.scene, inputs.targets, inputs.uniforms);
-        let refresh = Pass::new("asm_refresh", move |cmd| {
+        let refresh = Pass::new(REFRESH_PASS, move |cmd| {
             self.pages.record(ctx, cmd, scene, &self.refresh);
         });
         // The eye view the analysis reads is the lighting pass' depth prepass.
@@ -651,7 +696,7 @@ impl Technique for Asm {
     fn analysed(&mut self) -> Result<()> {
         let requests = self.read_requests()?;
         let model = self.cost.scaled(self.cost_scale);
-        let (frame, time_ms, view_proj) = (self.frame, self.settings.time_ms, self.view_proj());
+        let (frame, time_ms, view_proj) = (self.frame, self.time_budget_ms(), self.view_proj());
         let resident: std::collections::HashSet<TileKey> = self.pool.resident().map(|(k, _)| k).collect();
         self.evicted = 0;
         let mut planned = Vec::new();
@@ -700,7 +745,7 @@ impl Technique for Asm {
 
     fn passes<'a>(&'a self, inputs: &FrameInputs<'a>) -> Vec<Pass<'a>> {
         let (ctx, scene) = (inputs.ctx, inputs.scene);
-        let tiles = Pass::new("asm_tiles", move |cmd| {
+        let tiles = Pass::new(TILES_PASS, move |cmd| {
             self.pages.record(ctx, cmd, scene, &self.render);
         });
         let mut bindings = vec![
@@ -715,14 +760,17 @@ impl Technique for Asm {
         vec![tiles, lighting]
     }
 
-    /// Scales the cost model by how long this frame's planned tiles took against what the
+    /// Keeps the GPU time of the frame's other passes for the next frame's tile budget, and
+    /// scales the cost model by how long this frame's planned tiles took against what the
     /// start-up model predicted (`plan::rescaled`).
     fn timed(&mut self, timings: &[PassTiming]) {
+        let others = timings.iter().filter(|t| !TILE_PASSES.contains(&t.name));
+        self.other_ms = others.map(|t| t.gpu_ms).sum::<Option<f64>>().filter(|ms| *ms > 0.0);
         // Frames of a few tiles time mostly the pass' own overhead.
         if self.planned_ms < 4.0 * self.cost.ms_per_tile.max(0.01) {
             return;
         }
-        let measured = timings.iter().find(|t| t.name == "asm_tiles").and_then(|t| t.gpu_ms);
+        let measured = timings.iter().find(|t| t.name == TILES_PASS).and_then(|t| t.gpu_ms);
         if let Some(ms) = measured.filter(|ms| *ms > 0.0) {
             self.cost_scale = rescaled(self.cost_scale, self.planned_ms, ms);
         }

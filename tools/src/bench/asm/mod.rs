@@ -22,7 +22,7 @@ use kage::reference::{shadow_flips, shadow_mismatch, SHADOW_THRESHOLD};
 use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
 use kage::techniques::asm::technique::AsmTest;
-use kage::techniques::asm::AsmSettings;
+use kage::techniques::asm::{AsmSettings, AsmTimeBudget};
 use kage::techniques::description::TechniqueDesc;
 use report::{FrameRow, Series};
 use std::path::PathBuf;
@@ -71,6 +71,9 @@ pub struct AsmBenchArgs {
     /// configuration), `summary.csv` and `error-time.png`.
     #[arg(long)]
     out: PathBuf,
+    /// The tile time budget of every `asm` and `asm-id` configuration.
+    #[command(flatten)]
+    asm_time: AsmTimeBudget,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -83,7 +86,7 @@ struct ConfigKind {
     parameter: &'static str,
     /// The chart's series, naming what the values count.
     series: &'static str,
-    settings: fn(&str) -> Result<TechniqueDesc>,
+    settings: fn(&str, AsmTimeBudget) -> Result<TechniqueDesc>,
 }
 
 const KINDS: &[ConfigKind] = &[
@@ -107,23 +110,23 @@ const KINDS: &[ConfigKind] = &[
     },
 ];
 
-fn shadowmap(value: &str) -> Result<TechniqueDesc> {
+fn shadowmap(value: &str, _: AsmTimeBudget) -> Result<TechniqueDesc> {
     let size = value.parse().with_context(|| format!("{value:?} is not a whole number of texels"))?;
     Ok(TechniqueDesc::ShadowMap { size })
 }
 
-fn asm_with(value: &str, test: AsmTest) -> Result<TechniqueDesc> {
+fn asm_with(value: &str, time: AsmTimeBudget, test: AsmTest) -> Result<TechniqueDesc> {
     let budget_mb = value.parse().with_context(|| format!("{value:?} is not a number of MB"))?;
-    Ok(TechniqueDesc::Asm(AsmSettings { budget_mb, test, ..AsmSettings::default() }))
+    Ok(TechniqueDesc::Asm(AsmSettings { budget_mb, time, test, ..AsmSettings::default() }))
 }
 
-fn asm(value: &str) -> Result<TechniqueDesc> {
-    asm_with(value, AsmTest::Bias)
+fn asm(value: &str, time: AsmTimeBudget) -> Result<TechniqueDesc> {
+    asm_with(value, time, AsmTest::Bias)
 }
 
 /// ASM with the paper's polygon-ID test (its pages twice the bytes).
-fn asm_id(value: &str) -> Result<TechniqueDesc> {
-    asm_with(value, AsmTest::Id)
+fn asm_id(value: &str, time: AsmTimeBudget) -> Result<TechniqueDesc> {
+    asm_with(value, time, AsmTest::Id)
 }
 
 /// One configuration of the run.
@@ -137,7 +140,7 @@ pub struct Config {
     settings: TechniqueDesc,
 }
 
-fn parse_config(arg: &str) -> Result<Config> {
+fn parse_config(arg: &str, time: AsmTimeBudget) -> Result<Config> {
     let known = || KINDS.iter().map(|k| format!("{}:VALUE", k.name)).collect::<Vec<_>>().join(", ");
     let Some((kind, value)) = arg.split_once(':') else {
         bail!("--only {arg}: expected KIND:VALUE, one of {}", known());
@@ -145,7 +148,7 @@ fn parse_config(arg: &str) -> Result<Config> {
     let Some(kind) = KINDS.iter().find(|k| k.name == kind) else {
         bail!("--only {arg}: no technique {kind:?}; the benchmark knows {}", known());
     };
-    let settings = (kind.settings)(value).with_context(|| format!("--only {arg}"))?;
+    let settings = (kind.settings)(value, time).with_context(|| format!("--only {arg}"))?;
     Ok(Config {
         name: arg.to_string(),
         kind: kind.name,
@@ -196,6 +199,7 @@ impl AsmBenchArgs {
             converge_tolerance: 1e-4,
             cache: None,
             out,
+            asm_time: AsmTimeBudget::default(),
             gpu,
         }
     }
@@ -233,7 +237,8 @@ pub fn measure(args: &AsmBenchArgs) -> Result<Measured> {
     if args.configs.is_empty() {
         bail!("--only needs at least one configuration");
     }
-    let configs: Vec<Config> = args.configs.iter().map(|c| parse_config(c)).collect::<Result<_>>()?;
+    let configs: Vec<Config> =
+        args.configs.iter().map(|c| parse_config(c, args.asm_time)).collect::<Result<_>>()?;
     let scene = Scene::from_arg(&args.scene)?;
     if scene.walkthrough.is_empty() {
         bail!("scene {} has no camera walkthrough to follow (scene files: \"walkthrough\")", scene.name);
@@ -353,7 +358,7 @@ mod tests {
 
     #[test]
     fn configurations_parse_or_say_what_is_known() {
-        let c = parse_config("shadowmap:2048").unwrap();
+        let c = parse_config("shadowmap:2048", AsmTimeBudget::default()).unwrap();
         assert_eq!((c.kind, c.value.as_str()), ("shadowmap", "2048"));
         assert!(matches!(c.settings, TechniqueDesc::ShadowMap { size: 2048 }));
         for (bad, expected) in [
@@ -361,7 +366,7 @@ mod tests {
             ("cube:4", "no technique \"cube\""),
             ("shadowmap:big", "\"big\" is not a whole number"),
         ] {
-            let err = format!("{:#}", parse_config(bad).err().unwrap());
+            let err = format!("{:#}", parse_config(bad, AsmTimeBudget::default()).err().unwrap());
             assert!(err.contains(expected), "{bad}: {err}");
         }
     }
