@@ -9,7 +9,7 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::{Light, Scene};
 use kage::techniques::asm::memory::{edge_records, AsmMemory};
 use kage::techniques::asm::pool::{DEPTH_PAGE_BYTES, ID_PAGE_BYTES};
-use kage::techniques::asm::technique::{AsmTest, AsmTimeBudget, MAX_TIME_SHARE, MB};
+use kage::techniques::asm::technique::{AsmTest, AsmTimeBudget, MAX_TIME_SHARE, MB, TILE_PASSES};
 use kage::techniques::asm::tile::TileKey;
 use kage::techniques::asm::AsmSettings;
 use kage::techniques::description::TechniqueDesc;
@@ -315,7 +315,6 @@ fn a_fast_camera_turn_keeps_the_churn_per_frame_within_the_time_budget() {
 #[test]
 fn a_camera_turn_renders_tiles_within_the_share_of_the_frame() {
     let ctx = Validated::new();
-    let tile_passes = ["asm_refresh", "asm_tiles"];
     let turn = |time_share: f64| {
         let time = AsmTimeBudget { time_ms: 1000.0, time_share };
         let technique = TechniqueDesc::Asm(AsmSettings { time, ..settings(MB, AsmTest::Bias) });
@@ -329,7 +328,7 @@ fn a_camera_turn_renders_tiles_within_the_share_of_the_frame() {
         for _ in 0..4 {
             let other: f64 = timings
                 .iter()
-                .filter(|t| !tile_passes.contains(&t.name))
+                .filter(|t| !TILE_PASSES.contains(&t.name))
                 .map(|t| t.gpu_ms.expect("lavapipe has timestamps"))
                 .sum();
             timings = r.render().unwrap();

@@ -88,11 +88,12 @@ impl AsmTest {
 
 /// Most levels of refinement [`AsmSettings::extra_levels`] may ask for beyond an eye pixel's.
 pub const MAX_EXTRA_LEVELS: u32 = 8;
+
 /// The passes that render tiles: the resident tiles a moving group made stale, then the planned
-/// ones.
+/// ones. The other passes' time is what [`AsmTimeBudget::time_share`] takes a share of.
 const REFRESH_PASS: &str = "asm_refresh";
 const TILES_PASS: &str = "asm_tiles";
-const TILE_PASSES: [&str; 2] = [REFRESH_PASS, TILES_PASS];
+pub const TILE_PASSES: [&str; 2] = [REFRESH_PASS, TILES_PASS];
 
 /// Largest [`AsmTimeBudget::time_share`]: tile renders up to a hundred times the rest of a frame.
 pub const MAX_TIME_SHARE: f64 = 100.0;
