@@ -171,6 +171,13 @@ impl SceneBvh {
         self.triangles.len()
     }
 
+    /// The world-space box of every group as placed (the top level's root); `None` without
+    /// triangles.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let root = self.tlas_nodes.first().map(node_bounds)?;
+        (!self.triangles.is_empty() && !root.is_empty()).then_some(root)
+    }
+
     /// The scene group, mesh and mesh triangle behind BVH triangle `triangle` (a
     /// `RayHit.triangle`).
     pub fn triangle_origin(&self, triangle: u32) -> Option<TriangleOrigin> {

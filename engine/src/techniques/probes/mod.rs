@@ -27,6 +27,7 @@
 mod capture;
 mod delaunay;
 mod dering;
+mod detour;
 mod extrapolate;
 pub mod fit;
 mod input;
