@@ -31,8 +31,8 @@ use kage::reference::IrradianceReference;
 use kage::scene::Scene;
 use kage::sh::ShRgb9;
 use kage::techniques::probes::{
-    bounds, capture_at, grid_lattice, reduce, CaptureSettings, Lattice, Occluders, ProbeGroups, ProbeSet,
-    ProbeVisibility, Solids, MAX_GRID,
+    bounds, capture_at, grid_lattice, open_to_probes, reduce, CaptureSettings, Lattice, Occluders,
+    ProbeGroups, ProbeSet, ProbeVisibility, Solids, MAX_GRID,
 };
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -508,8 +508,12 @@ pub fn measure(ctx: &Arc<Context>, scene: &Scene, params: &Params) -> Result<Mea
                 sh
             }
         };
-        let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) =
-            lattice.positions().into_iter().zip(sh).filter(|(p, _)| !solids.contains(p.as_vec3())).unzip();
+        let (positions, sh): (Vec<DVec3>, Vec<ShRgb9>) = lattice
+            .positions()
+            .into_iter()
+            .zip(sh)
+            .filter(|(p, _)| open_to_probes(&solids, &occluders, *p))
+            .unzip();
         // Each grid fitted to the same captures as automatic placement: how much of its gain
         // is the fit and how much the placement.
         let (positions, sh) = (&positions, &sh);

@@ -23,6 +23,10 @@ use std::collections::BinaryHeap;
 /// Cells along the box's longest side.
 pub const CELLS_LONGEST: usize = 48;
 
+/// A space holding less than this share of the grid's cells is a sealed pocket, not a room
+/// ([`FreeGrid::sealed`]): in the atrium, gaps between the arches' boxes and the edge beam.
+pub const MIN_SPACE_SHARE: f64 = 0.01;
+
 /// The forward half of the 26 neighbour offsets (the other half is their negation).
 const FORWARD: [[i32; 3]; 13] = [
     [1, 0, 0],
@@ -50,6 +54,9 @@ pub struct FreeGrid {
     dims: [usize; 3],
     /// Per cell, bit k: the join to the cell at `FORWARD[k]` is open.
     open: Vec<u16>,
+    /// Per cell, the number of cells its joins connect it to, itself included: the size of
+    /// its space.
+    space: Vec<u32>,
 }
 
 impl FreeGrid {
@@ -73,7 +80,8 @@ impl FreeGrid {
             }
         }));
         let lo = (lo + hi) * 0.5 - size * DVec3::from_array(dims.map(|d| d as f64)) * 0.5;
-        let mut grid = FreeGrid { lo, cell: size, dims, open: vec![0; dims[0] * dims[1] * dims[2]] };
+        let cells = dims[0] * dims[1] * dims[2];
+        let mut grid = FreeGrid { lo, cell: size, dims, open: vec![0; cells], space: vec![0; cells] };
         for index in 0..grid.open.len() {
             let at = grid.coords(index);
             let centre = grid.centre(at);
@@ -87,7 +95,55 @@ impl FreeGrid {
             }
             grid.open[index] = bits;
         }
+        grid.space = grid.space_sizes();
         Some(grid)
+    }
+
+    /// Each cell's [`FreeGrid::space`]: the cells connected, found by walking the joins.
+    fn space_sizes(&self) -> Vec<u32> {
+        let mut label = vec![u32::MAX; self.open.len()];
+        let mut sizes = Vec::new();
+        for start in 0..self.open.len() {
+            if label[start] != u32::MAX {
+                continue;
+            }
+            let id = sizes.len() as u32;
+            label[start] = id;
+            let mut stack = vec![start];
+            let mut size = 0u32;
+            while let Some(cell) = stack.pop() {
+                size += 1;
+                for (next, _) in self.joined(cell) {
+                    if label[next] == u32::MAX {
+                        label[next] = id;
+                        stack.push(next);
+                    }
+                }
+            }
+            sizes.push(size);
+        }
+        label.into_iter().map(|id| sizes[id as usize]).collect()
+    }
+
+    /// The cells joined to `cell`, each with the join's index into `FORWARD`.
+    fn joined(&self, cell: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let at = self.coords(cell);
+        FORWARD.iter().enumerate().flat_map(move |(k, offset)| {
+            [1, -1].into_iter().filter_map(move |sign| {
+                let next = self.index(self.neighbour(at, offset.map(|o| o * sign))?);
+                // The join's bit is kept by the cell it leaves forward from.
+                let from = if sign == 1 { cell } else { next };
+                (self.open[from] & (1 << k) != 0).then_some((next, k))
+            })
+        })
+    }
+
+    /// Whether `q` is sealed off in a pocket: every cell around it that it sees lies in a space
+    /// of less than [`MIN_SPACE_SHARE`] of the grid's cells (or it sees none), as a gap closed
+    /// on all sides between boxes that do not quite overlap, or the inside of a solid.
+    pub(super) fn sealed(&self, q: DVec3, occluders: &Occluders) -> bool {
+        let least = MIN_SPACE_SHARE * self.open.len() as f64;
+        self.entries(q, occluders).iter().all(|&(cell, _)| f64::from(self.space[cell]) < least)
     }
 
     fn coords(&self, index: usize) -> [usize; 3] {
@@ -154,23 +210,11 @@ impl FreeGrid {
             if d > distance[cell] {
                 continue;
             }
-            let at = self.coords(cell);
-            for (k, offset) in FORWARD.iter().enumerate() {
-                for sign in [1, -1] {
-                    let Some(next) = self.neighbour(at, offset.map(|o| o * sign)) else {
-                        continue;
-                    };
-                    let next = self.index(next);
-                    // The join's bit is kept by the cell it leaves forward from.
-                    let from = if sign == 1 { cell } else { next };
-                    if self.open[from] & (1 << k) == 0 {
-                        continue;
-                    }
-                    let through = d + steps[k] as f32;
-                    if through < distance[next] {
-                        distance[next] = through;
-                        heap.push(Reverse((through.to_bits(), next)));
-                    }
+            for (next, k) in self.joined(cell) {
+                let through = d + steps[k] as f32;
+                if through < distance[next] {
+                    distance[next] = through;
+                    heap.push(Reverse((through.to_bits(), next)));
                 }
             }
         }

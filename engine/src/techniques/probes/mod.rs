@@ -57,8 +57,9 @@ pub use lookup::{Location, Walker};
 pub use reduce::reduce;
 pub use relocate::relocate;
 pub use set::{
-    bounds, capture_at, grid_lattice, Lookup, ProbeCounts, ProbeGroups, ProbeInterpolation, ProbePlacement,
-    ProbeSet, ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID, DEFAULT_TOLERANCE, MAX_GRID,
+    bounds, capture_at, grid_lattice, open_to_probes, Lookup, ProbeCounts, ProbeGroups, ProbeInterpolation,
+    ProbePlacement, ProbeSet, ProbeSettings, StaticLighting, AUTO_CANDIDATES, DEFAULT_GRID,
+    DEFAULT_TOLERANCE, MAX_GRID,
 };
 pub use solids::{Hit, Solids};
 pub use tetmesh::{Across, TetMesh};

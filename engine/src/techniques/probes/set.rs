@@ -85,7 +85,8 @@ pub enum ProbePlacement {
     /// Explicit world positions (`{"positions": [[x, y, z], ...]}` on the command line).
     Positions(Arc<[DVec3]>),
     /// Automatic: the cell centres of a `candidates` grid over the static groups' bounding box
-    /// that are not inside a solid ([`Solids`]) are captured, then those that the others
+    /// that are not inside a solid ([`Solids`]) nor sealed in a pocket ([`Occluders::sealed`])
+    /// are captured, then those that the others
     /// reproduce by tetrahedral interpolation within `tolerance` are dropped (see
     /// [`super::reduce`]), the kept ones moved to nearby candidates while that lowers the error
     /// over all of them ([`super::relocate`]) and their SH fitted to every capture
@@ -205,12 +206,22 @@ impl ProbeSettings {
                         extent.to_array().map(along)
                     }
                 };
-                let solids = Solids::of_static(scene);
+                let (solids, occluders) = (Solids::of_static(scene), Occluders::of_static(scene)?);
                 let lattice = grid_lattice(scene, counts)?;
-                Ok(lattice.positions().into_iter().filter(|p| !solids.contains(p.as_vec3())).collect())
+                Ok(lattice
+                    .positions()
+                    .into_iter()
+                    .filter(|&p| open_to_probes(&solids, &occluders, p))
+                    .collect())
             }
         }
     }
+}
+
+/// Whether automatic placement may keep a candidate at `p`: outside the solids, and not sealed
+/// in a pocket of free space ([`Occluders::sealed`]).
+pub fn open_to_probes(solids: &Solids, occluders: &Occluders, p: DVec3) -> bool {
+    !solids.contains(p.as_vec3()) && !occluders.sealed(p)
 }
 
 /// The cell centres of a `counts` grid over the static groups' bounding box. Along an axis

@@ -150,6 +150,13 @@ impl Occluders {
             .is_some_and(|d| d <= DETOUR * p.distance(q) + DETOUR_CELLS * grid.cell_size())
     }
 
+    /// Whether `q` lies sealed off in a pocket of free space ([`FreeGrid::sealed`]), such as a
+    /// gap closed on all sides between boxes: a probe there captures only the pocket's walls.
+    /// False without a grid.
+    pub fn sealed(&self, q: DVec3) -> bool {
+        self.grid.as_ref().is_some_and(|grid| grid.sealed(q, self))
+    }
+
     /// Whether no static surface lies between `p` and `q`. A surface within a millionth of the
     /// distance of `q` does not hide it: a probe placed on a wall sees the room it faces.
     pub fn sees(&self, p: DVec3, q: DVec3) -> bool {
@@ -375,6 +382,7 @@ mod tests {
     use super::*;
     use crate::scene::motion::Key;
     use crate::scene::{shapes, Camera, EnvMap, Group, Motion, Transform};
+    use crate::techniques::probes::Solids;
     use glam::Vec3;
 
     /// A wall 0.1 thick at x = 0 (y and z within ±2), a sealed box around (0, 0, 5), a pole 4 cm
@@ -503,6 +511,50 @@ mod tests {
         assert!(!occluders.same_space(DVec3::new(0.2, 0.0, 5.0), DVec3::new(1.0, 0.0, 5.0)));
         // A point sealed off from the grid (inside the pole) reaches no cell.
         assert!(!occluders.same_space(DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)));
+    }
+
+    /// Six slabs 0.1 thick closing a cube `side` wide around the origin (their outer faces,
+    /// front faces, face its inside), on a floor 8 m wide that sets the grid's cells (1/6 m).
+    fn pocket(side: f32) -> (Occluders, Solids) {
+        let (h, t) = (0.5 * side, 0.1);
+        let slabs = [
+            ([-h - t, -h - t, -h - t], [h + t, -h, h + t]),
+            ([-h - t, h, -h - t], [h + t, h + t, h + t]),
+            ([-h - t, -h, -h - t], [-h, h, h + t]),
+            ([h, -h, -h - t], [h + t, h, h + t]),
+            ([-h, -h, -h - t], [h, h, -h]),
+            ([-h, -h, h], [h, h, h + t]),
+            ([-4.0, -2.0, -4.0], [4.0, -1.9, 4.0]),
+        ];
+        let walls = shapes::boxes("pocket", &slabs, [0.5; 3]).unwrap();
+        let ball = shapes::boxes("ball", &[([-0.1; 3], [0.1; 3])], [0.5; 3]).unwrap();
+        let at = Transform { translation: Vec3::splat(50.0), ..Transform::default() };
+        let motion = Motion { keys: vec![Key::posed(0.0, at)], loop_seconds: None };
+        let scene = Scene::new(
+            "pocket",
+            vec![
+                Group { motion: Some(motion), ..Group::new("ball", vec![ball], at) },
+                Group::new("walls", vec![walls], Transform::default()),
+            ],
+            EnvMap::constant([1.0; 3]),
+            Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
+        );
+        (Occluders::of_static(&scene).unwrap(), Solids::of_static(&scene))
+    }
+
+    #[test]
+    fn a_pocket_is_sealed_and_a_closed_room_is_not() {
+        // 30 cm: about 8 cells of the grid's 48 × 14 × 48 (less than 1 %), which `Solids` does
+        // not count as inside a solid.
+        let (occluders, solids) = pocket(0.3);
+        let inside = DVec3::new(0.02, -0.03, 0.01);
+        assert!(occluders.sealed(inside) && !solids.contains(inside.as_vec3()));
+        assert!(!occluders.sealed(DVec3::new(1.0, 0.0, 0.0)));
+        // 1.5 m: a closed room of about 700 cells (over 2 %).
+        let (occluders, _) = pocket(1.5);
+        assert!(!occluders.sealed(inside));
+        // Inside a slab: no cell seen.
+        assert!(occluders.sealed(DVec3::new(0.0, -0.8, 0.0)));
     }
 
     #[test]
