@@ -150,9 +150,9 @@ impl Occluders {
             .is_some_and(|d| d <= DETOUR * p.distance(q) + DETOUR_CELLS * grid.cell_size())
     }
 
-    /// Whether `q` lies sealed off in a pocket of free space ([`FreeGrid::sealed`]), such as a
-    /// gap closed on all sides between boxes: a probe there captures only the pocket's walls.
-    /// False without a grid.
+    /// Whether `q` lies sealed off in a pocket of free space (a space of the way-round grid,
+    /// `detour.rs`, under 1 % of its cells), such as a gap closed on all sides between boxes: a
+    /// probe there captures only the pocket's walls. False without a grid.
     pub fn sealed(&self, q: DVec3) -> bool {
         self.grid.as_ref().is_some_and(|grid| grid.sealed(q, self))
     }
