@@ -381,7 +381,7 @@ fn nearest_seen(p: DVec3, positions: &[DVec3], occluders: &Occluders) -> Option<
 mod tests {
     use super::*;
     use crate::scene::motion::Key;
-    use crate::scene::{shapes, Camera, EnvMap, Group, Motion, Transform};
+    use crate::scene::{shapes, Camera, EnvMap, Group, Mesh, Motion, Transform};
     use crate::techniques::probes::Solids;
     use glam::Vec3;
 
@@ -395,19 +395,23 @@ mod tests {
         )
         .unwrap();
         let sealed = shapes::boxes("sealed", &[([-0.5, -0.5, 4.5], [0.5, 0.5, 5.5])], [0.5; 3]).unwrap();
+        Arc::new(Occluders::of_static(&with_walls("walled", vec![wall, sealed])).unwrap())
+    }
+
+    /// A scene of static `walls` and a moving ball far away (so that the walls are static).
+    fn with_walls(name: &str, walls: Vec<Mesh>) -> Scene {
         let ball = shapes::boxes("ball", &[([-0.1; 3], [0.1; 3])], [0.5; 3]).unwrap();
         let at = Transform { translation: Vec3::splat(50.0), ..Transform::default() };
         let motion = Motion { keys: vec![Key::posed(0.0, at)], loop_seconds: None };
-        let scene = Scene::new(
-            "walled",
+        Scene::new(
+            name,
             vec![
                 Group { motion: Some(motion), ..Group::new("ball", vec![ball], at) },
-                Group::new("walls", vec![wall, sealed], Transform::default()),
+                Group::new("walls", walls, Transform::default()),
             ],
             EnvMap::constant([1.0; 3]),
             Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
-        );
-        Arc::new(Occluders::of_static(&scene).unwrap())
+        )
     }
 
     /// Probes 0 and 1 west of the wall, 2 and 3 east of it, 4 inside the sealed box.
@@ -526,19 +530,7 @@ mod tests {
             ([-h, -h, h], [h, h, h + t]),
             ([-4.0, -2.0, -4.0], [4.0, -1.9, 4.0]),
         ];
-        let walls = shapes::boxes("pocket", &slabs, [0.5; 3]).unwrap();
-        let ball = shapes::boxes("ball", &[([-0.1; 3], [0.1; 3])], [0.5; 3]).unwrap();
-        let at = Transform { translation: Vec3::splat(50.0), ..Transform::default() };
-        let motion = Motion { keys: vec![Key::posed(0.0, at)], loop_seconds: None };
-        let scene = Scene::new(
-            "pocket",
-            vec![
-                Group { motion: Some(motion), ..Group::new("ball", vec![ball], at) },
-                Group::new("walls", vec![walls], Transform::default()),
-            ],
-            EnvMap::constant([1.0; 3]),
-            Camera { position: Vec3::Z * 9.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 },
-        );
+        let scene = with_walls("pocket", vec![shapes::boxes("pocket", &slabs, [0.5; 3]).unwrap()]);
         (Occluders::of_static(&scene).unwrap(), Solids::of_static(&scene))
     }
 
