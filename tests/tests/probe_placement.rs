@@ -6,7 +6,8 @@ use kage::renderer::{RenderOptions, Renderer};
 use kage::scene::Scene;
 use kage::techniques::description::TechniqueDesc;
 use kage::techniques::probes::{
-    CaptureSettings, CapturedLight, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings, Solids,
+    CaptureSettings, CapturedLight, Occluders, ProbeInterpolation, ProbePlacement, ProbeSet, ProbeSettings,
+    Solids,
 };
 use kage_tests::Validated;
 
@@ -50,7 +51,7 @@ fn candidates_inside_the_atriums_walls_and_columns_are_not_captured() {
         ProbePlacement::Auto { tolerance: 0.1, candidates: Some([16, 5, 16]) },
         ProbeInterpolation::Tetrahedral,
     );
-    let candidates = settings.positions(&scene).unwrap();
+    let candidates = settings.positions(&scene, &Occluders::of_static(&scene).unwrap()).unwrap();
     let solids = Solids::of_static(&scene);
     // The walls, the columns and the arches' boxes hold a few of the 1,280 cell centres.
     assert!(candidates.len() < 16 * 5 * 16 && candidates.len() > 1000, "{}", candidates.len());

@@ -94,11 +94,11 @@ enum Command {
     /// kage render ... --technique probes --probes auto[:TOL[:NX,NY,NZ]] [--probe-interpolation
     /// tetrahedral|trilinear] [--probe-statics unshadowed|sloan]: automatic placement (see
     /// "Probes"): candidates on a grid over the static groups (default 8 along the longest side),
-    /// those inside solids dropped, captured, the redundant ones dropped at relative tolerance TOL
-    /// (default 0.05), the kept ones relocated to nearby candidates and their SH fitted to all the
-    /// captures; `trilinear` interpolates a `grid:` placement cell by cell instead of by
-    /// tetrahedra; `--probe-statics` lights the static groups unshadowed or by Sloan's PRT; prints
-    /// how many probes were kept
+    /// those inside solids or sealed in pockets of free space dropped, captured, the redundant
+    /// ones dropped at relative tolerance TOL (default 0.05), the kept ones relocated to nearby
+    /// candidates and their SH fitted to all the captures; `trilinear` interpolates a `grid:`
+    /// placement cell by cell instead of by tetrahedra; `--probe-statics` lights the static
+    /// groups unshadowed or by Sloan's PRT; prints how many probes were kept
     ///
     /// kage render ... --technique asm [--asm-budget-mb M] [--asm-time-ms T] [--asm-test bias|id]:
     /// adaptive shadow maps for the scene's one point or spot light (see "Adaptive shadow maps");

@@ -267,6 +267,7 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
                 row.method, row.setting, row.probes, row.error
             );
         }
+        print_power_laws(&m.rows);
         // Like for like (each region's grid against automatic placement in it), and the
         // paper's comparison: a grid over the whole box against probes where objects move.
         // Then what the fit adds: placement with captured values against the grid, and the
@@ -292,6 +293,49 @@ pub fn run(args: &ProbeCountArgs) -> Result<()> {
         }
     }
     args.gpu.finish(&ctx)
+}
+
+/// Each method's power law `error ≈ a·n^b` over its sets (n probes), fitted by least squares
+/// in log–log, and the sets' scatter about it (the RMS of the log residuals). Placement's sets
+/// move by more than the differences runs are compared for when a few candidates change
+/// (BENCHMARKS.md), so two runs are compared by their curves as well as set by set.
+fn print_power_laws(rows: &[Row]) {
+    const AT: [f64; 4] = [4.0, 16.0, 64.0, 256.0];
+    println!(
+        "power laws (error ≈ a·n^b over each method's sets, all candidates apart; scatter: RMS of the log residuals):\n{:<52} {:>7} {:>7} {:>8}   error at n = {AT:?}",
+        "method", "a", "b", "scatter"
+    );
+    let mut methods: Vec<&str> = Vec::new();
+    for row in rows {
+        if !methods.contains(&row.method.as_str()) {
+            methods.push(&row.method);
+        }
+    }
+    for method in methods {
+        let logs: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.method == method && r.setting != Setting::AllCandidates && r.error > 0.0)
+            .map(|r| ((r.probes as f64).ln(), r.error.ln()))
+            .collect();
+        let Some((a, b, scatter)) = power_law(&logs) else { continue };
+        let at: Vec<String> = AT.iter().map(|n| format!("{:.4}", a * n.powf(b))).collect();
+        println!("{method:<52} {a:>7.4} {b:>7.4} {:>7.1} %   {}", 100.0 * scatter, at.join(", "));
+    }
+}
+
+/// The least-squares line through `(ln n, ln error)` as `(a, b, scatter)`: `error ≈ a·n^b`;
+/// `None` for fewer than three sets or one probe count only.
+fn power_law(logs: &[(f64, f64)]) -> Option<(f64, f64, f64)> {
+    let k = logs.len() as f64;
+    let (mx, my) = logs.iter().fold((0.0, 0.0), |(x, y), p| (x + p.0 / k, y + p.1 / k));
+    let sxx: f64 = logs.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if logs.len() < 3 || sxx <= 0.0 {
+        return None;
+    }
+    let b = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
+    let ln_a = my - b * mx;
+    let residual: f64 = logs.iter().map(|p| (p.1 - ln_a - b * p.0).powi(2)).sum();
+    Some((ln_a.exp(), b, (residual / k).sqrt()))
 }
 
 /// For each target error (`target`, or each of `grid`'s errors), the fewest probes with which
@@ -718,6 +762,19 @@ mod tests {
     use super::*;
     use kage::techniques::probes::CapturedLight;
     use kage_tests::Validated;
+
+    #[test]
+    fn a_power_law_is_recovered_with_no_scatter() {
+        let logs: Vec<(f64, f64)> =
+            [4.0f64, 10.0, 50.0].iter().map(|&n| (n.ln(), (0.8 * n.powf(-0.3)).ln())).collect();
+        let (a, b, scatter) = power_law(&logs).unwrap();
+        assert!((a - 0.8).abs() < 1e-12 && (b + 0.3).abs() < 1e-12 && scatter < 1e-12, "{a} {b} {scatter}");
+        // Sets a factor e above and below the line scatter by 1 (in the log).
+        let spread = [(1.0, 1.0), (1.0, -1.0), (2.0, 1.0), (2.0, -1.0)];
+        assert_eq!(power_law(&spread), Some((1.0, 0.0, 1.0)));
+        assert_eq!(power_law(&logs[..2]), None);
+        assert_eq!(power_law(&[(1.0, 0.0), (1.0, 1.0), (1.0, 2.0)]), None);
+    }
 
     #[test]
     fn box_test_points_spread_over_the_static_box() {

@@ -37,8 +37,8 @@ pub enum ProbesCommand {
     /// normals; `--out` writes `{"sh": [[r,g,b] × 9], "irradiance": {"+x": [r,g,b], ...}}`
     CaptureImage(capture_image::CaptureImageArgs),
     /// Automatic placement: candidates on a grid over the scene's static groups (those inside
-    /// solids dropped) are captured, the redundant ones dropped; the kept positions are written
-    /// as a probe file for `kage render --probes FILE`.
+    /// solids or sealed in pockets of free space dropped) are captured, the redundant ones
+    /// dropped; the kept positions are written as a probe file for `kage render --probes FILE`.
     ///
     /// kage probes place [--scene S] [--probes auto:TOL] [--probe-cube-size N] [--probe-light
     /// sky-and-walls|sky] --out PROBES.json: automatic placement once: prints how many of the

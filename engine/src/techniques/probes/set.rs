@@ -188,8 +188,9 @@ impl ProbeSettings {
         Ok(self)
     }
 
-    /// The probe positions in `scene`; for automatic placement, the candidates.
-    pub fn positions(&self, scene: &Scene) -> Result<Vec<DVec3>> {
+    /// The probe positions in `scene`; for automatic placement, the candidates that are
+    /// [`open_to_probes`] (`occluders`: `scene`'s static groups, [`Occluders::of_static`]).
+    pub fn positions(&self, scene: &Scene, occluders: &Occluders) -> Result<Vec<DVec3>> {
         match &self.placement {
             ProbePlacement::Positions(positions) => Ok(positions.to_vec()),
             ProbePlacement::Grid(counts) => Ok(grid_lattice(scene, *counts)?.positions()),
@@ -206,12 +207,12 @@ impl ProbeSettings {
                         extent.to_array().map(along)
                     }
                 };
-                let (solids, occluders) = (Solids::of_static(scene), Occluders::of_static(scene)?);
+                let solids = Solids::of_static(scene);
                 let lattice = grid_lattice(scene, counts)?;
                 Ok(lattice
                     .positions()
                     .into_iter()
-                    .filter(|&p| open_to_probes(&solids, &occluders, p))
+                    .filter(|&p| open_to_probes(&solids, occluders, p))
                     .collect())
             }
         }
@@ -328,7 +329,9 @@ impl ProbeSet {
     ) -> Result<ProbeSet> {
         let settings = settings.clone().validated()?;
         let mut capture = ProbeCapture::new(ctx, scene, settings.capture)?;
-        let (positions, invalid) = capture.keep_valid(&settings.positions(scene)?);
+        // One BVH and one free-space grid for the placement's candidates and the lookups.
+        let occluders = Arc::new(capture.occluders());
+        let (positions, invalid) = capture.keep_valid(&settings.positions(scene, &occluders)?);
         // A warning, not an error: the set still lights the scene without them.
         for probe in &invalid {
             let p = probe.position;
@@ -354,7 +357,7 @@ impl ProbeSet {
         if !progress(candidates, candidates + 1) {
             return Err(cancelled());
         }
-        let occluders = (settings.visibility == ProbeVisibility::Rays).then(|| Arc::new(capture.occluders()));
+        let occluders = (settings.visibility == ProbeVisibility::Rays).then_some(occluders);
         let set = match (&settings.placement, settings.interpolation) {
             (ProbePlacement::Auto { tolerance, .. }, _) => {
                 ProbeSet::placed(&positions, &sh, *tolerance, occluders.clone())?
@@ -591,7 +594,8 @@ mod tests {
         }
         // Every group moving leaves none to place probes in, and the message says which move.
         let all = scene(vec![group("ball", Vec3::ZERO, true), group("cart", Vec3::X, true)]);
-        let error = ProbeSettings::default().positions(&all).unwrap_err().to_string();
+        let occluders = Occluders::of_static(&all).unwrap();
+        let error = ProbeSettings::default().positions(&all, &occluders).unwrap_err().to_string();
         assert!(error.contains("no static group") && error.contains("group 1 (\"cart\")"), "{error}");
     }
 }

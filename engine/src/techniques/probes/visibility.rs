@@ -49,7 +49,7 @@ use crate::raycast::SceneBvh;
 use crate::scene::Scene;
 use glam::DVec3;
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Whether a lookup weighs probes by whether the point sees them.
 #[repr(u32)]
@@ -98,7 +98,9 @@ pub const MIN_SEEN_WEIGHT: f64 = 1e-9;
 pub struct Occluders {
     bvh: SceneBvh,
     /// The free space around them, for the way round ([`FreeGrid`]); `None` without surfaces.
-    grid: Option<FreeGrid>,
+    /// Built on first use: a set that never asks about the way round (no visibility, no
+    /// automatic placement) does not pay for it.
+    grid: OnceLock<Option<FreeGrid>>,
     /// The paths through the grid from each probe position asked about so far
     /// ([`FreeGrid::distances_from`]), by its coordinates' bits: automatic placement tries the
     /// same candidates in many sets.
@@ -111,11 +113,14 @@ impl Occluders {
         Ok(Occluders::from_bvh(SceneBvh::build(&static_scene(scene))?))
     }
 
-    /// Occluders from the static groups' BVH, with their free-space grid.
+    /// Occluders from the static groups' BVH.
     pub(super) fn from_bvh(bvh: SceneBvh) -> Occluders {
-        let mut occluders = Occluders { bvh, grid: None, ways: Mutex::default() };
-        occluders.grid = FreeGrid::build(&occluders.bvh, &occluders);
-        occluders
+        Occluders { bvh, grid: OnceLock::new(), ways: Mutex::default() }
+    }
+
+    /// The free-space grid, built the first time it is asked for.
+    fn grid(&self) -> Option<&FreeGrid> {
+        self.grid.get_or_init(|| FreeGrid::build(&self.bvh, self)).as_ref()
     }
 
     /// The distance from `q` to the nearest static surface, times [`FREE_FRACTION`] (see
@@ -134,7 +139,7 @@ impl Occluders {
     /// space is at most [`DETOUR`] times the straight line (plus [`DETOUR_CELLS`] cells for
     /// the grid's steps), as past a column, an arch or a roof's edge, not through a wall.
     fn same_space(&self, p: DVec3, q: DVec3) -> bool {
-        let Some(grid) = &self.grid else {
+        let Some(grid) = self.grid() else {
             return false;
         };
         let key = q.to_array().map(f64::to_bits);
@@ -154,7 +159,7 @@ impl Occluders {
     /// `detour.rs`, under 1 % of its cells), such as a gap closed on all sides between boxes: a
     /// probe there captures only the pocket's walls. False without a grid.
     pub fn sealed(&self, q: DVec3) -> bool {
-        self.grid.as_ref().is_some_and(|grid| grid.sealed(q, self))
+        self.grid().is_some_and(|grid| grid.sealed(q, self))
     }
 
     /// Whether no static surface lies between `p` and `q`. A surface within a millionth of the
@@ -501,7 +506,7 @@ mod tests {
         let occluders = walled();
         // In open space the way round is the straight line to within the joins' 13 % and the
         // steps into the grid at each end (4 cells at most), and never shorter.
-        let grid = occluders.grid.as_ref().unwrap();
+        let grid = occluders.grid().unwrap();
         let (p, q) = (DVec3::new(1.0, -1.5, -1.5), DVec3::new(1.5, 1.5, 4.0));
         let way = grid.way_round(&grid.distances_from(q, &occluders), p, &occluders).unwrap();
         assert!(way >= p.distance(q) && way <= 1.13 * p.distance(q) + 4.0 * grid.cell_size(), "{way}");
