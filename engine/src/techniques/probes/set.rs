@@ -374,6 +374,9 @@ impl ProbeSet {
             }
             _ => ProbeSet::tetrahedral(&positions, sh)?,
         };
+        if let Some(occluders) = &occluders {
+            occluders.keep_ways_of(set.mesh.positions());
+        }
         let mut set = set.seeing(occluders);
         set.candidates = candidates;
         set.invalid = invalid;

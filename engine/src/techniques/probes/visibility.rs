@@ -48,7 +48,7 @@ use crate::error::Result;
 use crate::raycast::SceneBvh;
 use crate::scene::Scene;
 use glam::DVec3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Whether a lookup weighs probes by whether the point sees them.
@@ -92,6 +92,11 @@ pub const NEAREST_TRIES: usize = 32;
 /// The weight the seen probes must hold to be renormalised: below it they are a rounding's
 /// remainder, and the point counts as seeing none.
 pub const MIN_SEEN_WEIGHT: f64 = 1e-9;
+
+/// A probe position's key in [`Occluders`]'s paths: its coordinates' bits.
+fn way_key(q: DVec3) -> [u64; 3] {
+    q.to_array().map(f64::to_bits)
+}
 
 /// The static groups' surfaces, which hide probes from a point.
 #[derive(Debug)]
@@ -142,7 +147,7 @@ impl Occluders {
         let Some(grid) = self.grid() else {
             return false;
         };
-        let key = q.to_array().map(f64::to_bits);
+        let key = way_key(q);
         let known = self.ways.lock().ok().and_then(|ways| ways.get(&key).cloned());
         let way = known.unwrap_or_else(|| {
             let way: Arc<[f32]> = grid.distances_from(q, self).into();
@@ -153,6 +158,15 @@ impl Occluders {
         });
         grid.way_round(&way, p, self)
             .is_some_and(|d| d <= DETOUR * p.distance(q) + DETOUR_CELLS * grid.cell_size())
+    }
+
+    /// Forgets the paths from every probe position but `kept`: placement asks about each
+    /// candidate, the finished set's lookups about its own probes only.
+    pub(super) fn keep_ways_of(&self, kept: &[DVec3]) {
+        let keys: HashSet<[u64; 3]> = kept.iter().map(|&q| way_key(q)).collect();
+        if let Ok(mut ways) = self.ways.lock() {
+            ways.retain(|key, _| keys.contains(key));
+        }
     }
 
     /// Whether `q` lies sealed off in a pocket of free space (a space of the way-round grid,
@@ -520,6 +534,11 @@ mod tests {
         assert!(!occluders.same_space(DVec3::new(0.2, 0.0, 5.0), DVec3::new(1.0, 0.0, 5.0)));
         // A point sealed off from the grid (inside the pole) reaches no cell.
         assert!(!occluders.same_space(DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)));
+        // The paths from each probe asked about are kept until a finished set keeps its own.
+        let paths = || occluders.ways.lock().unwrap().len();
+        assert_eq!(paths(), 5);
+        occluders.keep_ways_of(&[q, DVec3::new(3.0, 0.0, 0.0), DVec3::new(-0.4, 0.0, 1.9)]);
+        assert_eq!(paths(), 2);
     }
 
     /// Six slabs 0.1 thick closing a cube `side` wide around the origin (their outer faces,
