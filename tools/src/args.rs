@@ -5,6 +5,7 @@ use glam::DVec3;
 use kage::backend::{Context, ContextDesc};
 use kage::files;
 use kage::scene::Scene;
+use kage::techniques::description::{RenderedLight, TechniqueKind};
 use kage::techniques::probes::{positions_file, ProbePlacement, DEFAULT_TOLERANCE};
 use std::path::Path;
 use std::sync::Arc;
@@ -88,6 +89,30 @@ pub fn read_scene(arg: &str, env_replaced: bool) -> Result<kage::scene::Scene> {
         );
     }
     Ok(loaded.scene)
+}
+
+/// A technique's name as the command line spells it.
+pub fn technique_name(kind: TechniqueKind) -> String {
+    clap::ValueEnum::to_possible_value(&kind)
+        .map_or_else(|| format!("{kind:?}"), |v| v.get_name().to_string())
+}
+
+/// Says so when the scene has lights that `kind` leaves out ([`TechniqueKind::rendered_light`]):
+/// each technique renders its paper's light, and a spot missing from a picture should not pass
+/// for a bug.
+pub fn report_unrendered_lights(kind: TechniqueKind, scene: &Scene) {
+    let lights = scene.lights.len();
+    let name = technique_name(kind);
+    let note = match kind.rendered_light() {
+        RenderedLight::Environment if lights > 0 => format!(
+            "technique {name} renders the environment alone: the scene's {lights} point or spot light(s) are left out (`shadowmap` and `asm` render them)"
+        ),
+        RenderedLight::Probes if lights > 0 => format!(
+            "the scene's {lights} point or spot light(s) reach the moving groups through the probes' capture but not the static groups, which technique {name} lights by the environment alone"
+        ),
+        _ => return,
+    };
+    eprintln!("kage: note: {note}");
 }
 
 /// Says so when loading an environment map changed it (negative texels clamped to 0).

@@ -156,6 +156,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let exposure = args.exposure.checked(&scene)?;
     let ctx = args.gpu.context()?;
     let technique = technique(args, &scene)?;
+    crate::args::report_unrendered_lights(args.technique, &scene);
     let transfer = match technique.precomputation() {
         None => None,
         Some(params) => {

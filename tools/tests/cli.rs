@@ -1305,6 +1305,32 @@ fn the_default_sky_note_is_printed_only_when_the_default_stays() {
     assert!(!render(&given, &[]), "no note where the file gives an environment");
 }
 
+/// A technique that leaves out some of the scene's light says so: the Blender export's spot
+/// light under an environment technique, and under the probes on the static groups; not under
+/// the shadow maps, which render it, nor where the scene has no point or spot light.
+#[test]
+fn the_lights_a_technique_leaves_out_are_named() {
+    let dir = scratch_dir("cli-unrendered-lights");
+    let blender = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/blender-suzanne/scene.glb");
+    let gltf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/assets/gltf/khronos-box/Box.gltf");
+    let note = |scene: &str, technique: &str| {
+        let out = dir.join("out.exr");
+        let args = ["render", "--scene", scene, "--technique", technique, "--width", "8", "--height", "8"];
+        let run = kage(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+        assert!(run.status.success(), "{}", text(&run));
+        text(&run).lines().find(|l| l.contains("point or spot light(s)")).map(str::to_string)
+    };
+    let unshadowed = note(blender, "unshadowed").unwrap_or_default();
+    assert!(unshadowed.contains("technique unshadowed renders the environment alone: the scene's 1 point or spot light(s) are left out"), "{unshadowed}");
+    let probes = note(blender, "probes").unwrap_or_default();
+    assert!(
+        probes.contains("reach the moving groups through the probes' capture but not the static groups"),
+        "{probes}"
+    );
+    assert_eq!(note(blender, "shadowmap"), None);
+    assert_eq!(note(gltf, "unshadowed"), None);
+}
+
 /// `kage render --scene bunny.obj`: the scanned bunny with its `vn 0 0 0`, read alone, renders
 /// under the constant sky with notes for the defaults and the repaired normal; the default
 /// camera has it in the middle of the picture. A bad OBJ is an error naming it.

@@ -64,6 +64,35 @@ pub enum TechniqueKind {
     Asm = 6,
 }
 
+/// Which of a scene's lights a technique renders: each models its paper's light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RenderedLight {
+    /// The environment alone (with the dominant lights taken out of its map, for Tamura); the
+    /// scene's point and spot lights are left out.
+    Environment,
+    /// The scene's point and spot lights alone; the environment is left out.
+    Local,
+    /// The environment on the static groups; on the moving groups whatever the probes
+    /// captured: the environment and the point and spot lights.
+    Probes,
+}
+
+impl TechniqueKind {
+    /// The lights this technique renders.
+    pub fn rendered_light(self) -> RenderedLight {
+        match self {
+            TechniqueKind::Unshadowed
+            | TechniqueKind::SloanSelf
+            | TechniqueKind::SloanScene
+            | TechniqueKind::Tamura
+            | TechniqueKind::TamuraPaper
+            | TechniqueKind::ParallelLights => RenderedLight::Environment,
+            TechniqueKind::ShadowMap | TechniqueKind::Asm => RenderedLight::Local,
+            TechniqueKind::Probes => RenderedLight::Probes,
+        }
+    }
+}
+
 /// A technique and its parameters.
 #[derive(Clone, Debug)]
 pub enum TechniqueDesc {

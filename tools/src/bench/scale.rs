@@ -4,7 +4,7 @@
 //! build, PRT precomputation, device memory and frame time per technique, side by side in one
 //! run; `DIR/scale.csv` and a log-log chart `DIR/scale.png`, each curve's slope printed per
 //! decade.
-use crate::args::GpuArgs;
+use crate::args::{technique_name, GpuArgs};
 use crate::chart;
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::Args;
@@ -90,7 +90,7 @@ pub fn run(args: &ScaleArgs) -> Result<()> {
             step.peak_rss_mb
         );
         for (kind, mb, ms) in &step.techniques {
-            write!(line, " {}: {mb:.1}, {ms:.1};", name(*kind)).expect("writing to a String");
+            write!(line, " {}: {mb:.1}, {ms:.1};", technique_name(*kind)).expect("writing to a String");
         }
         println!("{line}");
         steps.push(step);
@@ -109,11 +109,6 @@ pub fn run(args: &ScaleArgs) -> Result<()> {
         args.rays
     );
     args.gpu.finish(&ctx)
-}
-
-fn name(kind: TechniqueKind) -> String {
-    clap::ValueEnum::to_possible_value(&kind)
-        .map_or_else(|| format!("{kind:?}"), |v| v.get_name().to_string())
 }
 
 /// The PRT rays of a step: every vertex casts `prt.rays`.
@@ -157,8 +152,8 @@ fn measure(ctx: &Arc<kage::backend::Context>, args: &ScaleArgs, prt: PrtParams, 
         };
         let before = ctx.allocated_bytes();
         let options = RenderOptions { width: args.size, height: args.size, technique, transfer };
-        let mut renderer =
-            Renderer::new(ctx, &scene, &options).with_context(|| format!("setting up {}", name(kind)))?;
+        let mut renderer = Renderer::new(ctx, &scene, &options)
+            .with_context(|| format!("setting up {}", technique_name(kind)))?;
         let mb = (ctx.allocated_bytes() - before) as f64 / (1 << 20) as f64;
         renderer.render()?;
         let mut table = TimingTable::default();
@@ -239,12 +234,12 @@ fn series(steps: &[Step], prt: PrtParams) -> Vec<(String, &'static str, Vec<Opti
     ];
     for (t, (kind, _, _)) in steps[0].techniques.iter().enumerate() {
         out.push((
-            format!("{} frame", name(*kind)),
+            format!("{} frame", technique_name(*kind)),
             "ms",
             steps.iter().map(|s| Some(s.techniques[t].2)).collect(),
         ));
         out.push((
-            format!("{} memory", name(*kind)),
+            format!("{} memory", technique_name(*kind)),
             "MB",
             steps.iter().map(|s| Some(s.techniques[t].1)).collect(),
         ));
