@@ -427,7 +427,9 @@ fn light_of(
 }
 
 /// A camera that sees every group wherever its motion takes it (its box at rest and at each of
-/// its keys): from the front (+Z), above their box's centre.
+/// its keys): from the front (+Z) and a little above, far enough that the sphere around their
+/// box fits the vertical field of view (and the horizontal one of any picture at least as wide
+/// as tall).
 pub fn overview(groups: &[Group]) -> Camera {
     let (lo, hi) = groups
         .iter()
@@ -447,11 +449,13 @@ pub fn overview(groups: &[Group]) -> Camera {
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
     let centre = 0.5 * (lo + hi);
     let radius = (0.5 * (hi - lo).length()).max(1e-3);
+    let fov_y_deg: f32 = 40.0;
+    let distance = radius / (0.5 * fov_y_deg.to_radians()).sin();
     Camera {
-        position: centre + Vec3::new(0.0, 0.5, 2.5) * radius,
+        position: centre + Vec3::new(0.0, 0.2, 1.0).normalize() * distance,
         target: centre,
         up: Vec3::Y,
-        fov_y_deg: 40.0,
+        fov_y_deg,
     }
 }
 
