@@ -70,11 +70,15 @@ void tangent_frame(vec3 n, out vec3 t, out vec3 b) {
 
 // The Hammersley index k of a vertex's j-th ray, a permutation of 0 .. rays - 1 (the estimator
 // sums the same points in another order). With P = KAGE_BVH_PACKET = 2^b and rays = 2^m
-// (m ≥ b), k's bits are [A | c | D]: c = j mod P (the ray within its packet), A (its top h
-// bits) and D (its low m - b - h bits) the rest of j. The P rays of one (A, D) have k/N within
-// 2^-h of each other and radical inverses within 2^-(m-b-h): the Hammersley set is a
-// (0, m, 2)-net in base 2, so every such elementary interval holds exactly P points, and one
-// packet casts them together. Other counts keep k = j.
+// (m ≥ b), k's bits are [A | c | D]: c = j mod P (the ray within its packet), A (h bits) and D
+// (l = m - b - h bits) from j's cell j / P. The P rays of one (A, D) have k/N within 2^-h of
+// each other (band A of the disc's radius) and radical inverses within 2^-l (a sector of its
+// angle): the Hammersley set is a (0, m, 2)-net in base 2, so every such elementary interval
+// holds exactly P points, and one packet casts them together. The radical inverse reverses D,
+// so sector s is D = reverse(s); the cell's lowest bits, which tell the lanes of a vertex apart,
+// pick 4 neighbouring sectors (2 bits) by neighbouring bands (the other lane bits), so that the
+// SIMD lanes walk nearly the same nodes: on the Stanford bunny, 1.2x faster than cells whose
+// lowest bits were D's own (lanes 1/8 of a turn apart). Other counts keep k = j.
 uint hammersley_index(uint j, uint rays) {
     // b bits of k pick the point within a cell of KAGE_BVH_PACKET points.
     uint b = uint(findMSB(uint(KAGE_BVH_PACKET)));
@@ -83,7 +87,14 @@ uint hammersley_index(uint j, uint rays) {
     uint h = (m - b) / 2u;
     uint l = m - b - h;
     uint cell = j >> b;
-    return ((cell >> l) << (l + b)) | ((j & (uint(KAGE_BVH_PACKET) - 1u)) << l) | (cell & ((1u << l) - 1u));
+    uint lane_bits = uint(findMSB(uint(KAGE_PRT_LANES)));
+    uint sector_bits = min(min(2u, lane_bits), l);
+    uint band_bits = min(lane_bits - min(2u, lane_bits), h);
+    uint rest = cell >> (sector_bits + band_bits);
+    uint sector = (cell & ((1u << sector_bits) - 1u)) | ((rest & ((1u << (l - sector_bits)) - 1u)) << sector_bits);
+    uint band = ((cell >> sector_bits) & ((1u << band_bits) - 1u)) | ((rest >> (l - sector_bits)) << band_bits);
+    uint d = l == 0u ? 0u : bitfieldReverse(sector) >> (32u - l);
+    return (band << (l + b)) | ((j & (uint(KAGE_BVH_PACKET) - 1u)) << l) | d;
 }
 
 // The cosine-weighted direction of Hammersley point k of `rays` about n, shifted: a uniform
