@@ -173,7 +173,7 @@ impl FreeGrid {
 
     /// The (up to 8) cells whose centres surround `q` (the nearest ones, clamped to the grid,
     /// where `q` lies outside), those `q` sees, each with its distance from `q`.
-    fn entries(&self, q: DVec3, occluders: &Occluders) -> Vec<(usize, f64)> {
+    pub(super) fn entries(&self, q: DVec3, occluders: &Occluders) -> Vec<(usize, f64)> {
         let f = (q - self.lo) / self.cell - 0.5;
         let base: [i64; 3] = std::array::from_fn(|a| f[a].floor() as i64);
         let mut cells: Vec<usize> = (0..8)
@@ -221,14 +221,12 @@ impl FreeGrid {
         distance
     }
 
-    /// The length of the way round from `p` to the probe whose [`FreeGrid::distances_from`] is
-    /// `field`: into the grid at a cell around `p` that it sees, then along the joins; `None`
-    /// when `p` sees none.
-    pub(super) fn way_round(&self, field: &[f32], p: DVec3, occluders: &Occluders) -> Option<f64> {
-        self.entries(p, occluders)
-            .into_iter()
-            .map(|(cell, d)| d + f64::from(field[cell]))
-            .min_by(f64::total_cmp)
+    /// The length of the way round from a point `p` to the probe whose
+    /// [`FreeGrid::distances_from`] is `field`: into the grid at a cell around `p` that it sees
+    /// (`entries`, [`FreeGrid::entries`] of `p`), then along the joins; `None` when `p` sees
+    /// none.
+    pub(super) fn way_round(&self, field: &[f32], entries: &[(usize, f64)]) -> Option<f64> {
+        entries.iter().map(|&(cell, d)| d + f64::from(field[cell])).min_by(f64::total_cmp)
     }
 
     /// The largest side of a cell.

@@ -48,6 +48,7 @@ use crate::error::Result;
 use crate::raycast::SceneBvh;
 use crate::scene::Scene;
 use glam::DVec3;
+use std::cell::OnceCell;
 use std::collections::{HashMap, HashSet};
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -140,10 +141,12 @@ impl Occluders {
         FREE_FRACTION * nearest
     }
 
-    /// Whether the probe at `q` is in `p`'s space: the way round from `p` to `q` through free
-    /// space is at most [`DETOUR`] times the straight line (plus [`DETOUR_CELLS`] cells for
-    /// the grid's steps), as past a column, an arch or a roof's edge, not through a wall.
-    fn same_space(&self, p: DVec3, q: DVec3) -> bool {
+    /// Whether the probe at `q` is in the space of the lookup's point `p`: the way round from
+    /// `p` to `q` through free space is at most [`DETOUR`] times the straight line (plus
+    /// [`DETOUR_CELLS`] cells for the grid's steps), as past a column, an arch or a roof's
+    /// edge, not through a wall.
+    fn same_space(&self, point: &LookupPoint, q: DVec3) -> bool {
+        let p = point.p;
         let Some(grid) = self.grid() else {
             return false;
         };
@@ -156,7 +159,8 @@ impl Occluders {
             }
             way
         });
-        grid.way_round(&way, p, self)
+        let entries = point.entries.get_or_init(|| grid.entries(p, self));
+        grid.way_round(&way, entries)
             .is_some_and(|d| d <= DETOUR * p.distance(q) + DETOUR_CELLS * grid.cell_size())
     }
 
@@ -188,6 +192,19 @@ impl Occluders {
     }
 }
 
+/// A lookup's point and its way into the free-space grid ([`FreeGrid::entries`]: up to 8 rays),
+/// found the first time one of its probes is asked about and the same for all of them.
+struct LookupPoint {
+    p: DVec3,
+    entries: OnceCell<Vec<(usize, f64)>>,
+}
+
+impl LookupPoint {
+    fn new(p: DVec3) -> LookupPoint {
+        LookupPoint { p, entries: OnceCell::new() }
+    }
+}
+
 /// The occluders and each probe's free sphere: what a set's lookups test visibility with.
 #[derive(Clone, Debug)]
 pub struct Visibility {
@@ -205,9 +222,9 @@ impl Visibility {
 
     /// The share of probe `probe`'s weight that `p` keeps: all of it when the probe is in `p`'s
     /// own space ([`Occluders::same_space`]), else the fraction of it `p` sees.
-    fn kept_fraction(&self, p: DVec3, probe: usize, q: DVec3) -> f64 {
-        let seen = self.seen_fraction(p, probe, q);
-        if seen < 1.0 && self.occluders.same_space(p, q) {
+    fn kept_fraction(&self, point: &LookupPoint, probe: usize, q: DVec3) -> f64 {
+        let seen = self.seen_fraction(point.p, probe, q);
+        if seen < 1.0 && self.occluders.same_space(point, q) {
             1.0
         } else {
             seen
@@ -289,8 +306,9 @@ pub(super) fn weigh_by_visibility<const N: usize>(
     let (mut hidden, mut wholly) = (false, false);
     let before = *weights;
     let mut fractions = Vec::with_capacity(N);
+    let point = LookupPoint::new(p);
     for (probe, w) in weights.iter_mut().filter(|(_, w)| *w != 0.0) {
-        let seen = visibility.kept_fraction(p, *probe, positions[*probe]);
+        let seen = visibility.kept_fraction(&point, *probe, positions[*probe]);
         fractions.push((*probe, seen));
         *w *= seen;
         seen_weight += *w;
@@ -301,7 +319,7 @@ pub(super) fn weigh_by_visibility<const N: usize>(
         return Seen::All;
     }
     if let (true, Some((mesh, tet))) = (wholly, cell) {
-        if let Some(face) = nearest_seen_face(mesh, tet, p, visibility, &mut fractions) {
+        if let Some(face) = nearest_seen_face(mesh, tet, &point, visibility, &mut fractions) {
             *weights = [(face[0].0, 0.0); N];
             weights[..3].copy_from_slice(&face);
             return Seen::Some;
@@ -333,7 +351,7 @@ pub(super) fn weigh_by_visibility<const N: usize>(
 fn nearest_seen_face(
     mesh: &TetMesh,
     tet: u32,
-    p: DVec3,
+    point: &LookupPoint,
     visibility: &Visibility,
     fractions: &mut Vec<(usize, f64)>,
 ) -> Option<[(usize, f64); 3]> {
@@ -356,7 +374,7 @@ fn nearest_seen_face(
     let mut fraction = |probe: usize| match fractions.iter().find(|(i, _)| *i == probe) {
         Some(&(_, f)) => f,
         None => {
-            let f = visibility.kept_fraction(p, probe, positions[probe]);
+            let f = visibility.kept_fraction(point, probe, positions[probe]);
             fractions.push((probe, f));
             f
         }
@@ -369,7 +387,7 @@ fn nearest_seen_face(
             if seen.contains(&0.0) {
                 continue;
             }
-            let (w, distance2) = closest_on_triangle(p, face.map(|i| positions[i]));
+            let (w, distance2) = closest_on_triangle(point.p, face.map(|i| positions[i]));
             if best.is_none_or(|(d, _)| distance2 < d) {
                 best = Some((distance2, std::array::from_fn(|k| (face[k], w[k] * seen[k]))));
             }
@@ -522,18 +540,26 @@ mod tests {
         // steps into the grid at each end (4 cells at most), and never shorter.
         let grid = occluders.grid().unwrap();
         let (p, q) = (DVec3::new(1.0, -1.5, -1.5), DVec3::new(1.5, 1.5, 4.0));
-        let way = grid.way_round(&grid.distances_from(q, &occluders), p, &occluders).unwrap();
+        let way = grid.way_round(&grid.distances_from(q, &occluders), &grid.entries(p, &occluders)).unwrap();
         assert!(way >= p.distance(q) && way <= 1.13 * p.distance(q) + 4.0 * grid.cell_size(), "{way}");
         // Past the pole: a short way round.
-        assert!(occluders.same_space(DVec3::new(1.0, 0.0, 0.0), DVec3::new(3.0, 0.0, 0.0)));
+        assert!(occluders.same_space(&LookupPoint::new(DVec3::new(1.0, 0.0, 0.0)), DVec3::new(3.0, 0.0, 0.0)));
         // Through the wall: round its end at z = 2, over four times the straight line.
-        assert!(!occluders.same_space(DVec3::new(0.3, 0.0, 0.0), DVec3::new(-0.4, 0.0, -1.0)));
+        assert!(
+            !occluders.same_space(&LookupPoint::new(DVec3::new(0.3, 0.0, 0.0)), DVec3::new(-0.4, 0.0, -1.0))
+        );
         // Beside the wall's end the way round is hardly longer: the same space.
-        assert!(occluders.same_space(DVec3::new(1.5, 0.0, 1.9), DVec3::new(-0.4, 0.0, 1.9)));
+        assert!(
+            occluders.same_space(&LookupPoint::new(DVec3::new(1.5, 0.0, 1.9)), DVec3::new(-0.4, 0.0, 1.9))
+        );
         // Into the sealed box: no way at all.
-        assert!(!occluders.same_space(DVec3::new(0.2, 0.0, 5.0), DVec3::new(1.0, 0.0, 5.0)));
+        assert!(
+            !occluders.same_space(&LookupPoint::new(DVec3::new(0.2, 0.0, 5.0)), DVec3::new(1.0, 0.0, 5.0))
+        );
         // A point sealed off from the grid (inside the pole) reaches no cell.
-        assert!(!occluders.same_space(DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)));
+        assert!(
+            !occluders.same_space(&LookupPoint::new(DVec3::new(2.0, 0.0, 0.0)), DVec3::new(1.0, 0.0, 0.0))
+        );
         // The paths from each probe asked about are kept until a finished set keeps its own.
         let paths = || occluders.ways.lock().unwrap().len();
         assert_eq!(paths(), 5);
