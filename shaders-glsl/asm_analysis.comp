@@ -13,6 +13,7 @@
 // to a silhouette from taking its neighbour's surface.
 #include "layouts.glsl"
 #include "shadow_test.glsl"
+#include "eye_ray.glsl"
 
 layout(local_size_x = KAGE_ASM_ANALYSIS_GROUP, local_size_y = KAGE_ASM_ANALYSIS_GROUP) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
@@ -31,9 +32,10 @@ vec4 surface(ivec2 q) {
     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) return vec4(0.0);
     float d = texelFetch(eye_depth, q, 0).r;
     if (d >= 1.0) return vec4(0.0);
-    vec2 ndc = (vec2(q) + 0.5) / vec2(size) * 2.0 - 1.0;
-    vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
-    return vec4(world.xyz / world.w, 1.0);
+    // The view depth of Vulkan depth d (depth 0 at the near plane), along the pixel's eye ray.
+    float near = frame.viewport.z, far = frame.viewport.w;
+    float depth = near * far / (far - d * (far - near));
+    return vec4(frame.camera_pos.xyz + depth * eye_ray(frame.eye_rays, eye_ndc(vec2(q) + 0.5, vec2(size))), 1.0);
 }
 
 // The smaller of the differences to the neighbours at q - step and q + step (0 where neither

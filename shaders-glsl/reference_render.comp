@@ -12,6 +12,7 @@
 #include "bvh.glsl"
 #include "reference.glsl"
 #include "local_light.glsl"
+#include "eye_ray.glsl"
 
 layout(local_size_x = KAGE_REFERENCE_GROUP, local_size_y = KAGE_REFERENCE_GROUP) in;
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 4, std430) readonly buffer Lights {
@@ -30,10 +31,7 @@ vec3 local_lighting(SurfacePoint s) {
 
 // The primary ray through `at` (in pixels from the image's top-left corner).
 vec3 primary_dir(vec2 at) {
-    // Row 0 at the top is NDC y = -1, as in the rasterizer's framebuffer.
-    vec2 ndc = at / vec2(p.frame.xy) * 2.0 - 1.0;
-    vec4 far = p.inv_view_proj * vec4(ndc, 0.5, 1.0);
-    return normalize(far.xyz / far.w - p.camera_pos.xyz);
+    return normalize(eye_ray(p.eye_rays, eye_ndc(at, vec2(p.frame.xy))));
 }
 
 // Local lighting seen along a primary ray: black where it misses.

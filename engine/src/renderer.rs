@@ -5,13 +5,13 @@ use crate::error::{Error, Result};
 use crate::frame::background::Background;
 use crate::frame::environment::GpuEnvironment;
 use crate::frame::sh_projection::ShProjection;
-use crate::frame::{FrameInputs, FrameState, GpuScene, Targets};
+use crate::frame::{eye_rays, FrameInputs, FrameState, GpuScene, Targets};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass, PassTiming};
 use crate::progress::Progress;
 use crate::prt::TransferSet;
-use crate::scene::{check_extent, Light, Scene};
+use crate::scene::{check_extent, Light, Scene, FAR, NEAR};
 use crate::techniques::description::TechniqueDesc;
 use crate::techniques::{Technique, TechniqueStats};
 use glam::Mat4;
@@ -166,13 +166,14 @@ impl Renderer {
     /// Renders one frame and reads it back; returns each pass's GPU time.
     pub fn render(&mut self) -> Result<Vec<PassTiming>> {
         let (width, height) = (self.targets.color.width, self.targets.color.height);
-        let view_proj = self.camera.projection(width as f32 / height as f32) * self.camera.view();
+        let aspect = width as f32 / height as f32;
+        let view_proj = self.camera.projection(aspect) * self.camera.view();
         let uniforms = FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
-            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            eye_rays: eye_rays(&self.camera, aspect),
             camera_pos: self.camera.position.extend(1.0).to_array(),
             env_params: [1.0, self.env_rotation, 0.0, 0.0],
-            viewport: [width as f32, height as f32, 0.0, 0.0],
+            viewport: [width as f32, height as f32, NEAR, FAR],
         };
         self.frame_uniforms.write(0, bytes_of(&uniforms))?;
 

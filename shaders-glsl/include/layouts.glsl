@@ -9,13 +9,23 @@
 
 #include "constants.glsl"
 
+// The eye ray through NDC point (x, y): world direction forward + x * ndc.x + y * ndc.y, of unit
+// view depth (eye_ray.glsl). Built from the camera's basis in double precision: unprojecting an
+// NDC point through the inverse view-projection in float strays about 1/50 px from the pixel
+// (the near plane's ill-conditioning), so rays and raster coverage disagreed at edges.
+struct EyeRays {
+    vec4 x; // xyz: world vector per unit of NDC x, w: unused
+    vec4 y; // xyz: world vector per unit of NDC y (rows downward), w: unused
+    vec4 forward; // xyz: the unit view axis, w: unused
+};
+
 // Per-frame camera data (uniform buffer, std140).
 struct FrameUniforms {
     mat4 view_proj;
-    mat4 inv_view_proj;
+    EyeRays eye_rays;
     vec4 camera_pos; // xyz: world-space camera position, w: unused
     vec4 env_params; // x: intensity, y: rotation in radians, z, w: unused
-    vec4 viewport; // xy: the target's size in pixels, zw: unused
+    vec4 viewport; // xy: the target's size in pixels, z: near plane, w: far plane (view depth)
 };
 
 // Per-draw data (push constants).
@@ -132,7 +142,7 @@ struct ReferenceLight {
 
 // Push constants of the reference renderer (reference_render.comp).
 struct ReferencePush {
-    mat4 inv_view_proj;
+    EyeRays eye_rays;
     vec4 camera_pos; // xyz: camera position, w: the environment's sum of luminance x solid angle (0: no environment sampling)
     uvec4 frame; // x: width, y: height, z: samples accumulated before this batch, w: samples in this batch
     uvec4 params; // x: 0 environment light, 1 local lights, y: light count, z: seed, w: the rasterizer's sub-pixel precision bits

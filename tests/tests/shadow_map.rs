@@ -257,9 +257,9 @@ fn the_depth_prepass_leaves_no_pixel_unshaded() {
 
 /// The rasterizer and the reference shade the same point: the Blender export's 1000 W spot on
 /// its ground alone (the crate and Suzanne removed), so the cone's edge is the only boundary
-/// between lit and unlit. Before the scene pass moved its interpolated position onto the eye
-/// ray through the pixel centre, that position strayed by about 1/100 px (float interpolation
-/// across the ground's large triangles) and 7 pixels along the edge differed at 512².
+/// between lit and unlit. When the eye rays were unprojected through the inverse
+/// view-projection in float, the reference's strayed by about 1/50 px from the pixel centre the
+/// rasterizer samples (`Camera::eye_rays`), and 7 pixels along the edge differed at 512².
 /// The reference's edge ties (pixels whose state changes when the primary ray moves by the
 /// rasterizer's sub-pixel precision) lie on the boundary, and are a small part of it.
 #[test]

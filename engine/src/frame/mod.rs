@@ -18,10 +18,17 @@ pub use gpu_scene::{GpuMesh, GpuScene};
 pub use targets::{Targets, COLOR_FORMAT, DEPTH_FORMAT, MAX_SIZE};
 
 use crate::backend::{Buffer, Context};
-use crate::scene::Light;
+use crate::layouts::EyeRays;
+use crate::scene::{Camera, Light};
 use environment::GpuEnvironment;
 use glam::Mat4;
 use std::sync::Arc;
+
+/// The eye rays of `camera` at `aspect` as the shaders take them (shaders-glsl/include/eye_ray.glsl).
+pub fn eye_rays(camera: &Camera, aspect: f32) -> EyeRays {
+    let [x, y, forward] = camera.eye_rays(aspect).map(|v| v.extend(0.0).to_array());
+    EyeRays { x, y, forward }
+}
 
 /// What every technique may read while recording a frame.
 pub struct FrameInputs<'a> {

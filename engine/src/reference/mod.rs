@@ -25,7 +25,7 @@ pub use metrics::{
     compare, diff_image, frames_to_converge, shadow_flips, shadow_mismatch, shadow_mismatch_image, EdgeTies,
     ImageMetrics, ShadowFlips, ShadowMismatch, SHADOW_THRESHOLD,
 };
-pub use render::{LightMode, ReferenceOptions, ReferenceRenderer};
+pub use render::{LightMode, ReferenceOptions, ReferenceRenderer, OUTPUT_VERSION};
 pub use statistics::Statistics;
 
 use crate::layouts::constants;

@@ -1,20 +1,26 @@
 //! The reference renderer: progressive Monte Carlo direct lighting of the scene, a batch of
 //! samples per pixel per submission (shaders-glsl/reference_render.comp).
 //!
-//! Same camera and pixel grid as the renderer: the camera's view and
-//! projection matrices and one primary ray through each pixel centre ((i + ½) / width, row 0 at
-//! the top), so that a render and the reference compare pixel by pixel (neither antialiases).
+//! Same camera and pixel grid as the renderer: one primary ray through each pixel centre
+//! ((i + ½) / width, row 0 at the top) along the camera's eye rays (`Camera::eye_rays`, the
+//! rasterized passes' too), so that a render and the reference compare pixel by pixel (neither
+//! antialiases).
 use super::lighting::ReferenceLighting;
 use super::metrics::EdgeTies;
 use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{BindingKind, Buffer, ComputePipeline, Context};
 use crate::error::{Error, Result};
-use crate::frame::MAX_SIZE;
+use crate::frame::{eye_rays, MAX_SIZE};
 use crate::imageio::RgbaF32Image;
 use crate::layouts::{bytes_of, constants, spirv, ReferenceLight, ReferencePush};
 use crate::pass::{FrameExecutor, Pass};
 use crate::scene::{Camera, Light, Scene};
 use std::sync::Arc;
+
+/// The version of the reference's output, for caches of references on disk: bump it when the
+/// same scene, camera and options give another image. 3: primary rays from the camera's basis,
+/// not unprojected through the inverse view-projection in float (1/50 px apart).
+pub const OUTPUT_VERSION: u32 = 3;
 
 /// Which light the reference renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,12 +85,11 @@ impl ReferenceRenderer {
     pub fn run_batch(&mut self, spp: u32) -> Result<()> {
         let after = samples_after(self.samples, spp, "pixel")?;
         let (width, height) = (self.options.width, self.options.height);
-        let view_proj = self.camera.projection(width as f32 / height as f32) * self.camera.view();
         let group = constants::REFERENCE_GROUP;
         let groups = [width.div_ceil(group), height.div_ceil(group), 1];
         let pipeline = &self.pipeline;
         let (lighting, accum, lights) = (&self.lighting, &self.accum, &self.lighting.lights);
-        let inv_view_proj = view_proj.inverse().to_cols_array_2d();
+        let eye_rays = eye_rays(&self.camera, width as f32 / height as f32);
         let camera_pos = self.camera.position.extend(self.lighting.env_total).to_array();
         let params = [
             (self.options.light == LightMode::Local) as u32,
@@ -93,8 +98,7 @@ impl ReferenceRenderer {
             self.edge_bits,
         ];
         let passes = super::sample_passes(spp, self.samples, |first, count| {
-            let push =
-                ReferencePush { inv_view_proj, camera_pos, frame: [width, height, first, count], params };
+            let push = ReferencePush { eye_rays, camera_pos, frame: [width, height, first, count], params };
             let bindings = lighting.bindings(&[accum, lights]);
             Pass::new("reference_render", move |cmd| {
                 pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)

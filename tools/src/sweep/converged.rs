@@ -6,7 +6,7 @@ use kage::backend::Context;
 use kage::files;
 use kage::imageio::{self, RgbaF32Image};
 use kage::prt::cache;
-use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer};
+use kage::reference::{LightMode, ReferenceOptions, ReferenceRenderer, OUTPUT_VERSION};
 use kage::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -19,8 +19,9 @@ pub struct Reference {
     pub spp: u32,
 }
 
-/// What the reference depends on: the scene's geometry, albedos, transforms, camera and map,
-/// the image size and the noise target. 64-bit FNV-1a.
+/// What the reference depends on: the reference renderer's output version, the scene's
+/// geometry, albedos, transforms, camera and map, the image size and the noise target. 64-bit
+/// FNV-1a.
 fn key(scene: &Scene, size: u32, target: f64) -> u64 {
     let mut h = 0xcbf29ce484222325u64;
     let mut write = |bytes: &[u8]| {
@@ -28,6 +29,7 @@ fn key(scene: &Scene, size: u32, target: f64) -> u64 {
             h = (h ^ u64::from(*b)).wrapping_mul(0x100000001b3);
         }
     };
+    write(&OUTPUT_VERSION.to_le_bytes());
     write(&cache::geometry_hash(scene).to_le_bytes());
     for group in &scene.groups {
         group.transform.matrix().to_cols_array().iter().for_each(|v| write(&v.to_le_bytes()));

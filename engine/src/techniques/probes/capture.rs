@@ -35,14 +35,14 @@ use crate::frame::gpu_scene::MESH_POSITIONS_UVS;
 use crate::frame::scene_pass::{bind_lit, scene_pipeline_with};
 use crate::frame::sh_projection::{Mapping, ProjectionNames, ShProjection};
 
-use crate::frame::{GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::frame::{eye_rays, GpuScene, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::layouts::ReferenceLight;
 use crate::layouts::{bytes_of, spirv, DrawPush, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass};
 
 use crate::raycast::SceneBvh;
 use crate::reference::{irradiance::check_bounces, surface_radiance};
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, Scene, FAR};
 use crate::sh::{eval_basis, ShRgb9};
 use glam::{DVec3, Mat3, Vec3};
 use std::ops::RangeInclusive;
@@ -276,10 +276,10 @@ impl ProbeCapture {
             let view_proj = camera.projection_from(1.0, CAPTURE_NEAR) * camera.view();
             let uniforms = FrameUniforms {
                 view_proj: view_proj.to_cols_array_2d(),
-                inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+                eye_rays: eye_rays(&camera, 1.0),
                 camera_pos: position.extend(1.0).to_array(),
                 env_params: [1.0, 0.0, 0.0, 0.0],
-                viewport: [self.settings.cube_size as f32, self.settings.cube_size as f32, 0.0, 0.0],
+                viewport: [self.settings.cube_size as f32, self.settings.cube_size as f32, CAPTURE_NEAR, FAR],
             };
             buffer.write(0, bytes_of(&uniforms))?;
         }

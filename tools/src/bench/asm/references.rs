@@ -3,20 +3,17 @@
 //! driver, and every run visits the same cameras.
 //!
 //! A reference is a 32-bit EXR named for a hash of everything it depends on: the geometry
-//! (`geometry_hash`), the group transforms, the lights, the camera and the image size, and a
-//! version to bump when the reference renderer's output changes, with its edge ties beside it
+//! (`geometry_hash`), the group transforms, the lights, the camera and the image size, and the
+//! reference renderer's [`OUTPUT_VERSION`], with its edge ties beside it
 //! (`-edges.exr`, see [`EdgeTies`]). A pair that cannot be read is computed again and replaced.
 use anyhow::{Context as _, Result};
 use kage::backend::Context;
 use kage::imageio::RgbaF32Image;
 use kage::prt::cache::{geometry_hash, Fnv64};
-use kage::reference::{EdgeTies, LightMode, ReferenceOptions, ReferenceRenderer};
+use kage::reference::{EdgeTies, LightMode, ReferenceOptions, ReferenceRenderer, OUTPUT_VERSION};
 use kage::scene::{Camera, Scene};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-/// Part of every file name's hash: bump it when `kage reference --light local` changes.
-const VERSION: u32 = 2;
 
 /// A frame's reference: the image and where a raster render's state is a tie.
 #[derive(Clone)]
@@ -47,7 +44,7 @@ impl References {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         }
         let mut key = Fnv64::new();
-        key.write(&VERSION.to_le_bytes());
+        key.write(&OUTPUT_VERSION.to_le_bytes());
         key.write(&geometry_hash(scene).to_le_bytes());
         // Debug formatting prints every float exactly (shortest round-trip form).
         let transforms: Vec<_> = scene.groups.iter().map(|g| g.transform).collect();
