@@ -108,10 +108,12 @@
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 17
 // Levels the ASM refinement asks for by default (`AsmSettings::extra_levels`) beyond the one
-// whose texels match the eye pixel's footprint: a reconstructed edge lies within a fraction of a texel of the true one, so texels a
-// sixteenth of the pixel keep the lit/shadowed state of pixel centres right but near an edge
-// (with 128² tiles an eighth, 3, was as good as 4: the pages they took ran out first).
-#define KAGE_ASM_EXTRA_LEVELS 4
+// whose texels match the eye pixel's footprint: a reconstructed edge lies within a fraction of
+// a texel of the true one, so texels a thirty-second of the pixel keep the lit/shadowed state of
+// pixel centres right but near an edge. 5 against 4 (BENCHMARKS.md, "At 512²"): at 256 MiB 39
+// pixels wrong instead of 90 at the asm overview, at 4 and 16 MiB the same (the pages run out
+// first), and the same errors over the 256² walkthrough.
+#define KAGE_ASM_EXTRA_LEVELS 5
 // The page table's directory: one entry per tile of this level (256² entries, 256 KiB) naming
 // the finest resident tile at or above it, where the lookup's descent starts. The descent is a
 // chain of dependent reads, one per level, that a CPU rasterizer pays per fragment in full (it

@@ -115,8 +115,8 @@ pub struct AsmSettings {
     pub test: AsmTest,
     /// Adaptive shadow maps: levels of refinement asked for at shadow edges beyond the one
     /// whose texels match the eye pixel, 0 to 8: each halves the edge's texels and may take up
-    /// to four times their pages (BENCHMARKS.md: 5 is better than 4 at 256 MiB, no better at
-    /// 16 MiB, where the pages run out first).
+    /// to four times their pages (BENCHMARKS.md: 5 is better than 4 at 256 MiB, no better at 4
+    /// and 16 MiB, where the pages run out first; 6 better still at 256 MiB, worse at 4).
     #[cfg_attr(feature = "clap", arg(long = "asm-extra-levels", value_name = "LEVELS", default_value_t = AsmSettings::default().extra_levels))]
     pub extra_levels: u32,
 }
