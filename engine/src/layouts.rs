@@ -74,10 +74,11 @@ mod tests {
             ..Default::default()
         };
         let bytes = bytes_of(&frame);
-        assert_eq!(bytes.len(), 176);
-        assert_eq!(floats(&bytes[128..144]), [1.0, 2.0, 3.0, 0.0]);
-        assert_eq!(floats(&bytes[144..160]), [4.0, 0.5, 0.0, 0.0]);
-        assert!(floats(&bytes[..128]).iter().all(|&x| x == 0.0));
+        // view_proj (64 bytes) and eye_rays (three vec4) first.
+        assert_eq!(bytes.len(), 160);
+        assert_eq!(floats(&bytes[112..128]), [1.0, 2.0, 3.0, 0.0]);
+        assert_eq!(floats(&bytes[128..144]), [4.0, 0.5, 0.0, 0.0]);
+        assert!(floats(&bytes[..112]).iter().all(|&x| x == 0.0));
     }
 
     #[test]
