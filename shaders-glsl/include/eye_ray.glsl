@@ -1,5 +1,6 @@
-// Eye rays through pixels, shared by the rasterized passes and the reference so that a pixel's
-// ray is the same everywhere (layouts.glsl, EyeRays).
+// Eye rays through pixels (layouts.glsl, EyeRays), shared by the reference's primary rays, the
+// background pass and ASM's analysis, so that a pixel's ray is the same everywhere and passes
+// through the centre the rasterizer samples.
 #ifndef KAGE_EYE_RAY_GLSL
 #define KAGE_EYE_RAY_GLSL
 

@@ -2,9 +2,9 @@
 //! samples per pixel per submission (shaders-glsl/reference_render.comp).
 //!
 //! Same camera and pixel grid as the renderer: one primary ray through each pixel centre
-//! ((i + ½) / width, row 0 at the top) along the camera's eye rays (`Camera::eye_rays`, the
-//! rasterized passes' too), so that a render and the reference compare pixel by pixel (neither
-//! antialiases).
+//! ((i + ½) / width, row 0 at the top) along the camera's eye rays (`Camera::eye_rays`, which
+//! the background pass and ASM's analysis take too), so that a render and the reference compare
+//! pixel by pixel (neither antialiases).
 use super::lighting::ReferenceLighting;
 use super::metrics::EdgeTies;
 use super::statistics::{accum_buffer, samples_after, Statistics};
