@@ -32,9 +32,8 @@ vec4 surface(ivec2 q) {
     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) return vec4(0.0);
     float d = texelFetch(eye_depth, q, 0).r;
     if (d >= 1.0) return vec4(0.0);
-    // The view depth of Vulkan depth d (depth 0 at the near plane), along the pixel's eye ray.
-    float near = frame.viewport.z, far = frame.viewport.w;
-    float depth = near * far / (far - d * (far - near));
+    // The view depth along the pixel's eye ray.
+    float depth = view_depth(d, frame.viewport.z, frame.viewport.w);
     return vec4(frame.camera_pos.xyz + depth * eye_ray(frame.eye_rays, eye_ndc(vec2(q) + 0.5, vec2(size))), 1.0);
 }
 

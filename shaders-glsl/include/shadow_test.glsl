@@ -5,6 +5,7 @@
 #define KAGE_SHADOW_TEST_GLSL
 
 #include "layouts.glsl"
+#include "view_depth.glsl"
 
 // The light's map coordinates of p: xy in [0, 1) inside the map (rows downward, as texels),
 // z the view depth along the light's axis (clip w); w < 0 where p is outside the map.
@@ -34,10 +35,7 @@ float shadow_receiver_depth(ShadowLight s, float w, vec3 p, vec3 ng, float texel
 // Whether a receiver whose biased depth is `receiver` (shadow_receiver_depth) is lit past a
 // texel that stores Vulkan depth `stored`.
 bool shadow_lit_past(ShadowLight s, float stored, float receiver) {
-    // Vulkan depth of a right-handed perspective projection back to view depth:
-    // z = near * far / (far - d * (far - near)).
-    float near = s.map.x, far = s.map.y;
-    return receiver <= near * far / (far - stored * (far - near));
+    return receiver <= view_depth(stored, s.map.x, s.map.y);
 }
 
 // Whether a receiver at view depth w is lit past a texel that stores Vulkan depth `stored`
