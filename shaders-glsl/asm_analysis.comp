@@ -70,6 +70,19 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, s.map.z / scale, vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0));
 }
 
+// The stored depth at the centre of tile texel `texel`, a neighbour of texel t across its page's
+// border: that texel is not stored in the page (a resident child covers it, another page or
+// another tile holds it), so the finest resident tile there answers. The 3x3 test clamped to
+// the page would read the border texel again, and a thin occluder that crosses the border but
+// that the page's own texels miss would never ask for refinement on this side (a wedge of its
+// shadow lit, tests/tests/asm.rs).
+float across_border_depth(AsmPage page, ivec2 texel) {
+    float scale = float(1u << page.tile.x);
+    vec2 uv = clamp((vec2(page.tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale, vec2(0.0), vec2(1.0));
+    AsmPage there = asm_page(asm_descend(uv), uv);
+    return asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
+}
+
 void main() {
     // One pixel of each 2x2 block per frame, the block's corner turning frame by frame (the
     // paper analyses 1/8 of the pixels per frame): the refinement is progressive anyway.
@@ -120,6 +133,12 @@ void main() {
         for (int i = -1; i <= 1; ++i) {
             edge = edge || shadow_lit_past(s, asm_depth(page, t + ivec2(i, j)), wide) != centre;
         }
+    }
+    // On the page's border, the texel across it (one descent: the diagonal one at a corner).
+    ivec2 across = t + ivec2(lessThan(t, page.quadrant + 1)) * -1 +
+                   ivec2(greaterThanEqual(t, page.quadrant + KAGE_ASM_PAGE_TEXELS - 1));
+    if (!edge && across != t) {
+        edge = shadow_lit_past(s, across_border_depth(page, across), wide) != centre;
     }
     // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
     // under grazing light): a finer tile's bias is narrower and shows the shadow.
