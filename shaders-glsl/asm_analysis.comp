@@ -71,16 +71,17 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
 }
 
 // The stored depth at the centre of tile texel `texel`, a neighbour of texel t across its page's
-// border: that texel is not stored in the page (a resident child covers it, another page or
-// another tile holds it), so the finest resident tile there answers. The 3x3 test clamped to
-// the page would read the border texel again, and a thin occluder that crosses the border but
-// that the page's own texels miss would never ask for refinement on this side (a wedge of its
-// shadow lit, tests/tests/asm.rs).
-float across_border_depth(AsmPage page, ivec2 texel) {
+// border, where a tile at least as fine as the page's holds it (a resident child, another
+// quadrant's page, a neighbouring tile): the 3x3 test clamped to the page would read the border
+// texel again, and a thin occluder that crosses the border but that the page's own texels miss
+// would never ask for refinement on this side (a wedge of its shadow lit, tests/tests/asm.rs).
+// Where only a coarser tile holds it, its texel's centre lies farther than the test's bias
+// allows for, so the page's border texel (`kept`) answers as before.
+float across_border_depth(AsmPage page, ivec2 texel, float kept) {
     float scale = float(1u << page.tile.x);
     vec2 uv = clamp((vec2(page.tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale, vec2(0.0), vec2(1.0));
     AsmPage there = asm_page(asm_descend(uv), uv);
-    return asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
+    return there.tile.x < page.tile.x ? kept : asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
 }
 
 void main() {
@@ -134,11 +135,15 @@ void main() {
             edge = edge || shadow_lit_past(s, asm_depth(page, t + ivec2(i, j)), wide) != centre;
         }
     }
-    // On the page's border, the texel across it (one descent: the diagonal one at a corner).
-    ivec2 across = t + ivec2(lessThan(t, page.quadrant + 1)) * -1 +
-                   ivec2(greaterThanEqual(t, page.quadrant + KAGE_ASM_PAGE_TEXELS - 1));
-    if (!edge && across != t) {
-        edge = shadow_lit_past(s, across_border_depth(page, across), wide) != centre;
+    // On the page's border, the texel across it along each axis whose border t lies on (at a
+    // corner two descents; the diagonal texel is left out).
+    ivec2 across = ivec2(greaterThanEqual(t, page.quadrant + KAGE_ASM_PAGE_TEXELS - 1)) -
+                ivec2(lessThanEqual(t, page.quadrant));
+    if (!edge && across.x != 0) {
+        edge = shadow_lit_past(s, across_border_depth(page, t + ivec2(across.x, 0), stored), wide) != centre;
+    }
+    if (!edge && across.y != 0) {
+        edge = shadow_lit_past(s, across_border_depth(page, t + ivec2(0, across.y), stored), wide) != centre;
     }
     // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
     // under grazing light): a finer tile's bias is narrower and shows the shadow.
