@@ -112,7 +112,7 @@ def limb(mesh, joint, angles, lengths, radius, segments):
 
 
 def robot():
-    """A figure about 1.6 tall standing on y = 0: a torso, a head with eyes, arms and legs of
+    """A figure about 1.7 tall standing on y = 0: a torso, a head with eyes, arms and legs of
     two cylinders each (one arm raised and bent, one leg stepping forward), boxy hands and feet."""
     m = Mesh()
     m.add(*box((-0.22, 0.85, -0.12), (0.22, 1.35, 0.12)))  # torso
@@ -135,7 +135,8 @@ def robot():
 
 
 def sculpture():
-    """A (3, 7) torus knot of a 1.5 cm tube, 0.35 across, on a post 0.8 tall: 300 rings of 14."""
+    """A (3, 7) torus knot of a 1.5 cm tube, 0.7 across, centred 1.15 up, on a post 0.95 tall and
+    a base: 300 rings of 14."""
     m = Mesh()
     p_turns, q_turns, rings, around, tube = 3, 7, 300, 14, 0.015
 

@@ -62,12 +62,11 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     float b = 1.0 / my.z - iw;
     vec2 slope = vec2(a * uy.y - b * ux.y, ux.x * b - uy.x * a) / det;
     ivec2 texel = asm_quadrant_texel(page, ivec2(asm_texel_coords(page.tile, m.xy)));
-    float scale = float(1u << page.tile.x);
-    vec2 centre = (vec2(page.tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale;
+    vec2 centre = asm_texel_centre(page.tile, texel);
     float inv = iw + dot(slope, centre - m.xy);
     if (inv <= 0.0) return false;
     float stored = asm_depth(page, texel);
-    return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, s.map.z / scale, vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0));
+    return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, asm_texel_size(s, page.tile.x), vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0));
 }
 
 // The stored depth at the centre of tile texel `texel`, a neighbour of texel t across its page's
@@ -78,8 +77,7 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
 // Where only a coarser tile holds it, its texel's centre lies farther than the test's bias
 // allows for, so the page's border texel (`kept`) answers as before.
 float across_border_depth(AsmPage page, ivec2 texel, float kept) {
-    float scale = float(1u << page.tile.x);
-    vec2 uv = clamp((vec2(page.tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / scale, vec2(0.0), vec2(1.0));
+    vec2 uv = clamp(asm_texel_centre(page.tile, texel), vec2(0.0), vec2(1.0));
     AsmPage there = asm_page(asm_descend(uv), uv);
     return there.tile.x < page.tile.x ? kept : asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
 }

@@ -59,6 +59,11 @@ vec2 asm_texel_coords(uvec3 tile, vec2 uv) {
     return (uv * float(1u << tile.x) - vec2(tile.yz)) * float(KAGE_ASM_TILE_TEXELS);
 }
 
+// The light uv of the centre of texel `texel` of tile `tile` (the inverse of asm_texel_coords).
+vec2 asm_texel_centre(uvec3 tile, ivec2 texel) {
+    return (vec2(tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / float(1u << tile.x);
+}
+
 // The page of node `node`'s quadrant holding uv: the node is the finest resident tile there
 // (asm_descend), so no resident child covers that quadrant and its page is stored.
 AsmPage asm_page(uint node, vec2 uv) {

@@ -37,12 +37,20 @@ fn settings(budget_bytes: u64, test: AsmTest) -> AsmSettings {
 }
 
 fn renderer(ctx: &Validated, scene: &Scene, technique: TechniqueDesc) -> Renderer {
-    Renderer::new(ctx, scene, &RenderOptions { width: SIZE, height: SIZE, technique, transfer: None })
+    renderer_sized(ctx, scene, technique, SIZE)
+}
+
+fn renderer_sized(ctx: &Validated, scene: &Scene, technique: TechniqueDesc, size: u32) -> Renderer {
+    Renderer::new(ctx, scene, &RenderOptions { width: size, height: size, technique, transfer: None })
         .unwrap()
 }
 
 fn reference(ctx: &Validated, scene: &Scene) -> RgbaF32Image {
-    let options = ReferenceOptions { width: SIZE, height: SIZE, light: LightMode::Local, seed: 1 };
+    reference_sized(ctx, scene, SIZE)
+}
+
+fn reference_sized(ctx: &Validated, scene: &Scene, size: u32) -> RgbaF32Image {
+    let options = ReferenceOptions { width: size, height: size, light: LightMode::Local, seed: 1 };
     let mut r = ReferenceRenderer::new(ctx, scene, &options).unwrap();
     r.run_batch(1).unwrap();
     r.image().unwrap()
@@ -436,14 +444,8 @@ fn a_thin_occluder_across_a_page_border_still_asks_for_refinement() {
     let mut scene = Scene::load(&path).unwrap();
     scene.camera = scene.walkthrough[1];
     let size = 512;
-    let options = ReferenceOptions { width: size, height: size, light: LightMode::Local, seed: 1 };
-    let mut reference = ReferenceRenderer::new(&ctx, &scene, &options).unwrap();
-    reference.run_batch(1).unwrap();
-    let truth = reference.image().unwrap();
-    let technique = TechniqueDesc::Asm(settings(256 * MB, AsmTest::Bias));
-    let mut asm =
-        Renderer::new(&ctx, &scene, &RenderOptions { width: size, height: size, technique, transfer: None })
-            .unwrap();
+    let truth = reference_sized(&ctx, &scene, size);
+    let mut asm = renderer_sized(&ctx, &scene, TechniqueDesc::Asm(settings(256 * MB, AsmTest::Bias)), size);
     for _ in 0..16 {
         asm.render().unwrap();
     }
