@@ -78,8 +78,10 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
 // allows for, so the page's border texel (`kept`) answers as before.
 float across_border_depth(AsmPage page, ivec2 texel, float kept) {
     vec2 uv = clamp(asm_texel_centre(page.tile, texel), vec2(0.0), vec2(1.0));
-    AsmPage there = asm_page(asm_descend(uv), uv);
-    return there.tile.x < page.tile.x ? kept : asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
+    AsmTile at = asm_descend(uv);
+    if (at.level < page.tile.x) return kept;
+    AsmPage there = asm_page(at, uv);
+    return asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
 }
 
 void main() {
@@ -102,9 +104,9 @@ void main() {
     if (dot(ng, l) <= 0.0) return;
     if (s.light.position.w > 0.5 && dot(-l, s.light.direction.xyz) < s.light.direction.w) return;
 
-    uint node = asm_descend(m.xy);
-    requests[1u + node] = 1u;
-    AsmPage page = asm_page(node, m.xy);
+    AsmTile at = asm_descend(m.xy);
+    requests[1u + at.node] = 1u;
+    AsmPage page = asm_page(at, m.xy);
     uint level = page.tile.x;
     if (level >= uint(KAGE_ASM_MAX_LEVEL)) return;
     // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
@@ -150,9 +152,9 @@ void main() {
     if (!edge) return;
     uint record = atomicAdd(requests[0], 1u);
     if (record >= push.size.w) return;
-    uint at = 1u + push.size.z + 4u * record;
-    requests[at] = floatBitsToUint(m.x);
-    requests[at + 1u] = floatBitsToUint(m.y);
-    requests[at + 2u] = node;
-    requests[at + 3u] = uint(missing);
+    uint word = 1u + push.size.z + 4u * record;
+    requests[word] = floatBitsToUint(m.x);
+    requests[word + 1u] = floatBitsToUint(m.y);
+    requests[word + 2u] = at.node;
+    requests[word + 3u] = uint(missing);
 }

@@ -612,7 +612,7 @@ typedef struct {
    */
   double asm_budget_mb;
   /**
-   * Adaptive shadow maps: tile rendering time per frame in ms; default 32 (as
+   * Adaptive shadow maps: tile rendering time per frame in ms; default 16 (as
    * `kage_technique_desc_default` sets it).
    */
   double asm_time_ms;

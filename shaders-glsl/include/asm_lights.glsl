@@ -22,9 +22,9 @@ bool visible(uint k, vec3 p, vec3 ng) {
     ShadowLight s = lights[k];
     vec4 m = shadow_map_coords(s, p);
     if (m.w < 0.0) return true;
-    uint node = asm_descend(m.xy);
-    asm_used[node] = draw.params.z;
-    AsmPage page = asm_page(node, m.xy);
+    AsmTile at = asm_descend(m.xy);
+    asm_used[at.node] = draw.params.z;
+    AsmPage page = asm_page(at, m.xy);
     vec2 f = asm_texel_coords(page.tile, m.xy);
 #ifdef ASM_ID_TEST
     if (texelFetch(asm_ids, asm_atlas_texel(page, ivec2(f)), 0).r == draw.params.y + uint(gl_PrimitiveID)) {

@@ -12,32 +12,45 @@
 layout(set = 0, binding = 2) uniform sampler2D asm_pool;
 // The page table as uvec4 texels: the directory (rows of ASM_DIRECTORY_SIDE entries, four to a
 // texel: node index | level << 24, the finest resident tile at or above the directory's level
-// over each of its tiles), then the nodes (an AsmNode is three texels: children, pages, tile).
-// A texel buffer because llvmpipe gathers texel fetches and reads storage buffers lane by lane
-// (vendor-notes.md).
+// over each of its tiles), then the nodes (an AsmNode is ASM_NODE_TEXELS texels: below[0..3],
+// pages). A texel buffer because llvmpipe gathers texel fetches and reads storage buffers lane by
+// lane (vendor-notes.md).
 layout(set = 0, binding = 3) uniform usamplerBuffer asm_table;
 #define ASM_DIRECTORY_TEXELS int(ASM_DIRECTORY_SIDE * ASM_DIRECTORY_SIDE / 4u)
+#define ASM_NODE_TEXELS 5
+#define ASM_NODE_PAGES 4
 
 uint asm_directory(uint entry) { return texelFetch(asm_table, int(entry >> 2))[entry & 3u]; }
-// Texel `field` (0: children, 1: pages, 2: tile) of node `node`.
-uvec4 asm_node(uint node, int field) { return texelFetch(asm_table, ASM_DIRECTORY_TEXELS + 3 * int(node) + field); }
+// Texel `field` (0 to 3: below's rows, ASM_NODE_PAGES: pages) of node `node`.
+uvec4 asm_node(uint node, int field) {
+    return texelFetch(asm_table, ASM_DIRECTORY_TEXELS + ASM_NODE_TEXELS * int(node) + field);
+}
 
-// The node of the finest resident tile holding light uv `uv`: the directory's tile, then into
-// the child holding uv while it is resident. A missing tile so falls back to its nearest
-// resident ancestor, at worst the root, never to "lit".
-uint asm_descend(vec2 uv) {
+// A resident tile: its page-table node and its level.
+struct AsmTile {
+    uint node;
+    uint level;
+};
+
+// The finest resident tile holding light uv `uv`: the directory's tile, then down two levels a
+// step through each node's `below` while the tile two levels down is resident (one texel fetch
+// per step: the descent's cost in the lighting pass is its fetches). A missing tile so falls back
+// to its nearest resident ancestor, at worst the root, never to "lit".
+AsmTile asm_descend(vec2 uv) {
     uvec2 entry_cell = min(uvec2(uv * float(ASM_DIRECTORY_SIDE)), uvec2(ASM_DIRECTORY_SIDE - 1u));
     uint entry = asm_directory(entry_cell.y * ASM_DIRECTORY_SIDE + entry_cell.x);
-    uint at = entry & 0xffffffu;
+    AsmTile at = AsmTile(entry & 0xffffffu, entry >> 24);
     // A tile above the directory's level has no resident child over uv: the directory would
     // name that child.
-    if ((entry >> 24) < uint(KAGE_ASM_DIRECTORY_LEVEL)) return at;
-    for (uint level = uint(KAGE_ASM_DIRECTORY_LEVEL) + 1u; level <= uint(KAGE_ASM_MAX_LEVEL); ++level) {
-        uint n = 1u << level;
-        uvec2 cell = min(uvec2(uv * float(n)), uvec2(n - 1u));
-        uint next = asm_node(at, 0)[2u * (cell.y & 1u) + (cell.x & 1u)];
-        if (next == 0u) break;
-        at = next;
+    if (at.level < uint(KAGE_ASM_DIRECTORY_LEVEL)) return at;
+    for (uint step = 0u; step < (uint(KAGE_ASM_MAX_LEVEL - KAGE_ASM_DIRECTORY_LEVEL) + 1u) / 2u; ++step) {
+        uint n = 4u << at.level;
+        uvec2 cell = min(uvec2(uv * float(n)), uvec2(n - 1u)) & 3u;
+        uint below = asm_node(at.node, int(cell.y))[cell.x];
+        uint down = below >> 24;
+        if (down == 0u) break;
+        at = AsmTile(below & 0xffffffu, at.level + down);
+        if (down == 1u) break;
     }
     return at;
 }
@@ -49,7 +62,7 @@ ivec2 asm_cell_origin(uint cell) {
 
 // The quadrant of a resident tile that holds a point: the tile, and where its texels lie.
 struct AsmPage {
-    uvec3 tile; // x: level, y, z: tile x, y at that level (AsmNode.tile)
+    uvec3 tile; // x: level, y, z: tile x, y at that level
     ivec2 quadrant; // the quadrant's first texel within the tile
     ivec2 atlas; // the page's first texel in the atlas
 };
@@ -64,12 +77,14 @@ vec2 asm_texel_centre(uvec3 tile, ivec2 texel) {
     return (vec2(tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / float(1u << tile.x);
 }
 
-// The page of node `node`'s quadrant holding uv: the node is the finest resident tile there
-// (asm_descend), so no resident child covers that quadrant and its page is stored.
-AsmPage asm_page(uint node, vec2 uv) {
-    uvec3 tile = asm_node(node, 2).xyz;
+// The page of resident tile `at`'s quadrant holding uv: the tile is the finest resident one
+// there (asm_descend, whose cells give the tile's coordinates again), so no resident child
+// covers that quadrant and its page is stored.
+AsmPage asm_page(AsmTile at, vec2 uv) {
+    uint n = 1u << at.level;
+    uvec3 tile = uvec3(at.level, min(uvec2(uv * float(n)), uvec2(n - 1u)));
     ivec2 q = ivec2(clamp(asm_texel_coords(tile, uv) / float(KAGE_ASM_PAGE_TEXELS), vec2(0.0), vec2(1.0)));
-    return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_node(node, 1)[2 * q.y + q.x]));
+    return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_node(at.node, ASM_NODE_PAGES)[2 * q.y + q.x]));
 }
 
 // Tile texel `texel` kept in the page's quadrant (the texels beyond it are in other pages, or in

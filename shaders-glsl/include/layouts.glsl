@@ -288,12 +288,12 @@ struct LocalDrawPush {
 };
 
 // A node of the adaptive shadow map's page table: one resident tile of the quadtree over the
-// light's view. Node 0 is the root; the lookup descends into the child holding the point while
-// it is resident and uses the last node's page (engine/src/techniques/asm/page_table.rs).
+// light's view. Node 0 is the root; the lookup descends two levels a step, through the finest
+// resident tile up to two levels below each node, and uses the last node's page
+// (engine/src/techniques/asm/page_table.rs).
 struct AsmNode {
-    uvec4 children; // node index of the child in quadrant 2 * (y & 1) + (x & 1); 0: not resident
-    uvec4 pages; // the atlas cell (column | row << 16) of the page of each quadrant whose child is not resident (else unused)
-    uvec4 tile; // x: level, y, z: tile x, y at that level, w: unused
+    uvec4 below[4]; // over cell (x & 3, y & 3) of the tile's grandchildren, below[y & 3][x & 3]: the grandchild's node index | 2 << 24 where it is resident, else the child's | 1 << 24 where that is, else 0
+    uvec4 pages; // the atlas cell (column | row << 16) of the page of each quadrant 2 * (y & 1) + (x & 1) whose child is not resident (else unused)
 };
 
 // Push constants of an ASM tile render with polygon IDs (asm_tile.vert/frag): one draw per mesh.

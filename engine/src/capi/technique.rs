@@ -84,7 +84,7 @@ pub struct kage_technique_desc {
     pub probe_light: u32,
     /// Adaptive shadow maps: the page pool's budget in MB (MiB), never exceeded; default 16.
     pub asm_budget_mb: f64,
-    /// Adaptive shadow maps: tile rendering time per frame in ms; default 32 (as
+    /// Adaptive shadow maps: tile rendering time per frame in ms; default 16 (as
     /// `kage_technique_desc_default` sets it).
     pub asm_time_ms: f64,
     /// A `kage_asm_test` value; default bias.

@@ -15,8 +15,8 @@
 //!   scratch target, each drawing only the triangle clusters over its square) that fill them.
 //! - [`page_table`]: the resident tree flattened into `AsmNode` records for the GPU lookup
 //!   (shaders-glsl/include/layouts.glsl) behind a directory of one level's tiles: start at the
-//!   directory's tile and descend while the child holding the point is resident; the last node
-//!   reached is the finest resident tile, and its quadrant holding the point is stored, so a
+//!   directory's tile and descend, two levels a step, while the tile holding the point is
+//!   resident; the last node reached is the finest resident tile, and its quadrant holding the point is stored, so a
 //!   missing tile falls back to its nearest resident ancestor, at worst the root (always
 //!   resident), never to "lit".
 pub mod light_view;

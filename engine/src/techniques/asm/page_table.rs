@@ -1,8 +1,10 @@
 //! The page table the GPU lookup descends: the resident tiles as a tree of `AsmNode` records
-//! in a texel buffer, the root at index 0 and every node's children after it (breadth first).
-//! A child index of 0 means "not resident" (the root is no one's child), so the lookup stops
-//! there and uses the last node's page of that quadrant: the finest resident tile over the
-//! point, which stores every quadrant no resident child covers (`pool`).
+//! in a texel buffer, the root at index 0 and every node's descendants after it (breadth
+//! first). Each node names, over each cell of its grandchildren's 4×4 grid, the finest resident
+//! tile up to two levels below it, so that the lookup goes down two levels per texel fetch; it
+//! stops where that tile is less than two levels down (or none is) and uses the last node's
+//! page of that quadrant: the finest resident tile over the point, which stores every quadrant
+//! no resident child covers (`pool`).
 //!
 //! A directory comes first in the buffer: one entry per tile of level
 //! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
@@ -18,14 +20,16 @@ use std::collections::VecDeque;
 pub const DIRECTORY_SIDE: u32 = 1 << ASM_DIRECTORY_LEVEL;
 /// Bytes of the directory at the head of the page-table buffer.
 pub const DIRECTORY_BYTES: u64 = 4 * DIRECTORY_SIDE as u64 * DIRECTORY_SIDE as u64;
-/// A directory entry's level field (the node index below it).
+/// The levels-down field of a directory entry (its tile's level) and of a node's `below`
+/// entries (1 or 2), above the node index.
 const LEVEL_SHIFT: u32 = 24;
 
 /// What the page-table buffer holds: the directory (row by row, `node | level << 24`), then
-/// the nodes.
+/// the nodes; and each node's tile, for the host.
 pub struct PageTable {
     pub directory: Vec<u32>,
     pub nodes: Vec<AsmNode>,
+    pub keys: Vec<TileKey>,
 }
 
 impl PageTable {
@@ -45,13 +49,14 @@ impl PageTable {
 /// out as `layout`.
 pub fn build(pool: &PagePool, layout: &AtlasLayout) -> PageTable {
     // A covered quadrant's page is never read: 0 stands in.
-    let node = |key: TileKey, pages: TilePages| AsmNode {
-        children: [0; 4],
+    let node = |pages: TilePages| AsmNode {
+        below: [[0; 4]; 4],
         pages: pages.map(|p| p.map_or(0, |p| layout.cell(p))),
-        tile: [key.level, key.x, key.y, 0],
     };
     let root = pool.pages(TileKey::ROOT).expect("the root is always resident");
-    let mut nodes = vec![node(TileKey::ROOT, root)];
+    let (mut nodes, mut keys) = (vec![node(root)], vec![TileKey::ROOT]);
+    // Each node's resident children (node indices, 0: none), for the `below` entries.
+    let mut children = vec![[0u32; 4]];
     let mut directory = vec![0u32; (DIRECTORY_SIDE * DIRECTORY_SIDE) as usize];
     let mut queue = VecDeque::from([(TileKey::ROOT, 0usize)]);
     while let Some((key, at)) = queue.pop_front() {
@@ -64,16 +69,32 @@ pub fn build(pool: &PagePool, layout: &AtlasLayout) -> PageTable {
                 directory[row + (key.x * span) as usize..row + ((key.x + 1) * span) as usize].fill(entry);
             }
         }
-        let Some(children) = key.children() else { continue };
-        for (q, child) in children.into_iter().enumerate() {
+        let Some(tiles) = key.children() else { continue };
+        for (q, child) in tiles.into_iter().enumerate() {
             if let Some(pages) = pool.pages(child) {
-                nodes[at].children[q] = nodes.len() as u32;
+                children[at][q] = nodes.len() as u32;
                 queue.push_back((child, nodes.len()));
-                nodes.push(node(child, pages));
+                nodes.push(node(pages));
+                keys.push(child);
+                children.push([0; 4]);
             }
         }
     }
-    PageTable { directory, nodes }
+    // Children come after their parents: each node's grandchildren are known by now.
+    for at in 0..nodes.len() {
+        for (q, &child) in children[at].iter().enumerate().filter(|(_, c)| **c != 0) {
+            for (g, &grandchild) in children[child as usize].iter().enumerate() {
+                // Cell (x, y) of the 4×4 grid: the child's quadrant is its high bit, the
+                // grandchild's the low one.
+                let (x, y) = (2 * (q & 1) + (g & 1), 2 * (q >> 1) + (g >> 1));
+                nodes[at].below[y][x] = match grandchild {
+                    0 => child | 1 << LEVEL_SHIFT,
+                    _ => grandchild | 2 << LEVEL_SHIFT,
+                };
+            }
+        }
+    }
+    PageTable { directory, nodes, keys }
 }
 
 #[cfg(test)]
@@ -83,44 +104,49 @@ mod tests {
     const LAYOUT: AtlasLayout = AtlasLayout { columns: 16, rows: 16 };
 
     /// asm_lookup.glsl reads the table as 16-byte texels: the directory four entries to a
-    /// texel, each node three (children, pages, tile).
+    /// texel, each node five (below's four rows, pages: ASM_NODE_TEXELS, ASM_NODE_PAGES).
     #[test]
     fn the_table_is_whole_texels_as_the_shader_reads_it() {
         assert_eq!(DIRECTORY_BYTES % 16, 0);
-        assert_eq!(size_of::<AsmNode>(), 3 * 16);
-        assert_eq!(std::mem::offset_of!(AsmNode, children), 0);
-        assert_eq!(std::mem::offset_of!(AsmNode, pages), 16);
-        assert_eq!(std::mem::offset_of!(AsmNode, tile), 32);
+        assert_eq!(size_of::<AsmNode>(), 5 * 16);
+        assert_eq!(std::mem::offset_of!(AsmNode, below), 0);
+        assert_eq!(std::mem::offset_of!(AsmNode, pages), 4 * 16);
     }
 
-    fn key_of(node: &AsmNode) -> TileKey {
-        let [level, x, y, _] = node.tile;
-        TileKey { level, x, y }
-    }
-
-    /// From node `at`, into the resident child holding `uv` until there is none.
-    fn descend(table: &PageTable, mut at: usize, uv: [f32; 2]) -> TileKey {
-        loop {
-            let here = key_of(&table.nodes[at]);
-            let Some(child) = TileKey::containing(uv, here.level + 1) else { return here };
-            match table.nodes[at].children[child.quadrant()] {
-                0 => return here,
-                next => at = next as usize,
-            }
+    /// The finest tile over `uv` whose ancestors are all resident, from the pool alone.
+    fn finest(pool: &PagePool, uv: [f32; 2]) -> TileKey {
+        let mut found = TileKey::ROOT;
+        while let Some(next) = TileKey::containing(uv, found.level + 1).filter(|k| pool.pages(*k).is_some()) {
+            found = next;
         }
+        found
     }
 
     /// The GPU's lookup (asm_lookup.glsl) on the CPU: the directory's tile over `uv`, and on
-    /// from there only where that tile is of the directory's level.
+    /// from there, two levels a step, only where that tile is of the directory's level.
     fn lookup(table: &PageTable, uv: [f32; 2]) -> TileKey {
-        let cell = |c: f32| ((c * DIRECTORY_SIDE as f32) as u32).min(DIRECTORY_SIDE - 1);
-        let entry = table.directory[(cell(uv[1]) * DIRECTORY_SIDE + cell(uv[0])) as usize];
-        let at = (entry & 0xff_ffff) as usize;
-        assert_eq!(table.nodes[at].tile[0], entry >> LEVEL_SHIFT, "the entry's level is its node's");
+        let cell = |c: f32, n: u32| ((c * n as f32) as u32).min(n - 1);
+        let entry = table.directory
+            [(cell(uv[1], DIRECTORY_SIDE) * DIRECTORY_SIDE + cell(uv[0], DIRECTORY_SIDE)) as usize];
+        let mut at = (entry & 0xff_ffff) as usize;
+        assert_eq!(table.keys[at].level, entry >> LEVEL_SHIFT, "the entry's level is its node's");
         if entry >> LEVEL_SHIFT < ASM_DIRECTORY_LEVEL {
-            return key_of(&table.nodes[at]);
+            return table.keys[at];
         }
-        descend(table, at, uv)
+        loop {
+            let n = 4 << table.keys[at].level;
+            let below = table.nodes[at].below[(cell(uv[1], n) & 3) as usize][(cell(uv[0], n) & 3) as usize];
+            let down = below >> LEVEL_SHIFT;
+            if down == 0 {
+                return table.keys[at];
+            }
+            let next = (below & 0xff_ffff) as usize;
+            assert_eq!(table.keys[next].level, table.keys[at].level + down);
+            at = next;
+            if down == 1 {
+                return table.keys[at];
+            }
+        }
     }
 
     #[test]
@@ -141,17 +167,17 @@ mod tests {
         // Far away: the root, which every lookup can fall back to; never "no tile".
         assert_eq!(lookup(&table, [0.9, 0.1]), TileKey::ROOT);
         // Each node's pages are its tile's in the pool, where no child covers the quadrant.
-        for node in &table.nodes {
-            let pages = pool.pages(key_of(node)).unwrap();
-            for (q, page) in pages.iter().enumerate() {
-                assert_eq!(page.is_none(), node.children[q] != 0);
+        for (node, key) in table.nodes.iter().zip(&table.keys) {
+            let pages = pool.pages(*key).unwrap();
+            for (q, (page, child)) in pages.iter().zip(key.children().unwrap()).enumerate() {
+                assert_eq!(page.is_none(), pool.pages(child).is_some());
                 assert_eq!(page.map_or(0, |p| LAYOUT.cell(p)), node.pages[q]);
             }
         }
     }
 
     #[test]
-    fn children_follow_their_parents_and_point_at_the_right_quadrant() {
+    fn each_node_names_the_finest_resident_tile_two_levels_down_in_the_right_cell() {
         let mut pool = PagePool::new(19, PAGE_BYTES).unwrap();
         for child in TileKey::ROOT.children().unwrap() {
             pool.insert(child, 1, 1.0).unwrap();
@@ -160,17 +186,40 @@ mod tests {
         pool.insert(grandchild, 1, 1.0).unwrap();
         let table = build(&pool, &LAYOUT);
         assert_eq!(table.nodes.len(), 6);
-        for (at, node) in table.nodes.iter().enumerate() {
-            for (q, &child) in node.children.iter().enumerate().filter(|(_, c)| **c != 0) {
-                assert!(child as usize > at);
-                let key = key_of(&table.nodes[child as usize]);
-                assert_eq!((key.parent(), key.quadrant()), (Some(key_of(node)), q));
+        let mut named = [0; 3];
+        for (at, (node, key)) in table.nodes.iter().zip(&table.keys).enumerate() {
+            for (y, row) in node.below.iter().enumerate() {
+                for (x, &entry) in row.iter().enumerate() {
+                    let cell =
+                        TileKey { level: key.level + 2, x: 4 * key.x + x as u32, y: 4 * key.y + y as u32 };
+                    let down = (entry >> LEVEL_SHIFT) as usize;
+                    named[down] += 1;
+                    // The finest resident tile of the cell's ancestors up to two levels down.
+                    let resident = (1..=2).rev().find(|d| {
+                        pool.pages(TileKey {
+                            level: key.level + d,
+                            x: cell.x >> (2 - d),
+                            y: cell.y >> (2 - d),
+                        })
+                        .is_some()
+                    });
+                    assert_eq!(down as u32, resident.unwrap_or(0), "cell {x}, {y} of {key:?}");
+                    if down > 0 {
+                        let below = (entry & 0xff_ffff) as usize;
+                        assert!(below > at);
+                        assert_eq!(table.keys[below].level, key.level + down as u32);
+                        assert!(table.keys[below].covers(cell));
+                    }
+                }
             }
         }
+        // The root names the grandchild in one cell and its children in the 15 others, the
+        // grandchild's parent names it in the 4 cells under it; the other 76 cells name none.
+        assert_eq!(named, [6 * 16 - 20, 15 + 4, 1]);
     }
 
     #[test]
-    fn the_directory_starts_every_descent_where_the_root_would_arrive() {
+    fn the_lookup_finds_the_finest_resident_tile_wherever_the_chains_end() {
         // Chains refined past the directory's level at two points, and a full level 2, so that
         // the directory holds tiles above, at and (through them) below its level.
         let deep = ASM_DIRECTORY_LEVEL + 3;
@@ -196,14 +245,14 @@ mod tests {
                     let step = 1.0 / (1u32 << deep) as f32 / 8.0;
                     let uv = [centre[0] + (i as f32 - 32.0) * step, centre[1] + (j as f32 - 32.0) * step];
                     let found = lookup(&table, uv);
-                    assert_eq!(found, descend(&table, 0, uv), "at {uv:?}");
+                    assert_eq!(found, finest(&pool, uv), "at {uv:?}");
                     reached_deep += usize::from(found.level == deep);
                 }
             }
         }
         assert!(reached_deep > 0, "the lattice reaches the chains' deepest tiles");
         for uv in [[0.0, 0.0], [0.999_99, 0.999_99], [0.5, 0.25]] {
-            assert_eq!(lookup(&table, uv), descend(&table, 0, uv));
+            assert_eq!(lookup(&table, uv), finest(&pool, uv));
         }
     }
 }
