@@ -11,6 +11,9 @@
 // there.
 #include "constants.glsl"
 #include "layouts.glsl"
+layout(push_constant) uniform Push { IrradiancePush p; };
+// transport.z 0: every ray a miss, to time all but the traversal (IrradianceReference::untraced_seconds).
+#define KAGE_BVH_TRACE (p.transport.z != 0u)
 #include "bvh.glsl"
 #include "reference.glsl"
 #include "local_light.glsl"
@@ -28,7 +31,9 @@ layout(set = 0, binding = KAGE_BVH_BINDINGS + 6, std430) readonly buffer Radianc
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 7, std430) readonly buffer TriangleVertices {
     uvec4 triangle_vertices[];
 };
-layout(push_constant) uniform Push { IrradiancePush p; };
+// The rays the invocations traced, added up (a u32 that wraps: the host reads it after every
+// batch, which traces far fewer than 2^32).
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 8, std430) buffer RaysTraced { uint rays_traced; };
 
 // One cosine-weighted sample of the irradiance from the surfaces' radiance: L cos / pdf = L pi.
 vec3 surface_irradiance_sample(vec3 position, vec3 n, inout Rng rng) {
@@ -66,4 +71,5 @@ void main() {
         m2 += delta * (x - mean);
     }
     accum_merge(index, before, count, mean, m2);
+    atomicAdd(rays_traced, bvh_rays_traced);
 }

@@ -388,17 +388,28 @@ bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
     return found;
 }
 
+// The rays this invocation traced through bvh_closest_hit and bvh_occluded: a shader that
+// reports its rays adds them up (reference_irradiance.comp); the others leave it unread.
+uint bvh_rays_traced = 0u;
+// A shader may define KAGE_BVH_TRACE as a condition (a push constant's): false, both take every
+// ray as a miss, so that timing it measures everything but the traversal.
+#ifndef KAGE_BVH_TRACE
+#define KAGE_BVH_TRACE true
+#endif
+
 // Closest hit along a unit world-space ray within (0, tmax), over every group.
 RayHit bvh_closest_hit(vec3 origin, vec3 dir, float tmax) {
+    ++bvh_rays_traced;
     RayHit hit = RayHit(tmax, KAGE_NO_HIT, 0u, vec2(0.0));
-    bvh_traverse(origin, dir, false, hit);
+    if (KAGE_BVH_TRACE) bvh_traverse(origin, dir, false, hit);
     return hit;
 }
 
 // Whether anything lies along the world-space ray within (0, tmax).
 bool bvh_occluded(vec3 origin, vec3 dir, float tmax) {
+    ++bvh_rays_traced;
     RayHit hit = RayHit(tmax, KAGE_NO_HIT, 0u, vec2(0.0));
-    return bvh_traverse(origin, dir, true, hit);
+    return KAGE_BVH_TRACE && bvh_traverse(origin, dir, true, hit);
 }
 
 // Whether any triangle of group `instance` lies along the ray, given in that group's object

@@ -158,7 +158,7 @@ struct IrradiancePoint {
 struct IrradiancePush {
     uvec4 params; // x: point count, y: samples accumulated before this batch, z: samples in this batch, w: seed
     vec4 env; // x: the environment's sum of luminance x solid angle (0: no environment sampling), yzw: unused
-    uvec4 transport; // x: local light count, y: 1 when the surfaces hit radiate their per-vertex radiance (one more bounce), zw: unused
+    uvec4 transport; // x: local light count, y: 1 when the surfaces hit radiate their per-vertex radiance (one more bounce), z: 1 to trace the rays, 0 to take each as a miss (timing all but the traversal), w: unused
 };
 
 // A vertex of the PRT precomputation, in its group's object space.

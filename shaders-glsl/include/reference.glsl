@@ -11,14 +11,17 @@
 #include "sampling.glsl"
 
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 0) uniform sampler2D env;
-// height + 1 entries, P(row < j).
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) readonly buffer EnvMarginal {
-    float env_marginal[];
-};
-// height runs of width + 1 entries, P(column < i | row j).
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) readonly buffer EnvConditional {
-    float env_conditional[];
-};
+// The sampling distribution's CDFs as texel buffers of four floats a texel: llvmpipe gathers a
+// texel fetch where it reads a storage buffer lane by lane, and a sample's binary searches read
+// them a few hundred times (vendor-notes.md). The marginal: height + 1 entries, P(row < j).
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 1) uniform usamplerBuffer env_marginal_texels;
+// The conditionals: height runs of width + 1 entries, P(column < i | row j).
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 2) uniform usamplerBuffer env_conditional_texels;
+
+float env_marginal(uint k) { return uintBitsToFloat(texelFetch(env_marginal_texels, int(k >> 2))[k & 3u]); }
+float env_conditional(uint k) {
+    return uintBitsToFloat(texelFetch(env_conditional_texels, int(k >> 2))[k & 3u]);
+}
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer Accum { ReferenceAccum accum[]; };
 
 const float REFERENCE_PI = 3.14159265358979323846;
@@ -33,12 +36,12 @@ ivec2 env_texel_of(vec3 dir) {
     return min(ivec2(uv * vec2(size)), size - 1);
 }
 
-// First entry of env_marginal[0 .. n] greater than u, minus one: never an empty interval.
+// First entry of the marginal's 0 .. n greater than u, minus one: never an empty interval.
 uint env_pick_row(float u, uint n) {
     uint lo = 0u, hi = n + 1u;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (env_marginal[mid] <= u) lo = mid + 1u; else hi = mid;
+        if (env_marginal(mid) <= u) lo = mid + 1u; else hi = mid;
     }
     return clamp(lo, 1u, n) - 1u;
 }
@@ -49,7 +52,7 @@ uint env_pick_column(float u, uint j, uint n) {
     uint lo = 0u, hi = n + 1u;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (env_conditional[base + mid] <= u) lo = mid + 1u; else hi = mid;
+        if (env_conditional(base + mid) <= u) lo = mid + 1u; else hi = mid;
     }
     return clamp(lo, 1u, n) - 1u;
 }
@@ -65,10 +68,10 @@ void env_sample(vec2 u, float total, out vec3 dir, out vec3 radiance, out float 
     ivec2 size = textureSize(env, 0);
     uint w = uint(size.x), h = uint(size.y);
     uint j = env_pick_row(u.x, h);
-    float v_in = env_within(u.x, env_marginal[j], env_marginal[j + 1u]);
+    float v_in = env_within(u.x, env_marginal(j), env_marginal(j + 1u));
     uint i = env_pick_column(u.y, j, w);
     uint base = j * (w + 1u);
-    float u_in = env_within(u.y, env_conditional[base + i], env_conditional[base + i + 1u]);
+    float u_in = env_within(u.y, env_conditional(base + i), env_conditional(base + i + 1u));
     float cos0 = cos(REFERENCE_PI * float(j) / float(h));
     float cos1 = cos(REFERENCE_PI * float(j + 1u) / float(h));
     float cos_theta = mix(cos0, cos1, v_in);

@@ -212,7 +212,8 @@ fn captured_scene_light_matches_the_reference_with_bounces() {
         samples: 64,
         ..Default::default()
     };
-    let radiance = surface_radiance(&ctx, &scene, capture.bounces, capture.samples, RADIANCE_SEED).unwrap();
+    let radiance =
+        surface_radiance(&ctx, &scene, capture.bounces, capture.samples, RADIANCE_SEED).unwrap().radiance;
     let points: Vec<Point> =
         POINTS[..3].iter().map(|&(position, normal)| Point { position, normal }).collect();
     let mut reference =
@@ -482,4 +483,23 @@ fn two_moving_groups_in_two_rooms_take_no_light_through_the_wall() {
         (up(visible, BESIDE_WALL), up(leaking, BESIDE_WALL), up(visible, BRIGHT));
     eprintln!("facing up: dim room {dim:?} (without visibility {dim_leaking:?}), sunlit room {sunlit:?}");
     assert!((0..3).all(|k| dim[k] < 0.8 * dim_leaking[k] && dim[k] < 0.5 * sunlit[k]));
+}
+
+/// The walls' radiance counts the rays its shader traces, as `kage render` prints them beside
+/// their rate. Under a black sky with no lights, a vertex's sample on an open floor casts
+/// exactly one ray in the first pass (the cosine-weighted sky direction; the sky strategy
+/// draws nothing from a map of total 0) and two in the second (that, and the bounce's).
+#[test]
+fn the_walls_radiance_counts_every_ray_it_traces() {
+    let ctx = Validated::new();
+    let floor = shapes::plane("floor", [2.0, 2.0], [3, 3], [0.5; 3]).unwrap();
+    let camera =
+        Camera { position: Vec3::new(0.0, 2.0, 3.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 };
+    let scene = kage_tests::single_mesh_scene(floor, EnvMap::constant([0.0; 3]), camera);
+    let samples = 8;
+    let radiance = surface_radiance(&ctx, &scene, 2, samples, RADIANCE_SEED).unwrap();
+    assert_eq!(radiance.rays, 9 * u64::from(samples) * (1 + 2));
+    // Both the batches and their untraced copy were timed.
+    assert!(radiance.seconds > 0.0 && radiance.untraced_seconds > 0.0, "{radiance:?}");
+    assert_eq!(radiance.radiance.map(|r| r.len()), Some(9));
 }

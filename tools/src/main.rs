@@ -82,7 +82,9 @@ enum Command {
     /// kage render ... --technique probes [--probes grid:NX,NY,NZ|scene|FILE] [--probe-cube-size N]
     /// [--probe-light sky-and-walls|sky] [--probe-bounces 1|2] [--probe-samples N] [--probe-dering
     /// off|nonnegative|hanning:W|lanczos:W]: light probes (see "Probes"): captured when the
-    /// renderer is built (the time is printed), on a grid over the static groups (default
+    /// renderer is built (the time is printed, and its split: the walls' radiance's GPU rays
+    /// with their traversal's rate and the rest of their batches, the cube maps, the CPU's
+    /// rays), on a grid over the static groups (default
     /// `grid:3,2,3`, cell centres, 2 to 64 a side), at the scene file's `probes` or at the
     /// positions of a probe file; cube faces of 8 to 256 texels (default 128); the moving groups
     /// (those with keyframes; without any, the first group, with a note) each take their irradiance

@@ -220,7 +220,8 @@ fn run_irradiance(
         args.bounce_samples,
         kage::techniques::probes::RADIANCE_SEED,
     )
-    .context("computing the surfaces' radiance")?;
+    .context("computing the surfaces' radiance")?
+    .radiance;
     let mut reference =
         IrradianceReference::with_radiance(ctx, scene, &points.points, args.seed, radiance.as_deref())
             .context("setting up the irradiance reference")?;

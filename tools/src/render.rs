@@ -198,6 +198,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             ),
             false => eprintln!("probes: {}{left_out}, captured in {seconds:.2} s", counts.kept),
         }
+        if let Some(cost) = renderer.stats().probe_capture {
+            eprintln!("{}", capture_split(&cost, seconds));
+        }
     }
     renderer.set_env_rotation(args.env_rotation.to_radians())?;
     let bar = Bar::new(u64::from(args.warmup) + u64::from(args.frames), "frames");
@@ -313,4 +316,34 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         trace.write(path, &ctx.info().name)?;
     }
     args.gpu.finish(&ctx)
+}
+
+/// Where the probes' capture time went (`CaptureCost`), split as the precompute's time is: the
+/// walls' radiance (its GPU rays' traversal and rate, everything else of its batches, its
+/// set-up), the cube maps, the CPU's rays, and the rest of `seconds` (placement,
+/// tetrahedralization, visibility set-up).
+fn capture_split(cost: &kage::techniques::probes::CaptureCost, seconds: f64) -> String {
+    let per_probe = match cost.cubes {
+        0 => 0.0,
+        n => 1e3 * cost.cube_seconds / f64::from(n),
+    };
+    let traversal = cost.radiance_traversal_seconds();
+    format!(
+        "capture split: walls' radiance {:.2} s (ray traversal {traversal:.2} s, {} rays, {:.2} M rays/s; \
+         everything else {:.2} s = {:.1} % of its batches; set-up and the split's timing {:.2} s), {} cube maps {:.2} s ({per_probe:.1} ms \
+         each, {:.1} M texels/s), {} CPU rays {:.2} s, BVH {:.2} s, the rest {:.2} s",
+        cost.radiance_seconds,
+        cost.radiance_rays,
+        cost.radiance_mrays_per_second(),
+        cost.radiance_untraced_seconds,
+        100.0 * cost.radiance_untraced_seconds / cost.radiance_batch_seconds.max(f64::MIN_POSITIVE),
+        (cost.radiance_seconds - cost.radiance_batch_seconds).max(0.0),
+        cost.cubes,
+        cost.cube_seconds,
+        cost.cube_mtexels_per_second(),
+        cost.cpu_rays,
+        cost.cpu_seconds,
+        cost.bvh_seconds,
+        (seconds - cost.seconds()).max(0.0),
+    )
 }

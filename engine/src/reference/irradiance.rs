@@ -25,6 +25,7 @@ use crate::scene::Scene;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
+use std::time::Instant;
 
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -91,21 +92,51 @@ impl IrradianceFile {
 }
 
 pub struct IrradianceReference {
+    shader: IrradianceShader,
+    samples: u32,
+    executor: FrameExecutor,
+    /// The ray count as last read, and the rays traced so far.
+    rays_read: u32,
+    rays_traced: u64,
+    /// Seconds the batches took, submission to completion.
+    seconds: f64,
+}
+
+/// What the irradiance shader's dispatches bind and push.
+struct IrradianceShader {
     lighting: ReferenceLighting,
     pipeline: ComputePipeline,
     points: Buffer,
     accum: Buffer,
+    /// The shader's count of the rays it traced (a wrapping u32).
+    rays: Buffer,
     /// Per scene vertex, the radiance the surfaces reflect (a bounce), or one unused entry.
     radiance: Buffer,
     bounce: bool,
     count: u32,
     seed: u32,
-    samples: u32,
-    executor: FrameExecutor,
 }
 
 /// Most bounces the reference and the probes' capture compute.
 pub const MAX_BOUNCES: u32 = 2;
+
+/// The surfaces' radiance ([`surface_radiance`]) and what computing it took.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfaceRadiance {
+    /// Per scene vertex, RGB and an unused 0; `None` with 0 bounces.
+    pub radiance: Option<Vec<[f32; 4]>>,
+    /// The rays the passes traced, as the shader counted them.
+    pub rays: u64,
+    /// Seconds of the passes' batches, submission to completion.
+    pub seconds: f64,
+    /// Of those, the seconds of all but the traversal: each pass's batches again with every
+    /// ray a miss, timed on [`UNTRACED_SAMPLES`] samples and scaled to all of them (as the PRT
+    /// precomputation splits its time).
+    pub untraced_seconds: f64,
+}
+
+/// Samples per point of the untraced batch that times all but the traversal.
+pub const UNTRACED_SAMPLES: u32 = 16;
 
 /// The outgoing radiance albedo / π · E of every vertex of `scene` (scene order: groups,
 /// meshes, vertices; RGB and an unused 0) with light that reflected up to `bounces` − 1 times
@@ -119,7 +150,7 @@ pub fn surface_radiance(
     bounces: u32,
     samples: u32,
     seed: u32,
-) -> Result<Option<Vec<[f32; 4]>>> {
+) -> Result<SurfaceRadiance> {
     check_bounces(bounces)?;
     if bounces > 0 && samples == 0 {
         return Err(Error::InvalidArgument(format!(
@@ -127,25 +158,30 @@ pub fn surface_radiance(
         )));
     }
     let points = vertex_points(scene);
+    let mut out = SurfaceRadiance::default();
     if points.is_empty() {
-        return Ok((bounces > 0).then(Vec::new));
+        out.radiance = (bounces > 0).then(Vec::new);
+        return Ok(out);
     }
     let albedo: Vec<[f32; 3]> =
         scene.meshes().flat_map(|(_, mesh)| std::iter::repeat_n(mesh.albedo, mesh.positions.len())).collect();
-    let mut radiance: Option<Vec<[f32; 4]>> = None;
     for pass in 0..bounces {
         let mut reference = IrradianceReference::with_radiance(
             ctx,
             scene,
             &points,
             seed.wrapping_add(pass),
-            radiance.as_deref(),
+            out.radiance.as_deref(),
         )?;
         for batch in (0..samples).step_by(RADIANCE_BATCH as usize) {
             reference.run_batch((samples - batch).min(RADIANCE_BATCH))?;
         }
+        out.rays += reference.rays_traced();
+        out.seconds += reference.seconds();
         let e = reference.statistics()?.mean;
-        radiance = Some(
+        let timed = samples.min(UNTRACED_SAMPLES);
+        out.untraced_seconds += reference.untraced_seconds(timed)? * f64::from(samples) / f64::from(timed);
+        out.radiance = Some(
             e.iter()
                 .zip(&albedo)
                 .map(|(e, a)| {
@@ -155,7 +191,7 @@ pub fn surface_radiance(
                 .collect(),
         );
     }
-    Ok(radiance)
+    Ok(out)
 }
 
 /// Samples per vertex per submission: a submission must stay short on a CPU driver.
@@ -238,13 +274,14 @@ impl IrradianceReference {
                 normal: Vec3::from(p.normal).normalize().extend(0.0).to_array(),
             })
             .collect();
-        Ok(IrradianceReference {
+        let shader = IrradianceShader {
             lighting: ReferenceLighting::new(ctx, scene)?,
             pipeline: ComputePipeline::new(
                 ctx,
                 "reference_irradiance",
                 spirv::REFERENCE_IRRADIANCE_COMP,
-                &ReferenceLighting::binding_kinds(&[BindingKind::StorageBuffer; 5]),
+                // Accumulators, points, lights, radiance, triangle vertices, the ray count.
+                &ReferenceLighting::binding_kinds(&[BindingKind::StorageBuffer; 6]),
                 size_of::<IrradiancePush>() as u32,
             )?,
             points: Buffer::with_data(
@@ -254,6 +291,12 @@ impl IrradianceReference {
                 bytes_of_slice(&gpu_points),
             )?,
             accum: accum_buffer(ctx, "irradiance_accum", points.len())?,
+            rays: Buffer::with_data(
+                ctx,
+                "irradiance_rays",
+                BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
+                &[0; 4],
+            )?,
             radiance: Buffer::with_data(
                 ctx,
                 "irradiance_surface_radiance",
@@ -269,34 +312,49 @@ impl IrradianceReference {
             bounce: radiance.is_some(),
             count,
             seed,
-            samples: 0,
-            executor: FrameExecutor::new(ctx, "reference_irradiance")?,
-        })
+        };
+        let mut executor = FrameExecutor::new(ctx, "reference_irradiance")?;
+        // The shader's compilation on a CPU driver, outside the batches' time.
+        executor.run(shader.batch(true, 1, 0, 0))?;
+        Ok(IrradianceReference { shader, samples: 0, executor, rays_read: 0, rays_traced: 0, seconds: 0.0 })
     }
 
     /// Adds `spp` samples per point in one submission.
     pub fn run_batch(&mut self, spp: u32) -> Result<()> {
         let after = samples_after(self.samples, spp, "point")?;
-        let groups = [self.count.div_ceil(constants::IRRADIANCE_GROUP), 1, 1];
-        let pipeline = &self.pipeline;
-        let (lighting, accum, points, radiance) = (&self.lighting, &self.accum, &self.points, &self.radiance);
-        let (count_points, seed, env_total) = (self.count, self.seed, self.lighting.env_total);
-        let transport = [self.lighting.light_count, self.bounce as u32, 0, 0];
-        let passes = super::sample_passes(spp, self.samples, |first, count| {
-            let push = IrradiancePush {
-                params: [count_points, first, count, seed],
-                env: [env_total, 0.0, 0.0, 0.0],
-                transport,
-            };
-            let bindings =
-                lighting.bindings(&[accum, points, &lighting.lights, radiance, &lighting.triangle_vertices]);
-            Pass::new("reference_irradiance", move |cmd| {
-                pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
-            })
-        });
+        let shader = &self.shader;
+        let passes = shader.batch(true, spp, self.samples, shader.count);
+        let start = Instant::now();
         self.executor.run(passes)?;
+        self.seconds += start.elapsed().as_secs_f64();
         self.samples = after;
+        let count = shader.rays.read()?.get(..4).and_then(|b| b.try_into().ok()).map(u32::from_ne_bytes);
+        let count =
+            count.ok_or_else(|| Error::Internal("the irradiance ray count read back short".into()))?;
+        self.rays_traced += u64::from(count.wrapping_sub(self.rays_read));
+        self.rays_read = count;
         Ok(())
+    }
+
+    /// The seconds a batch of `spp` samples per point takes with every ray taken as a miss
+    /// (the same pipeline, told by a push constant not to trace): all but the traversal.
+    /// Consumes the reference: the batch overwrites its statistics.
+    pub fn untraced_seconds(mut self, spp: u32) -> Result<f64> {
+        let shader = &self.shader;
+        let passes = shader.batch(false, spp, self.samples, shader.count);
+        let start = Instant::now();
+        self.executor.run(passes)?;
+        Ok(start.elapsed().as_secs_f64())
+    }
+
+    /// The rays the batches so far traced, as the shader counted them.
+    pub fn rays_traced(&self) -> u64 {
+        self.rays_traced
+    }
+
+    /// Seconds the batches so far took, submission to completion.
+    pub fn seconds(&self) -> f64 {
+        self.seconds
     }
 
     pub fn samples(&self) -> u32 {
@@ -304,7 +362,37 @@ impl IrradianceReference {
     }
 
     pub fn statistics(&self) -> Result<Statistics> {
-        Statistics::read(&self.accum, self.samples)
+        Statistics::read(&self.shader.accum, self.samples)
+    }
+}
+
+impl IrradianceShader {
+    /// The passes adding `spp` samples, from sample `first` on, to each of the first `points`
+    /// points, tracing their rays or (`trace` false) taking each as a miss (0 points: a
+    /// dispatch that only compiles the shader on a CPU driver).
+    fn batch(&self, trace: bool, spp: u32, first: u32, points: u32) -> Vec<Pass<'_>> {
+        let pipeline = &self.pipeline;
+        let groups = [points.div_ceil(constants::IRRADIANCE_GROUP).max(1), 1, 1];
+        let lighting = &self.lighting;
+        let buffers = [
+            &self.accum,
+            &self.points,
+            &lighting.lights,
+            &self.radiance,
+            &lighting.triangle_vertices,
+            &self.rays,
+        ];
+        let push = |first, count| IrradiancePush {
+            params: [points, first, count, self.seed],
+            env: [lighting.env_total, 0.0, 0.0, 0.0],
+            transport: [lighting.light_count, self.bounce as u32, u32::from(trace), 0],
+        };
+        super::sample_passes(spp, first, |first, count| {
+            let (push, bindings) = (push(first, count), lighting.bindings(&buffers));
+            Pass::new("reference_irradiance", move |cmd| {
+                pipeline.dispatch(cmd, &bindings, bytes_of(&push), groups)
+            })
+        })
     }
 }
 

@@ -3,7 +3,7 @@
 //! and what both need besides: the scene's point and spot lights.
 use super::env_sampling::EnvDistribution;
 use super::render::reference_light;
-use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context};
+use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context, TexelBuffer};
 use crate::error::Result;
 use crate::frame::environment::GpuEnvironment;
 
@@ -16,8 +16,9 @@ use std::sync::Arc;
 pub struct ReferenceLighting {
     bvh: GpuBvh,
     env: GpuEnvironment,
-    marginal: Buffer,
-    conditional: Buffer,
+    /// The environment's sampling CDFs (reference.glsl), four floats a texel.
+    marginal: TexelBuffer,
+    conditional: TexelBuffer,
     /// Σ luminance × solid angle of the map; 0 turns environment sampling off (black map).
     pub env_total: f32,
     /// The scene's lights as `ReferenceLight`s (one unused entry when there are none: a
@@ -36,8 +37,10 @@ impl ReferenceLighting {
         let distribution = EnvDistribution::new(&scene.environment);
         let storage = BufferUsage::STORAGE;
         let upload = |name: &str, values: &[f32]| {
-            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_ne_bytes()).collect();
-            Buffer::with_data(ctx, name, storage, &bytes)
+            let mut bytes: Vec<u8> = values.iter().flat_map(|v| v.to_ne_bytes()).collect();
+            // Whole texels: the shader never reads the padding.
+            bytes.resize(bytes.len().div_ceil(16).max(1) * 16, 0);
+            TexelBuffer::with_data(ctx, name, &bytes)
         };
         let mut lights: Vec<ReferenceLight> = scene.lights.iter().map(reference_light).collect();
         if lights.is_empty() {
@@ -67,7 +70,7 @@ impl ReferenceLighting {
     /// The binding kinds of a reference shader: these, then the shader's own `extra`.
     pub fn binding_kinds(extra: &[BindingKind]) -> Vec<BindingKind> {
         let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
-        kinds.extend([BindingKind::SampledImage, BindingKind::StorageBuffer, BindingKind::StorageBuffer]);
+        kinds.extend([BindingKind::SampledImage, BindingKind::TexelBuffer, BindingKind::TexelBuffer]);
         kinds.extend_from_slice(extra);
         kinds
     }
@@ -77,8 +80,8 @@ impl ReferenceLighting {
         let mut bindings: Vec<Binding> = self.bvh.bindings().into_iter().collect();
         bindings.extend([
             Binding::Sampled(&self.env.image, &self.env.sampler),
-            Binding::Storage(&self.marginal),
-            Binding::Storage(&self.conditional),
+            Binding::Texel(&self.marginal),
+            Binding::Texel(&self.conditional),
         ]);
         bindings.extend(extra.iter().map(|b| Binding::Storage(b)));
         bindings

@@ -20,7 +20,9 @@ pub mod metrics;
 pub mod render;
 pub mod statistics;
 
-pub use irradiance::{surface_radiance, IrradianceFile, IrradianceReference, PointsFile, MAX_BOUNCES};
+pub use irradiance::{
+    surface_radiance, IrradianceFile, IrradianceReference, PointsFile, SurfaceRadiance, MAX_BOUNCES,
+};
 pub use metrics::{
     compare, diff_image, frames_to_converge, shadow_flips, shadow_mismatch, shadow_mismatch_image, EdgeTies,
     ImageMetrics, ShadowFlips, ShadowMismatch, SHADOW_THRESHOLD,

@@ -52,6 +52,8 @@ pub struct TechniqueStats {
     pub asm: Option<asm::AsmStats>,
     /// The light probes placed and kept.
     pub probes: Option<probes::ProbeCounts>,
+    /// What capturing the light probes took.
+    pub probe_capture: Option<probes::CaptureCost>,
     /// The probe lookups since the technique was built, by what their visibility test did.
     pub probe_lookups: Option<probes::LookupCounts>,
 }

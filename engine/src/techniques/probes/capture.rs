@@ -41,12 +41,13 @@ use crate::layouts::{bytes_of, spirv, DrawPush, FrameUniforms};
 use crate::pass::{FrameExecutor, Pass};
 
 use crate::raycast::SceneBvh;
-use crate::reference::{irradiance::check_bounces, surface_radiance};
+use crate::reference::{irradiance::check_bounces, surface_radiance, SurfaceRadiance};
 use crate::scene::{Camera, Scene, FAR};
 use crate::sh::{eval_basis, ShRgb9};
 use glam::{DVec3, Mat3, Vec3};
 use std::ops::RangeInclusive;
 use std::sync::Arc;
+use std::time::Instant;
 
 /// Texels per side of a cube face: the issue's range and default.
 pub const CUBE_SIZES: RangeInclusive<u32> = 8..=256;
@@ -167,6 +168,66 @@ pub struct InvalidProbe {
     pub back_faces: f32,
 }
 
+/// Where a capture's time goes (`kage render` prints it; BENCHMARKS.md "Light probes: capture
+/// time"): the GPU's rays for the walls' radiance, counted by the shader, the cube maps (drawn
+/// and projected on the GPU, read back), and the CPU's rays through the static groups' BVH
+/// (back faces and the local lights' visibility). Seconds are wall-clock, each part's work
+/// waited for.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CaptureCost {
+    /// The walls' radiance: its seconds (set-up and read-back included), the rays it traced
+    /// (all its bounces), the seconds of its batches of rays, and of those the seconds of all
+    /// but the traversal ([`crate::reference::SurfaceRadiance::untraced_seconds`]).
+    pub radiance_seconds: f64,
+    pub radiance_rays: u64,
+    pub radiance_batch_seconds: f64,
+    pub radiance_untraced_seconds: f64,
+    /// The static groups' BVH for the CPU's rays, built once.
+    pub bvh_seconds: f64,
+    /// Cube maps captured, the texels each drew and projected (six faces), and their seconds.
+    pub cubes: u32,
+    pub cube_texels: u64,
+    pub cube_seconds: f64,
+    /// Rays the CPU cast (back faces, local lights) and their seconds.
+    pub cpu_rays: u64,
+    pub cpu_seconds: f64,
+}
+
+impl CaptureCost {
+    /// The seconds the walls' radiance spent in ray traversal: its batches' less the untraced.
+    pub fn radiance_traversal_seconds(&self) -> f64 {
+        (self.radiance_batch_seconds - self.radiance_untraced_seconds).max(0.0)
+    }
+
+    /// Millions of rays per second of the walls' radiance's traversal (0 without rays).
+    pub fn radiance_mrays_per_second(&self) -> f64 {
+        per_second(self.radiance_rays, self.radiance_traversal_seconds()) * 1e-6
+    }
+
+    /// Millions of the CPU's rays per second.
+    pub fn cpu_mrays_per_second(&self) -> f64 {
+        per_second(self.cpu_rays, self.cpu_seconds) * 1e-6
+    }
+
+    /// Millions of cube-map texels drawn and projected per second.
+    pub fn cube_mtexels_per_second(&self) -> f64 {
+        per_second(self.cube_texels * u64::from(self.cubes), self.cube_seconds) * 1e-6
+    }
+
+    /// The seconds of the parts.
+    pub fn seconds(&self) -> f64 {
+        self.radiance_seconds + self.bvh_seconds + self.cube_seconds + self.cpu_seconds
+    }
+}
+
+fn per_second(count: u64, seconds: f64) -> f64 {
+    if seconds > 0.0 {
+        count as f64 / seconds
+    } else {
+        0.0
+    }
+}
+
 /// Per-vertex radiance as a second vertex buffer (location 1).
 const RADIANCE_ATTRIBUTES: [VertexAttribute; 1] =
     [VertexAttribute { location: 1, format: Format::RGBA32_FLOAT, offset: 0 }];
@@ -193,6 +254,7 @@ pub struct ProbeCapture {
     statics: SceneBvh,
     projection: ShProjection,
     executor: FrameExecutor,
+    cost: CaptureCost,
 }
 
 impl ProbeCapture {
@@ -203,6 +265,20 @@ impl ProbeCapture {
         let settings = settings.validated()?;
         let side = settings.cube_size;
         let statics = static_scene(scene);
+        let start = Instant::now();
+        let (radiance, computed) = static_radiance(ctx, &statics, settings)?;
+        let radiance_seconds = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let bvh = SceneBvh::build(&statics)?;
+        let cost = CaptureCost {
+            radiance_seconds,
+            radiance_rays: computed.rays,
+            radiance_batch_seconds: computed.seconds,
+            radiance_untraced_seconds: computed.untraced_seconds,
+            bvh_seconds: start.elapsed().as_secs_f64(),
+            cube_texels: 6 * u64::from(side) * u64::from(side),
+            ..Default::default()
+        };
         let image = |name, format, usage| {
             Image::new(
                 ctx,
@@ -250,11 +326,12 @@ impl ProbeCapture {
                 &[MESH_POSITIONS_UVS, RADIANCE_VERTICES],
                 DepthTest::Less,
             )?,
-            radiance: static_radiance(ctx, &statics, settings)?,
+            radiance,
             lights: scene.lights.iter().map(crate::reference::render::reference_light).collect(),
-            statics: SceneBvh::build(&statics)?,
+            statics: bvh,
             projection: ShProjection::new(ctx, Mapping::Cube { side }, PROBE_CUBE)?,
             executor: FrameExecutor::new(ctx, "probe_capture")?,
+            cost,
         })
     }
 
@@ -320,12 +397,23 @@ impl ProbeCapture {
             }),
         ];
         passes.extend(self.projection.passes(&self.cube, &self.sampler));
+        let start = Instant::now();
         self.executor.run(passes)?;
         let mut sh = self.projection.read()?;
+        self.cost.cubes += 1;
+        self.cost.cube_seconds += start.elapsed().as_secs_f64();
+        let start = Instant::now();
         for light in &self.lights {
-            self.add_light(&mut sh, light, position);
+            self.cost.cpu_rays += u64::from(self.add_light(&mut sh, light, position));
         }
+        self.cost.cpu_seconds += start.elapsed().as_secs_f64();
         Ok(self.settings.dering.apply(&sh))
+    }
+
+    /// What the capture took so far: the walls' radiance and BVH when it was made, then every
+    /// probe's cube map, local lights and back-face check.
+    pub fn cost(&self) -> CaptureCost {
+        self.cost
     }
 
     /// The static groups as occluders of the probes ([`Occluders`]), from the BVH the
@@ -359,9 +447,11 @@ impl ProbeCapture {
 
     /// The positions of probes not inside geometry ([`ProbeCapture::back_faces`] at most
     /// [`MAX_BACK_FACES`]), and those left out.
-    pub fn keep_valid(&self, positions: &[DVec3]) -> (Vec<DVec3>, Vec<InvalidProbe>) {
+    pub fn keep_valid(&mut self, positions: &[DVec3]) -> (Vec<DVec3>, Vec<InvalidProbe>) {
+        let start = Instant::now();
         let mut kept = Vec::with_capacity(positions.len());
         let mut invalid = Vec::new();
+        self.cost.cpu_rays += u64::from(BACK_FACE_RAYS) * positions.len() as u64;
         for (index, &position) in positions.iter().enumerate() {
             let back_faces = self.back_faces(position.as_vec3());
             if back_faces > MAX_BACK_FACES {
@@ -370,24 +460,25 @@ impl ProbeCapture {
                 kept.push(position);
             }
         }
+        self.cost.cpu_seconds += start.elapsed().as_secs_f64();
         (kept, invalid)
     }
 
     /// Adds `light`'s delta of radiance to `sh` where the probe at `p` sees it (see the module
-    /// documentation); the same cone and falloff as local_light.glsl.
-    fn add_light(&self, sh: &mut ShRgb9, light: &ReferenceLight, p: Vec3) {
+    /// documentation); the same cone and falloff as local_light.glsl. Whether it cast a ray.
+    fn add_light(&self, sh: &mut ShRgb9, light: &ReferenceLight, p: Vec3) -> bool {
         let to_light = Vec3::from_slice(&light.position[..3]) - p;
         let d = to_light.length();
         if d <= 0.0 {
-            return;
+            return false;
         }
         let l = to_light / d;
         let spot = light.position[3] > 0.5;
         if spot && (-l).dot(Vec3::from_slice(&light.direction[..3])) < light.direction[3] {
-            return;
+            return false;
         }
         if self.statics.occluded(p, l, d) {
-            return;
+            return true;
         }
         let mut y = [0.0; 9];
         eval_basis(3, l, &mut y);
@@ -396,6 +487,7 @@ impl ProbeCapture {
                 *v += intensity / (d * d) * y;
             }
         }
+        true
     }
 }
 
@@ -412,19 +504,21 @@ pub(super) fn static_scene(scene: &Scene) -> Scene {
     statics
 }
 
-/// The radiance vertex buffers of [`ProbeCapture::radiance`] for the static scene `statics`:
-/// zero with [`CapturedLight::Sky`].
+/// The radiance vertex buffers of [`ProbeCapture::radiance`] for the static scene `statics`
+/// (zero with [`CapturedLight::Sky`]), with the rays and seconds computing it took (its
+/// radiance moved into the buffers).
 fn static_radiance(
     ctx: &Arc<Context>,
     statics: &Scene,
     settings: CaptureSettings,
-) -> Result<Vec<Vec<Option<Buffer>>>> {
-    let radiance = match settings.light {
-        CapturedLight::Sky => None,
+) -> Result<(Vec<Vec<Option<Buffer>>>, SurfaceRadiance)> {
+    let mut computed = match settings.light {
+        CapturedLight::Sky => SurfaceRadiance::default(),
         CapturedLight::SkyAndWalls => {
             surface_radiance(ctx, statics, settings.bounces, settings.samples, RADIANCE_SEED)?
         }
     };
+    let radiance = computed.radiance.take();
     let mut next = 0;
     let mut buffers = Vec::new();
     for group in &statics.groups {
@@ -443,5 +537,5 @@ fn static_radiance(
         }
         buffers.push(meshes);
     }
-    Ok(buffers)
+    Ok((buffers, computed))
 }

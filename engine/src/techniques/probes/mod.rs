@@ -48,7 +48,7 @@ mod trilinear;
 mod visibility;
 
 pub use capture::{
-    CaptureSettings, CapturedLight, InvalidProbe, ProbeCapture, BACK_FACE_RAYS, CUBE_SIZES,
+    CaptureCost, CaptureSettings, CapturedLight, InvalidProbe, ProbeCapture, BACK_FACE_RAYS, CUBE_SIZES,
     DEFAULT_CUBE_SIZE, DEFAULT_SAMPLES, MAX_BACK_FACES, RADIANCE_SEED,
 };
 pub use dering::Dering;

@@ -1,7 +1,7 @@
 //! A captured probe set (Morishige 2014, steps 1–5): where the probes are, their
 //! tetrahedralization, each probe's SH, and the SH interpolated at any point with the
 //! tetrahedral weights.
-use super::capture::{CaptureSettings, InvalidProbe, ProbeCapture};
+use super::capture::{CaptureCost, CaptureSettings, InvalidProbe, ProbeCapture};
 use super::fit::fit;
 use super::reduce::{blend, reduce};
 use super::relocate::relocate;
@@ -304,6 +304,8 @@ pub struct ProbeSet {
     /// What hides probes from a lookup point ([`ProbeVisibility::Rays`]); `None`: every probe
     /// of the cell weighs.
     pub visibility: Option<Visibility>,
+    /// What [`ProbeSet::capture`] took; `None` for a set made from SH given.
+    pub capture_cost: Option<CaptureCost>,
 }
 
 /// (probe, weight) pairs: a grid cell's eight, or a tetrahedron's four and four of weight 0.
@@ -380,6 +382,7 @@ impl ProbeSet {
         let mut set = set.seeing(occluders);
         set.candidates = candidates;
         set.invalid = invalid;
+        set.capture_cost = Some(capture.cost());
         progress(candidates + 1, candidates + 1);
         Ok(set)
     }
@@ -394,6 +397,7 @@ impl ProbeSet {
             candidates,
             invalid: Vec::new(),
             visibility: None,
+            capture_cost: None,
         })
     }
 

@@ -185,6 +185,7 @@ impl Technique for ProbeTechnique {
     fn stats(&self) -> TechniqueStats {
         TechniqueStats {
             probes: Some(self.set.counts()),
+            probe_capture: self.set.capture_cost,
             probe_lookups: Some(self.lookups),
             ..Default::default()
         }
