@@ -11,9 +11,11 @@
 #include "sampling.glsl"
 
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 0) uniform sampler2D env;
-// The sampling distribution's CDFs as texel buffers of four floats a texel: llvmpipe gathers a
-// texel fetch where it reads a storage buffer lane by lane, and a sample's binary searches read
-// them a few hundred times (vendor-notes.md). The marginal: height + 1 entries, P(row < j).
+// The sampling distribution's CDFs as texel buffers of four words a texel: llvmpipe gathers a
+// texel fetch where it reads a storage buffer lane by lane (vendor-notes.md). Each holds the
+// CDF entries' bits, up to a whole texel, then their guide (EnvDistribution::marginal_words):
+// per run of n + 1 entries, for each of n equal cells of u, a word with the range of indices
+// where the search for u can end. The marginal: height + 1 entries, P(row < j).
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 1) uniform usamplerBuffer env_marginal_texels;
 // The conditionals: height runs of width + 1 entries, P(column < i | row j).
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 2) uniform usamplerBuffer env_conditional_texels;
@@ -21,6 +23,13 @@ layout(set = 0, binding = KAGE_BVH_BINDINGS + 2) uniform usamplerBuffer env_cond
 float env_marginal(uint k) { return uintBitsToFloat(texelFetch(env_marginal_texels, int(k >> 2))[k & 3u]); }
 float env_conditional(uint k) {
     return uintBitsToFloat(texelFetch(env_conditional_texels, int(k >> 2))[k & 3u]);
+}
+
+// Where the search of cell `cell` starts and ends: the guide's word for it (after the texels of
+// `entries` CDF entries), start | end << 16.
+uvec2 env_guide(usamplerBuffer cdf, uint entries, uint cell) {
+    uint word = texelFetch(cdf, int((entries + 3u) / 4u + cell / 4u))[cell & 3u];
+    return uvec2(word & 0xffffu, word >> 16);
 }
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer Accum { ReferenceAccum accum[]; };
 
@@ -36,9 +45,13 @@ ivec2 env_texel_of(vec3 dir) {
     return min(ivec2(uv * vec2(size)), size - 1);
 }
 
-// First entry of the marginal's 0 .. n greater than u, minus one: never an empty interval.
+// First entry of the marginal's 0 .. n greater than u, minus one: never an empty interval. The
+// guide's range for u's cell holds that entry, so a search of it alone ends where a search of
+// all of them would.
 uint env_pick_row(float u, uint n) {
-    uint lo = 0u, hi = n + 1u;
+    uint cell = min(uint(u * float(n)), n - 1u);
+    uvec2 range = env_guide(env_marginal_texels, n + 1u, cell);
+    uint lo = range.x, hi = range.y;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
         if (env_marginal(mid) <= u) lo = mid + 1u; else hi = mid;
@@ -46,10 +59,12 @@ uint env_pick_row(float u, uint n) {
     return clamp(lo, 1u, n) - 1u;
 }
 
-// The same over the run of row j in env_conditional.
-uint env_pick_column(float u, uint j, uint n) {
+// The same over the run of row j of `rows` in env_conditional.
+uint env_pick_column(float u, uint j, uint n, uint rows) {
     uint base = j * (n + 1u);
-    uint lo = 0u, hi = n + 1u;
+    uint cell = j * n + min(uint(u * float(n)), n - 1u);
+    uvec2 range = env_guide(env_conditional_texels, rows * (n + 1u), cell);
+    uint lo = range.x, hi = range.y;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
         if (env_conditional(base + mid) <= u) lo = mid + 1u; else hi = mid;
@@ -69,7 +84,7 @@ void env_sample(vec2 u, float total, out vec3 dir, out vec3 radiance, out float 
     uint w = uint(size.x), h = uint(size.y);
     uint j = env_pick_row(u.x, h);
     float v_in = env_within(u.x, env_marginal(j), env_marginal(j + 1u));
-    uint i = env_pick_column(u.y, j, w);
+    uint i = env_pick_column(u.y, j, w, h);
     uint base = j * (w + 1u);
     float u_in = env_within(u.y, env_conditional(base + i), env_conditional(base + i + 1u));
     float cos0 = cos(REFERENCE_PI * float(j) / float(h));

@@ -72,6 +72,20 @@ impl EnvDistribution {
         &self.marginal_cdf
     }
 
+    /// The marginal CDF as the GPU reads it (reference.glsl): its entries' bits, up to a
+    /// whole texel of four words, then its guide (per cell of u, the range where the search
+    /// for u ends).
+    pub fn marginal_words(&self) -> Vec<u32> {
+        gpu_words(&self.marginal_cdf, guide(&self.marginal_cdf))
+    }
+
+    /// The conditional CDFs as the GPU reads them: all their entries' bits, up to a whole
+    /// texel, then each row's guide in row order.
+    pub fn conditional_words(&self) -> Vec<u32> {
+        let runs = self.conditional_cdf.chunks_exact(self.width as usize + 1);
+        gpu_words(&self.conditional_cdf, runs.flat_map(guide).collect())
+    }
+
     pub fn conditional_cdf(&self) -> &[f32] {
         &self.conditional_cdf
     }
@@ -139,6 +153,35 @@ fn cdf(weights: impl Iterator<Item = f64>, n: usize) -> Vec<f32> {
     cdf
 }
 
+/// How far beyond its cell of u a [`guide`] entry looks: far more than the f32 rounding of
+/// u · n on the GPU moves u (2^-24 of it), far less than a cell of a 16k-wide map.
+const GUIDE_MARGIN: f64 = 1e-6;
+
+/// Where the search for the first entry of `cdf` (n + 1 entries) greater than u can end, for u
+/// in each of n equal cells of [0, 1), cell g = ⌊u n⌋: a word per cell, the first entry greater
+/// than the cell's least u | the first greater than its greatest << 16 (each widened by
+/// [`GUIDE_MARGIN`]; a map is at most 16,384 texels wide, `EnvMap::check_size`, so an index
+/// fits 16 bits). The answer is monotone in u, so it lies between them, and a search of that
+/// range alone ends where the whole one does: the same samples in a read or two, where a
+/// binary search of a 1k-wide row takes ten.
+fn guide(cdf: &[f32]) -> Vec<u32> {
+    let n = cdf.len() - 1;
+    let first_above = |u: f64| cdf.partition_point(|&c| f64::from(c) <= u).min(n) as u32;
+    let cell = |g: usize| g as f64 / n as f64;
+    (0..n)
+        .map(|g| first_above(cell(g) - GUIDE_MARGIN) | first_above(cell(g + 1) + GUIDE_MARGIN) << 16)
+        .collect()
+}
+
+/// A CDF's bits up to a whole texel of four words, then its guide, up to a whole texel.
+fn gpu_words(cdf: &[f32], guide: Vec<u32>) -> Vec<u32> {
+    let mut words: Vec<u32> = cdf.iter().map(|c| c.to_bits()).collect();
+    words.resize(words.len().div_ceil(4) * 4, 0);
+    words.extend(guide);
+    words.resize(words.len().div_ceil(4) * 4, 0);
+    words
+}
+
 /// The interval k with cdf[k] <= u < cdf[k + 1] (never an empty one), and where u lies in it.
 fn pick(cdf: &[f32], u: f32) -> (usize, f32) {
     let n = cdf.len() - 1;
@@ -180,6 +223,55 @@ mod tests {
             z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
             z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
             ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// reference.glsl's search through the guide, on the words the GPU reads (`entries` CDF
+    /// entries, runs of n + 1), in run `run`: the cell of u as f32 arithmetic gives it, then a
+    /// binary search between the cell's two indices.
+    fn guided_pick(words: &[u32], entries: usize, run: usize, n: usize, u: f32) -> usize {
+        let g = ((u * n as f32) as usize).min(n - 1);
+        let range = words[entries.div_ceil(4) * 4 + run * n + g] as usize;
+        let (mut lo, mut hi) = (range & 0xffff, range >> 16);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if f32::from_bits(words[run * (n + 1) + mid]) <= u {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        lo.clamp(1, n) - 1
+    }
+
+    #[test]
+    fn the_guided_search_picks_what_the_whole_search_picks() {
+        let dist = EnvDistribution::new(&uneven_map());
+        let (w, h) = (dist.width as usize, dist.height as usize);
+        let (marginal, conditional) = (dist.marginal_words(), dist.conditional_words());
+        let mut next = uniforms(11);
+        // Random u, the cells' edges and their neighbours in f32, the largest u below 1.
+        let mut us: Vec<f32> = (0..20_000).map(|_| next()).collect();
+        for n in [w, h] {
+            for g in 0..=n {
+                let edge = g as f32 / n as f32;
+                us.extend(
+                    [edge.next_down(), edge, edge.next_up()].into_iter().filter(|u| (0.0..1.0).contains(u)),
+                );
+            }
+        }
+        us.push(1.0f32.next_down());
+        for &u in &us {
+            assert_eq!(
+                guided_pick(&marginal, h + 1, 0, h, u),
+                pick(dist.marginal_cdf(), u).0,
+                "row at u = {u}"
+            );
+            for j in [0, 3, 7, 12, 15] {
+                let row = &dist.conditional_cdf()[j * (w + 1)..(j + 1) * (w + 1)];
+                let column = guided_pick(&conditional, h * (w + 1), j, w, u);
+                assert_eq!(column, pick(row, u).0, "row {j}, u = {u}");
+            }
         }
     }
 

@@ -16,7 +16,7 @@ use std::sync::Arc;
 pub struct ReferenceLighting {
     bvh: GpuBvh,
     env: GpuEnvironment,
-    /// The environment's sampling CDFs (reference.glsl), four floats a texel.
+    /// The environment's sampling CDFs and their guides (reference.glsl), four words a texel.
     marginal: TexelBuffer,
     conditional: TexelBuffer,
     /// Σ luminance × solid angle of the map; 0 turns environment sampling off (black map).
@@ -36,10 +36,8 @@ impl ReferenceLighting {
         let bvh = GpuBvh::new(ctx, &scene_bvh)?;
         let distribution = EnvDistribution::new(&scene.environment);
         let storage = BufferUsage::STORAGE;
-        let upload = |name: &str, values: &[f32]| {
-            let mut bytes: Vec<u8> = values.iter().flat_map(|v| v.to_ne_bytes()).collect();
-            // Whole texels: the shader never reads the padding.
-            bytes.resize(bytes.len().div_ceil(16).max(1) * 16, 0);
+        let upload = |name: &str, words: Vec<u32>| {
+            let bytes: Vec<u8> = words.iter().flat_map(|v| v.to_ne_bytes()).collect();
             TexelBuffer::with_data(ctx, name, &bytes)
         };
         let mut lights: Vec<ReferenceLight> = scene.lights.iter().map(reference_light).collect();
@@ -49,8 +47,8 @@ impl ReferenceLighting {
         Ok(ReferenceLighting {
             bvh,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
-            marginal: upload("env_marginal_cdf", distribution.marginal_cdf())?,
-            conditional: upload("env_conditional_cdf", distribution.conditional_cdf())?,
+            marginal: upload("env_marginal_cdf", distribution.marginal_words())?,
+            conditional: upload("env_conditional_cdf", distribution.conditional_words())?,
             env_total: distribution.total(),
             lights: Buffer::with_data(ctx, "reference_lights", storage, bytes_of_slice(&lights))?,
             light_count: scene.lights.len() as u32,
