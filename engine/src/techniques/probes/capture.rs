@@ -204,11 +204,6 @@ impl CaptureCost {
         per_second(self.radiance_rays, self.radiance_traversal_seconds()) * 1e-6
     }
 
-    /// Millions of the CPU's rays per second.
-    pub fn cpu_mrays_per_second(&self) -> f64 {
-        per_second(self.cpu_rays, self.cpu_seconds) * 1e-6
-    }
-
     /// Millions of cube-map texels drawn and projected per second.
     pub fn cube_mtexels_per_second(&self) -> f64 {
         per_second(self.cube_texels * u64::from(self.cubes), self.cube_seconds) * 1e-6
