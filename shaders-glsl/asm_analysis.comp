@@ -152,9 +152,9 @@ void main() {
     if (!edge) return;
     uint record = atomicAdd(requests[0], 1u);
     if (record >= push.size.w) return;
-    uint word = 1u + push.size.z + 4u * record;
-    requests[word] = floatBitsToUint(m.x);
-    requests[word + 1u] = floatBitsToUint(m.y);
-    requests[word + 2u] = at.node;
-    requests[word + 3u] = uint(missing);
+    uint word = 1u + push.size.z + KAGE_ASM_EDGE_WORDS * record;
+    const float cells = float(1u << KAGE_ASM_EDGE_CELL_BITS);
+    uvec2 cell = uvec2(clamp(asm_texel_coords(page.tile, m.xy) * (cells / float(KAGE_ASM_TILE_TEXELS)), 0.0, cells - 1.0));
+    requests[word] = at.node | uint(missing) << 24;
+    requests[word + 1u] = cell.x | cell.y << 16;
 }

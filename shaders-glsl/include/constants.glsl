@@ -114,15 +114,21 @@
 // pixels wrong instead of 90 at the asm overview, at 4 and 16 MiB the same (the pages run out
 // first), and the same errors over the 256² walkthrough.
 #define KAGE_ASM_EXTRA_LEVELS 5
-// The page table's directory: one entry per tile of this level (256² entries, 256 KiB) naming
-// the finest resident tile at or above it, where the lookup's descent starts. The descent is a
-// chain of dependent reads, one per level, that a CPU rasterizer pays per fragment in full (it
-// was half of the lighting pass on lavapipe); below this level views rarely refine.
-#define KAGE_ASM_DIRECTORY_LEVEL 8
+// The page table's directory: one entry per tile of this level (64² entries, 16 KiB of the
+// budget) naming the finest resident tile at or above it, where the lookup's descent starts.
+// The descent is a chain of dependent reads, two levels each, that a CPU rasterizer pays per
+// fragment in full. Level 8 (256 KiB) took 60 pages (20 tiles) at 4 MiB for no time the
+// lighting pass showed once the descent went two levels a read (BENCHMARKS.md, "At 512²").
+#define KAGE_ASM_DIRECTORY_LEVEL 6
 // Levels below a pixel's finest resident tile the ASM analysis asks for at once (the tiles of
 // its chain, each at most this many levels under the tile): a camera arriving at a new view
 // refines that many levels in one frame instead of one.
 #define KAGE_ASM_CHAIN_LEVELS 4
+// Words of an edge record of the ASM analysis (AsmAnalysisPush): the node | missing levels << 24,
+// and where in that node's tile the pixel lies, KAGE_ASM_EDGE_CELL_BITS an axis (the host needs
+// its cell at most KAGE_ASM_CHAIN_LEVELS levels down). Half the light uv as two floats took.
+#define KAGE_ASM_EDGE_WORDS 2
+#define KAGE_ASM_EDGE_CELL_BITS 16
 // Workgroup of the ASM refinement analysis: 8x8 eye pixels.
 #define KAGE_ASM_ANALYSIS_GROUP 8
 

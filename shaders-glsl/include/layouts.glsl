@@ -304,9 +304,10 @@ struct AsmTilePush {
 
 // Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer is uint
 // words: `[0]` the number of edge records written; `[1, 1 + size.z)` a used flag per page table
-// node (a pixel's lookup ended there); then up to size.w edge records of 4 words, one per eye
-// pixel on a shadow edge short of resolution: its light uv (2 floats), the node of the finest
-// resident tile holding it, and the levels finer than that tile it needs (at least 1).
+// node (a pixel's lookup ended there); then up to size.w edge records of KAGE_ASM_EDGE_WORDS
+// words, one per eye pixel on a shadow edge short of resolution: the node of the finest resident
+// tile holding it | the levels finer than that tile it needs (at least 1) << 24, then its place
+// in that tile, x | y << 16, in units of 2^-KAGE_ASM_EDGE_CELL_BITS of the tile's side.
 struct AsmAnalysisPush {
     uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: most edge records
     uvec4 phase; // x: the pixel of each 2x2 block analysed this frame (x + 2y), y, z, w: unused

@@ -7,13 +7,11 @@ use super::page_table::PageTable;
 use super::pages::scratch_bytes;
 use super::pool::TILE_PAGES;
 use crate::error::{Error, Result};
-use crate::layouts::constants::MAX_LOCAL_LIGHTS;
+use crate::layouts::constants::{self, MAX_LOCAL_LIGHTS};
 use crate::layouts::ShadowLight;
 
-/// Bytes per record of the analysis's `requests` buffer (a u32).
+/// Bytes per word of the analysis's `requests` buffer (a u32).
 const WORD: u64 = 4;
-/// Words per edge record of the analysis: light uv (2), node, missing levels.
-const EDGE_WORDS: u64 = 4;
 
 /// The bytes of each part of the technique's memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -93,7 +91,7 @@ pub fn nodes(pages: u32) -> u32 {
 
 /// The analysis's `requests` buffer: a counter, a flag per node, then `edges` edge records.
 pub fn requests_bytes(nodes: u32, edges: u32) -> u64 {
-    WORD * (1 + u64::from(nodes) + EDGE_WORDS * u64::from(edges))
+    WORD * (1 + u64::from(nodes) + u64::from(constants::ASM_EDGE_WORDS) * u64::from(edges))
 }
 
 /// The lighting's use marks: one frame number per node.

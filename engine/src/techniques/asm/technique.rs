@@ -503,6 +503,11 @@ impl Asm {
     /// levels (at most `ASM_CHAIN_LEVELS`), each counting the pixel and the levels it still
     /// lacks at that tile's parent.
     fn read_requests(&mut self) -> Result<Vec<Request>> {
+        // A record's cells are 16 bits an axis (x | y << 16), fine enough for every level of a chain.
+        const _: () = assert!(
+            constants::ASM_EDGE_CELL_BITS == 16
+                && constants::ASM_CHAIN_LEVELS <= constants::ASM_EDGE_CELL_BITS
+        );
         let last = (self.frame - 1) as u32;
         for (key, mark) in self.lit_keys.iter().zip(read_words(&self.used)?) {
             if mark == last {
@@ -518,20 +523,11 @@ impl Asm {
         }
         let count = words[0].min(self.edge_capacity) as usize;
         let mut asked: HashMap<TileKey, (u32, u32)> = HashMap::new();
-        for edge in words[1 + nodes..].chunks_exact(4).take(count) {
-            let uv = [f32::from_bits(edge[0]), f32::from_bits(edge[1])];
-            let (key, missing) = (self.table_keys[edge[2] as usize], edge[3]);
+        for edge in words[1 + nodes..].chunks_exact(constants::ASM_EDGE_WORDS as usize).take(count) {
+            let (key, missing) = (self.table_keys[(edge[0] & 0xff_ffff) as usize], edge[0] >> 24);
+            let within = [edge[1] & 0xffff, edge[1] >> 16];
             for depth in 1..=missing.min(constants::ASM_CHAIN_LEVELS) {
-                let level = key.level + depth;
-                if level > constants::ASM_MAX_LEVEL {
-                    break;
-                }
-                // The descendant of `key` at `level` holding uv, as the analysis placed it.
-                let n = 1u32 << level;
-                let cell = |c: f32, at: u32| {
-                    ((c * n as f32) as u32).min(n - 1).clamp(at << depth, ((at + 1) << depth) - 1)
-                };
-                let tile = TileKey { level, x: cell(uv[0], key.x), y: cell(uv[1], key.y) };
+                let Some(tile) = key.descendant(within, depth) else { break };
                 let slot = asked.entry(tile).or_default();
                 slot.0 += 1;
                 slot.1 += missing - depth + 1;

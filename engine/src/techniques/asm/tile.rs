@@ -1,7 +1,7 @@
 //! Tiles of the quadtree over the light's view, addressed by level and position. The view is
 //! the unit square of the light map's uv (u right, v down, as the shadow maps' texel rows); the
 //! root (level 0) covers all of it, and tile (L, x, y) covers [x, x + 1) × [y, y + 1) / 2^L.
-use crate::layouts::constants::ASM_MAX_LEVEL;
+use crate::layouts::constants::{ASM_EDGE_CELL_BITS, ASM_MAX_LEVEL};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct TileKey {
@@ -45,6 +45,19 @@ impl TileKey {
         (2 * (self.y & 1) + (self.x & 1)) as usize
     }
 
+    /// The descendant `depth` levels down (1 ..= [`ASM_EDGE_CELL_BITS`]) holding the point at
+    /// `cell` within this tile, in units of 2^-ASM_EDGE_CELL_BITS of its side (as the
+    /// analysis's edge records give it); `None` below the deepest level.
+    pub fn descendant(self, cell: [u32; 2], depth: u32) -> Option<TileKey> {
+        let level = self.level + depth;
+        let down = |at: u32, c: u32| at << depth | c >> (ASM_EDGE_CELL_BITS - depth);
+        (level <= ASM_MAX_LEVEL).then(|| TileKey {
+            level,
+            x: down(self.x, cell[0]),
+            y: down(self.y, cell[1]),
+        })
+    }
+
     /// Whether `self` is `other` or one of its ancestors.
     pub fn covers(self, other: TileKey) -> bool {
         other.level >= self.level
@@ -75,5 +88,24 @@ mod tests {
         assert_eq!(TileKey::containing([1.0, 0.5], 1), None);
         assert_eq!(TileKey::containing([f32::NAN, 0.5], 1), None);
         assert_eq!(TileKey::containing([0.5, 0.5], ASM_MAX_LEVEL + 1), None);
+    }
+
+    #[test]
+    fn an_edge_records_cell_names_the_descendants_its_point_lies_in() {
+        let cells = (1u32 << ASM_EDGE_CELL_BITS) as f64;
+        for (i, level) in (0..=12).enumerate() {
+            // Points spread over the view, none on a tile border of the levels below.
+            let uv = [(0.137 + 0.071 * i as f64) % 1.0, (0.911 - 0.053 * i as f64) % 1.0];
+            let key = TileKey::containing(uv.map(|c| c as f32), level).unwrap();
+            let n = (1u64 << level) as f64;
+            let cell =
+                [uv[0] * n - f64::from(key.x), uv[1] * n - f64::from(key.y)].map(|c| (c * cells) as u32);
+            for depth in 1..=4 {
+                let expected = TileKey::containing(uv.map(|c| c as f32), level + depth);
+                assert_eq!(key.descendant(cell, depth), expected, "uv {uv:?}, level {level} + {depth}");
+            }
+        }
+        let deepest = TileKey::containing([0.5, 0.5], ASM_MAX_LEVEL).unwrap();
+        assert_eq!(deepest.descendant([0, 0], 1), None);
     }
 }
