@@ -77,24 +77,26 @@ float env_within(float u, float c0, float c1) {
 }
 
 // A direction drawn in proportion to luminance x solid angle: texel by the CDFs, then uniform in
-// solid angle inside it, so the pdf is luminance / total everywhere in the texel.
-// Needs total > 0.
-void env_sample(vec2 u, float total, out vec3 dir, out vec3 radiance, out float pdf) {
+// solid angle inside it, so the pdf is luminance / total everywhere in the texel. Returns the
+// texel, or (-1, -1) where an interval of the CDFs it lies in is empty (a direction of no
+// density, which only u past the last entry reaches). Needs a map of positive total.
+ivec2 env_sample(vec2 u, out vec3 dir) {
     ivec2 size = textureSize(env, 0);
     uint w = uint(size.x), h = uint(size.y);
     uint j = env_pick_row(u.x, h);
-    float v_in = env_within(u.x, env_marginal(j), env_marginal(j + 1u));
+    float row0 = env_marginal(j), row1 = env_marginal(j + 1u);
     uint i = env_pick_column(u.y, j, w, h);
     uint base = j * (w + 1u);
-    float u_in = env_within(u.y, env_conditional(base + i), env_conditional(base + i + 1u));
+    float column0 = env_conditional(base + i), column1 = env_conditional(base + i + 1u);
+    float v_in = env_within(u.x, row0, row1);
+    float u_in = env_within(u.y, column0, column1);
     float cos0 = cos(REFERENCE_PI * float(j) / float(h));
     float cos1 = cos(REFERENCE_PI * float(j + 1u) / float(h));
     float cos_theta = mix(cos0, cos1, v_in);
     float sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
     float phi = 2.0 * REFERENCE_PI * (float(i) + u_in) / float(w);
     dir = vec3(sin_theta * sin(phi), cos_theta, -sin_theta * cos(phi));
-    radiance = texelFetch(env, ivec2(i, j), 0).rgb;
-    pdf = luminance(radiance) / total;
+    return row1 > row0 && column1 > column0 ? ivec2(i, j) : ivec2(-1);
 }
 
 // Candidates of the environment strategy's resampling (see env_irradiance_sample).
@@ -119,21 +121,23 @@ vec3 env_irradiance_sample(vec3 p, vec3 n, vec3 ng, float total, inout Rng rng) 
     vec3 origin = offset_ray_origin(p, ng);
     vec3 sum = vec3(0.0);
     if (total > 0.0) {
-        vec3 kept_dir = vec3(0.0), kept_radiance = vec3(0.0);
-        float kept_pdf = 0.0, weights = 0.0;
+        vec3 kept_dir = vec3(0.0);
+        ivec2 kept_texel = ivec2(0);
+        float weights = 0.0;
+        // The candidates' weights need their directions only: the kept one's texel is read once.
         for (uint k = 0u; k < REFERENCE_CANDIDATES; ++k) {
-            vec3 dir, radiance;
-            float pdf;
-            env_sample(vec2(rng_next(rng), rng_next(rng)), total, dir, radiance, pdf);
-            float w = pdf > 0.0 && dot(ng, dir) > 0.0 ? max(dot(n, dir), 0.0) : 0.0;
+            vec3 dir;
+            ivec2 texel = env_sample(vec2(rng_next(rng), rng_next(rng)), dir);
+            float w = texel.x >= 0 && dot(ng, dir) > 0.0 ? max(dot(n, dir), 0.0) : 0.0;
             weights += w;
             if (w > 0.0 && rng_next(rng) * weights < w) {
                 kept_dir = dir;
-                kept_radiance = radiance;
-                kept_pdf = pdf;
+                kept_texel = texel;
             }
         }
-        if (weights > 0.0 && !bvh_occluded(origin, kept_dir, REFERENCE_FAR)) {
+        vec3 kept_radiance = texelFetch(env, kept_texel, 0).rgb;
+        float kept_pdf = luminance(kept_radiance) / total;
+        if (weights > 0.0 && kept_pdf > 0.0 && !bvh_occluded(origin, kept_dir, REFERENCE_FAR)) {
             float cos_n = dot(n, kept_dir);
             sum += power_heuristic(kept_pdf, cos_n / REFERENCE_PI) * kept_radiance
                 * (weights / float(REFERENCE_CANDIDATES) / kept_pdf);
