@@ -20,17 +20,8 @@ layout(set = 0, binding = KAGE_BVH_BINDINGS + 1) uniform usamplerBuffer env_marg
 // The conditionals: height runs of width + 1 entries, P(column < i | row j).
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 2) uniform usamplerBuffer env_conditional_texels;
 
-float env_marginal(uint k) { return uintBitsToFloat(texelFetch(env_marginal_texels, int(k >> 2))[k & 3u]); }
-float env_conditional(uint k) {
-    return uintBitsToFloat(texelFetch(env_conditional_texels, int(k >> 2))[k & 3u]);
-}
-
-// Where the search of cell `cell` starts and ends: the guide's word for it (after the texels of
-// `entries` CDF entries), start | end << 16.
-uvec2 env_guide(usamplerBuffer cdf, uint entries, uint cell) {
-    uint word = texelFetch(cdf, int((entries + 3u) / 4u + cell / 4u))[cell & 3u];
-    return uvec2(word & 0xffffu, word >> 16);
-}
+// Entry k of a CDF texel buffer.
+float env_cdf(usamplerBuffer cdf, uint k) { return uintBitsToFloat(texelFetch(cdf, int(k >> 2))[k & 3u]); }
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer Accum { ReferenceAccum accum[]; };
 
 const float REFERENCE_PI = 3.14159265358979323846;
@@ -45,29 +36,18 @@ ivec2 env_texel_of(vec3 dir) {
     return min(ivec2(uv * vec2(size)), size - 1);
 }
 
-// First entry of the marginal's 0 .. n greater than u, minus one: never an empty interval. The
-// guide's range for u's cell holds that entry, so a search of it alone ends where a search of
-// all of them would.
-uint env_pick_row(float u, uint n) {
-    uint cell = min(uint(u * float(n)), n - 1u);
-    uvec2 range = env_guide(env_marginal_texels, n + 1u, cell);
-    uint lo = range.x, hi = range.y;
+// In run `run` of n + 1 entries of `cdf` (`runs` of them), the first entry greater than u,
+// minus one: never an empty interval. The guide's word for u's cell (after the texels of all
+// the runs' entries, start | end << 16) bounds where that entry lies, so a search of its range
+// alone ends where a search of the whole run would.
+uint env_pick(usamplerBuffer cdf, uint run, uint runs, uint n, float u) {
+    uint base = run * (n + 1u);
+    uint cell = run * n + min(uint(u * float(n)), n - 1u);
+    uint guide = texelFetch(cdf, int((runs * (n + 1u) + 3u) / 4u + cell / 4u))[cell & 3u];
+    uint lo = guide & 0xffffu, hi = guide >> 16;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (env_marginal(mid) <= u) lo = mid + 1u; else hi = mid;
-    }
-    return clamp(lo, 1u, n) - 1u;
-}
-
-// The same over the run of row j of `rows` in env_conditional.
-uint env_pick_column(float u, uint j, uint n, uint rows) {
-    uint base = j * (n + 1u);
-    uint cell = j * n + min(uint(u * float(n)), n - 1u);
-    uvec2 range = env_guide(env_conditional_texels, rows * (n + 1u), cell);
-    uint lo = range.x, hi = range.y;
-    while (lo < hi) {
-        uint mid = (lo + hi) / 2u;
-        if (env_conditional(base + mid) <= u) lo = mid + 1u; else hi = mid;
+        if (env_cdf(cdf, base + mid) <= u) lo = mid + 1u; else hi = mid;
     }
     return clamp(lo, 1u, n) - 1u;
 }
@@ -83,11 +63,12 @@ float env_within(float u, float c0, float c1) {
 ivec2 env_sample(vec2 u, out vec3 dir) {
     ivec2 size = textureSize(env, 0);
     uint w = uint(size.x), h = uint(size.y);
-    uint j = env_pick_row(u.x, h);
-    float row0 = env_marginal(j), row1 = env_marginal(j + 1u);
-    uint i = env_pick_column(u.y, j, w, h);
+    uint j = env_pick(env_marginal_texels, 0u, 1u, h, u.x);
+    float row0 = env_cdf(env_marginal_texels, j), row1 = env_cdf(env_marginal_texels, j + 1u);
+    uint i = env_pick(env_conditional_texels, j, h, w, u.y);
     uint base = j * (w + 1u);
-    float column0 = env_conditional(base + i), column1 = env_conditional(base + i + 1u);
+    float column0 = env_cdf(env_conditional_texels, base + i);
+    float column1 = env_cdf(env_conditional_texels, base + i + 1u);
     float v_in = env_within(u.x, row0, row1);
     float u_in = env_within(u.y, column0, column1);
     float cos0 = cos(REFERENCE_PI * float(j) / float(h));
