@@ -32,7 +32,10 @@
 //! box (min = +inf, max = -inf) that every ray misses, so no shader needs a special case.
 //!
 //! Intersection is the watertight test of Woop, Benthin and Wald (2013) on both sides
-//! ([`WatertightRay`]), and [`offset_ray_origin`] follows Wächter and Binder (2019).
+//! ([`WatertightRay`]), except for packets of rays from one origin (the PRT's), which the GPU
+//! tests in the Plücker form that shares each triangle's edge planes through the origin among
+//! them (`bvh_fan` in bvh.glsl), watertight as well; [`offset_ray_origin`] follows Wächter and
+//! Binder (2019).
 mod aabb;
 mod brute_force;
 mod caster;
