@@ -8,7 +8,10 @@
 #
 # Benchmark only, not part of CI: needs `pip install embreex numpy`.
 # Run by hand: bash scripts/embree-compare.sh [SCENE]   (default: the full Stanford bunny)
-# Environment: KAGE_DEVICE (device name substring), KAGE (the kage binary; default: build it).
+# Environment: KAGE_DEVICE (device name substring), KAGE (the kage binary; default: build it),
+# ROUNDS (default 1): rounds of the precomputation, each followed at once by Embree's PRT rays,
+# whose ratios are printed with their median: a machine whose speed drifts from minute to
+# minute moves both sides of a round alike.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -23,25 +26,36 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 "$KAGE" bench rays --scene "$scene" --export "$work" "${device[@]}" | tee "$work/kage.txt"
-"$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" | tee "$work/precompute.txt"
-python3 scripts/embree-rays.py "$work" | tee "$work/embree.txt"
+"$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" | tee "$work/precompute-1.txt"
+python3 scripts/embree-rays.py "$work" | tee "$work/embree-1.txt"
+for round in $(seq 2 "${ROUNDS:-1}"); do
+  "$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" > "$work/precompute-$round.txt"
+  python3 scripts/embree-rays.py "$work" 5 --prt-only > "$work/embree-$round.txt"
+done
 
-python3 - "$work" <<'PY'
+python3 - "$work" "${ROUNDS:-1}" <<'PY'
 import re, sys
-folder = sys.argv[1]
+folder, rounds = sys.argv[1], int(sys.argv[2])
 kage = open(f"{folder}/kage.txt").read()
-embree = open(f"{folder}/embree.txt").read()
-precompute = open(f"{folder}/precompute.txt").read()
+embree = open(f"{folder}/embree-1.txt").read()
 print("\nKage over Embree (one thread), Mrays/s:")
 for query in ["closest hit", "any hit"]:
     k = re.search(rf"^{query}\s+\S+\s+(\S+)\s+\S+\s+(\S+)", kage, re.M)
     for ray_set, value in [("coherent", float(k.group(1))), ("incoherent", float(k.group(2)))]:
         e = float(re.search(rf"^{query}\s+{ray_set}\s+\S+\s+(\S+)", embree, re.M).group(1))
         print(f"  {query:<12} {ray_set:<11} {value:8.3f} / {e:8.3f} = {value / e:.2f}x")
-seconds = float(re.search(r"^time: (\S+) s", precompute, re.M).group(1))
-vertices, per_vertex = re.search(r"(\d+) vertices; .* (\d+) rays per vertex", precompute).groups()
-rays = float(vertices) * float(per_vertex)
-e = float(re.search(r"^closest hit\s+prt\s+\S+\s+(\S+)", embree, re.M).group(1)) * 1e6
-print(f"  precompute: Kage {seconds:.2f} s for {rays / 1e6:.1f} M rays; Embree at its PRT-ray rate "
-      f"{e / 1e6:.2f} Mrays/s: {rays / e:.2f} s; Kage / Embree = {seconds / (rays / e):.2f}x")
+ratios = []
+for r in range(1, rounds + 1):
+    precompute = open(f"{folder}/precompute-{r}.txt").read()
+    seconds = float(re.search(r"^time: (\S+) s", precompute, re.M).group(1))
+    vertices, per_vertex = re.search(r"(\d+) vertices; .* (\d+) rays per vertex", precompute).groups()
+    rays = float(vertices) * float(per_vertex)
+    prt = open(f"{folder}/embree-{r}.txt").read()
+    e = float(re.search(r"^closest hit\s+prt\s+\S+\s+(\S+)", prt, re.M).group(1)) * 1e6
+    ratios.append(seconds / (rays / e))
+    print(f"  precompute, round {r}: Kage {seconds:.2f} s for {rays / 1e6:.1f} M rays; Embree at its PRT-ray "
+          f"rate {e / 1e6:.2f} Mrays/s: {rays / e:.2f} s; Kage / Embree = {ratios[-1]:.2f}x")
+ratios.sort()
+print(f"  precompute, Kage / Embree over {rounds} round(s): median {ratios[len(ratios) // 2]:.2f}x, "
+      f"{ratios[0]:.2f}-{ratios[-1]:.2f}x")
 PY

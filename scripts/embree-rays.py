@@ -13,7 +13,8 @@ The last line casts the PRT precomputation's rays of every 16th vertex (`prt.f32
 hits against each ray's own group, as `kage precompute` casts them: its Mrays/s against the
 precomputation's.
 
-Usage: python3 scripts/embree-rays.py DIR [RUNS]
+Usage: python3 scripts/embree-rays.py DIR [RUNS] [--prt-only]
+(--prt-only: the last line alone, for the paired rounds of scripts/embree-compare.sh)
 """
 import os
 import sys
@@ -24,8 +25,10 @@ from embreex import mesh_construction, rtcore_scene
 
 
 def main():
-    folder = sys.argv[1]
-    runs = int(sys.argv[2]) if len(sys.argv) > 2 else 5
+    args = [a for a in sys.argv[1:] if a != "--prt-only"]
+    prt_only = len(args) < len(sys.argv) - 1
+    folder = args[0]
+    runs = int(args[1]) if len(args) > 1 else 5
     os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
     triangles = np.fromfile(os.path.join(folder, "triangles.f32"), dtype="<f4").reshape(-1, 3, 3)
     build = time.perf_counter()
@@ -45,7 +48,7 @@ def main():
                 times.append(time.perf_counter() - start)
         return sorted(times)[len(times) // 2], result
 
-    for query, name in [("INTERSECT", "closest hit"), ("OCCLUDED", "any hit")]:
+    for query, name in [] if prt_only else [("INTERSECT", "closest hit"), ("OCCLUDED", "any hit")]:
         for ray_set in ["coherent", "incoherent"]:
             rays = np.fromfile(os.path.join(folder, ray_set + ".f32"), dtype="<f4").reshape(-1, 7)
             origins = np.ascontiguousarray(rays[:, 0:3])
