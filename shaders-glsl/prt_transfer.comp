@@ -166,7 +166,7 @@ void main() {
             if (hit.instance != KAGE_NO_HIT) {
                 // The hit normal is taken to the space the ray was cast in (the scale is
                 // uniform, so the rotation part carries normals).
-                BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+                BvhTriangleAttributes a = bvh_attributes(hit.triangle);
                 vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
                 vec3 normal = w.x * a.n0.xyz + w.y * a.n1.xyz + w.z * a.n2.xyz;
                 vec3 ray_dir = dirs[r];

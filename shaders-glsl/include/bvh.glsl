@@ -11,17 +11,16 @@
 #include "constants.glsl"
 #include "layouts.glsl"
 
-// What the traversal reads (pairs, top-level nodes, instances, triangles) are texel buffers of
-// uvec4s, read through the accessors below: llvmpipe gathers a texel fetch over the SIMD lanes
-// without branching, where it reads a storage buffer one lane and word at a time
-// (vendor-notes.md). What only a hit reads stays in storage buffers.
+// What the traversal reads (pairs, top-level nodes, instances, triangles) and what every hit
+// reads (the triangles' attributes) are texel buffers of uvec4s, read through the accessors
+// below: llvmpipe gathers a texel fetch over the SIMD lanes without branching, where it reads
+// a storage buffer one lane and word at a time (vendor-notes.md). The albedo maps, which only
+// a textured hit reads, stay in storage buffers.
 layout(set = 0, binding = 0) uniform usamplerBuffer bvh_blas_pairs;
 layout(set = 0, binding = 1) uniform usamplerBuffer bvh_tlas_nodes;
 layout(set = 0, binding = 2) uniform usamplerBuffer bvh_instances;
 layout(set = 0, binding = 3) uniform usamplerBuffer bvh_triangles;
-layout(set = 0, binding = 4, std430) readonly buffer BvhAttributes {
-    BvhTriangleAttributes bvh_attributes[];
-};
+layout(set = 0, binding = 4) uniform usamplerBuffer bvh_attribute_texels;
 // The scene's albedo maps (entry 0 unused: a triangle without a map) and their texels, RGBA8
 // sRGB packed little-endian, row after row from the top.
 layout(set = 0, binding = 5, std430) readonly buffer BvhAlbedoMaps { BvhAlbedoMap bvh_albedo_maps[]; };
@@ -58,6 +57,15 @@ BvhTriangle bvh_triangle(uint index) {
     return BvhTriangle(uintBitsToFloat(texelFetch(bvh_triangles, texel)),
                        uintBitsToFloat(texelFetch(bvh_triangles, texel + 1)),
                        uintBitsToFloat(texelFetch(bvh_triangles, texel + 2)));
+}
+
+// The attributes of triangle `index` of the triangle buffer.
+BvhTriangleAttributes bvh_attributes(uint index) {
+    int texel = KAGE_BVH_ATTRIBUTE_TEXELS * int(index);
+    return BvhTriangleAttributes(
+        uintBitsToFloat(texelFetch(bvh_attribute_texels, texel)), uintBitsToFloat(texelFetch(bvh_attribute_texels, texel + 1)),
+        uintBitsToFloat(texelFetch(bvh_attribute_texels, texel + 2)), uintBitsToFloat(texelFetch(bvh_attribute_texels, texel + 3)),
+        uintBitsToFloat(texelFetch(bvh_attribute_texels, texel + 4)), uintBitsToFloat(texelFetch(bvh_attribute_texels, texel + 5)));
 }
 
 // instance == KAGE_NO_HIT on a miss; triangle indexes the BVH triangle buffer; barycentric holds
@@ -500,7 +508,7 @@ vec3 bvh_albedo_texel(uint index, vec2 uv) {
 
 // What the albedo map of the triangle hit multiplies its albedo by at the hit (1 without one).
 vec3 bvh_hit_texel(RayHit hit) {
-    BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+    BvhTriangleAttributes a = bvh_attributes(hit.triangle);
     vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
     vec2 uv = w.x * a.uv01.xy + w.y * a.uv01.zw + w.z * a.uv2.xy;
     return bvh_albedo_texel(floatBitsToUint(a.albedo.a), uv);
@@ -511,7 +519,7 @@ vec3 bvh_hit_texel(RayHit hit) {
 // mesh's times its albedo map's texel there.
 SurfacePoint bvh_surface(RayHit hit, vec3 ray_dir) {
     BvhTriangle v = bvh_triangle(hit.triangle);
-    BvhTriangleAttributes a = bvh_attributes[hit.triangle];
+    BvhTriangleAttributes a = bvh_attributes(hit.triangle);
     mat4 to_world = bvh_object_to_world(hit.instance);
     vec3 w = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
     vec3 p = w.x * v.v0.xyz + w.y * v.v1.xyz + w.z * v.v2.xyz;

@@ -39,11 +39,13 @@
 #define KAGE_BVH_PACKET 4
 // The uvec4 texels of one record in the BVH's texel buffers (bvh.glsl's accessors; sizes checked
 // against layouts.glsl's structs by engine/src/raycast/gpu.rs): a BvhPair, a BvhNode, a
-// BvhInstance (object to world at texel 0, world to object at 4, info at 8) and a BvhTriangle.
+// BvhInstance (object to world at texel 0, world to object at 4, info at 8), a BvhTriangle and
+// its BvhTriangleAttributes.
 #define KAGE_BVH_PAIR_TEXELS 3
 #define KAGE_BVH_NODE_TEXELS 2
 #define KAGE_BVH_INSTANCE_TEXELS 9
 #define KAGE_BVH_TRIANGLE_TEXELS 3
+#define KAGE_BVH_ATTRIBUTE_TEXELS 6
 // Traversal stack entries per BVH level; the CPU build keeps every tree shallower than this.
 #define KAGE_BVH_STACK 32
 // Invocations per workgroup of the ray casting test and benchmark shader.

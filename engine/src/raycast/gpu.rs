@@ -1,5 +1,6 @@
 //! The scene BVH in device-local buffers, bound as bvh.glsl declares them: what the traversal
-//! reads as texel buffers, what only a hit reads (attributes, albedo maps) as storage buffers.
+//! and every hit read (nodes, triangles, attributes) as texel buffers, the albedo maps, which
+//! only a textured hit reads, as storage buffers.
 use super::SceneBvh;
 use crate::backend::{Binding, BindingKind, Buffer, BufferUsage, Context, TexelBuffer};
 use crate::error::{Error, Result};
@@ -14,7 +15,7 @@ pub struct GpuBvh {
     tlas_nodes: TexelBuffer,
     instances: TexelBuffer,
     triangles: TexelBuffer,
-    attributes: Buffer,
+    attributes: TexelBuffer,
     albedo_maps: Buffer,
     albedo_texels: Buffer,
 }
@@ -26,7 +27,7 @@ impl GpuBvh {
         BindingKind::TexelBuffer,
         BindingKind::TexelBuffer,
         BindingKind::TexelBuffer,
-        BindingKind::StorageBuffer,
+        BindingKind::TexelBuffer,
         BindingKind::StorageBuffer,
         BindingKind::StorageBuffer,
     ];
@@ -37,7 +38,7 @@ impl GpuBvh {
             tlas_nodes: upload_texels(ctx, "bvh.tlas_nodes", &bvh.tlas_nodes)?,
             instances: upload_texels(ctx, "bvh.instances", &bvh.instances)?,
             triangles: upload_texels(ctx, "bvh.triangles", &bvh.triangles)?,
-            attributes: upload(ctx, "bvh.attributes", &bvh.attributes)?,
+            attributes: upload_texels(ctx, "bvh.attributes", &bvh.attributes)?,
             albedo_maps: upload(ctx, "bvh.albedo_maps", &bvh.albedo_maps)?,
             albedo_texels: upload(ctx, "bvh.albedo_texels", &bvh.albedo_texels)?,
         })
@@ -72,7 +73,7 @@ impl GpuBvh {
             Binding::Texel(&self.tlas_nodes),
             Binding::Texel(&self.instances),
             Binding::Texel(&self.triangles),
-            Binding::Storage(&self.attributes),
+            Binding::Texel(&self.attributes),
             Binding::Storage(&self.albedo_maps),
             Binding::Storage(&self.albedo_texels),
         ]
@@ -110,7 +111,7 @@ fn one_at_least<T: Pod + Default>(items: &[T]) -> std::borrow::Cow<'_, [T]> {
 
 #[cfg(test)]
 mod tests {
-    use crate::layouts::{constants, BvhInstance, BvhNode, BvhPair, BvhTriangle};
+    use crate::layouts::{constants, BvhInstance, BvhNode, BvhPair, BvhTriangle, BvhTriangleAttributes};
     use std::mem::{offset_of, size_of};
 
     /// bvh.glsl reads each record as this many 16-byte texels, the instance's fields at fixed
@@ -122,6 +123,7 @@ mod tests {
         assert_eq!(size_of::<BvhNode>(), constants::BVH_NODE_TEXELS as usize * TEXEL);
         assert_eq!(size_of::<BvhTriangle>(), constants::BVH_TRIANGLE_TEXELS as usize * TEXEL);
         assert_eq!(size_of::<BvhInstance>(), constants::BVH_INSTANCE_TEXELS as usize * TEXEL);
+        assert_eq!(size_of::<BvhTriangleAttributes>(), constants::BVH_ATTRIBUTE_TEXELS as usize * TEXEL);
         assert_eq!(offset_of!(BvhInstance, object_to_world), 0);
         assert_eq!(offset_of!(BvhInstance, world_to_object), 4 * TEXEL);
         assert_eq!(offset_of!(BvhInstance, info), 8 * TEXEL);
