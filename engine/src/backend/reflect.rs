@@ -169,8 +169,8 @@ mod tests {
                 (3, StorageImage, true)
             ]
         );
-        // The ray caster reads the BVH's traversal data as texel buffers, its hit data and rays
-        // as storage buffers, and writes only its results.
+        // The ray caster reads the BVH's traversal data and triangle attributes as texel
+        // buffers, its albedo maps and rays as storage buffers, and writes only its results.
         assert_eq!(
             kinds(spirv::RAYCAST_COMP),
             [
@@ -178,7 +178,7 @@ mod tests {
                 (1, TexelBuffer, false),
                 (2, TexelBuffer, false),
                 (3, TexelBuffer, false),
-                (4, StorageBuffer, false),
+                (4, TexelBuffer, false),
                 (5, StorageBuffer, false),
                 (6, StorageBuffer, false),
                 (7, StorageBuffer, false),
