@@ -10,10 +10,11 @@
 //! without renormalising the direction, so t is the same world-space distance in both spaces.
 //!
 //! # GPU layout (bindings 0 .. `KAGE_BVH_BINDINGS` - 1, structs in layouts.glsl)
-//! Bindings 0-3, what the traversal reads, are texel buffers of `uvec4`s read through
-//! bvh.glsl's accessors (`bvh_pair`, `bvh_tlas_node`, `bvh_instance_info`, `bvh_triangle`, ...):
-//! llvmpipe reads a storage buffer one lane and word at a time, and texel fetches made the
-//! traversal 1.6-3.5x faster there (BENCHMARKS.md, "Ray casting"). 4-6 are storage buffers.
+//! Bindings 0-4, what the traversal and every hit read, are texel buffers of `uvec4`s read
+//! through bvh.glsl's accessors (`bvh_pair`, `bvh_tlas_node`, `bvh_instance_info`,
+//! `bvh_triangle`, `bvh_attributes`, ...): llvmpipe reads a storage buffer one lane and word at
+//! a time, and texel fetches made the traversal 1.6-3.5x faster there (BENCHMARKS.md, "Ray
+//! casting"). 5-6, the albedo maps, are storage buffers.
 //! 0. `BvhPair[]`, the bottom-level trees of every group as the GPU reads them, one pair per
 //!    interior node holding its two children's quantized boxes and references (see `raycast/pairs.rs`),
 //!    each group's from its root pair (`BvhInstance.info.w`); 1. `BvhNode[]`, the top level,
