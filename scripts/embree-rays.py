@@ -25,8 +25,8 @@ from embreex import mesh_construction, rtcore_scene
 
 
 def main():
+    prt_only = "--prt-only" in sys.argv[1:]
     args = [a for a in sys.argv[1:] if a != "--prt-only"]
-    prt_only = len(args) < len(sys.argv) - 1
     folder = args[0]
     runs = int(args[1]) if len(args) > 1 else 5
     os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})

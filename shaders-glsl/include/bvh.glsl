@@ -107,6 +107,18 @@ WatertightRay bvh_watertight_ray(vec3 origin, vec3 dir) {
                          vec3(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]));
 }
 
+// Whether edge functions u, w1 and w2 put a ray inside a triangle: none of them of another sign
+// than the others, a value of exactly zero counting as inside.
+bool bvh_edges_inside(float u, float w1, float w2) {
+    return !((u < 0.0 || w1 < 0.0 || w2 < 0.0) && (u > 0.0 || w1 > 0.0 || w2 > 0.0));
+}
+
+// Whether t = tt / denominator lies in (0, tmax), tested without the division and for either
+// sign of the denominator (none for zero).
+bool bvh_t_in_range(float tt, float denominator, float tmax) {
+    return denominator > 0.0 ? (tt > 0.0 && tt < tmax * denominator) : (tt < 0.0 && tt > tmax * denominator);
+}
+
 // Hit with t in (0, tmax): returns t and the weights of v1 and v2. `precise` forbids fused
 // multiply-adds, so that an edge shared by two triangles gets bit-identical (negated) edge
 // functions in both and no ray slips between them. Edge functions of exactly zero count as
@@ -124,15 +136,12 @@ bool bvh_intersect(WatertightRay r, BvhTriangle v, float tmax, out float t, out 
     precise float u = cx * by - cy * bx;
     precise float w1 = ax * cy - ay * cx;
     precise float w2 = bx * ay - by * ax;
-    if ((u < 0.0 || w1 < 0.0 || w2 < 0.0) && (u > 0.0 || w1 > 0.0 || w2 > 0.0)) return false;
+    if (!bvh_edges_inside(u, w1, w2)) return false;
     precise float det = u + w1 + w2;
     if (det == 0.0) return false;
     precise float tt = u * (r.shear.z * a[r.k.z]) + w1 * (r.shear.z * b[r.k.z])
                      + w2 * (r.shear.z * c[r.k.z]);
-    // t = tt / det in (0, tmax), tested without the division and for either sign of det.
-    if (det > 0.0 ? (tt <= 0.0 || tt >= tmax * det) : (tt >= 0.0 || tt <= tmax * det)) {
-        return false;
-    }
+    if (!bvh_t_in_range(tt, det, tmax)) return false;
     float inv = 1.0 / det;
     t = tt * inv;
     bary = vec2(w1, w2) * inv;
@@ -156,12 +165,20 @@ struct BvhFan {
     float height;
 };
 
+// x × y with each component the difference of two rounded products: `precise` reaches no
+// further than the function it is declared in, and a fused multiply-add would round x × y and
+// y × x differently.
+vec3 bvh_cross_unfused(vec3 x, vec3 y) {
+    precise vec3 product = vec3(x.y * y.z - x.z * y.y, x.z * y.x - x.x * y.z, x.x * y.y - x.y * y.x);
+    return product;
+}
+
 BvhFan bvh_fan(BvhTriangle v, vec3 origin) {
     precise vec3 a = v.v0.xyz - origin;
     precise vec3 b = v.v1.xyz - origin;
     precise vec3 c = v.v2.xyz - origin;
     vec3 normal = cross(v.v1.xyz - v.v0.xyz, v.v2.xyz - v.v0.xyz);
-    return BvhFan(cross(b, c), cross(c, a), cross(a, b), normal, dot(a, normal));
+    return BvhFan(bvh_cross_unfused(b, c), bvh_cross_unfused(c, a), bvh_cross_unfused(a, b), normal, dot(a, normal));
 }
 
 // The per-ray half: as bvh_intersect, for a ray from the fan's origin (dir of any length, t
@@ -170,16 +187,13 @@ bool bvh_intersect_fan(BvhFan f, vec3 dir, float tmax, out float t, out vec2 bar
     precise float u = dot(dir, f.edge0);
     precise float w1 = dot(dir, f.edge1);
     precise float w2 = dot(dir, f.edge2);
-    if ((u < 0.0 || w1 < 0.0 || w2 < 0.0) && (u > 0.0 || w1 > 0.0 || w2 > 0.0)) return false;
+    if (!bvh_edges_inside(u, w1, w2)) return false;
     precise float det = u + w1 + w2;
     if (det == 0.0) return false;
     // t = height / dot(dir, normal); the weights divide by det, so that they sum to one.
     float slope = dot(dir, f.normal);
-    float tt = f.height;
-    if (slope > 0.0 ? (tt <= 0.0 || tt >= tmax * slope) : (tt >= 0.0 || tt <= tmax * slope)) {
-        return false;
-    }
-    t = tt / slope;
+    if (!bvh_t_in_range(f.height, slope, tmax)) return false;
+    t = f.height / slope;
     bary = vec2(w1, w2) / det;
     return t > 0.0 && t < tmax;
 }

@@ -387,6 +387,69 @@ fn mesh_scene_matches_brute_force_in_world_and_object_space() {
     assert!(compared > 450 && found > 50 && found < compared, "{compared} packet rays compared, {found} hit");
 }
 
+/// Packets leak through no shared edge: rays from one origin aimed at every inner vertex of a
+/// bumpy, jittered grid and at points along its inner edges (each within rounding of two or more
+/// triangles' shared boundary, where a test that rounds a shared edge differently in its two
+/// triangles lets a ray pass between them) all hit, through the packets' test (`bvh_fan`).
+#[test]
+fn packets_leak_through_no_shared_edge() {
+    let ctx = Validated::new();
+    let mut rng = Rng(5);
+    const N: usize = 9;
+    let positions: Vec<[f32; 3]> = (0..N * N)
+        .map(|i| {
+            let (x, z) =
+                ((i % N) as f32 / (N - 1) as f32 * 2.0 - 1.0, (i / N) as f32 / (N - 1) as f32 * 2.0 - 1.0);
+            let jitter =
+                if i % N == 0 || i % N == N - 1 || i / N == 0 || i / N == N - 1 { 0.0 } else { 0.08 };
+            [
+                x + jitter * (rng.next() - 0.5),
+                0.2 * (3.0 * x).sin() * (2.0 * z).cos(),
+                z + jitter * (rng.next() - 0.5),
+            ]
+        })
+        .collect();
+    let indices: Vec<u32> = (0..(N - 1) * (N - 1))
+        .flat_map(|c| {
+            let v = (c / (N - 1) * N + c % (N - 1)) as u32;
+            [v, v + N as u32, v + 1, v + 1, v + N as u32, v + N as u32 + 1]
+        })
+        .collect();
+    let inner = |v: u32| {
+        let (i, j) = (v as usize % N, v as usize / N);
+        i > 0 && i < N - 1 && j > 0 && j < N - 1
+    };
+    let mut targets: Vec<Vec3> =
+        (0..(N * N) as u32).filter(|&v| inner(v)).map(|v| Vec3::from(positions[v as usize])).collect();
+    for tri in indices.chunks_exact(3) {
+        for (a, b) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
+            if inner(a) || inner(b) {
+                let (p, q) = (Vec3::from(positions[a as usize]), Vec3::from(positions[b as usize]));
+                targets.extend([0.25, 0.5, 0.75].map(|s| p.lerp(q, s)));
+            }
+        }
+    }
+    let mesh = Mesh::new("grid", positions, None, indices, [0.5; 3]).unwrap();
+    let scene = scene(vec![Group::new("grid", vec![mesh], Transform::default())]);
+    let gpu = GpuBvh::new(&ctx, &SceneBvh::build(&scene).unwrap()).unwrap();
+    let mut caster = RayCaster::new(&ctx).unwrap();
+    let origin = Vec3::new(0.07, 2.0, -0.03);
+    targets.truncate(targets.len() / constants::BVH_PACKET as usize * constants::BVH_PACKET as usize);
+    let rays: Vec<(Vec3, Vec3, f32)> =
+        targets.iter().map(|&p| (origin, (p - origin).normalize(), INFINITE)).collect();
+    let results = cast(&ctx, &mut caster, &gpu, &rays, Query::PacketObjectSpace { instance: 0 });
+    let leaks: Vec<Vec3> =
+        targets.iter().zip(&results).filter(|(_, r)| hit(r).is_none()).map(|(&p, _)| p).collect();
+    assert!(targets.len() > 500, "{} rays", targets.len());
+    assert!(
+        leaks.is_empty(),
+        "{} of {} packet rays passed between triangles, towards {:?}",
+        leaks.len(),
+        targets.len(),
+        leaks
+    );
+}
+
 #[test]
 fn moving_a_group_rewrites_only_the_top_level() {
     let ctx = Validated::new();
