@@ -19,21 +19,21 @@ layout(push_constant) uniform Push { IrradiancePush p; };
 #include "local_light.glsl"
 
 layout(local_size_x = KAGE_IRRADIANCE_GROUP) in;
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 4, std430) readonly buffer Points {
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) readonly buffer Points {
     IrradiancePoint points[];
 };
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 5, std430) readonly buffer Lights {
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 4, std430) readonly buffer Lights {
     ReferenceLight lights[];
 };
 // Per scene vertex (scene order: groups, meshes, vertices): outgoing radiance, rgb.
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 6, std430) readonly buffer Radiance { vec4 radiance[]; };
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 5, std430) readonly buffer Radiance { vec4 radiance[]; };
 // Per BVH triangle: the scene vertex indices of its v0, v1, v2.
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 7, std430) readonly buffer TriangleVertices {
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 6, std430) readonly buffer TriangleVertices {
     uvec4 triangle_vertices[];
 };
 // The rays the invocations traced, added up (a u32 that wraps: the host reads it after every
 // batch, which traces far fewer than 2^32).
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 8, std430) buffer RaysTraced { uint rays_traced; };
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 7, std430) buffer RaysTraced { uint rays_traced; };
 
 // One cosine-weighted sample of the irradiance from the surfaces' radiance: L cos / pdf = L pi.
 vec3 surface_irradiance_sample(vec3 position, vec3 n, inout Rng rng) {

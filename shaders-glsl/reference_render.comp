@@ -15,7 +15,7 @@
 #include "eye_ray.glsl"
 
 layout(local_size_x = KAGE_REFERENCE_GROUP, local_size_y = KAGE_REFERENCE_GROUP) in;
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 4, std430) readonly buffer Lights {
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) readonly buffer Lights {
     ReferenceLight lights[];
 };
 layout(push_constant) uniform Push { ReferencePush p; };

@@ -1,7 +1,7 @@
 // The Monte Carlo reference's shared half: the environment map and its sampling distribution
 // (engine/src/reference/env_sampling.rs builds it), the per-item statistics, and the estimator
 // of direct environment lighting with full visibility. The including shader includes bvh.glsl
-// first and declares its own bindings from KAGE_BVH_BINDINGS + 4 on.
+// first and declares its own bindings from KAGE_BVH_BINDINGS + 3 on.
 #ifndef KAGE_REFERENCE_GLSL
 #define KAGE_REFERENCE_GLSL
 
@@ -11,18 +11,12 @@
 #include "sampling.glsl"
 
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 0) uniform sampler2D env;
-// The sampling distribution's CDFs as texel buffers of four words a texel: llvmpipe gathers a
-// texel fetch where it reads a storage buffer lane by lane (vendor-notes.md). Each holds the
-// CDF entries' bits, up to a whole texel, then their guide (EnvDistribution::marginal_words):
-// per run of n + 1 entries, for each of n equal cells of u, a word with the range of indices
-// where the search for u can end. The marginal: height + 1 entries, P(row < j).
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 1) uniform usamplerBuffer env_marginal_texels;
-// The conditionals: height runs of width + 1 entries, P(column < i | row j).
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 2) uniform usamplerBuffer env_conditional_texels;
-
-// Entry k of a CDF texel buffer.
-float env_cdf(usamplerBuffer cdf, uint k) { return uintBitsToFloat(texelFetch(cdf, int(k >> 2))[k & 3u]); }
-layout(set = 0, binding = KAGE_BVH_BINDINGS + 3, std430) buffer Accum { ReferenceAccum accum[]; };
+// The sampling distribution's alias table (Walker 1977; EnvDistribution::alias_words), a texel
+// buffer of two entries a texel: per texel of the map, row by row, the chance in 2^32 that a
+// draw of its slot yields its alias instead, and the alias. A texel buffer because llvmpipe
+// gathers a texel fetch where it reads a storage buffer lane by lane (vendor-notes.md).
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 1) uniform usamplerBuffer env_alias_texels;
+layout(set = 0, binding = KAGE_BVH_BINDINGS + 2, std430) buffer Accum { ReferenceAccum accum[]; };
 
 const float REFERENCE_PI = 3.14159265358979323846;
 // "Infinite" ray length: the environment is at infinity.
@@ -36,48 +30,26 @@ ivec2 env_texel_of(vec3 dir) {
     return min(ivec2(uv * vec2(size)), size - 1);
 }
 
-// In run `run` of n + 1 entries of `cdf` (`runs` of them), the first entry greater than u,
-// minus one: never an empty interval. The guide's word for u's cell (after the texels of all
-// the runs' entries, start | end << 16) bounds where that entry lies, so a search of its range
-// alone ends where a search of the whole run would.
-uint env_pick(usamplerBuffer cdf, uint run, uint runs, uint n, float u) {
-    uint base = run * (n + 1u);
-    uint cell = run * n + min(uint(u * float(n)), n - 1u);
-    uint guide = texelFetch(cdf, int((runs * (n + 1u) + 3u) / 4u + cell / 4u))[cell & 3u];
-    uint lo = guide & 0xffffu, hi = guide >> 16;
-    while (lo < hi) {
-        uint mid = (lo + hi) / 2u;
-        if (env_cdf(cdf, base + mid) <= u) lo = mid + 1u; else hi = mid;
-    }
-    return clamp(lo, 1u, n) - 1u;
-}
-
-float env_within(float u, float c0, float c1) {
-    return c1 > c0 ? clamp((u - c0) / (c1 - c0), 0.0, 1.0) : 0.5;
-}
-
-// A direction drawn in proportion to luminance x solid angle: texel by the CDFs, then uniform in
-// solid angle inside it, so the pdf is luminance / total everywhere in the texel. Returns the
-// texel, or (-1, -1) where an interval of the CDFs it lies in is empty (a direction of no
-// density, which only u past the last entry reaches). Needs a map of positive total.
-ivec2 env_sample(vec2 u, out vec3 dir) {
+// A direction drawn in proportion to luminance x solid angle: the texel from the alias table (a
+// slot uniform over the texels, then the slot's texel or its alias by the slot's chance: one
+// fetch), then uniform in solid angle inside it, so the pdf is luminance / total everywhere in
+// the texel. Returns the texel. Needs a map of positive total.
+ivec2 env_sample(inout Rng rng, out vec3 dir) {
     ivec2 size = textureSize(env, 0);
     uint w = uint(size.x), h = uint(size.y);
-    uint j = env_pick(env_marginal_texels, 0u, 1u, h, u.x);
-    float row0 = env_cdf(env_marginal_texels, j), row1 = env_cdf(env_marginal_texels, j + 1u);
-    uint i = env_pick(env_conditional_texels, j, h, w, u.y);
-    uint base = j * (w + 1u);
-    float column0 = env_cdf(env_conditional_texels, base + i);
-    float column1 = env_cdf(env_conditional_texels, base + i + 1u);
-    float v_in = env_within(u.x, row0, row1);
-    float u_in = env_within(u.y, column0, column1);
+    uint slot = rng_below(rng, w * h);
+    uvec4 pair = texelFetch(env_alias_texels, int(slot >> 1u));
+    uvec2 entry = (slot & 1u) == 0u ? pair.xy : pair.zw;
+    uint t = rng_next_word(rng) < entry.x ? entry.y : slot;
+    uint i = t % w, j = t / w;
+    float v_in = rng_next(rng), u_in = rng_next(rng);
     float cos0 = cos(REFERENCE_PI * float(j) / float(h));
     float cos1 = cos(REFERENCE_PI * float(j + 1u) / float(h));
     float cos_theta = mix(cos0, cos1, v_in);
     float sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
     float phi = 2.0 * REFERENCE_PI * (float(i) + u_in) / float(w);
     dir = vec3(sin_theta * sin(phi), cos_theta, -sin_theta * cos(phi));
-    return row1 > row0 && column1 > column0 ? ivec2(i, j) : ivec2(-1);
+    return ivec2(i, j);
 }
 
 // Candidates of the environment strategy's resampling (see env_irradiance_sample).
@@ -108,8 +80,8 @@ vec3 env_irradiance_sample(vec3 p, vec3 n, vec3 ng, float total, inout Rng rng) 
         // The candidates' weights need their directions only: the kept one's texel is read once.
         for (uint k = 0u; k < REFERENCE_CANDIDATES; ++k) {
             vec3 dir;
-            ivec2 texel = env_sample(vec2(rng_next(rng), rng_next(rng)), dir);
-            float w = texel.x >= 0 && dot(ng, dir) > 0.0 ? max(dot(n, dir), 0.0) : 0.0;
+            ivec2 texel = env_sample(rng, dir);
+            float w = dot(ng, dir) > 0.0 ? max(dot(n, dir), 0.0) : 0.0;
             weights += w;
             if (w > 0.0 && rng_next(rng) * weights < w) {
                 kept_dir = dir;

@@ -20,10 +20,27 @@ Rng rng_init(uint seed, uint item, uint sample_index) {
     return Rng(pcg_hash(pcg_hash(pcg_hash(seed) + item) + sample_index));
 }
 
+// A uniform word: the generator's next state.
+uint rng_next_word(inout Rng rng) {
+    rng.state = pcg_hash(rng.state);
+    return rng.state;
+}
+
 // Uniform in [0, 1): the top 24 bits, so the float is exact and never rounds up to 1.
 float rng_next(inout Rng rng) {
-    rng.state = pcg_hash(rng.state);
-    return float(rng.state >> 8u) * (1.0 / 16777216.0);
+    return float(rng_next_word(rng) >> 8u) * (1.0 / 16777216.0);
+}
+
+// Uniform in [0, n) for n > 0, unbiased: the high word of a word times n, drawn again while the
+// low word falls in the 2^32 mod n values that would make some results likelier (Lemire,
+// "Fast Random Integer Generation in an Interval", 2019).
+uint rng_below(inout Rng rng, uint n) {
+    uint reject = (0u - n) % n;
+    uint high, low;
+    do {
+        umulExtended(rng_next_word(rng), n, high, low);
+    } while (low < reject);
+    return high;
 }
 
 // An orthonormal basis around unit n without branches on near-axis normals (Duff et al.,

@@ -1,5 +1,5 @@
 //! What both reference shaders bind first: the scene's BVH, the environment map and its
-//! sampling distribution (bindings 0 .. BVH_BINDINGS + 3, in the order reference.glsl declares);
+//! sampling distribution (bindings 0 .. BVH_BINDINGS + 2, in the order reference.glsl declares);
 //! and what both need besides: the scene's point and spot lights.
 use super::env_sampling::EnvDistribution;
 use super::render::reference_light;
@@ -16,9 +16,8 @@ use std::sync::Arc;
 pub struct ReferenceLighting {
     bvh: GpuBvh,
     env: GpuEnvironment,
-    /// The environment's sampling CDFs and their guides (reference.glsl), four words a texel.
-    marginal: TexelBuffer,
-    conditional: TexelBuffer,
+    /// The environment's alias table (reference.glsl), four words a texel.
+    alias: TexelBuffer,
     /// Σ luminance × solid angle of the map; 0 turns environment sampling off (black map).
     pub env_total: f32,
     /// The scene's lights as `ReferenceLight`s (one unused entry when there are none: a
@@ -36,10 +35,7 @@ impl ReferenceLighting {
         let bvh = GpuBvh::new(ctx, &scene_bvh)?;
         let distribution = EnvDistribution::new(&scene.environment);
         let storage = BufferUsage::STORAGE;
-        let upload = |name: &str, words: Vec<u32>| {
-            let bytes: Vec<u8> = words.iter().flat_map(|v| v.to_ne_bytes()).collect();
-            TexelBuffer::with_data(ctx, name, &bytes)
-        };
+        let alias: Vec<u8> = distribution.alias_words().iter().flat_map(|v| v.to_ne_bytes()).collect();
         let mut lights: Vec<ReferenceLight> = scene.lights.iter().map(reference_light).collect();
         if lights.is_empty() {
             lights.push(ReferenceLight::default());
@@ -47,8 +43,7 @@ impl ReferenceLighting {
         Ok(ReferenceLighting {
             bvh,
             env: GpuEnvironment::new(ctx, &scene.environment)?,
-            marginal: upload("env_marginal_cdf", distribution.marginal_words())?,
-            conditional: upload("env_conditional_cdf", distribution.conditional_words())?,
+            alias: TexelBuffer::with_data(ctx, "env_alias_table", &alias)?,
             env_total: distribution.total(),
             lights: Buffer::with_data(ctx, "reference_lights", storage, bytes_of_slice(&lights))?,
             light_count: scene.lights.len() as u32,
@@ -68,7 +63,7 @@ impl ReferenceLighting {
     /// The binding kinds of a reference shader: these, then the shader's own `extra`.
     pub fn binding_kinds(extra: &[BindingKind]) -> Vec<BindingKind> {
         let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
-        kinds.extend([BindingKind::SampledImage, BindingKind::TexelBuffer, BindingKind::TexelBuffer]);
+        kinds.extend([BindingKind::SampledImage, BindingKind::TexelBuffer]);
         kinds.extend_from_slice(extra);
         kinds
     }
@@ -76,11 +71,7 @@ impl ReferenceLighting {
     /// The bindings matching [`ReferenceLighting::binding_kinds`], then `extra`.
     pub fn bindings<'a>(&'a self, extra: &[&'a Buffer]) -> Vec<Binding<'a>> {
         let mut bindings: Vec<Binding> = self.bvh.bindings().into_iter().collect();
-        bindings.extend([
-            Binding::Sampled(&self.env.image, &self.env.sampler),
-            Binding::Texel(&self.marginal),
-            Binding::Texel(&self.conditional),
-        ]);
+        bindings.extend([Binding::Sampled(&self.env.image, &self.env.sampler), Binding::Texel(&self.alias)]);
         bindings.extend(extra.iter().map(|b| Binding::Storage(b)));
         bindings
     }
