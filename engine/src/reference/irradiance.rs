@@ -131,11 +131,12 @@ pub struct SurfaceRadiance {
     pub seconds: f64,
     /// Of those, the seconds of all but the traversal: each pass's batches again with every
     /// ray a miss, timed on [`UNTRACED_SAMPLES`] samples and scaled to all of them (as the PRT
-    /// precomputation splits its time).
+    /// precomputation splits its time), a submission's own cost counted once per batch
+    /// ([`IrradianceReference::untraced_seconds`]).
     pub untraced_seconds: f64,
 }
 
-/// Samples per point of the untraced batch that times all but the traversal.
+/// Samples per point of the untraced submission that times all but the traversal.
 pub const UNTRACED_SAMPLES: u32 = 16;
 
 /// The outgoing radiance albedo / π · E of every vertex of `scene` (scene order: groups,
@@ -179,8 +180,7 @@ pub fn surface_radiance(
         out.rays += reference.rays_traced();
         out.seconds += reference.seconds();
         let e = reference.statistics()?.mean;
-        let timed = samples.min(UNTRACED_SAMPLES);
-        out.untraced_seconds += reference.untraced_seconds(timed)? * f64::from(samples) / f64::from(timed);
+        out.untraced_seconds += reference.untraced_seconds(samples, RADIANCE_BATCH)?;
         out.radiance = Some(
             e.iter()
                 .zip(&albedo)
@@ -192,6 +192,15 @@ pub fn surface_radiance(
         );
     }
     Ok(out)
+}
+
+/// The seconds of `samples` samples in submissions of at most `batch`, from the seconds of a
+/// submission of one sample (`one`) and of `timed` (> 1) samples (`many`): a line through the
+/// two, a submission's own cost its intercept (neither part below 0, as noise can tilt it).
+fn scaled_to_batches(one: f64, many: f64, timed: u32, samples: u32, batch: u32) -> f64 {
+    let per_sample = ((many - one) / f64::from(timed - 1)).max(0.0);
+    let per_submission = (one - per_sample).max(0.0);
+    per_sample * f64::from(samples) + per_submission * f64::from(samples.div_ceil(batch.max(1)))
 }
 
 /// Samples per vertex per submission: a submission must stay short on a CPU driver.
@@ -336,10 +345,25 @@ impl IrradianceReference {
         Ok(())
     }
 
-    /// The seconds a batch of `spp` samples per point takes with every ray taken as a miss
-    /// (the same pipeline, told by a push constant not to trace): all but the traversal.
-    /// Consumes the reference: the batch overwrites its statistics.
-    pub fn untraced_seconds(mut self, spp: u32) -> Result<f64> {
+    /// The seconds `samples` samples per point, submitted in batches of at most `batch`, take
+    /// with every ray taken as a miss (the same pipeline, told by a push constant not to
+    /// trace): all but the traversal. Timed on a submission of one sample and one of
+    /// [`UNTRACED_SAMPLES`], which part a submission's own cost (recording, submitting, the
+    /// wait: 1.8 ms on the atrium on lavapipe) from a sample's, so that it counts once per
+    /// batch, as the batches pay it; scaling the second alone counted it per 16 samples.
+    /// Consumes the reference: the submissions overwrite its statistics.
+    pub fn untraced_seconds(mut self, samples: u32, batch: u32) -> Result<f64> {
+        let timed = samples.min(UNTRACED_SAMPLES);
+        let one = self.untraced_submission(1)?;
+        if timed < 2 {
+            return Ok(one * f64::from(samples));
+        }
+        let many = self.untraced_submission(timed)?;
+        Ok(scaled_to_batches(one, many, timed, samples, batch))
+    }
+
+    /// Seconds of one submission of `spp` samples per point with every ray a miss.
+    fn untraced_submission(&mut self, spp: u32) -> Result<f64> {
         let shader = &self.shader;
         let passes = shader.batch(false, spp, self.samples, shader.count);
         let start = Instant::now();
@@ -399,6 +423,18 @@ impl IrradianceShader {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A submission's own cost counts once per batch, a sample's once per sample: 2 ms a
+    /// submission and 1.5 ms a sample, timed on 1 and 16 samples, give 256 samples in batches
+    /// of 64 as 4 · 2 + 256 · 1.5 ms (scaling the 16-sample time alone gave 16 · 2 + 256 · 1.5).
+    #[test]
+    fn the_untraced_time_counts_a_submission_per_batch() {
+        let time = |spp: u32| 2e-3 + 1.5e-3 * f64::from(spp);
+        let total = scaled_to_batches(time(1), time(16), 16, 256, 64);
+        assert!((total - (4.0 * 2e-3 + 256.0 * 1.5e-3)).abs() < 1e-12, "{total}");
+        // Noise that times 16 samples below 1: no negative per-sample cost.
+        assert_eq!(scaled_to_batches(3e-3, 2e-3, 16, 256, 64), 4.0 * 3e-3);
+    }
 
     #[test]
     fn points_parse_and_bad_input_is_named() {
