@@ -21,7 +21,7 @@
 //! the frame writes is persistent (uploaded by the host, or written by an earlier frame).
 mod timings;
 
-pub use timings::{frame_ms, median, TimingRow, TimingTable};
+pub use timings::{frame_ms, median, scaled_to_submissions, TimingRow, TimingTable};
 
 use crate::backend::{AccessLog, Cmd, Context, TimestampPool, Touch};
 use crate::error::{Error, Result};

@@ -32,6 +32,17 @@ pub fn median(values: &[f64]) -> f64 {
     }
 }
 
+/// The seconds of `units` units of work (samples, rounds of rays) submitted at most
+/// `per_submission` to a submission, from the seconds of a submission of one unit (`one`) and
+/// of `timed` (> 1) units (`many`): a line through the two, a submission's own cost (recording,
+/// submitting, the wait) its intercept, counted once per submission; neither part below 0, as
+/// noise can tilt the line. Scaling `many` alone would count that cost once per `timed` units.
+pub fn scaled_to_submissions(one: f64, many: f64, timed: u32, units: u32, per_submission: u32) -> f64 {
+    let per_unit = ((many - one) / f64::from(timed.max(2) - 1)).max(0.0);
+    let per_call = (one - per_unit).max(0.0);
+    per_unit * f64::from(units) + per_call * f64::from(units.div_ceil(per_submission.max(1)))
+}
+
 /// A frame's device time: from its first pass's start to its last pass's end, the time between
 /// passes included (lavapipe writes a compute pass's timestamps when it next flushes, so part
 /// of a pass's work can fall between passes; vendor-notes.md). The sum of the passes' times
@@ -114,5 +125,17 @@ mod tests {
         let unplaced = [pass("a", Some(2.0), None), pass("b", Some(1.0), None)];
         assert_eq!(frame_ms(&unplaced), Some(3.0));
         assert_eq!(frame_ms(&[pass("a", None, None)]), None);
+    }
+
+    /// A submission's own cost counts once per submission, a unit's once per unit: 2 ms a
+    /// submission and 1.5 ms a unit, timed on 1 and 16 units, give 256 units in submissions of
+    /// 64 as 4 · 2 + 256 · 1.5 ms (scaling the 16-unit time alone gave 16 · 2 + 256 · 1.5).
+    #[test]
+    fn a_submission_counts_once_per_submission() {
+        let time = |units: u32| 2e-3 + 1.5e-3 * f64::from(units);
+        let total = scaled_to_submissions(time(1), time(16), 16, 256, 64);
+        assert!((total - (4.0 * 2e-3 + 256.0 * 1.5e-3)).abs() < 1e-12, "{total}");
+        // Noise that times 16 units below 1: no negative cost per unit.
+        assert_eq!(scaled_to_submissions(3e-3, 2e-3, 16, 256, 64), 4.0 * 3e-3);
     }
 }

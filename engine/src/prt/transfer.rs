@@ -12,7 +12,7 @@ use crate::backend::{
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, PrtTransferPush, PrtVertex};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{scaled_to_submissions, FrameExecutor, Pass};
 use crate::progress::Progress;
 
 use crate::raycast::{GpuBvh, SceneBvh};
@@ -219,20 +219,32 @@ impl<'a> Jobs<'a> {
     }
 
     /// The seconds the jobs spent tracing rays (see [`TransferSet::traversal_seconds`]): the
-    /// jobs' time less that of one dispatch per batch with tracing off, scaled from its rays to
-    /// all of them. Overwrites the results, which [`Jobs::run`] has read.
+    /// jobs' time less that of the same submissions with tracing off, each timed with one
+    /// dispatch round (`RAYS_PER_DISPATCH` rays per vertex) and with two, so that a
+    /// submission's own cost counts once per batch as the jobs paid it, not once per round
+    /// ([`scaled_to_submissions`]). Overwrites the results, which [`Jobs::run`] has read.
     fn traversal_seconds(mut self) -> Result<f32> {
-        let rays = self.params.rays.min(RAYS_PER_DISPATCH);
+        let rounds = self.params.rays.div_ceil(RAYS_PER_DISPATCH);
+        let round = self.params.rays.min(RAYS_PER_DISPATCH);
         let pipeline = self.pipeline(false)?;
         let batches = std::mem::take(&mut self.batches);
         // An untimed warm-up first (on a CPU driver, the shader's compilation).
-        self.submit(&pipeline, &batches[0], 0, rays)?;
+        self.submit(&pipeline, &batches[0], 0, round)?;
         let mut untraced = 0.0;
         for batch in &batches {
-            untraced += self.submit(&pipeline, batch, 0, rays)?;
+            let one = self.submit(&pipeline, batch, 0, round)?;
+            untraced += match rounds {
+                1 => one,
+                _ => scaled_to_submissions(
+                    one,
+                    self.submit(&pipeline, batch, 0, 2 * round)?,
+                    2,
+                    rounds,
+                    rounds,
+                ),
+            };
         }
-        let rest = untraced * f64::from(self.params.rays) / f64::from(rays);
-        Ok((self.job_seconds - rest).max(0.0) as f32)
+        Ok((self.job_seconds - untraced).max(0.0) as f32)
     }
 }
 

@@ -20,7 +20,7 @@ use super::statistics::{accum_buffer, samples_after, Statistics};
 use crate::backend::{BindingKind, Buffer, BufferUsage, ComputePipeline, Context};
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, IrradiancePoint, IrradiancePush};
-use crate::pass::{FrameExecutor, Pass};
+use crate::pass::{scaled_to_submissions, FrameExecutor, Pass};
 use crate::scene::Scene;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
@@ -194,15 +194,6 @@ pub fn surface_radiance(
     Ok(out)
 }
 
-/// The seconds of `samples` samples in submissions of at most `batch`, from the seconds of a
-/// submission of one sample (`one`) and of `timed` (> 1) samples (`many`): a line through the
-/// two, a submission's own cost its intercept (neither part below 0, as noise can tilt it).
-fn scaled_to_batches(one: f64, many: f64, timed: u32, samples: u32, batch: u32) -> f64 {
-    let per_sample = ((many - one) / f64::from(timed - 1)).max(0.0);
-    let per_submission = (one - per_sample).max(0.0);
-    per_sample * f64::from(samples) + per_submission * f64::from(samples.div_ceil(batch.max(1)))
-}
-
 /// Samples per vertex per submission: a submission must stay short on a CPU driver.
 const RADIANCE_BATCH: u32 = 64;
 
@@ -359,7 +350,7 @@ impl IrradianceReference {
             return Ok(one * f64::from(samples));
         }
         let many = self.untraced_submission(timed)?;
-        Ok(scaled_to_batches(one, many, timed, samples, batch))
+        Ok(scaled_to_submissions(one, many, timed, samples, batch))
     }
 
     /// Seconds of one submission of `spp` samples per point with every ray a miss.
@@ -423,18 +414,6 @@ impl IrradianceShader {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A submission's own cost counts once per batch, a sample's once per sample: 2 ms a
-    /// submission and 1.5 ms a sample, timed on 1 and 16 samples, give 256 samples in batches
-    /// of 64 as 4 · 2 + 256 · 1.5 ms (scaling the 16-sample time alone gave 16 · 2 + 256 · 1.5).
-    #[test]
-    fn the_untraced_time_counts_a_submission_per_batch() {
-        let time = |spp: u32| 2e-3 + 1.5e-3 * f64::from(spp);
-        let total = scaled_to_batches(time(1), time(16), 16, 256, 64);
-        assert!((total - (4.0 * 2e-3 + 256.0 * 1.5e-3)).abs() < 1e-12, "{total}");
-        // Noise that times 16 samples below 1: no negative per-sample cost.
-        assert_eq!(scaled_to_batches(3e-3, 2e-3, 16, 256, 64), 4.0 * 3e-3);
-    }
 
     #[test]
     fn points_parse_and_bad_input_is_named() {
