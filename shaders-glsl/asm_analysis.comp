@@ -26,6 +26,7 @@ layout(constant_id = 0) const uint EXTRA_LEVELS = KAGE_ASM_EXTRA_LEVELS;
 
 #include "asm_lookup.glsl"
 
+
 // The world position seen at pixel q, or w = 0 where the pixel shows no surface.
 vec4 surface(ivec2 q) {
     ivec2 size = ivec2(push.size.xy);
@@ -61,7 +62,7 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     float a = 1.0 / mx.z - iw;
     float b = 1.0 / my.z - iw;
     vec2 slope = vec2(a * uy.y - b * ux.y, ux.x * b - uy.x * a) / det;
-    ivec2 texel = asm_quadrant_texel(page, ivec2(asm_texel_coords(page.tile, m.xy)));
+    ivec2 texel = asm_slot_texel(page, ivec2(asm_texel_coords(page.tile, m.xy)));
     vec2 centre = asm_texel_centre(page.tile, texel);
     float inv = iw + dot(slope, centre - m.xy);
     if (inv <= 0.0) return false;
@@ -71,16 +72,15 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
 
 // The stored depth at the centre of tile texel `texel`, a neighbour of texel t across its page's
 // border, where a tile at least as fine as the page's holds it (a resident child, another
-// quadrant's page, a neighbouring tile): the 3x3 test clamped to the page would read the border
+// slot's page, a neighbouring tile): the 3x3 test clamped to the page would read the border
 // texel again, and a thin occluder that crosses the border but that the page's own texels miss
 // would never ask for refinement on this side (a wedge of its shadow lit, tests/tests/asm.rs).
 // Where only a coarser tile holds it, its texel's centre lies farther than the test's bias
 // allows for, so the page's border texel (`kept`) answers as before.
 float across_border_depth(AsmPage page, ivec2 texel, float kept) {
     vec2 uv = clamp(asm_texel_centre(page.tile, texel), vec2(0.0), vec2(1.0));
-    AsmTile at = asm_descend(uv);
-    if (at.level < page.tile.x) return kept;
-    AsmPage there = asm_page(at, uv);
+    AsmPage there = asm_page(asm_descend(uv), uv);
+    if (there.tile.x < page.tile.x) return kept;
     return asm_depth(there, ivec2(asm_texel_coords(there.tile, uv)));
 }
 
@@ -105,29 +105,39 @@ void main() {
     if (s.light.position.w > 0.5 && dot(-l, s.light.direction.xyz) < s.light.direction.w) return;
 
     AsmTile at = asm_descend(m.xy);
-    requests[1u + at.node] = 1u;
     AsmPage page = asm_page(at, m.xy);
     uint level = page.tile.x;
-    if (level >= uint(KAGE_ASM_MAX_LEVEL)) return;
+    uint n = 1u << at.level;
+    uvec3 at_tile = uvec3(at.level, min(uvec2(m.xy * float(n)), uvec2(n - 1u)));
     // The eye pixel's footprint in light uv: |det J| of the uv's screen derivatives. A tile at
     // level L has texels of 1 / (TILE 2^L) a side, so it matches the pixel where
     // 2^L = 1 / (TILE sqrt(area)); EXTRA_LEVELS finer.
     vec4 mx = shadow_map_coords(s, p + dx), my = shadow_map_coords(s, p + dy);
+    float texel = asm_texel_size(s, level);
+    ivec2 t = ivec2(asm_texel_coords(page.tile, m.xy));
+    float stored = asm_depth(page, t);
+    // Lit, but the slope-scaled bias hides an occluder in front of the receiver's plane (a
+    // coarse tile under grazing light): a finer tile's bias is narrower and shows the shadow.
+    bool lit = shadow_lit_past(s, stored, shadow_receiver_depth(s, m.z, p, ng, texel, push.bias));
+    bool hidden = lit && occluded_at_plane(s, m, p, ng, mx, my, page);
+    ivec2 at_slot = asm_slot(at_tile, m.xy);
+    uint slot_bit = 1u << (at_slot.y * (KAGE_ASM_TILE_TEXELS / KAGE_ASM_PAGE_TEXELS) + at_slot.x);
+    // Texels from two levels up or more: the slot of the tile's parent over the pixel is asked
+    // for (coarse texels can miss a thin occluder altogether, where no test sees it).
+    if (level + 2u <= at.level) atomicOr(requests[1u + 2u * at.node], slot_bit);
+    // Read from its tile's own texels: the slot is in use; from an ancestor's: that one's is.
+    atomicOr(requests[2u + 2u * at.node], level == at.level ? slot_bit : slot_bit << 16);
     vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
     float area = abs(ux.x * uy.y - ux.y * uy.x);
     float needed = area > 0.0 ? -log2(float(KAGE_ASM_TILE_TEXELS) * sqrt(area)) : float(KAGE_ASM_MAX_LEVEL);
     needed += float(EXTRA_LEVELS);
     float missing = min(ceil(needed), float(KAGE_ASM_MAX_LEVEL)) - float(level);
-    if (missing < 1.0) return;
     // On a shadow edge: the receiver's visibility against its texel and the 8 around it
     // disagrees (an occluder's silhouette, a depth discontinuity in the light's view, passes
     // within a texel). Neighbours lie up to 1 + sqrt(2) texels from p: the slope term grows so.
     // The receiver's biased depths are computed once for all the texels.
-    float texel = asm_texel_size(s, level);
     vec4 wide_bias = vec4(push.bias.x, push.bias.y * 2.5, push.bias.z, 0.0);
     float wide = shadow_receiver_depth(s, m.z, p, ng, texel, wide_bias);
-    ivec2 t = ivec2(asm_texel_coords(page.tile, m.xy));
-    float stored = asm_depth(page, t);
     bool centre = shadow_lit_past(s, stored, wide);
     bool edge = false;
     for (int j = -1; j <= 1; ++j) {
@@ -137,24 +147,24 @@ void main() {
     }
     // On the page's border, the texel across it along each axis whose border t lies on (at a
     // corner two descents; the diagonal texel is left out).
-    ivec2 across = ivec2(greaterThanEqual(t, page.quadrant + KAGE_ASM_PAGE_TEXELS - 1)) -
-                ivec2(lessThanEqual(t, page.quadrant));
+    ivec2 across = ivec2(greaterThanEqual(t, page.slot + KAGE_ASM_PAGE_TEXELS - 1)) -
+                ivec2(lessThanEqual(t, page.slot));
     if (!edge && across.x != 0) {
         edge = shadow_lit_past(s, across_border_depth(page, t + ivec2(across.x, 0), stored), wide) != centre;
     }
     if (!edge && across.y != 0) {
         edge = shadow_lit_past(s, across_border_depth(page, t + ivec2(0, across.y), stored), wide) != centre;
     }
-    // Or the slope-scaled bias hides an occluder in front of the receiver's plane (a coarse tile
-    // under grazing light): a finer tile's bias is narrower and shows the shadow.
-    bool lit = shadow_lit_past(s, stored, shadow_receiver_depth(s, m.z, p, ng, texel, push.bias));
-    edge = edge || (lit && occluded_at_plane(s, m, p, ng, mx, my, page));
-    if (!edge) return;
+    if (!(edge || hidden)) return;
+    // On an edge with its tile's own texels: the tile keeps that slot (see pool.rs, trials).
+    if (level == at.level) atomicOr(requests[1u + 2u * at.node], slot_bit << 16);
+    if (missing < 1.0 || level >= uint(KAGE_ASM_MAX_LEVEL)) return;
     uint record = atomicAdd(requests[0], 1u);
     if (record >= push.size.w) return;
-    uint word = 1u + push.size.z + KAGE_ASM_EDGE_WORDS * record;
+    uint word = 1u + 2u * push.size.z + KAGE_ASM_EDGE_WORDS * record;
     const float cells = float(1u << KAGE_ASM_EDGE_CELL_BITS);
-    uvec2 cell = uvec2(clamp(asm_texel_coords(page.tile, m.xy) * (cells / float(KAGE_ASM_TILE_TEXELS)), 0.0, cells - 1.0));
-    requests[word] = at.node | uint(missing) << 24;
+    // The cell is in the finest resident tile's square, the levels missing from the page's.
+    uvec2 cell = uvec2(clamp(asm_texel_coords(at_tile, m.xy) * (cells / float(KAGE_ASM_TILE_TEXELS)), 0.0, cells - 1.0));
+    requests[word] = at.node | uint(missing) << KAGE_ASM_EDGE_NODE_BITS | (at.level - level) << (KAGE_ASM_EDGE_NODE_BITS + 5);
     requests[word + 1u] = cell.x | cell.y << 16;
 }

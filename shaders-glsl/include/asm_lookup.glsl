@@ -1,6 +1,6 @@
 // The adaptive shadow map's page table and its descent (engine/src/techniques/asm/page_table.rs),
 // shared by the lighting pass and the refinement analysis, with the page pool (an atlas of
-// pages, each one quadrant of a tile). The including shader declares nothing else at set 0,
+// pages, each one slot of a tile: a 4x4 grid of KAGE_ASM_PAGE_TEXELS squares). The including shader declares nothing else at set 0,
 // bindings 2 and 3.
 #ifndef KAGE_ASM_LOOKUP_GLSL
 #define KAGE_ASM_LOOKUP_GLSL
@@ -13,15 +13,15 @@ layout(set = 0, binding = 2) uniform sampler2D asm_pool;
 // The page table as uvec4 texels: the directory (rows of ASM_DIRECTORY_SIDE entries, four to a
 // texel: node index | level << 24, the finest resident tile at or above the directory's level
 // over each of its tiles), then the nodes (an AsmNode is ASM_NODE_TEXELS texels: below[0..3],
-// pages). A texel buffer because llvmpipe gathers texel fetches and reads storage buffers lane by
+// pages[0..3]). A texel buffer because llvmpipe gathers texel fetches and reads storage buffers lane by
 // lane (vendor-notes.md).
 layout(set = 0, binding = 3) uniform usamplerBuffer asm_table;
 #define ASM_DIRECTORY_TEXELS int(ASM_DIRECTORY_SIDE * ASM_DIRECTORY_SIDE / 4u)
-#define ASM_NODE_TEXELS 5
+#define ASM_NODE_TEXELS 8
 #define ASM_NODE_PAGES 4
 
 uint asm_directory(uint entry) { return texelFetch(asm_table, int(entry >> 2))[entry & 3u]; }
-// Texel `field` (0 to 3: below's rows, ASM_NODE_PAGES: pages) of node `node`.
+// Texel `field` (0 to 3: below's rows, ASM_NODE_PAGES + 0 to 3: pages' rows) of node `node`.
 uvec4 asm_node(uint node, int field) {
     return texelFetch(asm_table, ASM_DIRECTORY_TEXELS + ASM_NODE_TEXELS * int(node) + field);
 }
@@ -55,15 +55,15 @@ AsmTile asm_descend(vec2 uv) {
     return at;
 }
 
-// The first atlas texel of the page in cell `cell` (column | row << 16, as AsmNode.pages).
+// The first atlas texel of the page in cell `cell` (column | row << 12, as AsmNode.pages).
 ivec2 asm_cell_origin(uint cell) {
-    return ivec2(cell & 0xffffu, cell >> 16) * KAGE_ASM_PAGE_TEXELS;
+    return ivec2(cell & 0xfffu, (cell >> 12) & 0xfffu) * KAGE_ASM_PAGE_TEXELS;
 }
 
-// The quadrant of a resident tile that holds a point: the tile, and where its texels lie.
+// The stored slot that holds a point: its tile, and where its texels lie.
 struct AsmPage {
     uvec3 tile; // x: level, y, z: tile x, y at that level
-    ivec2 quadrant; // the quadrant's first texel within the tile
+    ivec2 slot; // the slot's first texel within the tile
     ivec2 atlas; // the page's first texel in the atlas
 };
 
@@ -77,28 +77,38 @@ vec2 asm_texel_centre(uvec3 tile, ivec2 texel) {
     return (vec2(tile.yz) + (vec2(texel) + 0.5) / float(KAGE_ASM_TILE_TEXELS)) / float(1u << tile.x);
 }
 
-// The page of resident tile `at`'s quadrant holding uv: the tile is the finest resident one
-// there (asm_descend, whose cells give the tile's coordinates again), so no resident child
-// covers that quadrant and its page is stored.
+// The slot of tile `tile` holding uv.
+ivec2 asm_slot(uvec3 tile, vec2 uv) {
+    const float slots = float(KAGE_ASM_TILE_TEXELS / KAGE_ASM_PAGE_TEXELS);
+    return ivec2(clamp(asm_texel_coords(tile, uv) / float(KAGE_ASM_PAGE_TEXELS), vec2(0.0), vec2(slots - 1.0)));
+}
+
+// The stored slot holding uv, from resident tile `at`'s entry for its slot there: the tile is
+// the finest resident one (asm_descend, whose cells give the tile's coordinates again), so no
+// resident child covers the slot, and the entry names its page or, where the tile does not
+// store it, the nearest ancestor's that holds the point (levels up in the entry's top byte).
 AsmPage asm_page(AsmTile at, vec2 uv) {
     uint n = 1u << at.level;
-    uvec3 tile = uvec3(at.level, min(uvec2(uv * float(n)), uvec2(n - 1u)));
-    ivec2 q = ivec2(clamp(asm_texel_coords(tile, uv) / float(KAGE_ASM_PAGE_TEXELS), vec2(0.0), vec2(1.0)));
-    return AsmPage(tile, q * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(asm_node(at.node, ASM_NODE_PAGES)[2 * q.y + q.x]));
+    uvec2 xy = min(uvec2(uv * float(n)), uvec2(n - 1u));
+    ivec2 s = asm_slot(uvec3(at.level, xy), uv);
+    uint entry = asm_node(at.node, ASM_NODE_PAGES + s.y)[s.x];
+    uint up = entry >> 24;
+    uvec3 tile = uvec3(at.level - up, xy >> up);
+    return AsmPage(tile, asm_slot(tile, uv) * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(entry));
 }
 
-// Tile texel `texel` kept in the page's quadrant (the texels beyond it are in other pages, or in
-// none where a child covers them).
-ivec2 asm_quadrant_texel(AsmPage page, ivec2 texel) {
-    return clamp(texel, page.quadrant, page.quadrant + KAGE_ASM_PAGE_TEXELS - 1);
+// Tile texel `texel` kept in the page's slot (the texels beyond it are in other pages, or in
+// none where the tile does not store them).
+ivec2 asm_slot_texel(AsmPage page, ivec2 texel) {
+    return clamp(texel, page.slot, page.slot + KAGE_ASM_PAGE_TEXELS - 1);
 }
 
-// The atlas texel of tile texel `texel`, kept in the page's quadrant.
+// The atlas texel of tile texel `texel`, kept in the page's slot.
 ivec2 asm_atlas_texel(AsmPage page, ivec2 texel) {
-    return page.atlas + asm_quadrant_texel(page, texel) - page.quadrant;
+    return page.atlas + asm_slot_texel(page, texel) - page.slot;
 }
 
-// The stored depth of tile texel `texel` (kept in the page's quadrant).
+// The stored depth of tile texel `texel` (kept in the page's slot).
 float asm_depth(AsmPage page, ivec2 texel) {
     return texelFetch(asm_pool, asm_atlas_texel(page, texel), 0).r;
 }

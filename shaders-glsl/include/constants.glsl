@@ -102,10 +102,11 @@
 // tiles misclassified 18 % fewer pixels of the `asm` walkthrough than 128² (BENCHMARKS.md); 32²
 // little fewer again, at a frame cost over the paper's 1.74x.
 #define KAGE_ASM_TILE_TEXELS 64
-// Texels per side of a page of the pool: one quadrant of a tile (4 KiB of D32). A tile keeps a
-// page only for the quadrants its resident children do not cover (every point there descends
-// into the child), so a tile refined all over takes no memory of its own.
-#define KAGE_ASM_PAGE_TEXELS 32
+// Texels per side of a page of the pool: one slot of a tile's 4x4 (1 KiB of D32). A tile keeps
+// pages only for the slots the analysis found eye pixels on shadow edges in and no finer tiles
+// cover (engine/src/techniques/asm/pool.rs): texels a thirty-second of the eye pixel put a
+// tile over a pixel or two, and most of its square holds no lookup.
+#define KAGE_ASM_PAGE_TEXELS 16
 // The deepest quadtree level: 2^17 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 17
@@ -126,11 +127,14 @@
 // its chain, each at most this many levels under the tile): a camera arriving at a new view
 // refines that many levels in one frame instead of one.
 #define KAGE_ASM_CHAIN_LEVELS 4
-// Words of an edge record of the ASM analysis (AsmAnalysisPush): the node | missing levels << 24,
-// and where in that node's tile the pixel lies, KAGE_ASM_EDGE_CELL_BITS an axis (the host needs
-// its cell at most KAGE_ASM_CHAIN_LEVELS levels down). Half the light uv as two floats took.
+// Words of an edge record of the ASM analysis (AsmAnalysisPush): the pixel's finest resident
+// tile's node | the levels missing from the tile its texels came from << KAGE_ASM_EDGE_NODE_BITS
+// | the levels from that tile down to the node's << (KAGE_ASM_EDGE_NODE_BITS + 5), and where in
+// the node's tile the pixel lies, KAGE_ASM_EDGE_CELL_BITS an axis (the host needs its cell at
+// most KAGE_ASM_CHAIN_LEVELS levels down). Half the light uv as two floats took.
 #define KAGE_ASM_EDGE_WORDS 2
 #define KAGE_ASM_EDGE_CELL_BITS 16
+#define KAGE_ASM_EDGE_NODE_BITS 22
 // Workgroup of the ASM refinement analysis: 8x8 eye pixels.
 #define KAGE_ASM_ANALYSIS_GROUP 8
 

@@ -5,7 +5,7 @@
 //! a page-table node, a use mark and a request flag. The pool gets what the fixed parts leave.
 use super::page_table::PageTable;
 use super::pages::scratch_bytes;
-use super::pool::TILE_PAGES;
+use super::pool::{max_tiles, TILE_PAGES};
 use crate::error::{Error, Result};
 use crate::layouts::constants::{self, MAX_LOCAL_LIGHTS};
 use crate::layouts::ShadowLight;
@@ -34,10 +34,10 @@ impl AsmMemory {
         self.pages + self.scratch + self.page_table + self.analysis + self.lights
     }
 
-    /// The parts for a pool of `pages` pages of `page_bytes`, its nodes (`nodes(pages)`), and
+    /// The parts for a pool of `pages` pages of `page_bytes`, its nodes ([`max_tiles`]), and
     /// `edges` edge records of the analysis ([`edge_records`]).
     pub fn of(pages: u32, page_bytes: u64, edges: u32) -> AsmMemory {
-        let nodes = nodes(pages);
+        let nodes = max_tiles(pages);
         AsmMemory {
             pages: u64::from(pages) * page_bytes,
             scratch: scratch_bytes(page_bytes),
@@ -51,12 +51,10 @@ impl AsmMemory {
     /// `budget`; an error naming the fixed parts when not even the root tile fits.
     pub fn within(budget: u64, page_bytes: u64, edges: u32) -> Result<(u32, AsmMemory)> {
         let fixed = AsmMemory::of(0, page_bytes, edges).total();
-        // N tiles take 3N + 1 pages and N nodes: a page carries a third of a node's bytes.
-        let per_node = AsmMemory::of(4, page_bytes, edges).total()
-            - AsmMemory::of(1, page_bytes, edges).total()
-            - 3 * page_bytes;
-        let estimate = budget.saturating_sub(fixed) * 3 / (3 * page_bytes + per_node);
-        // The estimate spreads a node over 3 pages; the exact count is a page or two away.
+        // A pool of N pages has N / 2 nodes: two pages carry a node's bytes.
+        let per_node = AsmMemory::of(2, page_bytes, edges).total() - fixed - 2 * page_bytes;
+        let estimate = budget.saturating_sub(fixed) * 2 / (2 * page_bytes + per_node);
+        // The estimate spreads a node over 2 pages; the exact count is a page or two away.
         let fits = |pages: u32| AsmMemory::of(pages, page_bytes, edges).total() <= budget;
         let mut pages = u32::try_from(estimate).unwrap_or(u32::MAX - 1);
         while fits(pages + 1) {
@@ -84,14 +82,9 @@ pub fn edge_records(size: (u32, u32)) -> u32 {
     (size.0.div_ceil(2) * size.1.div_ceil(2)).div_ceil(8)
 }
 
-/// The most tiles a pool of `pages` pages holds: N tiles take 3N + 1 pages.
-pub fn nodes(pages: u32) -> u32 {
-    pages.saturating_sub(1) / 3
-}
-
 /// The analysis's `requests` buffer: a counter, a flag per node, then `edges` edge records.
 pub fn requests_bytes(nodes: u32, edges: u32) -> u64 {
-    WORD * (1 + u64::from(nodes) + u64::from(constants::ASM_EDGE_WORDS) * u64::from(edges))
+    WORD * (1 + 2 * u64::from(nodes) + u64::from(constants::ASM_EDGE_WORDS) * u64::from(edges))
 }
 
 /// The lighting's use marks: one frame number per node.

@@ -8,17 +8,18 @@
 //! - [`tile`]: the quadtree of tiles over the light's view; a tile at level L covers 1/2^L of
 //!   the view's side and is rendered at `ASM_TILE_TEXELS`² texels, so each level doubles the
 //!   resolution.
-//! - [`pool`]: the physical page pool: a page is one quadrant of a tile, and a resident tile
-//!   keeps pages only for the quadrants its resident children do not cover; as many pages as a
-//!   byte budget holds (never more), least-recently-used eviction of leaf tiles.
+//! - [`pool`]: the physical page pool: a page is one slot of a tile (a 4 × 4 grid), and a
+//!   resident tile keeps pages only for the slots the analysis asked for that its resident
+//!   children do not cover (a new tile all of them for a few frames, its trial); as many pages
+//!   as a byte budget holds (never more), least-recently-used eviction of leaf tiles.
 //! - [`pages`]: the pool on the GPU: the atlas of pages, and the tile renders (through a
 //!   scratch target, each drawing only the triangle clusters over its square) that fill them.
 //! - [`page_table`]: the resident tree flattened into `AsmNode` records for the GPU lookup
 //!   (shaders-glsl/include/layouts.glsl) behind a directory of one level's tiles: start at the
 //!   directory's tile and descend, two levels a step, while the tile holding the point is
-//!   resident; the last node reached is the finest resident tile, and its quadrant holding the point is stored, so a
-//!   missing tile falls back to its nearest resident ancestor, at worst the root (always
-//!   resident), never to "lit".
+//!   resident; the last node reached is the finest resident tile, whose entry for the slot
+//!   holding the point names that slot's page or the nearest ancestor's that holds it, at worst
+//!   the root's (always resident, every slot wanted), never "lit".
 pub mod light_view;
 pub mod memory;
 pub mod page_table;

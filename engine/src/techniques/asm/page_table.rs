@@ -2,16 +2,18 @@
 //! in a texel buffer, the root at index 0 and every node's descendants after it (breadth
 //! first). Each node names, over each cell of its grandchildren's 4×4 grid, the finest resident
 //! tile up to two levels below it, so that the lookup goes down two levels per texel fetch; it
-//! stops where that tile is less than two levels down (or none is) and uses the last node's
-//! page of that quadrant: the finest resident tile over the point, which stores every quadrant
-//! no resident child covers (`pool`).
+//! stops where that tile is less than two levels down (or none is) and reads the last node's
+//! entry for the slot of its tile that holds the point: the page of that slot where the tile
+//! stores it, else the page of the nearest ancestor's slot that holds the point, with the levels
+//! up (`pool`: a tile stores only the slots asked for).
 //!
 //! A directory comes first in the buffer: one entry per tile of level
 //! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
 //! that the descent starts there instead of at the root.
 use super::pages::AtlasLayout;
-use super::pool::{PagePool, TilePages};
+use super::pool::{PagePool, SLOT_SIDE};
 use super::tile::TileKey;
+use crate::error::{Error, Result};
 use crate::layouts::constants::ASM_DIRECTORY_LEVEL;
 use crate::layouts::{bytes_of_slice, AsmNode};
 use std::collections::VecDeque;
@@ -47,14 +49,31 @@ impl PageTable {
 
 /// The page table of `pool`'s resident tiles, root first, their pages' cells in an atlas laid
 /// out as `layout`.
-pub fn build(pool: &PagePool, layout: &AtlasLayout) -> PageTable {
-    // A covered quadrant's page is never read: 0 stands in.
-    let node = |pages: TilePages| AsmNode {
-        below: [[0; 4]; 4],
-        pages: pages.map(|p| p.map_or(0, |p| layout.cell(p))),
+pub fn build(pool: &PagePool, layout: &AtlasLayout) -> Result<PageTable> {
+    // Per slot: its page, or the nearest ancestor's that holds it, with the levels up; a slot
+    // under a resident child is never read (the descent goes on): 0 stands in.
+    let node = |key: TileKey| -> Result<AsmNode> {
+        let pages = pool
+            .pages(key)
+            .ok_or_else(|| Error::Internal(format!("ASM tile {key:?} listed but not resident")))?;
+        let children = key.children();
+        let mut entries = [[0u32; 4]; 4];
+        for (slot, entry) in entries.as_flattened_mut().iter_mut().enumerate() {
+            let (x, y) = (slot as u32 % SLOT_SIDE, slot as u32 / SLOT_SIDE);
+            let half = SLOT_SIDE / 2;
+            let under = children.is_some_and(|c| pool.contains(c[((x / half) + 2 * (y / half)) as usize]));
+            *entry = match (pages[slot], under) {
+                (Some(page), _) => layout.cell(page),
+                (None, true) => 0,
+                (None, false) => {
+                    let (page, up) = pool.holder(key, slot as u32)?;
+                    layout.cell(page) | up << LEVEL_SHIFT
+                }
+            };
+        }
+        Ok(AsmNode { below: [[0; 4]; 4], pages: entries })
     };
-    let root = pool.pages(TileKey::ROOT).expect("the root is always resident");
-    let (mut nodes, mut keys) = (vec![node(root)], vec![TileKey::ROOT]);
+    let (mut nodes, mut keys) = (vec![node(TileKey::ROOT)?], vec![TileKey::ROOT]);
     // Each node's resident children (node indices, 0: none), for the `below` entries.
     let mut children = vec![[0u32; 4]];
     let mut directory = vec![0u32; (DIRECTORY_SIDE * DIRECTORY_SIDE) as usize];
@@ -71,10 +90,10 @@ pub fn build(pool: &PagePool, layout: &AtlasLayout) -> PageTable {
         }
         let Some(tiles) = key.children() else { continue };
         for (q, child) in tiles.into_iter().enumerate() {
-            if let Some(pages) = pool.pages(child) {
+            if pool.contains(child) {
                 children[at][q] = nodes.len() as u32;
                 queue.push_back((child, nodes.len()));
-                nodes.push(node(pages));
+                nodes.push(node(child)?);
                 keys.push(child);
                 children.push([0; 4]);
             }
@@ -94,21 +113,22 @@ pub fn build(pool: &PagePool, layout: &AtlasLayout) -> PageTable {
             }
         }
     }
-    PageTable { directory, nodes, keys }
+    Ok(PageTable { directory, nodes, keys })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::techniques::asm::pool::DEPTH_PAGE_BYTES as PAGE_BYTES;
+    use crate::techniques::asm::pool::SLOT_SIDE;
     const LAYOUT: AtlasLayout = AtlasLayout { columns: 16, rows: 16 };
 
     /// asm_lookup.glsl reads the table as 16-byte texels: the directory four entries to a
-    /// texel, each node five (below's four rows, pages: ASM_NODE_TEXELS, ASM_NODE_PAGES).
+    /// texel, each node eight (below's four rows, then pages': ASM_NODE_TEXELS, ASM_NODE_PAGES).
     #[test]
     fn the_table_is_whole_texels_as_the_shader_reads_it() {
         assert_eq!(DIRECTORY_BYTES % 16, 0);
-        assert_eq!(size_of::<AsmNode>(), 5 * 16);
+        assert_eq!(size_of::<AsmNode>(), 8 * 16);
         assert_eq!(std::mem::offset_of!(AsmNode, below), 0);
         assert_eq!(std::mem::offset_of!(AsmNode, pages), 4 * 16);
     }
@@ -151,13 +171,13 @@ mod tests {
 
     #[test]
     fn a_missing_tile_falls_back_to_its_nearest_resident_ancestor() {
-        let mut pool = PagePool::new(16, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(80, PAGE_BYTES).unwrap();
         // Refine towards uv = (0.3, 0.6) down to level 4.
         let uv = [0.3, 0.6];
         for level in 1..=4 {
-            pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1.0).unwrap();
+            pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1, 1.0).unwrap();
         }
-        let table = build(&pool, &LAYOUT);
+        let table = build(&pool, &LAYOUT).unwrap();
         assert_eq!(table.nodes.len(), 5);
         assert_eq!(lookup(&table, uv), TileKey::containing(uv, 4).unwrap());
         // A point in the same level-2 tile but another level-3 one gets the level-2 tile.
@@ -166,25 +186,38 @@ mod tests {
         assert_eq!(lookup(&table, beside), TileKey::containing(uv, 2).unwrap());
         // Far away: the root, which every lookup can fall back to; never "no tile".
         assert_eq!(lookup(&table, [0.9, 0.1]), TileKey::ROOT);
-        // Each node's pages are its tile's in the pool, where no child covers the quadrant.
+        // Each node names, per slot no resident child lies over, its own page or the nearest
+        // ancestor's that holds the slot, with the levels up.
         for (node, key) in table.nodes.iter().zip(&table.keys) {
             let pages = pool.pages(*key).unwrap();
-            for (q, (page, child)) in pages.iter().zip(key.children().unwrap()).enumerate() {
-                assert_eq!(page.is_none(), pool.pages(child).is_some());
-                assert_eq!(page.map_or(0, |p| LAYOUT.cell(p)), node.pages[q]);
+            for (slot, &entry) in node.pages.as_flattened().iter().enumerate() {
+                let (x, y) = (slot as u32 % SLOT_SIDE, slot as u32 / SLOT_SIDE);
+                let child = key.children().unwrap()[((x / 2) + 2 * (y / 2)) as usize];
+                if pool.contains(child) {
+                    continue;
+                }
+                let expected = match pages[slot] {
+                    Some(page) => LAYOUT.cell(page),
+                    None => {
+                        let (page, up) = pool.holder(*key, slot as u32).unwrap();
+                        assert!(up > 0 && pool.pages(TileKey::ROOT).is_some());
+                        LAYOUT.cell(page) | up << LEVEL_SHIFT
+                    }
+                };
+                assert_eq!(entry, expected, "{key:?} slot {slot}");
             }
         }
     }
 
     #[test]
     fn each_node_names_the_finest_resident_tile_two_levels_down_in_the_right_cell() {
-        let mut pool = PagePool::new(19, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(96, PAGE_BYTES).unwrap();
         for child in TileKey::ROOT.children().unwrap() {
-            pool.insert(child, 1, 1.0).unwrap();
+            pool.insert(child, 1, 1, 1.0).unwrap();
         }
         let grandchild = TileKey::ROOT.children().unwrap()[2].children().unwrap()[1];
-        pool.insert(grandchild, 1, 1.0).unwrap();
-        let table = build(&pool, &LAYOUT);
+        pool.insert(grandchild, 1, 1, 1.0).unwrap();
+        let table = build(&pool, &LAYOUT).unwrap();
         assert_eq!(table.nodes.len(), 6);
         let mut named = [0; 3];
         for (at, (node, key)) in table.nodes.iter().zip(&table.keys).enumerate() {
@@ -223,19 +256,19 @@ mod tests {
         // Chains refined past the directory's level at two points, and a full level 2, so that
         // the directory holds tiles above, at and (through them) below its level.
         let deep = ASM_DIRECTORY_LEVEL + 3;
-        let mut pool = PagePool::new(256, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::new(1024, PAGE_BYTES).unwrap();
         for uv in [[0.3, 0.6], [0.71, 0.12]] {
             for level in 1..=deep {
-                pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1.0).unwrap();
+                pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1, 1.0).unwrap();
             }
         }
         for key in TileKey::ROOT.children().unwrap() {
-            pool.insert(key, 1, 1.0).unwrap();
+            pool.insert(key, 1, 1, 1.0).unwrap();
             for child in key.children().unwrap() {
-                pool.insert(child, 1, 1.0).unwrap();
+                pool.insert(child, 1, 1, 1.0).unwrap();
             }
         }
-        let table = build(&pool, &LAYOUT);
+        let table = build(&pool, &LAYOUT).unwrap();
         assert_eq!(table.bytes().len() as u64, PageTable::buffer_bytes(table.nodes.len() as u32));
         // A lattice of points finer than the deepest tiles near the chains, coarser elsewhere.
         let mut reached_deep = 0;

@@ -1,13 +1,13 @@
 //! The GPU side of the page pool ([`super::pool`]): the atlas every page lives in, and the
-//! recording of the pool's page operations. Pages are a tile's quadrants and need not lie side
+//! recording of the pool's page operations. Pages are slots of tiles and need not lie side
 //! by side in the atlas, so every page write goes through a scratch target of
 //! [`SCRATCH_TILES`] tiles side by side: tiles render into it whole, in one rendering scope,
-//! and their stored quadrants are copied out together (a CPU rasterizer waits at every barrier
+//! and their stored slots are copied out together (a CPU rasterizer waits at every barrier
 //! and pays for every scope, so a copy and a scope per tile cost more than the tile's
 //! triangles). The scratch counts in the budget.
 //!
 //! The polygon-ID test keeps a second atlas and scratch, of IDs, laid out as the depth ones.
-use super::pool::{TilePages, TILE_PAGES};
+use super::pool::{SLOT_SIDE, TILE_PAGES};
 use super::tile::TileKey;
 use crate::backend::{
     Binding, Cmd, Context, Depth, DepthTest, Edge, Format, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
@@ -67,9 +67,10 @@ impl AtlasLayout {
         self.columns * self.rows
     }
 
-    /// The page's cell in the atlas as `AsmNode.pages` holds it: column | row << 16.
+    /// The page's cell in the atlas as `AsmNode.pages` holds it: column | row << 12 (at most
+    /// `MAX_COLUMNS` of each, the largest image side over a page's).
     pub fn cell(&self, page: u32) -> u32 {
-        (page % self.columns) | ((page / self.columns) << 16)
+        (page % self.columns) | ((page / self.columns) << 12)
     }
 
     /// The page's first texel in the atlas.
@@ -78,26 +79,16 @@ impl AtlasLayout {
     }
 }
 
-/// A tile render of this frame (`super::pool::PageOp`): the square of `key` at `side`² texels,
-/// its quadrants `pages` names stored.
+/// A tile render of this frame (`super::pool::PageOp`): the square of `key`, its slots
+/// `stores` names stored in their pages.
 pub struct TileWrite {
     pub key: TileKey,
-    pub side: u32,
-    pub pages: TilePages,
+    /// (slot, page) pairs.
+    pub stores: Vec<(u32, u32)>,
     /// The light's projection cropped to the tile's square.
     pub view_proj: Mat4,
     /// The index runs it draws: (mesh of the scene, first index, index count).
     pub draws: Vec<(usize, u32, u32)>,
-}
-
-impl TileWrite {
-    /// The tile whose texels it writes: its own, or at its parent's resolution its parent's.
-    pub fn owner(&self) -> TileKey {
-        match self.side {
-            ASM_TILE_TEXELS => self.key,
-            _ => self.key.parent().expect("the root holds no parent's quadrant"),
-        }
-    }
 }
 
 struct IdPages {
@@ -182,7 +173,6 @@ impl PageStore {
 
     /// Records `writes` in order, one debug label each.
     pub fn record(&self, ctx: &Context, cmd: Cmd, scene: &GpuScene, writes: &[TileWrite]) {
-        let half = ASM_PAGE_TEXELS;
         for batch in writes.chunks(SCRATCH_TILES as usize) {
             self.begin_batch(ctx, cmd);
             // Squares of the scratch to store (their first texel), with their pages.
@@ -191,11 +181,13 @@ impl PageStore {
                 let key = write.key;
                 ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
                 let at = [i as u32 % 2 * ASM_TILE_TEXELS, i as u32 / 2 * ASM_TILE_TEXELS];
-                ctx.restrict_to_square(cmd, at, write.side);
+                ctx.restrict_to_square(cmd, at, ASM_TILE_TEXELS);
                 self.draw_tile(ctx, cmd, scene, write);
-                for (q, page) in write.pages.iter().enumerate().filter_map(|(q, p)| p.map(|p| (q as u32, p)))
-                {
-                    let from = [at[0] + q % 2 * half, at[1] + q / 2 * half];
+                for &(slot, page) in &write.stores {
+                    let from = [
+                        at[0] + slot % SLOT_SIDE * ASM_PAGE_TEXELS,
+                        at[1] + slot / SLOT_SIDE * ASM_PAGE_TEXELS,
+                    ];
                     squares.push((from, page));
                 }
                 ctx.end_label(cmd);
@@ -231,8 +223,8 @@ impl PageStore {
     }
 
     /// Copies squares of the scratch (each with the page it goes to) into the atlases. A page
-    /// written twice keeps the later square: a tile's quadrant given back to a child rendered
-    /// after it in the same batch, or an evicted tile's page taken by another.
+    /// written twice keeps the later square: a slot given back by a tile and taken by another
+    /// rendered after it in the same batch.
     fn store(&self, cmd: Cmd, pending: Vec<([u32; 2], u32)>) {
         let mut seen = std::collections::HashSet::new();
         let mut squares: Vec<([u32; 2], [u32; 2])> = pending
@@ -298,14 +290,14 @@ mod tests {
     #[test]
     fn the_atlas_holds_what_the_bytes_allow_near_square() {
         let page = 4096;
-        for (pages, expected) in [(4, (2, 2)), (1020, (34, 30)), (4092, (66, 62)), (1021, (34, 30))] {
+        for (pages, expected) in [(16, (4, 4)), (1020, (34, 30)), (4092, (66, 62)), (1021, (1021, 1))] {
             let layout = AtlasLayout::within(pages * page + page / 2, page).unwrap();
             assert_eq!((layout.columns, layout.rows), expected, "{pages} pages");
             assert!(u64::from(layout.pages()) <= pages && layout.rows <= layout.columns);
         }
-        assert!(AtlasLayout::within(3 * page, page).is_err());
+        assert!(AtlasLayout::within((TILE_PAGES - 1) * page, page).is_err());
         let layout = AtlasLayout { columns: 34, rows: 30 };
-        assert_eq!(layout.cell(35), 1 | 1 << 16);
+        assert_eq!(layout.cell(35), 1 | 1 << 12);
         assert_eq!(layout.origin(35), [ASM_PAGE_TEXELS, ASM_PAGE_TEXELS]);
     }
 }

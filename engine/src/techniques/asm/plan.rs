@@ -1,6 +1,6 @@
 //! The refinement planner (Fernando et al. 2001, section 4.2): which requested tiles to render
-//! this frame. A request is a child tile (a quadrant of a resident tile) that the analysis found
-//! eye pixels on a shadow edge in, whose shadow resolution is coarser than the eye's.
+//! this frame. A request is a tile and the slots of it (`pool`) that the analysis found eye
+//! pixels on a shadow edge in, whose shadow resolution is coarser than the eye's.
 //!
 //! - Benefit: edge pixels × resolution deficit, the deficit being the mean number of levels
 //!   (factors of two in texel size) those pixels lack.
@@ -10,19 +10,19 @@
 //!   the model planned took (`Asm::timed`): tiles timed one by one at start-up and tiles
 //!   rendered back to back in a frame cost differently on some devices (4x on lavapipe).
 //! - Requests are taken by benefit/cost, best first, until what the taken ones planned (their
-//!   renders and those of the parents their evictions give quadrants back to) and the next one's
+//!   renders and those of the ancestors their evictions give slots back to) and the next one's
 //!   cost would pass the per-frame time budget; the best one is always taken, so that the
-//!   refinement progresses on a device slower than the budget assumes. A request under a tile
-//!   that is not resident (the analysis asks for whole chains of tiles) waits until its parent
-//!   is taken.
+//!   refinement progresses on a device slower than the budget assumes. The pool makes the
+//!   tiles between a request and its nearest resident ancestor resident without pages.
+use super::pool::Slots;
 use super::tile::TileKey;
-use std::collections::HashMap;
 
-/// A child tile the analysis asked for.
+/// Slots of a tile the analysis asked for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Request {
     pub key: TileKey,
-    /// Eye pixels on a shadow edge inside it, short of resolution.
+    pub slots: Slots,
+    /// Eye pixels on a shadow edge inside them, short of resolution.
     pub edge_pixels: u32,
     /// Their missing levels, summed.
     pub missing_levels: u32,
@@ -91,41 +91,28 @@ pub fn rescaled(scale: f64, predicted_ms: f64, measured_ms: f64) -> f64 {
     (scale * (measured_ms / predicted_ms).clamp(0.05, 20.0)).sqrt()
 }
 
-/// Takes the requests to render this frame within `budget_ms`, in an order that takes every
-/// tile after its parent: among the requests whose parent is `resident` or taken already, the
-/// best benefit/cost first. `take(request)` takes one and returns the ms it
-/// planned by the model (its render and the renders its evictions need), or `None` where the
-/// tile could not be taken (its children then wait). The best is always taken; returns the
-/// requests taken, in order.
+/// Takes the requests to render this frame within `budget_ms`, the best benefit/cost first.
+/// `take(request)` takes one and returns the ms it planned by the model (its render and the
+/// renders its evictions need), or `None` where the tile could not be taken. The best is
+/// always taken; returns the requests taken, in order.
 pub fn plan(
-    requests: Vec<Request>,
+    mut requests: Vec<Request>,
     model: &CostModel,
     budget_ms: f64,
-    resident: impl Fn(TileKey) -> bool,
     mut take: impl FnMut(&Request) -> Option<f64>,
 ) -> Vec<Request> {
     let ratio = |r: &Request| r.benefit() / model.cost_ms(r.triangles);
-    let mut ready = Vec::new();
-    let mut waiting: HashMap<TileKey, Vec<Request>> = HashMap::new();
-    for r in requests.into_iter().filter(|r| r.benefit() > 0.0) {
-        match r.key.parent().filter(|&p| !resident(p)) {
-            Some(parent) => waiting.entry(parent).or_default().push(r),
-            None => ready.push(r),
-        }
-    }
+    requests.retain(|r| r.benefit() > 0.0);
+    requests.sort_by(|a, b| ratio(b).total_cmp(&ratio(a)).then(a.key.cmp(&b.key)));
     let mut spent = 0.0;
     let mut taken = Vec::new();
-    while let Some(best) = (0..ready.len())
-        .max_by(|&a, &b| ratio(&ready[a]).total_cmp(&ratio(&ready[b])).then(ready[b].key.cmp(&ready[a].key)))
-    {
-        let r = ready.swap_remove(best);
+    for r in requests {
         if !taken.is_empty() && spent + model.cost_ms(r.triangles) > budget_ms {
             break;
         }
         let Some(ms) = take(&r) else { continue };
         spent += ms;
         taken.push(r);
-        ready.extend(waiting.remove(&r.key).unwrap_or_default());
     }
     taken
 }
@@ -135,7 +122,7 @@ mod tests {
     use super::*;
 
     fn request(x: u32, edge_pixels: u32, missing_levels: u32, triangles: u64) -> Request {
-        Request { key: TileKey { level: 1, x, y: 0 }, edge_pixels, missing_levels, triangles }
+        Request { key: TileKey { level: 1, x, y: 0 }, slots: 1, edge_pixels, missing_levels, triangles }
     }
 
     #[test]
@@ -165,50 +152,23 @@ mod tests {
             request(3, 0, 0, 1000),
         ];
         let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key.x).collect::<Vec<_>>();
-        let root = |_| true;
         // Each take planned its tile's cost.
         let render = |r: &Request| Some(model.cost_ms(r.triangles));
         // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
-        assert_eq!(keys(plan(requests.clone(), &model, 15.0, root, render)), vec![2, 1, 0]);
-        assert_eq!(keys(plan(requests.clone(), &model, 13.0, root, render)), vec![2, 1]);
+        assert_eq!(keys(plan(requests.clone(), &model, 15.0, render)), vec![2, 1, 0]);
+        assert_eq!(keys(plan(requests.clone(), &model, 13.0, render)), vec![2, 1]);
         // The best is taken even when it alone is over budget; nothing after it then.
-        assert_eq!(keys(plan(requests.clone(), &model, 1.0, root, render)), vec![2]);
+        assert_eq!(keys(plan(requests.clone(), &model, 1.0, render)), vec![2]);
         // No benefit, no request.
-        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0, root, render).is_empty());
+        assert!(plan(vec![request(3, 0, 0, 1)], &model, 100.0, render).is_empty());
         // What a take planned beyond its tile (an eviction's render) counts: with the big one's
         // 11 ms, a 2 ms one fits in 14; with an eviction's 2 ms more, none does.
-        assert_eq!(keys(plan(requests.clone(), &model, 14.0, root, render)), vec![2, 1]);
+        assert_eq!(keys(plan(requests.clone(), &model, 14.0, render)), vec![2, 1]);
         let evicting = |r: &Request| Some(model.cost_ms(r.triangles) + 2.0);
-        assert_eq!(keys(plan(requests.clone(), &model, 14.0, root, evicting)), vec![2]);
+        assert_eq!(keys(plan(requests.clone(), &model, 14.0, evicting)), vec![2]);
         // A refused take is skipped, the next taken.
         let refusing = |r: &Request| (r.key.x != 2).then(|| model.cost_ms(r.triangles));
-        assert_eq!(keys(plan(requests, &model, 15.0, root, refusing)), vec![1, 0]);
-    }
-
-    #[test]
-    fn a_chain_is_taken_parent_first_and_waits_for_its_parent() {
-        let model = CostModel { ms_per_triangle: 0.0, ms_per_tile: 1.0 };
-        let child = TileKey { level: 1, x: 1, y: 0 };
-        let grandchild = child.children().unwrap()[2];
-        let beside = TileKey { level: 1, x: 0, y: 1 };
-        let ask = |key, missing_levels| Request { key, edge_pixels: 1, missing_levels, triangles: 10 };
-        // The grandchild has the best ratio, but comes after its parent; the tile beside
-        // comes between them, as its ratio is better than the grandchild's parent's.
-        let requests = vec![ask(grandchild, 50), ask(child, 10), ask(beside, 20)];
-        let render = |_: &Request| Some(1.0);
-        let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key).collect::<Vec<_>>();
-        let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT, render);
-        assert_eq!(keys(chosen), vec![beside, child, grandchild]);
-        // Within a budget of two tiles the grandchild waits for a later frame.
-        let chosen = plan(requests.clone(), &model, 2.0, |k| k == TileKey::ROOT, render);
-        assert_eq!(keys(chosen), vec![beside, child]);
-        // A parent refused keeps its child waiting.
-        let refusing = |r: &Request| (r.key != child).then_some(1.0);
-        let chosen = plan(requests.clone(), &model, 10.0, |k| k == TileKey::ROOT, refusing);
-        assert_eq!(keys(chosen), vec![beside]);
-        // With its parent resident it is taken first.
-        let chosen = plan(requests, &model, 1.0, |k| k == TileKey::ROOT || k == child, render);
-        assert_eq!(chosen[0].key, grandchild);
+        assert_eq!(keys(plan(requests, &model, 15.0, refusing)), vec![1, 0]);
     }
 
     #[test]

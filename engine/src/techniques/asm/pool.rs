@@ -1,39 +1,81 @@
-//! The physical page pool. A page is one quadrant of a tile (`ASM_PAGE_TEXELS`² texels, a
-//! cell of the pool's atlas), and the pool holds as many pages as its byte budget allows, never
-//! more. A resident tile keeps a page for each quadrant that no resident child covers: where a
-//! child is resident every lookup descends into it, so the parent's texels there would never be
-//! read. A leaf so takes four pages, and each tile refining a quadrant of its parent adds three
-//! (it takes four, its parent gives one back): N resident tiles hold exactly 3N + 1 pages. The
-//! root is allocated first and never evicted, so every lookup finds a tile.
+//! The physical page pool. A tile's `ASM_TILE_TEXELS`² texels are cut into `TILE_PAGES` slots of
+//! `ASM_PAGE_TEXELS`² (a 4 × 4 grid), and a page (a cell of the pool's atlas) holds one slot. The
+//! pool holds as many pages as its byte budget allows, never more.
 //!
-//! Evicting a leaf gives its parent the quadrant back, which a render of the leaf's square at
-//! the parent's resolution fills again (exactly: a rebuild from the leaf's finer texels would
-//! shift the coarse samples off their centres; the parent's texels there sample the same
-//! points, and the render draws only what lies over the leaf's square). The renders this takes
-//! are queued as [`PageOp`]s, in order: a page one frees may be written by a later one; the
-//! technique records them before the lookups.
+//! A tile stores only its *wanted* slots, not its whole square: with texels a thirty-second of
+//! the eye pixel, a finest tile spans a pixel or two and a shadow edge crosses a few of its
+//! slots, and a slot no pixel looks up needs no texels. A point in a slot its finest resident
+//! tile does not store reads the nearest ancestor's slot that holds it (the page table names
+//! it), at worst the root's, which wants every slot.
 //!
-//! Eviction follows the paper: among the evictable tiles (resident leaves other than the root:
-//! evicting a tile with resident children would cut them off from the lookup's descent) the
-//! least recently used one not used in the current frame goes first; if every evictable tile
-//! was used this frame, the one of least benefit goes, and only for a tile of a benefit
-//! `EVICTION_MARGIN` times as large.
+//! A new tile is on *trial* for `TRIAL_FRAMES`: it stores every slot (its render is paid
+//! anyway; the analysis sees a quarter of the pixels a frame, and each slot asked for later
+//! would cost a render of its own) and notes the slots asked for (edge pixels needing them or
+//! finer ones, or resolved by them) and those pixels read; at its end it wants the first, and
+//! the second too while half the pages are free. A tile on trial covers nothing of its
+//! parent's, so that its end needs no render of the parent.
+//!
+//! A wanted slot is not stored where it is *covered*: its child tile is resident and stores
+//! (or covers) all four of the child's slots under it, so every lookup there finds finer
+//! texels. Where the child holds only some of them, the parent keeps the slot for the others.
+//! Tiles between the root and a requested tile that nobody asked for are resident without
+//! pages (the lookup descends through them), and go when their last child does.
+//!
+//! Every render is a whole tile's, into a scratch from which the slots it stores are copied
+//! ([`PageOp`]); they are queued in order (a page one frees may be written by a later one) and
+//! the technique records them before the lookups. Evicting a leaf frees its pages; an ancestor
+//! whose wanted slot it covered stores it again, from a render of that ancestor.
+//!
+//! Eviction follows the paper's least recently used order, per slot first: when pages run short,
+//! the wanted slots no pixel asked for or read (its own texels, or a descendant's lookup falling
+//! back to them) in `STALE_FRAMES` are given back, once a frame (a tile in view is looked up
+//! every frame, but in motion most of its slots fall out of use; without this a full pool
+//! refused nearly every request while moving). Then, among the evictable tiles (resident leaves
+//! other than the root: evicting a tile with resident children would cut them off from the
+//! lookup's descent) the least recently used one not used in the current frame goes first; if
+//! every evictable tile was used this frame, the one of least benefit goes, and only for a tile
+//! of a benefit `EVICTION_MARGIN` times as large.
 use super::tile::TileKey;
 use crate::error::{Error, Result};
 use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 
-/// Bytes of one page for the depth test with bias: a quadrant of D32 depth texels.
+/// Frames the analysis takes to see every eye pixel (one of each 2×2 block a frame): a trial's
+/// length.
+pub const ANALYSIS_PHASES: u64 = 4;
+const TRIAL_FRAMES: u64 = ANALYSIS_PHASES;
+
+/// Bytes of one page for the depth test with bias: a slot of D32 depth texels.
 pub const DEPTH_PAGE_BYTES: u64 = 4 * ASM_PAGE_TEXELS as u64 * ASM_PAGE_TEXELS as u64;
 /// Bytes of one page for the polygon-ID test: D32 depth and an R32_UINT polygon ID per texel.
 pub const ID_PAGE_BYTES: u64 = 2 * DEPTH_PAGE_BYTES;
-/// Pages of a tile: its quadrants.
-pub const TILE_PAGES: u64 =
-    (ASM_TILE_TEXELS / ASM_PAGE_TEXELS) as u64 * (ASM_TILE_TEXELS / ASM_PAGE_TEXELS) as u64;
+/// Slots per side of a tile.
+pub const SLOT_SIDE: u32 = ASM_TILE_TEXELS / ASM_PAGE_TEXELS;
+/// Slots of a tile: the root's pages.
+pub const TILE_PAGES: u64 = SLOT_SIDE as u64 * SLOT_SIDE as u64;
+const SLOTS: usize = TILE_PAGES as usize;
 
-/// A resident tile's pages, by quadrant ([`TileKey::quadrant`]): `None` where a resident child
-/// covers the quadrant.
-pub type TilePages = [Option<u32>; 4];
+/// Frames after which a slot nobody asked for or read is given back when pages run short:
+/// twice the analysis's phases, in each of which it sees a quarter of the pixels.
+const STALE_FRAMES: u64 = 2 * ANALYSIS_PHASES;
+
+fn see(seen: &mut [u64; SLOTS], slots: Slots, frame: u64) {
+    for (s, at) in seen.iter_mut().enumerate() {
+        if slots & 1 << s != 0 {
+            *at = (*at).max(frame);
+        }
+    }
+}
+
+/// A set of a tile's slots: bit `SLOT_SIDE · y + x` for slot (x, y).
+pub type Slots = u16;
+/// Every slot of a tile.
+pub const ALL_SLOTS: Slots = u16::MAX;
+const _: () = assert!(SLOTS == Slots::BITS as usize);
+
+/// A resident tile's pages, by slot: `None` where the slot is not stored.
+pub type TilePages = [Option<u32>; SLOTS];
 
 /// How much larger a tile's benefit must be than a resident tile's (used this frame) to evict
 /// it: with the paper's "larger" alone, tiles of like benefit displaced each other frame after
@@ -41,41 +83,95 @@ pub type TilePages = [Option<u32>; 4];
 /// evictions' on the walkthrough at 4 MiB).
 const EVICTION_MARGIN: f32 = 2.0;
 
+/// What the analysis saw of a tile on trial.
+#[derive(Clone, Copy, Debug)]
+struct Trial {
+    /// Slots asked for: edge pixels needing them or finer ones, or resolved by them.
+    asked: Slots,
+    /// Slots pixels read.
+    used: Slots,
+    /// The frame from which it keeps the slots asked for (and, where pages are plentiful,
+    /// those used).
+    ends: u64,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Resident {
     pages: TilePages,
+    /// The slots asked for.
+    wanted: Slots,
+    /// The slots stored or covered (see the module): what this tile gives its parent's cover.
+    full: Slots,
+    /// Resident children.
+    children: u8,
+    /// While a new tile stores every slot (see [`PagePool::insert`]).
+    trial: Option<Trial>,
     last_used: u64,
     benefit: f32,
+    /// The last frame each slot was asked for or read (its own texels, or by a descendant's
+    /// lookup falling back to it).
+    seen: [u64; SLOTS],
 }
 
-/// A render the pages need: the square of tile `key` at `side`² texels, its quadrants stored
-/// where `pages` names a page.
-#[derive(Clone, Copy, Debug, PartialEq)]
+impl Resident {
+    fn stored(&self) -> Slots {
+        self.pages.iter().enumerate().filter(|(_, p)| p.is_some()).fold(0, |m, (s, _)| m | 1 << s)
+    }
+}
+
+/// A render the pages need: tile `key`'s square, the listed (slot, page) pairs stored.
+#[derive(Clone, Debug, PartialEq)]
 pub struct PageOp {
     pub key: TileKey,
-    /// A tile's own (`ASM_TILE_TEXELS`), or its parent's resolution (`ASM_PAGE_TEXELS`: one
-    /// page, quadrant 0, the parent's quadrant over it that an eviction gives back).
-    pub side: u32,
-    pub pages: TilePages,
-}
-
-impl PageOp {
-    /// The render of a tile's quadrants `pages`.
-    pub fn tile(key: TileKey, pages: TilePages) -> PageOp {
-        PageOp { key, side: ASM_TILE_TEXELS, pages }
-    }
+    pub stores: Vec<(u32, u32)>,
 }
 
 /// What [`PagePool::insert`] did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Insert {
-    /// The tile was resident already (now marked used).
+    /// The tile was resident with those slots already (now marked used).
     Present,
-    /// The tile got pages (and its render is queued), evicting the listed number of tiles for
-    /// them (and queueing their parents' renders of the quadrants they give back).
+    /// The tile got the slots (and its render is queued), evicting the listed number of tiles
+    /// for them (and queueing the renders of the ancestors' slots they gave back).
     Inserted { evicted: usize },
-    /// No pages could be freed for it: it stays missing and lookups use an ancestor.
+    /// No pages could be freed for it: it stays as it was and lookups use an ancestor.
     Refused,
+}
+
+/// The slot of a tile of `level` holding the slot (`slot`) of a tile `down` levels below it at
+/// absolute texel position `texel` (the slot's first texel at its own level).
+fn slot_at(texel: [u64; 2], down: u32) -> u32 {
+    let within = |t: u64| ((t >> down) % u64::from(ASM_TILE_TEXELS)) as u32 / ASM_PAGE_TEXELS;
+    within(texel[0]) + SLOT_SIDE * within(texel[1])
+}
+
+/// The first texel of slot `slot` of `key`, in texels of its level from the view's corner.
+fn slot_texel(key: TileKey, slot: u32) -> [u64; 2] {
+    let at =
+        |tile: u32, s: u32| u64::from(tile) * u64::from(ASM_TILE_TEXELS) + u64::from(s * ASM_PAGE_TEXELS);
+    [at(key.x, slot % SLOT_SIDE), at(key.y, slot / SLOT_SIDE)]
+}
+
+/// The slots of `key`'s parent over `slots` of `key`.
+pub fn parent_slots(key: TileKey, slots: Slots) -> Slots {
+    (0..SLOTS as u32).filter(|s| slots & 1 << s != 0).fold(0, |m, s| m | 1 << slot_at(slot_texel(key, s), 1))
+}
+
+/// The slots of a tile covered where its children give `full` (per quadrant, as
+/// [`TileKey::children`]): a slot is covered when the four slots of its child under it are.
+fn covered_by(full: [Slots; 4]) -> Slots {
+    let mut covered = 0;
+    for slot in 0..SLOTS as u32 {
+        let (x, y) = (slot % SLOT_SIDE, slot / SLOT_SIDE);
+        let half = SLOT_SIDE / 2;
+        let child = full[((x / half) + 2 * (y / half)) as usize];
+        let (cx, cy) = (2 * (x % half), 2 * (y % half));
+        let under = [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(i, j)| 1u16 << ((cx + i) + SLOT_SIDE * (cy + j)));
+        if under.iter().all(|b| child & b != 0) {
+            covered |= 1 << slot;
+        }
+    }
+    covered
 }
 
 #[derive(Debug)]
@@ -85,15 +181,25 @@ pub struct PagePool {
     free: Vec<u32>,
     tiles: HashMap<TileKey, Resident>,
     ops: Vec<PageOp>,
+    /// The last frame stale slots were given back in.
+    released: u64,
+}
+
+/// A tile's state along a change's chain: its new wanted and full slots.
+struct Step {
+    key: TileKey,
+    wanted: Slots,
+    full: Slots,
+    stored: Slots,
 }
 
 impl PagePool {
-    /// A pool of `capacity` pages of `page_bytes`, with the root resident (used at frame 0, its
-    /// render queued); it must hold at least the root's pages.
+    /// A pool of `capacity` pages of `page_bytes`, with the root resident and every slot of it
+    /// wanted (used at frame 0, its render queued); it must hold at least the root's pages.
     pub fn new(capacity: u32, page_bytes: u64) -> Result<PagePool> {
         if u64::from(capacity) < TILE_PAGES {
             return Err(Error::InvalidArgument(format!(
-                "an ASM pool of {capacity} pages holds no tile: a tile takes {TILE_PAGES}"
+                "an ASM pool of {capacity} pages holds no tile: the root takes {TILE_PAGES}"
             )));
         }
         let mut pool = PagePool {
@@ -102,10 +208,9 @@ impl PagePool {
             free: (0..capacity).rev().collect(),
             tiles: HashMap::new(),
             ops: Vec::new(),
+            released: 0,
         };
-        let pages = pool.take_tile_pages();
-        pool.tiles.insert(TileKey::ROOT, Resident { pages, last_used: 0, benefit: f32::INFINITY });
-        pool.ops.push(PageOp::tile(TileKey::ROOT, pages));
+        pool.commit(pool.chain(TileKey::ROOT, ALL_SLOTS, false), 0, f32::INFINITY);
         Ok(pool)
     }
 
@@ -114,9 +219,10 @@ impl PagePool {
         self.capacity
     }
 
-    /// The most tiles the pool can hold: N tiles take 3N + 1 pages.
+    /// The most tiles the pool holds (the page table's nodes): half its pages, since a tile
+    /// that holds texels stores a few slots and the tiles between them none.
     pub fn max_tiles(&self) -> u32 {
-        (self.capacity - 1) / 3
+        max_tiles(self.capacity)
     }
 
     /// Bytes of all its pages: what the pool's images take, resident or not.
@@ -138,9 +244,40 @@ impl PagePool {
         self.tiles.get(&key).map(|r| r.pages)
     }
 
+    /// The (slot, page) pairs a resident tile stores.
+    pub fn stores(&self, key: TileKey) -> Vec<(u32, u32)> {
+        let pages = self.pages(key).unwrap_or([None; SLOTS]);
+        pages.iter().enumerate().filter_map(|(s, p)| p.map(|p| (s as u32, p))).collect()
+    }
+
     /// Resident tiles and their pages, in no particular order.
     pub fn resident(&self) -> impl Iterator<Item = (TileKey, TilePages)> + '_ {
         self.tiles.iter().map(|(k, r)| (*k, r.pages))
+    }
+
+    /// The page and the levels up to its tile of the nearest tile at or above resident `key`
+    /// that stores the point of `key`'s slot `slot` (the root wants every slot, and a slot
+    /// stored nowhere below is covered nowhere above, so one is always found).
+    pub fn holder(&self, key: TileKey, slot: u32) -> Result<(u32, u32)> {
+        let (_, _, page, up) = self.holding(key, slot).ok_or_else(|| {
+            Error::Internal(format!("no resident tile at or above ASM tile {key:?} stores its slot {slot}"))
+        })?;
+        Ok((page, up))
+    }
+
+    /// [`PagePool::holder`]'s tile and its slot too; `None` where the tiles break the rules.
+    fn holding(&self, key: TileKey, slot: u32) -> Option<(TileKey, usize, u32, u32)> {
+        let texel = slot_texel(key, slot);
+        let mut at = Some(key);
+        for up in 0..=key.level {
+            let tile = at?;
+            let s = slot_at(texel, up) as usize;
+            if let Some(page) = self.tiles.get(&tile)?.pages[s] {
+                return Some((tile, s, page, up));
+            }
+            at = tile.parent();
+        }
+        None
     }
 
     /// Marks a resident tile used in `frame` (a lookup landed in it); false if it is missing.
@@ -148,12 +285,15 @@ impl PagePool {
         self.tiles.get_mut(&key).map(|r| r.last_used = r.last_used.max(frame)).is_some()
     }
 
-    /// Queues a render of resident tile `key`'s stored quadrants (its texels went stale); a
-    /// tile whose children cover it all has nothing to render. False if it is missing.
+    /// Queues a render of resident tile `key`'s stored slots (its texels went stale); a tile
+    /// that stores none has nothing to render. False if it is missing.
     pub fn refresh(&mut self, key: TileKey) -> bool {
-        let Some(r) = self.tiles.get(&key) else { return false };
-        if r.pages.iter().any(Option::is_some) {
-            self.ops.push(PageOp::tile(key, r.pages));
+        if !self.contains(key) {
+            return false;
+        }
+        let stores = self.stores(key);
+        if !stores.is_empty() {
+            self.ops.push(PageOp { key, stores });
         }
         true
     }
@@ -163,59 +303,261 @@ impl PagePool {
         std::mem::take(&mut self.ops)
     }
 
-    /// Makes `key` resident in `frame` with `benefit` (the refinement's, per page), evicting
-    /// tiles if the pool is short of pages (see the module's rules), and queues its render. Its
-    /// parent must be resident: the tree grows from the root, so the lookup's descent reaches
-    /// every resident tile.
-    pub fn insert(&mut self, key: TileKey, frame: u64, benefit: f32) -> Result<Insert> {
-        if let Some(r) = self.tiles.get_mut(&key) {
-            r.last_used = r.last_used.max(frame);
-            r.benefit = benefit;
+    /// Notes that `slots` of `key` are asked for in `frame`; true if that needs no render: the
+    /// tile stores them, or stores every slot while on trial (see [`PagePool::insert`]).
+    /// With a `benefit`, that is the tile's now.
+    pub fn note(&mut self, key: TileKey, slots: Slots, frame: u64, benefit: Option<f32>) -> bool {
+        let Some(r) = self.tiles.get_mut(&key) else { return false };
+        see(&mut r.seen, slots, frame);
+        match &mut r.trial {
+            Some(trial) => trial.asked |= slots,
+            None if r.wanted & slots == slots => {}
+            None => return false,
+        }
+        r.last_used = r.last_used.max(frame);
+        r.benefit = benefit.unwrap_or(r.benefit);
+        true
+    }
+
+    /// Notes that pixels read `slots` of `key`'s own texels (kept past a trial where pages are
+    /// plentiful).
+    pub fn note_used(&mut self, key: TileKey, slots: Slots, frame: u64) {
+        let Some(r) = self.tiles.get_mut(&key) else { return };
+        see(&mut r.seen, slots, frame);
+        if let Some(trial) = r.trial.as_mut() {
+            trial.used |= slots;
+        }
+    }
+
+    /// Notes that pixels in `slots` of `key` read an ancestor's texels: the holders' slots.
+    pub fn note_read_above(&mut self, key: TileKey, slots: Slots, frame: u64) {
+        for slot in (0..SLOTS as u32).filter(|s| slots & 1 << s != 0) {
+            if let Some((tile, s, _, _)) = self.holding(key, slot) {
+                let seen = &mut self.tiles.get_mut(&tile).expect("found resident").seen[s];
+                *seen = (*seen).max(frame);
+            }
+        }
+    }
+
+    /// Gives back the wanted slots no pixel asked for or read in `STALE_FRAMES` (the paper's
+    /// least recently used tiles first, per slot), leaves left wanting nothing evicted.
+    fn release_stale(&mut self, frame: u64) {
+        let Some(before) = frame.checked_sub(STALE_FRAMES) else { return };
+        let mut keys: Vec<(TileKey, Slots)> = self
+            .tiles
+            .iter()
+            .filter(|(k, r)| **k != TileKey::ROOT && r.trial.is_none())
+            .map(|(k, r)| {
+                let stale = (0..SLOTS).filter(|&s| r.seen[s] < before).fold(0, |m, s| m | 1 << s);
+                (*k, r.wanted & stale)
+            })
+            .filter(|(_, stale)| *stale != 0)
+            .collect();
+        // Deepest first: a leaf's release may leave its parent a leaf.
+        keys.sort_by(|a, b| b.0.level.cmp(&a.0.level).then(a.0.cmp(&b.0)));
+        for (key, stale) in keys {
+            let Some(r) = self.tiles.get(&key) else { continue };
+            let wanted = r.wanted & !stale;
+            if wanted == 0 && r.children == 0 {
+                self.evict(key, frame);
+                continue;
+            }
+            let chain = self.chain(key, wanted, false);
+            let pages: i64 = chain
+                .iter()
+                .map(|s| {
+                    i64::from(s.stored.count_ones()) - i64::from(self.tiles[&s.key].stored().count_ones())
+                })
+                .sum();
+            if pages <= 0 {
+                self.commit(chain, frame, r.benefit);
+            }
+        }
+    }
+
+    /// Makes `slots` of `key` wanted in `frame` with `benefit` (the refinement's), the tiles
+    /// between it and its nearest resident ancestor resident without pages, evicting tiles if
+    /// the pool is short of pages or nodes (see the module's rules), and queues the renders. A
+    /// tile that stored nothing starts its trial ([`PagePool::end_trials`]).
+    pub fn insert(&mut self, key: TileKey, slots: Slots, frame: u64, benefit: f32) -> Result<Insert> {
+        if key.level > crate::layouts::constants::ASM_MAX_LEVEL {
+            return Err(Error::Internal(format!("ASM tile {key:?} is below the deepest level")));
+        }
+        if self.note(key, slots, frame, Some(benefit)) {
             return Ok(Insert::Present);
         }
-        let parent = key.parent().expect("the root is always resident");
-        if !self.tiles.contains_key(&parent) {
-            return Err(Error::InvalidArgument(format!(
-                "ASM tile {key:?}: its parent {parent:?} is not resident"
-            )));
-        }
-        // The tile takes a page per quadrant; its parent's page under it comes free.
+        let fresh = self.tiles.get(&key).is_none_or(|r| r.wanted == 0);
         let mut evicted = 0;
-        while self.free.len() + 1 < TILE_PAGES as usize {
-            let Some(victim) = self.victim(key, frame, benefit) else { return Ok(Insert::Refused) };
-            self.evict(victim);
+        loop {
+            let wanted = match fresh {
+                true => ALL_SLOTS,
+                false => self.tiles.get(&key).map_or(0, |r| r.wanted) | slots,
+            };
+            let chain = self.chain(key, wanted, fresh);
+            let new_tiles = chain.iter().filter(|s| !self.tiles.contains_key(&s.key)).count();
+            let pages: i64 = chain
+                .iter()
+                .map(|s| {
+                    let now = self.tiles.get(&s.key).map_or(0, |r| r.stored());
+                    i64::from(s.stored.count_ones()) - i64::from(now.count_ones())
+                })
+                .sum();
+            let fits_pages = pages <= self.free.len() as i64;
+            let fits_nodes = self.tiles.len() + new_tiles <= self.max_tiles() as usize;
+            if fits_pages && fits_nodes {
+                self.commit(chain, frame, benefit);
+                if fresh {
+                    let trial = Trial { asked: slots, used: 0, ends: frame + TRIAL_FRAMES };
+                    self.tiles.get_mut(&key).expect("committed").trial = Some(trial);
+                }
+                return Ok(Insert::Inserted { evicted });
+            }
+            if self.released < frame {
+                self.released = frame;
+                self.release_stale(frame);
+                continue;
+            }
+            let Some(victim) = self.victim(key, frame, benefit) else {
+                return Ok(Insert::Refused);
+            };
+            self.evict(victim, frame);
             evicted += 1;
         }
-        let given_back = self.tiles.get_mut(&parent).and_then(|p| p.pages[key.quadrant()].take());
-        self.free.extend(given_back);
-        let pages = self.take_tile_pages();
-        self.tiles.insert(key, Resident { pages, last_used: frame, benefit });
-        self.ops.push(PageOp::tile(key, pages));
-        Ok(Insert::Inserted { evicted })
     }
 
-    fn take_tile_pages(&mut self) -> TilePages {
-        std::array::from_fn(|_| self.free.pop())
+    /// Ends the trials due by `frame`: each such tile keeps the slots asked for during it, the
+    /// others' pages come free (its ancestors store what it no longer covers, renders queued).
+    pub fn end_trials(&mut self, frame: u64) {
+        let due: Vec<(TileKey, Trial)> = self
+            .tiles
+            .iter()
+            .filter_map(|(k, r)| r.trial.filter(|t| t.ends <= frame).map(|t| (*k, t)))
+            .collect();
+        for (key, trial) in due {
+            // While half the pages are free, the slots pixels read stay too: each would cost a
+            // render when the tile's coarser neighbours no longer suffice.
+            let plenty = 2 * self.free.len() >= self.capacity as usize;
+            let keep = trial.asked | if plenty { trial.used } else { 0 };
+            let chain = self.chain(key, keep, false);
+            let pages: i64 = chain
+                .iter()
+                .map(|s| {
+                    i64::from(s.stored.count_ones()) - i64::from(self.tiles[&s.key].stored().count_ones())
+                })
+                .sum();
+            // Uncovered slots of its ancestors could take more than it gives back: then later.
+            if pages <= self.free.len() as i64 {
+                self.tiles.get_mut(&key).expect("listed above").trial = None;
+                self.commit(chain, frame, 0.0);
+            }
+        }
     }
 
-    /// Evicts leaf `key`: one of its pages takes its parent's quadrant over it back (rendered
-    /// again), the other three come free.
-    fn evict(&mut self, key: TileKey) {
+    /// The states of `key` (wanted `wanted`) and of each ancestor up to the root after the
+    /// change: a tile's cover depends on its children's.
+    /// A tile on trial covers nothing of its parent's: the parent keeps those pages, so that
+    /// the trial's end, where the tile keeps fewer slots, needs no render of the parent.
+    fn chain(&self, key: TileKey, wanted: Slots, on_trial: bool) -> Vec<Step> {
+        let mut steps: Vec<Step> = Vec::new();
+        let mut at = Some(key);
+        while let Some(k) = at {
+            let wanted = match steps.last() {
+                None => wanted,
+                Some(_) => self.tiles.get(&k).map_or(0, |r| r.wanted),
+            };
+            let full = k.children().map_or([0; 4], |children| {
+                children.map(|c| {
+                    let trial = match c == key {
+                        true => on_trial,
+                        false => self.tiles.get(&c).is_some_and(|r| r.trial.is_some()),
+                    };
+                    match steps.last().filter(|s| s.key == c) {
+                        _ if trial => 0,
+                        Some(s) => s.full,
+                        None => self.tiles.get(&c).map_or(0, |r| r.full),
+                    }
+                })
+            });
+            let covered = covered_by(full);
+            steps.push(Step { key: k, wanted, full: wanted | covered, stored: wanted & !covered });
+            at = k.parent();
+        }
+        steps
+    }
+
+    /// Applies a chain of states: pages given back first, then taken, renders queued.
+    fn commit(&mut self, chain: Vec<Step>, frame: u64, benefit: f32) {
+        for step in &chain {
+            if let Some(r) = self.tiles.get_mut(&step.key) {
+                for (s, page) in r.pages.iter_mut().enumerate() {
+                    if step.stored & 1 << s == 0 {
+                        self.free.extend(page.take());
+                    }
+                }
+            }
+        }
+        // New tiles parents first, so that each counts in its parent's children.
+        for step in chain.iter().rev() {
+            if let Entry::Vacant(vacant) = self.tiles.entry(step.key) {
+                let resident = Resident {
+                    pages: [None; SLOTS],
+                    wanted: 0,
+                    full: 0,
+                    children: 0,
+                    trial: None,
+                    last_used: frame,
+                    benefit,
+                    seen: [frame; SLOTS],
+                };
+                vacant.insert(resident);
+                if let Some(parent) = step.key.parent() {
+                    self.tiles.get_mut(&parent).expect("inserted before its child").children += 1;
+                }
+            }
+        }
+        for step in chain {
+            let r = self.tiles.get_mut(&step.key).expect("inserted above");
+            r.wanted = step.wanted;
+            r.full = step.full;
+            let mut stores = Vec::new();
+            for s in 0..SLOTS {
+                if step.stored & 1 << s != 0 && r.pages[s].is_none() {
+                    let page = self.free.pop().expect("the change was checked to fit");
+                    r.pages[s] = Some(page);
+                    stores.push((s as u32, page));
+                }
+            }
+            if !stores.is_empty() {
+                self.ops.push(PageOp { key: step.key, stores });
+            }
+        }
+    }
+
+    /// Evicts leaf `key`: its pages come free, its ancestors that wanted what it covered store
+    /// it again (renders queued), and ancestors left with no child and nothing wanted go too.
+    fn evict(&mut self, key: TileKey, frame: u64) {
         let leaf = self.tiles.remove(&key).expect("the victim is resident");
-        let [first, rest @ ..] = leaf.pages.map(|p| p.expect("a leaf stores all its quadrants"));
-        let parent_key = key.parent().expect("the root is never evicted");
-        let parent = self.tiles.get_mut(&parent_key).expect("a resident tile's parent is resident");
-        parent.pages[key.quadrant()] = Some(first);
-        self.ops.push(PageOp { key, side: ASM_PAGE_TEXELS, pages: [Some(first), None, None, None] });
-        self.free.extend(rest);
+        self.free.extend(leaf.pages.iter().flatten());
+        let mut parent = key.parent().expect("the root is never evicted");
+        self.tiles.get_mut(&parent).expect("a resident tile's parent is resident").children -= 1;
+        while parent != TileKey::ROOT {
+            let r = self.tiles[&parent];
+            if r.children > 0 || r.wanted != 0 {
+                break;
+            }
+            self.tiles.remove(&parent);
+            parent = parent.parent().expect("not the root");
+            self.tiles.get_mut(&parent).expect("a resident tile's parent is resident").children -= 1;
+        }
+        // The chain holds no new tile: `frame` and the benefit go nowhere.
+        let (wanted, on_trial) = (self.tiles[&parent].wanted, self.tiles[&parent].trial.is_some());
+        self.commit(self.chain(parent, wanted, on_trial), frame, 0.0);
     }
 
     /// The tile to evict for `key`, if any may go.
     fn victim(&self, key: TileKey, frame: u64, benefit: f32) -> Option<TileKey> {
-        let evictable = self
-            .tiles
-            .iter()
-            .filter(|(k, r)| **k != TileKey::ROOT && !k.covers(key) && r.pages.iter().all(Option::is_some));
+        let evictable =
+            self.tiles.iter().filter(|(k, r)| **k != TileKey::ROOT && !k.covers(key) && r.children == 0);
         let (stale, current): (Vec<_>, Vec<_>) = evictable.partition(|(_, r)| r.last_used < frame);
         let lru = stale.into_iter().min_by(|a, b| {
             (a.1.last_used.cmp(&b.1.last_used)).then(a.1.benefit.total_cmp(&b.1.benefit)).then(a.0.cmp(b.0))
@@ -228,85 +570,145 @@ impl PagePool {
     }
 }
 
+/// The most tiles a pool of `pages` pages holds ([`PagePool::max_tiles`]).
+pub fn max_tiles(pages: u32) -> u32 {
+    pages / 2
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     const PAGE_BYTES: u64 = DEPTH_PAGE_BYTES;
+    const ROOT_PAGES: u32 = TILE_PAGES as u32;
 
     fn child(key: TileKey, q: usize) -> TileKey {
         key.children().unwrap()[q]
     }
 
-    fn budget(pages: u64) -> u64 {
-        pages * PAGE_BYTES
+    fn bit(x: u32, y: u32) -> Slots {
+        1 << (x + SLOT_SIDE * y)
+    }
+
+    fn in_use(pool: &PagePool) -> u64 {
+        pool.bytes_in_use() / PAGE_BYTES
     }
 
     #[test]
-    fn a_pool_below_one_tile_is_an_error() {
-        let err = PagePool::new(TILE_PAGES as u32 - 1, PAGE_BYTES).unwrap_err().to_string();
+    fn a_pool_below_the_roots_slots_is_an_error() {
+        let err = PagePool::new(ROOT_PAGES - 1, PAGE_BYTES).unwrap_err().to_string();
         assert!(err.contains("holds no tile"), "{err}");
-        let mut pool = PagePool::new(TILE_PAGES as u32, PAGE_BYTES).unwrap();
-        assert_eq!((pool.capacity(), pool.max_tiles(), pool.bytes_in_use()), (4, 1, budget(4)));
-        let root = pool.pages(TileKey::ROOT).unwrap();
-        assert_eq!(pool.take_ops(), vec![PageOp::tile(TileKey::ROOT, root)]);
-        assert_eq!(pool.insert(child(TileKey::ROOT, 0), 1, 1.0).unwrap(), Insert::Refused);
-    }
-
-    /// A child takes four pages and its parent gives back the one under it; evicting the child
-    /// gives that quadrant back to the parent, its render (the child's square at the parent's
-    /// resolution) queued after the child's.
-    #[test]
-    fn a_child_takes_three_pages_and_eviction_gives_its_quadrant_back() {
-        let mut pool = PagePool::new(7, PAGE_BYTES).unwrap();
-        pool.take_ops();
-        let a = child(TileKey::ROOT, 2);
-        assert_eq!(pool.insert(a, 1, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
-        assert_eq!(pool.bytes_in_use(), budget(7));
-        assert_eq!(pool.pages(TileKey::ROOT).unwrap()[2], None, "the root's quadrant under a is given back");
-        let a_pages = pool.pages(a).unwrap().map(Option::unwrap);
-        // Full: b takes a's place (a used in frame 1, stale in frame 2).
-        let b = child(TileKey::ROOT, 1);
-        assert_eq!(pool.insert(b, 2, 1.0).unwrap(), Insert::Inserted { evicted: 1 });
+        let mut pool = PagePool::new(ROOT_PAGES, PAGE_BYTES).unwrap();
+        assert_eq!((pool.capacity(), in_use(&pool)), (ROOT_PAGES, TILE_PAGES));
         let ops = pool.take_ops();
-        assert_eq!(ops[0], PageOp::tile(a, a_pages.map(Some)));
-        // a's square at the root's resolution: the root's quadrant over it.
-        let restored = PageOp { key: a, side: ASM_PAGE_TEXELS, pages: [Some(a_pages[0]), None, None, None] };
-        assert_eq!(ops[1], restored);
-        assert_eq!(pool.pages(TileKey::ROOT).unwrap()[2], Some(a_pages[0]));
-        assert_eq!(ops[2].key, b);
-        assert_eq!(ops.len(), 3);
-        assert!(!pool.contains(a) && pool.contains(b));
+        assert_eq!((ops.len(), ops[0].key, ops[0].stores.len()), (1, TileKey::ROOT, SLOTS));
+        assert_eq!(pool.insert(child(TileKey::ROOT, 0), bit(0, 0), 1, 1.0).unwrap(), Insert::Refused);
     }
 
+    /// A new tile stores every slot until its trial ends, then the slots asked for (and, with
+    /// half the pages free, those read); a slot it does not store is read from its parent's.
     #[test]
-    fn tiles_grow_from_the_root_and_evict_least_recently_used_leaves() {
-        // Room for the root and two children (3N + 1 = 10 pages).
-        let mut pool = PagePool::new(10, PAGE_BYTES).unwrap();
-        let (a, b) = (child(TileKey::ROOT, 0), child(TileKey::ROOT, 3));
-        assert!(pool.insert(child(a, 0), 1, 1.0).is_err(), "parent missing");
-        assert_eq!(pool.insert(a, 1, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
-        assert_eq!(pool.insert(b, 2, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
-        // Full. Frame 3 wants a's child: b (used at 2) is the least recently used leaf; a is
-        // the new tile's parent and stays.
-        assert_eq!(pool.insert(child(a, 1), 3, 1.0).unwrap(), Insert::Inserted { evicted: 1 });
-        assert!(!pool.contains(b));
-        // Now a has a resident child, so only that child is evictable; used this frame, it
-        // goes only for a benefit EVICTION_MARGIN times as large.
-        assert_eq!(pool.insert(b, 3, 0.5).unwrap(), Insert::Refused);
-        assert_eq!(pool.insert(b, 3, EVICTION_MARGIN).unwrap(), Insert::Refused);
-        assert_eq!(pool.insert(b, 3, 1.01 * EVICTION_MARGIN).unwrap(), Insert::Inserted { evicted: 1 });
-        assert!(pool.touch(a, 4) && !pool.touch(child(a, 1), 4));
-        assert!(pool.contains(TileKey::ROOT), "the root is never evicted");
+    fn a_trial_keeps_the_slots_asked_for() {
+        let mut pool = PagePool::new(64, PAGE_BYTES).unwrap();
+        pool.take_ops();
+        let a = child(TileKey::ROOT, 0);
+        assert_eq!(pool.insert(a, bit(1, 1), 1, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
+        // On trial it covers nothing of the root's.
+        assert_eq!(in_use(&pool), 2 * TILE_PAGES);
+        assert_eq!(pool.take_ops()[0].stores.len(), SLOTS);
+        assert!(pool.note(a, bit(2, 1), 2, None), "asked for on trial: no render");
+        pool.note_used(a, bit(3, 3), 2);
+        pool.end_trials(TRIAL_FRAMES);
+        assert_eq!(pool.stores(a).len(), SLOTS, "not over before its last frame");
+        // 32 of 64 pages in use: half are free, so the slot read stays too.
+        pool.end_trials(1 + TRIAL_FRAMES);
+        let kept: Vec<u32> = pool.stores(a).iter().map(|s| s.0).collect();
+        assert_eq!(kept, vec![5, 6, 15]);
+        assert!(pool.take_ops().is_empty(), "a trial's end renders nothing");
+        assert_eq!(in_use(&pool), TILE_PAGES + 3);
+        // Slot (0, 0) of `a` is the root's slot (0, 0), one level up.
+        assert_eq!(pool.holder(a, 0).unwrap(), (pool.pages(TileKey::ROOT).unwrap()[0].unwrap(), 1));
+        // Asked for later, a slot costs a render of the tile.
+        assert!(!pool.note(a, bit(0, 0), 9, None));
+        assert_eq!(pool.insert(a, bit(0, 0), 9, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
+        assert_eq!(
+            pool.take_ops(),
+            vec![PageOp { key: a, stores: vec![(0, pool.pages(a).unwrap()[0].unwrap())] }]
+        );
     }
 
-    /// Random requests over many frames: the pool never holds more than its budget, N tiles
-    /// hold 3N + 1 pages, the root stays, every resident tile's parent is resident (the lookup
-    /// reaches it), a tile stores exactly the quadrants no resident child covers, and no two
-    /// stored quadrants share a page.
+    /// A parent's slot whose four slots below its child stores gives its page back, and stores
+    /// it again (a render of the parent) when the child is evicted.
+    #[test]
+    fn a_covered_slot_is_given_back_and_stored_again_after_eviction() {
+        let mut pool = PagePool::new(48, PAGE_BYTES).unwrap();
+        let a = child(TileKey::ROOT, 0);
+        let under = bit(0, 0) | bit(1, 0) | bit(0, 1) | bit(1, 1);
+        pool.insert(a, under, 1, 1.0).unwrap();
+        // 32 of 48 in use: fewer than half free, so the slots asked for alone stay.
+        pool.end_trials(1 + TRIAL_FRAMES);
+        assert_eq!(pool.pages(TileKey::ROOT).unwrap()[0], None, "covered by a");
+        assert_eq!(in_use(&pool), TILE_PAGES - 1 + 4);
+        pool.take_ops();
+        // Another tile needs 16 pages; 29 are free. A third one evicts the least recently used.
+        let b = child(TileKey::ROOT, 3);
+        assert_eq!(pool.insert(b, bit(3, 3), 7, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
+        let c = child(TileKey::ROOT, 1);
+        assert_eq!(pool.insert(c, bit(3, 0), 8, 1.0).unwrap(), Insert::Inserted { evicted: 1 });
+        assert!(!pool.contains(a) && pool.contains(b) && pool.contains(c));
+        let ops = pool.take_ops();
+        let root_page = pool.pages(TileKey::ROOT).unwrap()[0].expect("stored again");
+        assert_eq!(ops[1], PageOp { key: TileKey::ROOT, stores: vec![(0, root_page)] });
+        assert_eq!(ops[2].key, c);
+    }
+
+    /// A full pool gives back the slots nobody asked for or read in `STALE_FRAMES` before it
+    /// weighs benefits: the tile stays with the slots still in use.
+    #[test]
+    fn stale_slots_are_given_back_when_pages_run_short() {
+        let mut pool = PagePool::new(ROOT_PAGES + 17, PAGE_BYTES).unwrap();
+        let a = child(TileKey::ROOT, 0);
+        pool.insert(a, bit(0, 0) | bit(3, 3), 1, 10.0).unwrap();
+        pool.end_trials(1 + TRIAL_FRAMES);
+        assert_eq!(pool.stores(a).len(), 2);
+        // Slot (0, 0) is read in frame 20, (3, 3) was last asked for in frame 1.
+        let frame = 2 + STALE_FRAMES + TRIAL_FRAMES;
+        pool.note_used(a, bit(0, 0), frame);
+        pool.touch(a, frame);
+        // 15 pages free, 16 needed; by benefit alone (1 against 10) nothing may go.
+        let b = child(TileKey::ROOT, 1);
+        assert_eq!(pool.insert(b, bit(0, 0), frame, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
+        assert_eq!(pool.stores(a).iter().map(|s| s.0).collect::<Vec<_>>(), vec![0]);
+        // Nothing stale is left: the next tile is refused.
+        let c = child(TileKey::ROOT, 2);
+        assert_eq!(pool.insert(c, bit(0, 0), frame, 1.0).unwrap(), Insert::Refused);
+    }
+
+    /// A lookup falling back to an ancestor's slot keeps that slot in use.
+    #[test]
+    fn a_slot_read_from_below_is_seen() {
+        let mut pool = PagePool::new(64, PAGE_BYTES).unwrap();
+        let a = child(TileKey::ROOT, 0);
+        let d = child(a, 3);
+        pool.insert(a, ALL_SLOTS, 1, 1.0).unwrap();
+        pool.insert(d, bit(0, 0), 1, 1.0).unwrap();
+        pool.end_trials(1 + TRIAL_FRAMES);
+        assert_eq!((pool.stores(a).len(), pool.stores(d).len()), (SLOTS, 1));
+        // d's slot (3, 3) lies in a's slot (3, 3), its slots (0, 0) and (1, 1) in a's (2, 2).
+        assert_eq!(parent_slots(d, bit(3, 3)), bit(3, 3));
+        assert_eq!(parent_slots(d, bit(0, 0) | bit(1, 1)), bit(2, 2));
+        pool.note_read_above(d, bit(3, 3), 9);
+        assert_eq!(pool.tiles[&a].seen[15], 9);
+        assert_eq!(pool.tiles[&a].seen[0], 1, "asked for when inserted");
+    }
+
+    /// Random requests over many frames: the pool never holds more than its budget or its
+    /// nodes, the root stays, every resident tile's parent is resident (the lookup reaches it),
+    /// a tile stores exactly its wanted slots that its children do not cover, every point
+    /// finds a stored slot, and no two stored slots share a page.
     #[test]
     fn the_budget_is_never_exceeded() {
-        let budget = budget(40);
-        let mut pool = PagePool::new(40, PAGE_BYTES).unwrap();
+        let capacity = 160;
+        let mut pool = PagePool::new(capacity, PAGE_BYTES).unwrap();
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = || {
             state ^= state << 13;
@@ -314,38 +716,52 @@ mod tests {
             state ^= state << 17;
             state
         };
-        let (mut replaced, mut refused) = (0, 0);
+        let (mut replaced, mut refused, mut trials) = (0, 0, 0);
         for frame in 1..400u64 {
             for _ in 0..8 {
-                // A random resident tile's random child: the refinement's shape.
+                // A random resident tile's random descendant one or two levels down.
                 let resident: Vec<TileKey> = pool.resident().map(|(k, _)| k).collect();
-                let parent = resident[(next() % resident.len() as u64) as usize];
-                let Some(children) = parent.children() else { continue };
-                let key = children[(next() % 4) as usize];
-                match pool.insert(key, frame, (next() % 100) as f32).unwrap() {
-                    Insert::Inserted { evicted } => replaced += evicted,
-                    Insert::Refused => refused += 1,
-                    Insert::Present => {}
+                let mut key = resident[(next() % resident.len() as u64) as usize];
+                for _ in 0..1 + next() % 2 {
+                    key = key.children().map_or(key, |c| c[(next() % 4) as usize]);
                 }
-                let tiles = pool.resident().count() as u64;
-                assert!(pool.bytes_in_use() <= budget && tiles <= u64::from(pool.max_tiles()));
-                assert_eq!(pool.bytes_in_use(), (3 * tiles + 1) * PAGE_BYTES);
-                assert!(pool.contains(TileKey::ROOT));
-                let mut pages: Vec<u32> = Vec::new();
-                for (k, stored) in pool.resident() {
-                    assert!(k.parent().is_none_or(|p| pool.contains(p)), "{k:?} cut off");
-                    for (q, page) in stored.iter().enumerate() {
-                        let covered = k.children().is_some_and(|c| pool.contains(c[q]));
-                        assert_eq!(page.is_none(), covered, "{k:?} quadrant {q}");
-                        pages.extend(page);
+                let slots = (next() & next() & 0xffff) as Slots;
+                if !pool.note(key, slots, frame, None) {
+                    match pool.insert(key, slots, frame, (next() % 100) as f32).unwrap() {
+                        Insert::Inserted { evicted } => replaced += evicted,
+                        Insert::Refused => refused += 1,
+                        Insert::Present => {}
                     }
                 }
-                let count = pages.len();
-                pages.sort_unstable();
-                pages.dedup();
-                assert_eq!(pages.len(), count, "two quadrants share a page");
+                pool.note_used(key, (next() & 0xffff) as Slots, frame);
             }
+            trials += pool.tiles.values().filter(|r| r.trial.is_some_and(|t| t.ends <= frame)).count();
+            pool.end_trials(frame);
+            assert!(in_use(&pool) <= u64::from(capacity) && pool.tiles.len() <= pool.max_tiles() as usize);
+            assert!(pool.contains(TileKey::ROOT));
+            let mut pages: Vec<u32> = Vec::new();
+            for (&k, r) in &pool.tiles {
+                assert!(k.parent().is_none_or(|p| pool.contains(p)), "{k:?} cut off");
+                // The deepest level has no children.
+                let full = k.children().map_or([0; 4], |children| {
+                    children.map(|c| pool.tiles.get(&c).filter(|r| r.trial.is_none()).map_or(0, |r| r.full))
+                });
+                assert_eq!(r.stored(), r.wanted & !covered_by(full), "{k:?}");
+                // A point in a slot with no child over it reads this tile's or an ancestor's.
+                for slot in 0..SLOT_SIDE * SLOT_SIDE {
+                    let (x, y) = (slot % SLOT_SIDE, slot / SLOT_SIDE);
+                    if !k.children().is_some_and(|c| pool.contains(c[(x / 2 + 2 * (y / 2)) as usize])) {
+                        pool.holder(k, slot).unwrap();
+                    }
+                }
+                pages.extend(r.pages.iter().flatten());
+            }
+            let count = pages.len();
+            assert_eq!(count as u64, in_use(&pool));
+            pages.sort_unstable();
+            pages.dedup();
+            assert_eq!(pages.len(), count, "two slots share a page");
         }
-        assert!(replaced > 100 && refused > 0, "the test should exercise eviction: {replaced}, {refused}");
+        assert!(replaced > 100 && refused > 0 && trials > 100, "{replaced}, {refused}, {trials}");
     }
 }

@@ -8,12 +8,14 @@
 //!    `depth_prepass` draws the scene's depth from the eye (the lighting pass shades over it),
 //!    and `asm_analysis` finds, per eye pixel (one of each 2×2 block per frame, in turn), the
 //!    tile it uses, and records the pixels on shadow edges short of resolution;
-//! 2. the host marks the used tiles, counts the edge pixels for the chain of finer tiles each
-//!    asks for, and plans within the time budget (`plan`); then the frame: `asm_tiles` renders
-//!    the planned tiles, each depth-only with the light's projection cropped to its square, into
-//!    the pool's pages (and the quadrants evictions give back, at the parents' resolution;
-//!    `pages`, one debug label each), and `scene` shades with each point's visibility looked up
-//!    in the finest resident tile holding it (the page table's directory and descent).
+//! 2. the host marks the used tiles, counts the edge pixels for the slots of the chain of finer
+//!    tiles each asks for (and the slots pixels whose texels come from two levels up ask of
+//!    their tile's parent), ends the trials due (`pool`), and plans within the time budget
+//!    (`plan`); then the frame: `asm_tiles` renders the planned tiles, each depth-only with the
+//!    light's projection cropped to its square, into the pool's pages (and the slots ancestors
+//!    store again when an eviction or a trial's end uncovers them; `pages`, one debug label
+//!    each), and `scene` shades with each point's visibility looked up in the finest resident
+//!    tile holding it (the page table's directory and descent).
 //!
 //! The light's view and lighting are the shadowmap technique's (`shadow_light`, the same bias),
 //! so the two compare pixel by pixel. Invalidation: the light's record changing (it moved or
@@ -27,7 +29,10 @@ use super::memory::{self, edge_records, AsmMemory};
 use super::page_table;
 use super::pages::{PageStore, TileWrite};
 use super::plan::{plan, rescaled, CostModel, Request};
-use super::pool::{Insert, PageOp, PagePool, DEPTH_PAGE_BYTES, ID_PAGE_BYTES, TILE_PAGES};
+use super::pool::{
+    parent_slots, Insert, PageOp, PagePool, Slots, ANALYSIS_PHASES, DEPTH_PAGE_BYTES, ID_PAGE_BYTES,
+    SLOT_SIDE, TILE_PAGES,
+};
 use super::tile::TileKey;
 use crate::backend::{
     Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, DepthTest, Edge,
@@ -216,7 +221,7 @@ pub struct AsmStats {
     /// Tiles rendered again this frame because a moving group touched them, in render order.
     pub refreshed: Vec<TileKey>,
     /// Tiles rendered this frame for the refinement, in render order (a tile refined, or given
-    /// a quadrant back by an eviction).
+    /// slots back by an eviction or a trial's end).
     pub rendered: Vec<TileKey>,
     /// Tiles evicted this frame.
     pub evicted: usize,
@@ -279,11 +284,13 @@ pub struct Asm {
     table_keys: Vec<TileKey>,
     /// Resident tiles a moving group made stale, rendered before the analysis.
     refresh: Vec<TileWrite>,
-    /// Tiles the analysis asked for, and the quadrants evictions gave back, before the lighting.
+    /// Tiles the analysis asked for, and the slots evictions gave back, before the lighting.
     render: Vec<TileWrite>,
     /// Tiles evicted this frame.
     evicted: usize,
     stats: AsmStats,
+    /// Requests for more slots of tiles rendered already, gathered since the frame given.
+    deferred: HashMap<TileKey, (Request, u64)>,
 }
 
 impl Asm {
@@ -412,6 +419,7 @@ impl Asm {
             refresh: Vec::new(),
             render: Vec::new(),
             evicted: 0,
+            deferred: HashMap::new(),
             // The memory is known from the start, before the first frame's statistics.
             stats: AsmStats { memory, budget_bytes: settings.budget_bytes(), ..Default::default() },
         };
@@ -442,10 +450,12 @@ impl Asm {
                 y,
             }));
         }
-        let pages = self.pool.pages(TileKey::ROOT).expect("the root is always resident");
+        let stores = self.pool.stores(TileKey::ROOT);
         let renders: Vec<TileWrite> = keys
             .iter()
-            .map(|&key| tile_write(PageOp::tile(key, pages), &view_proj, &self.clusters, &rects))
+            .map(|&key| {
+                tile_write(PageOp { key, stores: stores.clone() }, &view_proj, &self.clusters, &rects)
+            })
             .collect();
         let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
         let mut samples = Vec::new();
@@ -499,14 +509,17 @@ impl Asm {
 
     /// Marks the tiles the last frame's lighting and this frame's analysis looked up as used
     /// (the analysis sees the new view first), and counts the analysis' edge pixels for the
-    /// tiles of their chains: the tiles under the pixel's towards it, as deep as it lacks
-    /// levels (at most `ASM_CHAIN_LEVELS`), each counting the pixel and the levels it still
-    /// lacks at that tile's parent.
+    /// slots they ask for: each pixel the slot holding it in the tile as many levels below the
+    /// tile its texels came from as it lacks (at most `ASM_CHAIN_LEVELS`), with the levels it
+    /// lacks.
     fn read_requests(&mut self) -> Result<Vec<Request>> {
-        // A record's cells are 16 bits an axis (x | y << 16), fine enough for every level of a chain.
+        // A record's cells are 16 bits an axis (x | y << 16), fine enough for every level of a
+        // chain; its first word holds the node, then 5 bits of levels missing and 5 of levels up.
         const _: () = assert!(
             constants::ASM_EDGE_CELL_BITS == 16
-                && constants::ASM_CHAIN_LEVELS <= constants::ASM_EDGE_CELL_BITS
+                && constants::ASM_CHAIN_LEVELS + 6 <= constants::ASM_EDGE_CELL_BITS
+                && constants::ASM_MAX_LEVEL < 32
+                && constants::ASM_EDGE_NODE_BITS + 10 == 32
         );
         let last = (self.frame - 1) as u32;
         for (key, mark) in self.lit_keys.iter().zip(read_words(&self.used)?) {
@@ -516,35 +529,87 @@ impl Asm {
         }
         let words = read_words(&self.requests)?;
         let nodes = self.pool.max_tiles() as usize;
+        let mut asked: HashMap<TileKey, (Slots, u32, u32)> = HashMap::new();
         for (node, &key) in self.table_keys.iter().enumerate() {
-            if words[1 + node] != 0 {
+            let (word, used) = (words[1 + 2 * node], words[2 + 2 * node]);
+            if word | used != 0 {
                 self.pool.touch(key, self.frame);
+            }
+            self.pool.note_used(key, used as Slots, self.frame);
+            self.pool.note_read_above(key, (used >> 16) as Slots, self.frame);
+            // Slots on edges its own texels resolve: kept when a trial ends.
+            self.pool.note(key, (word >> 16) as Slots, self.frame, None);
+            // Slots of pixels whose texels came from two levels up or more: the slots of the
+            // tile's parent over them, so that they come from one level up at most.
+            let fill = (word & 0xffff) as Slots;
+            if let (true, Some(parent)) = (fill != 0, key.parent()) {
+                let slots = parent_slots(key, fill);
+                let entry = asked.entry(parent).or_default();
+                entry.0 |= slots;
+                entry.1 += slots.count_ones();
+                entry.2 += FILL_BENEFIT * slots.count_ones();
             }
         }
         let count = words[0].min(self.edge_capacity) as usize;
-        let mut asked: HashMap<TileKey, (u32, u32)> = HashMap::new();
-        for edge in words[1 + nodes..].chunks_exact(constants::ASM_EDGE_WORDS as usize).take(count) {
-            let (key, missing) = (self.table_keys[(edge[0] & 0xff_ffff) as usize], edge[0] >> 24);
-            let within = [edge[1] & 0xffff, edge[1] >> 16];
+        let node_bits = constants::ASM_EDGE_NODE_BITS;
+        for edge in words[1 + 2 * nodes..].chunks_exact(constants::ASM_EDGE_WORDS as usize).take(count) {
+            let at = self.table_keys[(edge[0] & ((1 << node_bits) - 1)) as usize];
+            let (missing, up) = ((edge[0] >> node_bits) & 31, edge[0] >> (node_bits + 5));
+            let from = at.level.saturating_sub(up);
             for depth in 1..=missing.min(constants::ASM_CHAIN_LEVELS) {
-                let Some(tile) = key.descendant(within, depth) else { break };
-                let slot = asked.entry(tile).or_default();
-                slot.0 += 1;
-                slot.1 += missing - depth + 1;
+                let Some((key, texel)) = at.at_level([edge[1] & 0xffff, edge[1] >> 16], from + depth) else {
+                    break;
+                };
+                let slot = texel[0] / constants::ASM_PAGE_TEXELS
+                    + SLOT_SIDE * (texel[1] / constants::ASM_PAGE_TEXELS);
+                let entry = asked.entry(key).or_default();
+                entry.0 |= 1 << slot;
+                entry.1 += 1;
+                entry.2 += missing - depth + 1;
             }
         }
         Ok(asked
             .into_iter()
-            .map(|(key, (edge_pixels, missing_levels))| {
+            .map(|(key, (slots, edge_pixels, missing_levels))| {
                 let triangles = draw_triangles(&tile_draws(&self.clusters, &self.cluster_rects, key));
-                Request { key, edge_pixels, missing_levels, triangles }
+                Request { key, slots, edge_pixels, missing_levels, triangles }
             })
             .collect())
     }
 
+    /// Requests for more slots of a tile rendered already wait until the analysis has been over
+    /// every pixel (its four phases), gathered, so that the tile renders once for all of them
+    /// (asked for one phase at a time, most renders were such extensions); a new tile's do not.
+    fn defer_extensions(&mut self, requests: Vec<Request>) -> Vec<Request> {
+        let mut ready = Vec::new();
+        for r in requests {
+            if !self.pool.pages(r.key).is_some_and(|p| p.iter().any(Option::is_some)) {
+                ready.push(r);
+                continue;
+            }
+            let empty = Request { slots: 0, edge_pixels: 0, missing_levels: 0, ..r };
+            let (gathered, _) = self.deferred.entry(r.key).or_insert((empty, self.frame));
+            gathered.slots |= r.slots;
+            gathered.edge_pixels += r.edge_pixels;
+            gathered.missing_levels += r.missing_levels;
+        }
+        let (frame, pool) = (self.frame, &self.pool);
+        self.deferred.retain(|key, (r, since)| {
+            if !pool.contains(*key) {
+                return false;
+            }
+            let due = frame + 1 - *since >= ANALYSIS_PHASES;
+            if due {
+                ready.push(*r);
+            }
+            !due
+        });
+        ready
+    }
+
     /// Rebuilds the page table from the pool and uploads it.
     fn write_table(&mut self) -> Result<()> {
-        let table = page_table::build(&self.pool, &self.pages.layout());
+        let table = page_table::build(&self.pool, &self.pages.layout())?;
         self.table.write(0, &table.bytes())?;
         self.table_keys = table.keys;
         Ok(())
@@ -589,12 +654,15 @@ fn tile_write(
 ) -> TileWrite {
     TileWrite {
         key: op.key,
-        side: op.side,
-        pages: op.pages,
         view_proj: tile_view_proj(view_proj, op.key),
         draws: tile_draws(clusters, rects, op.key),
+        stores: op.stores,
     }
 }
+
+/// The benefit of a slot asked for to keep a pixel's texels from coming from more than one level
+/// up, as many edge pixels' levels lacking.
+const FILL_BENEFIT: u32 = 16;
 
 /// Triangles of index runs.
 fn draw_triangles(draws: &[(usize, u32, u32)]) -> u64 {
@@ -629,6 +697,7 @@ impl Technique for Asm {
             // The light moved (or the depth range changed): every tile's depths are stale. The
             // new pool queues the root's render.
             self.pool = PagePool::new(self.pages.layout().pages(), self.settings.test.page_bytes())?;
+            self.deferred.clear();
         } else {
             let moved: Vec<UvRect> = (0..rects.len())
                 .filter(|&g| self.transforms[g] != state.transforms[g])
@@ -671,7 +740,7 @@ impl Technique for Asm {
             ctx.full_barrier(cmd);
             let push = AsmAnalysisPush {
                 size: [width, height, self.pool.max_tiles(), self.edge_capacity],
-                phase: [(self.frame % 4) as u32, 0, 0, 0],
+                phase: [(self.frame % ANALYSIS_PHASES) as u32, 0, 0, 0],
                 bias: DEPTH_BIAS,
             };
             let group = constants::ASM_ANALYSIS_GROUP;
@@ -693,36 +762,34 @@ impl Technique for Asm {
     }
 
     fn analysed(&mut self) -> Result<()> {
-        let requests = self.read_requests()?;
+        let mut requests = self.read_requests()?;
+        requests.retain(|r| !self.pool.note(r.key, r.slots, self.frame, Some(r.benefit() as f32)));
+        let requests = self.defer_extensions(requests);
         let model = self.cost.scaled(self.cost_scale);
         let (frame, time_ms, view_proj) = (self.frame, self.time_budget_ms(), self.view_proj());
-        let resident: std::collections::HashSet<TileKey> = self.pool.resident().map(|(k, _)| k).collect();
         self.evicted = 0;
         let mut planned = Vec::new();
-        plan(
-            requests,
-            &model,
-            time_ms,
-            |key| resident.contains(&key),
-            |request| {
-                // A parent evicted by an earlier insertion of this frame refuses its child (an error
-                // from the pool), as a pool with no page to free does: the child waits. The pool
-                // weighs tiles by benefit alone: an eviction trades pages, which every tile takes
-                // alike, where the plan's order trades milliseconds.
-                let Ok(Insert::Inserted { evicted }) =
-                    self.pool.insert(request.key, frame, request.benefit() as f32)
-                else {
-                    return None;
-                };
-                self.evicted += evicted;
-                let (clusters, rects) = (&self.clusters, &self.cluster_rects);
-                let writes =
-                    self.pool.take_ops().into_iter().map(|op| tile_write(op, &view_proj, clusters, rects));
-                let before = planned.len();
-                planned.extend(writes);
-                Some(planned[before..].iter().map(|w| model.cost_ms(draw_triangles(&w.draws))).sum())
-            },
-        );
+        plan(requests, &model, time_ms, |request| {
+            // A parent evicted by an earlier insertion of this frame refuses its child (an error
+            // from the pool), as a pool with no page to free does: the child waits. The pool
+            // weighs tiles by benefit alone: an eviction trades pages, which every tile takes
+            // alike, where the plan's order trades milliseconds.
+            let Ok(Insert::Inserted { evicted }) =
+                self.pool.insert(request.key, request.slots, frame, request.benefit() as f32)
+            else {
+                return None;
+            };
+            self.evicted += evicted;
+            let (clusters, rects) = (&self.clusters, &self.cluster_rects);
+            let writes =
+                self.pool.take_ops().into_iter().map(|op| tile_write(op, &view_proj, clusters, rects));
+            let before = planned.len();
+            planned.extend(writes);
+            Some(planned[before..].iter().map(|w| model.cost_ms(draw_triangles(&w.draws))).sum())
+        });
+        self.pool.end_trials(frame);
+        let ops = self.pool.take_ops();
+        planned.extend(self.writes(ops));
         self.render = planned;
         self.planned_ms = self.render.iter().map(|w| self.cost.cost_ms(draw_triangles(&w.draws))).sum();
         self.write_table()?;
@@ -734,8 +801,7 @@ impl Technique for Asm {
             resident_tiles: self.table_keys.len(),
             deepest_level: self.table_keys.iter().map(|k| k.level).max().unwrap_or(0),
             refreshed: self.refresh.iter().map(|w| w.key).collect(),
-            // A quadrant given back is its parent's texels.
-            rendered: self.render.iter().map(|w| w.owner()).collect(),
+            rendered: self.render.iter().map(|w| w.key).collect(),
             evicted: self.evicted,
             cost: (model.ms_per_triangle, model.ms_per_tile),
         };

@@ -1,7 +1,7 @@
 //! Tiles of the quadtree over the light's view, addressed by level and position. The view is
 //! the unit square of the light map's uv (u right, v down, as the shadow maps' texel rows); the
 //! root (level 0) covers all of it, and tile (L, x, y) covers [x, x + 1) × [y, y + 1) / 2^L.
-use crate::layouts::constants::{ASM_EDGE_CELL_BITS, ASM_MAX_LEVEL};
+use crate::layouts::constants::{ASM_EDGE_CELL_BITS, ASM_MAX_LEVEL, ASM_TILE_TEXELS};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct TileKey {
@@ -45,17 +45,21 @@ impl TileKey {
         (2 * (self.y & 1) + (self.x & 1)) as usize
     }
 
-    /// The descendant `depth` levels down (1 ..= [`ASM_EDGE_CELL_BITS`]) holding the point at
-    /// `cell` within this tile, in units of 2^-ASM_EDGE_CELL_BITS of its side (as the
-    /// analysis's edge records give it); `None` below the deepest level.
-    pub fn descendant(self, cell: [u32; 2], depth: u32) -> Option<TileKey> {
-        let level = self.level + depth;
-        let down = |at: u32, c: u32| at << depth | c >> (ASM_EDGE_CELL_BITS - depth);
-        (level <= ASM_MAX_LEVEL).then(|| TileKey {
-            level,
-            x: down(self.x, cell[0]),
-            y: down(self.y, cell[1]),
-        })
+    /// The tile of `level` holding the point at `cell` within this tile, in units of
+    /// 2^-ASM_EDGE_CELL_BITS of its side (as the analysis's edge records give it), and the
+    /// point's texel in that tile; an ancestor of this tile or a descendant at most
+    /// `ASM_EDGE_CELL_BITS - log2(ASM_TILE_TEXELS)` levels down, else `None`.
+    pub fn at_level(self, cell: [u32; 2], level: u32) -> Option<(TileKey, [u32; 2])> {
+        let bits = self.level + ASM_EDGE_CELL_BITS;
+        let texel_bits = ASM_TILE_TEXELS.trailing_zeros();
+        if level > ASM_MAX_LEVEL || level + texel_bits > bits {
+            return None;
+        }
+        let point = |tile: u32, c: u32| u64::from(tile) << ASM_EDGE_CELL_BITS | u64::from(c);
+        let (x, y) = (point(self.x, cell[0]), point(self.y, cell[1]));
+        let tile = |p: u64| (p >> (bits - level)) as u32;
+        let texel = |p: u64| (p >> (bits - level - texel_bits)) as u32 % ASM_TILE_TEXELS;
+        Some((TileKey { level, x: tile(x), y: tile(y) }, [texel(x), texel(y)]))
     }
 
     /// Whether `self` is `other` or one of its ancestors.
@@ -91,21 +95,29 @@ mod tests {
     }
 
     #[test]
-    fn an_edge_records_cell_names_the_descendants_its_point_lies_in() {
+    fn an_edge_records_cell_names_the_tiles_and_texels_its_point_lies_in() {
         let cells = (1u32 << ASM_EDGE_CELL_BITS) as f64;
         for (i, level) in (0..=12).enumerate() {
-            // Points spread over the view, none on a tile border of the levels below.
+            // Points spread over the view, none on a texel border of the levels asked.
             let uv = [(0.137 + 0.071 * i as f64) % 1.0, (0.911 - 0.053 * i as f64) % 1.0];
             let key = TileKey::containing(uv.map(|c| c as f32), level).unwrap();
             let n = (1u64 << level) as f64;
             let cell =
                 [uv[0] * n - f64::from(key.x), uv[1] * n - f64::from(key.y)].map(|c| (c * cells) as u32);
-            for depth in 1..=4 {
-                let expected = TileKey::containing(uv.map(|c| c as f32), level + depth);
-                assert_eq!(key.descendant(cell, depth), expected, "uv {uv:?}, level {level} + {depth}");
+            for at in level.saturating_sub(3)..=level + 4 {
+                let expected = TileKey::containing(uv.map(|c| c as f32), at).unwrap();
+                let side = (1u64 << at) as f64 * f64::from(ASM_TILE_TEXELS);
+                let texel =
+                    [uv[0] * side, uv[1] * side].map(|t| (t as u64 % u64::from(ASM_TILE_TEXELS)) as u32);
+                assert_eq!(
+                    key.at_level(cell, at),
+                    Some((expected, texel)),
+                    "uv {uv:?}, level {level} to {at}"
+                );
             }
+            assert_eq!(key.at_level(cell, level + 11), None, "finer than the cell");
         }
         let deepest = TileKey::containing([0.5, 0.5], ASM_MAX_LEVEL).unwrap();
-        assert_eq!(deepest.descendant([0, 0], 1), None);
+        assert_eq!(deepest.at_level([0, 0], ASM_MAX_LEVEL + 1), None);
     }
 }
