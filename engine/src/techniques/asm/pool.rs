@@ -6,7 +6,8 @@
 //! the eye pixel, a finest tile spans a pixel or two and a shadow edge crosses a few of its
 //! slots, and a slot no pixel looks up needs no texels. A point in a slot its finest resident
 //! tile does not store reads the nearest ancestor's slot that holds it (the page table names
-//! it), at worst the root's, which wants every slot.
+//! it), at worst the root's, which wants every slot, as do the tiles down to `WHOLE_LEVELS`
+//! (so that no lookup falls back further than a level-3 tile's texels).
 //!
 //! A new tile is on *trial* for `TRIAL_FRAMES`: it stores every slot (its render is paid
 //! anyway; the analysis sees a quarter of the pixels a frame, and each slot asked for later
@@ -55,6 +56,13 @@ pub const SLOT_SIDE: u32 = ASM_TILE_TEXELS / ASM_PAGE_TEXELS;
 /// Slots of a tile: the root's pages.
 pub const TILE_PAGES: u64 = SLOT_SIDE as u64 * SLOT_SIDE as u64;
 const SLOTS: usize = TILE_PAGES as usize;
+
+/// Tiles down to this level keep every slot, never trimmed at a trial's end nor given back
+/// stale. With slots alone a pixel where no edge asked for texels before reads a far ancestor's
+/// slot (the root's 64² over the whole view), which misses thin occluders: after a camera jump
+/// of 1,000 px at 512², 1 % of the pixels leaked for a frame (BENCHMARKS.md, "At 512²"). At most
+/// 85 tiles (1.3 MiB of depth pages), and the tiles every view asks for nearly whole.
+const WHOLE_LEVELS: u32 = 3;
 
 /// Frames after which a slot nobody asked for or read is given back when pages run short:
 /// twice the analysis's phases, in each of which it sees a quarter of the pixels.
@@ -183,6 +191,8 @@ pub struct PagePool {
     ops: Vec<PageOp>,
     /// The last frame stale slots were given back in.
     released: u64,
+    /// Tiles down to this level keep every slot (see [`WHOLE_LEVELS`]).
+    whole: u32,
 }
 
 /// A tile's state along a change's chain: its new wanted and full slots.
@@ -197,6 +207,11 @@ impl PagePool {
     /// A pool of `capacity` pages of `page_bytes`, with the root resident and every slot of it
     /// wanted (used at frame 0, its render queued); it must hold at least the root's pages.
     pub fn new(capacity: u32, page_bytes: u64) -> Result<PagePool> {
+        PagePool::keeping_whole(capacity, page_bytes, WHOLE_LEVELS)
+    }
+
+    /// [`PagePool::new`] with the tiles down to level `whole` keeping every slot.
+    fn keeping_whole(capacity: u32, page_bytes: u64, whole: u32) -> Result<PagePool> {
         if u64::from(capacity) < TILE_PAGES {
             return Err(Error::InvalidArgument(format!(
                 "an ASM pool of {capacity} pages holds no tile: the root takes {TILE_PAGES}"
@@ -209,6 +224,7 @@ impl PagePool {
             tiles: HashMap::new(),
             ops: Vec::new(),
             released: 0,
+            whole,
         };
         pool.commit(pool.chain(TileKey::ROOT, ALL_SLOTS, false), 0, f32::INFINITY);
         Ok(pool)
@@ -346,7 +362,7 @@ impl PagePool {
         let mut keys: Vec<(TileKey, Slots)> = self
             .tiles
             .iter()
-            .filter(|(k, r)| **k != TileKey::ROOT && r.trial.is_none())
+            .filter(|(k, r)| k.level > self.whole && r.trial.is_none())
             .map(|(k, r)| {
                 let stale = (0..SLOTS).filter(|&s| r.seen[s] < before).fold(0, |m, s| m | 1 << s);
                 (*k, r.wanted & stale)
@@ -437,7 +453,10 @@ impl PagePool {
             // While half the pages are free, the slots pixels read stay too: each would cost a
             // render when the tile's coarser neighbours no longer suffice.
             let plenty = 2 * self.free.len() >= self.capacity as usize;
-            let keep = trial.asked | if plenty { trial.used } else { 0 };
+            let keep = match key.level <= self.whole {
+                true => ALL_SLOTS,
+                false => trial.asked | if plenty { trial.used } else { 0 },
+            };
             let chain = self.chain(key, keep, false);
             let pages: i64 = chain
                 .iter()
@@ -608,7 +627,7 @@ mod tests {
     /// half the pages free, those read); a slot it does not store is read from its parent's.
     #[test]
     fn a_trial_keeps_the_slots_asked_for() {
-        let mut pool = PagePool::new(64, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::keeping_whole(64, PAGE_BYTES, 0).unwrap();
         pool.take_ops();
         let a = child(TileKey::ROOT, 0);
         assert_eq!(pool.insert(a, bit(1, 1), 1, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
@@ -640,7 +659,7 @@ mod tests {
     /// it again (a render of the parent) when the child is evicted.
     #[test]
     fn a_covered_slot_is_given_back_and_stored_again_after_eviction() {
-        let mut pool = PagePool::new(48, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::keeping_whole(48, PAGE_BYTES, 0).unwrap();
         let a = child(TileKey::ROOT, 0);
         let under = bit(0, 0) | bit(1, 0) | bit(0, 1) | bit(1, 1);
         pool.insert(a, under, 1, 1.0).unwrap();
@@ -665,7 +684,7 @@ mod tests {
     /// weighs benefits: the tile stays with the slots still in use.
     #[test]
     fn stale_slots_are_given_back_when_pages_run_short() {
-        let mut pool = PagePool::new(ROOT_PAGES + 17, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::keeping_whole(ROOT_PAGES + 17, PAGE_BYTES, 0).unwrap();
         let a = child(TileKey::ROOT, 0);
         pool.insert(a, bit(0, 0) | bit(3, 3), 1, 10.0).unwrap();
         pool.end_trials(1 + TRIAL_FRAMES);
@@ -683,10 +702,34 @@ mod tests {
         assert_eq!(pool.insert(c, bit(0, 0), frame, 1.0).unwrap(), Insert::Refused);
     }
 
+    /// The tiles down to `WHOLE_LEVELS` keep every slot past their trial, stale or not; a tile
+    /// below them keeps the slots asked for.
+    #[test]
+    fn the_upper_levels_keep_every_slot() {
+        let mut pool = PagePool::new(2000, PAGE_BYTES).unwrap();
+        let uv = [0.3, 0.6];
+        let key = |level| TileKey::containing(uv, level).unwrap();
+        for level in 1..=WHOLE_LEVELS + 1 {
+            pool.insert(key(level), bit(0, 0), 1, 1.0).unwrap();
+        }
+        pool.end_trials(1 + TRIAL_FRAMES);
+        for level in 1..=WHOLE_LEVELS {
+            // Wanted whole (its child covers four of them).
+            assert_eq!(pool.tiles[&key(level)].wanted, ALL_SLOTS, "level {level}");
+        }
+        // 2000 pages, 1000 free: not half, so the deepest keeps the slot asked for alone.
+        assert_eq!(pool.stores(key(WHOLE_LEVELS + 1)).len(), 1);
+        pool.release_stale(100);
+        for level in 1..=WHOLE_LEVELS {
+            assert_eq!(pool.tiles[&key(level)].wanted, ALL_SLOTS, "level {level} after a release");
+        }
+        assert!(!pool.contains(key(WHOLE_LEVELS + 1)), "stale and wanting nothing else: evicted");
+    }
+
     /// A lookup falling back to an ancestor's slot keeps that slot in use.
     #[test]
     fn a_slot_read_from_below_is_seen() {
-        let mut pool = PagePool::new(64, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::keeping_whole(64, PAGE_BYTES, 0).unwrap();
         let a = child(TileKey::ROOT, 0);
         let d = child(a, 3);
         pool.insert(a, ALL_SLOTS, 1, 1.0).unwrap();
@@ -707,8 +750,15 @@ mod tests {
     /// finds a stored slot, and no two stored slots share a page.
     #[test]
     fn the_budget_is_never_exceeded() {
+        // With every level trimmed, and with the engine's whole upper levels.
+        for whole in [0, WHOLE_LEVELS] {
+            random_requests(whole);
+        }
+    }
+
+    fn random_requests(whole: u32) {
         let capacity = 160;
-        let mut pool = PagePool::new(capacity, PAGE_BYTES).unwrap();
+        let mut pool = PagePool::keeping_whole(capacity, PAGE_BYTES, whole).unwrap();
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = || {
             state ^= state << 13;
