@@ -379,12 +379,7 @@ impl PagePool {
                 continue;
             }
             let chain = self.chain(key, wanted, false);
-            let pages: i64 = chain
-                .iter()
-                .map(|s| {
-                    i64::from(s.stored.count_ones()) - i64::from(self.tiles[&s.key].stored().count_ones())
-                })
-                .sum();
+            let pages = self.pages_needed(&chain);
             if pages <= 0 {
                 self.commit(chain, frame, r.benefit);
             }
@@ -411,13 +406,7 @@ impl PagePool {
             };
             let chain = self.chain(key, wanted, fresh);
             let new_tiles = chain.iter().filter(|s| !self.tiles.contains_key(&s.key)).count();
-            let pages: i64 = chain
-                .iter()
-                .map(|s| {
-                    let now = self.tiles.get(&s.key).map_or(0, |r| r.stored());
-                    i64::from(s.stored.count_ones()) - i64::from(now.count_ones())
-                })
-                .sum();
+            let pages = self.pages_needed(&chain);
             let fits_pages = pages <= self.free.len() as i64;
             let fits_nodes = self.tiles.len() + new_tiles <= self.max_tiles() as usize;
             if fits_pages && fits_nodes {
@@ -458,12 +447,7 @@ impl PagePool {
                 false => trial.asked | if plenty { trial.used } else { 0 },
             };
             let chain = self.chain(key, keep, false);
-            let pages: i64 = chain
-                .iter()
-                .map(|s| {
-                    i64::from(s.stored.count_ones()) - i64::from(self.tiles[&s.key].stored().count_ones())
-                })
-                .sum();
+            let pages = self.pages_needed(&chain);
             // Uncovered slots of its ancestors could take more than it gives back: then later.
             if pages <= self.free.len() as i64 {
                 self.tiles.get_mut(&key).expect("listed above").trial = None;
@@ -502,6 +486,13 @@ impl PagePool {
             at = k.parent();
         }
         steps
+    }
+
+    /// The pages a chain of states takes beyond those its tiles store now (negative where it
+    /// gives pages back).
+    fn pages_needed(&self, chain: &[Step]) -> i64 {
+        let now = |key: &TileKey| self.tiles.get(key).map_or(0, |r| r.stored().count_ones());
+        chain.iter().map(|s| i64::from(s.stored.count_ones()) - i64::from(now(&s.key))).sum()
     }
 
     /// Applies a chain of states: pages given back first, then taken, renders queued.
