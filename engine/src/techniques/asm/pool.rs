@@ -324,6 +324,11 @@ impl PagePool {
     /// With a `benefit`, that is the tile's now.
     pub fn note(&mut self, key: TileKey, slots: Slots, frame: u64, benefit: Option<f32>) -> bool {
         let Some(r) = self.tiles.get_mut(&key) else { return false };
+        // Nothing asked for is no use: the tile's last use stays (its eviction order with it;
+        // the technique notes every tile each frame, most with no slot).
+        if slots == 0 {
+            return true;
+        }
         see(&mut r.seen, slots, frame);
         match &mut r.trial {
             Some(trial) => trial.asked |= slots,
@@ -715,6 +720,20 @@ mod tests {
             assert_eq!(pool.tiles[&key(level)].wanted, ALL_SLOTS, "level {level} after a release");
         }
         assert!(!pool.contains(key(WHOLE_LEVELS + 1)), "stale and wanting nothing else: evicted");
+    }
+
+    /// Noting no slot is no use: the least recently used tile still goes first.
+    #[test]
+    fn noting_no_slot_leaves_the_eviction_order() {
+        let mut pool = PagePool::keeping_whole(ROOT_PAGES + 16, PAGE_BYTES, 0).unwrap();
+        let a = child(TileKey::ROOT, 0);
+        pool.insert(a, ALL_SLOTS, 1, 100.0).unwrap();
+        pool.end_trials(1 + TRIAL_FRAMES);
+        assert!(pool.note(a, 0, 9, None));
+        // Full; a tile of least benefit takes a's pages: a was last used in frame 1.
+        let b = child(TileKey::ROOT, 1);
+        assert_eq!(pool.insert(b, bit(0, 0), 9, 1.0).unwrap(), Insert::Inserted { evicted: 1 });
+        assert!(!pool.contains(a));
     }
 
     /// A lookup falling back to an ancestor's slot keeps that slot in use.
