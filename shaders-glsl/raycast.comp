@@ -6,20 +6,23 @@
 #include "bvh.glsl"
 
 layout(local_size_x = KAGE_RAYCAST_GROUP) in;
-layout(set = 0, binding = KAGE_BVH_BINDINGS, std430) readonly buffer Rays { CastRay rays[]; };
+// The rays as texels, two per CastRay (origin, direction): a texel fetch is a gather on a CPU
+// driver, where a storage buffer is read one lane and word at a time (bvh.glsl).
+layout(set = 0, binding = KAGE_BVH_BINDINGS) uniform usamplerBuffer ray_texels;
 layout(set = 0, binding = KAGE_BVH_BINDINGS + 1, std430) writeonly buffer Results {
     CastResult results[];
 };
 layout(push_constant) uniform Push { CastPush p; };
 
-const uint QUERY_CLOSEST = 0u;
-const uint QUERY_OCCLUDED = 1u;
-const uint QUERY_OCCLUDED_OBJECT_SPACE = 2u;
-const uint QUERY_SURFACE = 3u;
-const uint QUERY_PACKET_OBJECT_SPACE = 4u;
-// The packet query's pipeline: a specialization, because a CPU driver would otherwise run its
-// code, masked off, beside every single ray's (both sides of a branch run there).
-layout(constant_id = 0) const bool PACKETS = false;
+CastRay ray_at(uint i) {
+    return CastRay(uintBitsToFloat(texelFetch(ray_texels, 2 * int(i))),
+                   uintBitsToFloat(texelFetch(ray_texels, 2 * int(i) + 1)));
+}
+
+// The query (KAGE_CAST_*): a specialization, one pipeline per query, because a CPU driver runs
+// both sides of every branch under a lane mask, so the code of the queries not asked would run,
+// masked off, beside the one asked (on llvmpipe that cost more than the traversal itself).
+layout(constant_id = 0) const uint QUERY = KAGE_CAST_CLOSEST;
 
 // Rays first .. first + KAGE_BVH_PACKET - 1 (those in the list) as one packet from the first
 // one's origin through group p.params.z, in its object space: bvh_closest_hits_packet.
@@ -29,13 +32,13 @@ void cast_packet(uint first) {
     uint in_list = 0u;
     for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
         uint i = min(first + uint(r), p.params.x - 1u);
-        dirs[r] = rays[i].direction.xyz;
+        dirs[r] = ray_at(i).direction.xyz;
         bool listed = first + uint(r) < p.params.x;
         // A negative tmax: the packet does not cast it.
-        hits[r] = RayHit(listed ? rays[i].origin.w : -1.0, KAGE_NO_HIT, 0u, vec2(0.0));
+        hits[r] = RayHit(listed ? ray_at(i).origin.w : -1.0, KAGE_NO_HIT, 0u, vec2(0.0));
         if (listed) in_list |= 1u << r;
     }
-    bvh_closest_hits_packet(p.params.z, rays[first].origin.xyz, dirs, hits);
+    bvh_closest_hits_packet(p.params.z, ray_at(first).origin.xyz, dirs, hits);
     for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
         if ((in_list & (1u << r)) == 0u) continue;
         results[first + uint(r)].hit = vec4(hits[r].t, hits[r].barycentric, 0.0);
@@ -46,17 +49,16 @@ void cast_packet(uint first) {
 void main() {
     uint i = p.params.w + gl_GlobalInvocationID.x;
     if (i >= p.params.x) return;
-    if (PACKETS) {
+    if (QUERY == KAGE_CAST_PACKET_OBJECT_SPACE) {
         if (i % KAGE_BVH_PACKET == 0u) cast_packet(i);
         return;
     }
-    CastRay ray = rays[i];
+    CastRay ray = ray_at(i);
     vec3 origin = ray.origin.xyz;
     vec3 dir = ray.direction.xyz;
     float tmax = ray.origin.w;
-    uint query = p.params.y;
-    if (query == QUERY_OCCLUDED || query == QUERY_OCCLUDED_OBJECT_SPACE) {
-        bool occluded = query == QUERY_OCCLUDED
+    if (QUERY == KAGE_CAST_OCCLUDED || QUERY == KAGE_CAST_OCCLUDED_OBJECT_SPACE) {
+        bool occluded = QUERY == KAGE_CAST_OCCLUDED
                       ? bvh_occluded(origin, dir, tmax)
                       : bvh_occluded_object_space(p.params.z, origin, dir, tmax);
         // An any-hit query says only whether, not where: instance 0 stands for "occluded".
@@ -67,7 +69,7 @@ void main() {
     results[i].hit = vec4(hit.t, hit.barycentric, 0.0);
     results[i].ids = uvec4(hit.instance, hit.triangle, 0u, 0u);
     // Only surface queries pay for the surface and its 64 bytes of output.
-    if (query == QUERY_SURFACE && hit.instance != KAGE_NO_HIT) {
+    if (QUERY == KAGE_CAST_SURFACE && hit.instance != KAGE_NO_HIT) {
         SurfacePoint s = bvh_surface(hit, dir);
         results[i].position = vec4(s.position, 0.0);
         results[i].geometric_normal = vec4(s.geometric_normal, 0.0);

@@ -50,6 +50,14 @@
 #define KAGE_BVH_STACK 32
 // Invocations per workgroup of the ray casting test and benchmark shader.
 #define KAGE_RAYCAST_GROUP 256
+// What raycast.comp asks of each ray (its specialization constant): the closest hit; whether
+// occluded; whether occluded in one group's object space; the closest hit and its surface; the
+// closest hits in one group's object space by packets of KAGE_BVH_PACKET rays.
+#define KAGE_CAST_CLOSEST 0u
+#define KAGE_CAST_OCCLUDED 1u
+#define KAGE_CAST_OCCLUDED_OBJECT_SPACE 2u
+#define KAGE_CAST_SURFACE 3u
+#define KAGE_CAST_PACKET_OBJECT_SPACE 4u
 
 // Samples one invocation of the reference shaders takes per dispatch. llvmpipe silently ends an
 // invocation's loops after about 65,535 iterations in all; with BVH traversals inside every

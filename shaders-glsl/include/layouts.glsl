@@ -122,7 +122,7 @@ struct CastResult {
 
 // Push constants of the ray casting shader.
 struct CastPush {
-    uvec4 params; // x: ray count, y: query (0 closest, 1 occluded, 2 occluded in object space, 3 closest with surface, 4 closest in object space by packets), z: instance, w: first ray
+    uvec4 params; // x: ray count, y: zero, z: instance (object-space queries), w: first ray
 };
 
 // The reference's running statistics of one pixel or point: mean and sum of squared deviations

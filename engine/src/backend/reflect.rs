@@ -169,8 +169,8 @@ mod tests {
                 (3, StorageImage, true)
             ]
         );
-        // The ray caster reads the BVH's traversal data and triangle attributes as texel
-        // buffers, its albedo maps and rays as storage buffers, and writes only its results.
+        // The ray caster reads the BVH's traversal data, triangle attributes and rays as texel
+        // buffers, its albedo maps as storage buffers, and writes only its results.
         assert_eq!(
             kinds(spirv::RAYCAST_COMP),
             [
@@ -181,7 +181,7 @@ mod tests {
                 (4, TexelBuffer, false),
                 (5, StorageBuffer, false),
                 (6, StorageBuffer, false),
-                (7, StorageBuffer, false),
+                (7, TexelBuffer, false),
                 (8, StorageBuffer, true)
             ]
         );

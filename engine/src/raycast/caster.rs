@@ -3,6 +3,7 @@
 use super::GpuBvh;
 use crate::backend::{
     Binding, BindingKind, Buffer, BufferDesc, BufferUsage, ComputePipeline, Context, MemoryLocation,
+    TexelBuffer,
 };
 use crate::error::{Error, Result};
 use crate::layouts::{bytes_of, bytes_of_slice, constants, spirv, CastPush, CastRay, CastResult};
@@ -31,7 +32,8 @@ pub enum Query {
 
 /// Rays on the GPU with room for their results.
 pub struct GpuRays {
-    rays: Buffer,
+    /// Two texels per ray, as raycast.comp reads them.
+    rays: TexelBuffer,
     results: Buffer,
     count: u32,
 }
@@ -42,7 +44,7 @@ impl GpuRays {
             Error::InvalidArgument(format!("cannot cast {} rays: give 1 to 2^32 - 1", rays.len()))
         })?;
         Ok(GpuRays {
-            rays: Buffer::with_data(ctx, "raycast.rays", BufferUsage::STORAGE, bytes_of_slice(rays))?,
+            rays: TexelBuffer::with_data(ctx, "raycast.rays", bytes_of_slice(rays))?,
             results: Buffer::new(
                 ctx,
                 &BufferDesc {
@@ -79,32 +81,42 @@ impl GpuRays {
 }
 
 pub struct RayCaster {
-    pipeline: ComputePipeline,
-    /// The same shader specialized for [`Query::PacketObjectSpace`].
-    packet_pipeline: ComputePipeline,
+    ctx: Arc<Context>,
+    /// One pipeline per query (the shader's specialization constant), each made at its first
+    /// cast, indexed by the query's `constants::CAST_*` value.
+    pipelines: [Option<ComputePipeline>; QUERIES],
     executor: FrameExecutor,
 }
 
 /// Workgroups per dispatch: Vulkan guarantees at least 65535 in x.
 const MAX_GROUPS: u32 = 65535;
 
+/// The queries of raycast.comp (`constants::CAST_*` run from 0 up to this, exclusive).
+const QUERIES: usize = constants::CAST_PACKET_OBJECT_SPACE as usize + 1;
+
+impl Query {
+    /// The shader's query (`constants::CAST_*`), its pipeline's name and the group an
+    /// object-space query casts against.
+    fn shader_query(self) -> (u32, &'static str, u32) {
+        match self {
+            Query::ClosestHit => (constants::CAST_CLOSEST, "raycast.closest_hit", 0),
+            Query::Occluded => (constants::CAST_OCCLUDED, "raycast.occluded", 0),
+            Query::OccludedObjectSpace { instance } => {
+                (constants::CAST_OCCLUDED_OBJECT_SPACE, "raycast.occluded_object_space", instance)
+            }
+            Query::Surface => (constants::CAST_SURFACE, "raycast.surface", 0),
+            Query::PacketObjectSpace { instance } => {
+                (constants::CAST_PACKET_OBJECT_SPACE, "raycast.packet_object_space", instance)
+            }
+        }
+    }
+}
+
 impl RayCaster {
     pub fn new(ctx: &Arc<Context>) -> Result<RayCaster> {
-        let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
-        kinds.extend([BindingKind::StorageBuffer, BindingKind::StorageBuffer]);
-        let pipeline = |name, packets: bool| {
-            ComputePipeline::specialized(
-                ctx,
-                name,
-                spirv::RAYCAST_COMP,
-                &kinds,
-                size_of::<CastPush>() as u32,
-                &[u32::from(packets)],
-            )
-        };
         Ok(RayCaster {
-            pipeline: pipeline("raycast", false)?,
-            packet_pipeline: pipeline("raycast_packets", true)?,
+            ctx: ctx.clone(),
+            pipelines: Default::default(),
             executor: FrameExecutor::new(ctx, "raycast")?,
         })
     }
@@ -113,23 +125,29 @@ impl RayCaster {
     /// dispatch's workgroup limit) and returns the pass's GPU time in ms, if the device has
     /// timestamps. Read the results with [`GpuRays::read`].
     pub fn cast(&mut self, bvh: &GpuBvh, rays: &GpuRays, query: Query) -> Result<Option<f64>> {
-        let (mode, instance) = match query {
-            Query::ClosestHit => (0, 0),
-            Query::Occluded => (1, 0),
-            Query::OccludedObjectSpace { instance } => (2, instance),
-            Query::Surface => (3, 0),
-            Query::PacketObjectSpace { instance } => (4, instance),
+        let (mode, name, instance) = query.shader_query();
+        let pipeline = match &mut self.pipelines[mode as usize] {
+            Some(pipeline) => pipeline,
+            slot => {
+                let mut kinds = GpuBvh::BINDING_KINDS.to_vec();
+                kinds.extend([BindingKind::TexelBuffer, BindingKind::StorageBuffer]);
+                slot.insert(ComputePipeline::specialized(
+                    &self.ctx,
+                    name,
+                    spirv::RAYCAST_COMP,
+                    &kinds,
+                    size_of::<CastPush>() as u32,
+                    &[mode],
+                )?)
+            }
         };
+        let pipeline = &*pipeline;
         let per_dispatch = MAX_GROUPS * constants::RAYCAST_GROUP;
-        let pipeline = match query {
-            Query::PacketObjectSpace { .. } => &self.packet_pipeline,
-            _ => &self.pipeline,
-        };
         let timings = self.executor.run(vec![Pass::new("raycast", move |cmd| {
             let mut bindings: Vec<Binding> = bvh.bindings().into();
-            bindings.extend([Binding::Storage(&rays.rays), Binding::Storage(&rays.results)]);
+            bindings.extend([Binding::Texel(&rays.rays), Binding::Storage(&rays.results)]);
             for first in (0..rays.count).step_by(per_dispatch as usize) {
-                let push = CastPush { params: [rays.count, mode, instance, first] };
+                let push = CastPush { params: [rays.count, 0, instance, first] };
                 let n = (rays.count - first).min(per_dispatch);
                 pipeline.dispatch(
                     cmd,
