@@ -313,7 +313,7 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
             if (entered == 0) break;
             if (entered == 2) {
                 stack[top] = left_first ? pair.refs.y : pair.refs.x;
-                stack_enter[top] = left_first ? enter_right : enter_left;
+                if (!any_hit) stack_enter[top] = left_first ? enter_right : enter_left;
                 ++top;
             }
             next = left_first ? pair.refs.x : pair.refs.y;
@@ -331,11 +331,12 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
             }
         }
         if (found && any_hit) return true;
-        // Pop the next entry still within reach.
+        // Pop the next entry still within reach. Without a hit tmax has not moved since the
+        // entry was pushed within it, so an any-hit walk pops without looking.
         live = false;
         while (top > 0) {
             --top;
-            if (stack_enter[top] < hit.t) {
+            if (any_hit || stack_enter[top] < hit.t) {
                 next = stack[top];
                 live = true;
                 break;
@@ -417,16 +418,28 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
 }
 
 // Traverses the top-level tree (world space) and, at each instance leaf, that instance's tree.
+// While-while as bvh_traverse_blas: down through inner nodes in a loop of its own, so that the
+// instance's tree, whose code a CPU driver runs masked off on every pass that no lane needs
+// it, runs once per instance entered and not also on the passes through inner nodes.
 bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
     vec3 inv_dir = 1.0 / dir;
     bool found = false;
     uint stack[KAGE_BVH_STACK];
     int top = 0;
     BvhNode node = bvh_tlas_node(0u);
-    if (bvh_enter_box(node, origin, inv_dir, hit.t) == 1.0 / 0.0) return false;
-    while (true) {
-        uint index = bvh_node_index(node);
+    bool live = bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0;
+    while (live) {
+        // Down through inner nodes while a child is entered.
+        while (bvh_node_count(node) == 0u) {
+            uint index = bvh_node_index(node);
+            uint pushed;
+            int entered = bvh_children(bvh_tlas_node(index), bvh_tlas_node(index + 1u), index, origin, inv_dir, hit.t, node, pushed);
+            if (entered == 2) stack[top++] = pushed;
+            if (entered == 0) break;
+        }
+        // An instance leaf (none where the walk above ended on a node with no child entered).
         if (bvh_node_count(node) > 0u) {
+            uint index = bvh_node_index(node);
             mat4 to_object = bvh_world_to_object(index);
             vec3 o = (to_object * vec4(origin, 1.0)).xyz;
             vec3 d = mat3(to_object) * dir;
@@ -434,21 +447,16 @@ bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
                 found = true;
                 if (any_hit) return true;
             }
-        } else {
-            uint pushed;
-            int entered = bvh_children(bvh_tlas_node(index), bvh_tlas_node(index + 1u), index, origin, inv_dir, hit.t, node, pushed);
-            if (entered == 2) stack[top++] = pushed;
-            if (entered > 0) continue;
         }
-        bool next = false;
+        // Pop the next entry the ray still enters.
+        live = false;
         while (top > 0) {
             node = bvh_tlas_node(stack[--top]);
             if (bvh_enter_box(node, origin, inv_dir, hit.t) != 1.0 / 0.0) {
-                next = true;
+                live = true;
                 break;
             }
         }
-        if (!next) break;
     }
     return found;
 }
