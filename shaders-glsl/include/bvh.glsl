@@ -29,9 +29,12 @@ layout(set = 0, binding = 6, std430) readonly buffer BvhAlbedoTexels { BvhTexel 
 // Pair `index` of the bottom-level trees.
 BvhPair bvh_pair(uint index) {
     int texel = KAGE_BVH_PAIR_TEXELS * int(index);
-    return BvhPair(uintBitsToFloat(texelFetch(bvh_blas_pairs, texel)), texelFetch(bvh_blas_pairs, texel + 1),
-                   texelFetch(bvh_blas_pairs, texel + 2));
+    return BvhPair(texelFetch(bvh_blas_pairs, texel), texelFetch(bvh_blas_pairs, texel + 1));
 }
+
+// Where a pair's left and right child lead.
+uint bvh_pair_left(BvhPair pair) { return pair.origin.w; }
+uint bvh_pair_right(BvhPair pair) { return pair.boxes.w; }
 
 // Node `index` of the top-level tree.
 BvhNode bvh_tlas_node(uint index) {
@@ -241,8 +244,8 @@ int bvh_order(float enter_left, float enter_right, out bool left_first) {
 
 // A pair's children as bvh_order takes them: entered at these distances and present.
 int bvh_pair_order(BvhPair pair, float enter_left, float enter_right, out bool left_first) {
-    return bvh_order(pair.refs.x != KAGE_NO_HIT ? enter_left : 1.0 / 0.0,
-                     pair.refs.y != KAGE_NO_HIT ? enter_right : 1.0 / 0.0, left_first);
+    return bvh_order(bvh_pair_left(pair) != KAGE_NO_HIT ? enter_left : 1.0 / 0.0,
+                     bvh_pair_right(pair) != KAGE_NO_HIT ? enter_right : 1.0 / 0.0, left_first);
 }
 
 // The triangles of a child reference: none for a pair, count and first for a leaf.
@@ -262,20 +265,21 @@ int bvh_children(BvhNode left_node, BvhNode right_node, uint index, vec3 origin,
     return entered;
 }
 
-// One corner of a pair's child box: 3 bytes of grid steps from the pair's origin. q * step is
+// Corner c of a pair's children (0, 1: the left child's minimum and maximum, 2, 3: the
+// right child's), byte c of each axis's word of grid steps from the pair's origin. q * step is
 // exact, so the one rounding of the sum is the one the builder checked
 // (engine/src/raycast/pairs.rs).
-vec3 bvh_pair_corner(BvhPair pair, vec3 step, uint steps) {
-    return pair.origin.xyz + vec3(uvec3(steps, steps >> 8, steps >> 16) & 0xffu) * step;
+vec3 bvh_pair_corner(vec3 origin, vec3 step, uvec3 steps, int c) {
+    return origin + vec3((steps >> (8 * c)) & 0xffu) * step;
 }
 
 void bvh_pair_boxes(BvhPair pair, out vec3 left_lo, out vec3 left_hi, out vec3 right_lo, out vec3 right_hi) {
-    uint exponents = floatBitsToUint(pair.origin.w);
-    vec3 step = uintBitsToFloat((uvec3(exponents, exponents >> 8, exponents >> 16) & 0xffu) << 23);
-    left_lo = bvh_pair_corner(pair, step, pair.boxes.x);
-    left_hi = bvh_pair_corner(pair, step, pair.boxes.y);
-    right_lo = bvh_pair_corner(pair, step, pair.boxes.z);
-    right_hi = bvh_pair_corner(pair, step, pair.boxes.w);
+    vec3 origin = uintBitsToFloat(pair.origin.xyz & 0xffffff00u);
+    vec3 step = uintBitsToFloat((pair.origin.xyz & 0xffu) << 23);
+    left_lo = bvh_pair_corner(origin, step, pair.boxes.xyz, 0);
+    left_hi = bvh_pair_corner(origin, step, pair.boxes.xyz, 1);
+    right_lo = bvh_pair_corner(origin, step, pair.boxes.xyz, 2);
+    right_hi = bvh_pair_corner(origin, step, pair.boxes.xyz, 3);
 }
 
 // Traverses one bottom-level tree, ray in object space. With any_hit it returns at the first
@@ -312,11 +316,11 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
             int entered = bvh_pair_order(pair, enter_left, enter_right, left_first);
             if (entered == 0) break;
             if (entered == 2) {
-                stack[top] = left_first ? pair.refs.y : pair.refs.x;
+                stack[top] = left_first ? bvh_pair_right(pair) : bvh_pair_left(pair);
                 if (!any_hit) stack_enter[top] = left_first ? enter_right : enter_left;
                 ++top;
             }
-            next = left_first ? pair.refs.x : pair.refs.y;
+            next = left_first ? bvh_pair_left(pair) : bvh_pair_right(pair);
         }
         // A leaf: its triangles, all lanes that hold one together (none where the walk above
         // ended on a pair with no child entered).
@@ -384,11 +388,11 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
             int entered = bvh_pair_order(pair, enter_left, enter_right, left_first);
             if (entered == 0) break;
             if (entered == 2) {
-                stack[top] = left_first ? pair.refs.y : pair.refs.x;
+                stack[top] = left_first ? bvh_pair_right(pair) : bvh_pair_left(pair);
                 stack_enter[top] = left_first ? enter_right : enter_left;
                 ++top;
             }
-            next = left_first ? pair.refs.x : pair.refs.y;
+            next = left_first ? bvh_pair_left(pair) : bvh_pair_right(pair);
         }
         uint count = bvh_leaf_count(next);
         uint first = bvh_leaf_first(next);

@@ -41,7 +41,7 @@
 // against layouts.glsl's structs by engine/src/raycast/gpu.rs): a BvhPair, a BvhNode, a
 // BvhInstance (object to world at texel 0, world to object at 4, info at 8), a BvhTriangle and
 // its BvhTriangleAttributes.
-#define KAGE_BVH_PAIR_TEXELS 3
+#define KAGE_BVH_PAIR_TEXELS 2
 #define KAGE_BVH_NODE_TEXELS 2
 #define KAGE_BVH_INSTANCE_TEXELS 9
 #define KAGE_BVH_TRIANGLE_TEXELS 3

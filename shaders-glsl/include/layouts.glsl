@@ -63,11 +63,11 @@ struct BvhNode {
 
 // A bottom-level interior node as the ray casting shaders read it (engine/src/raycast/pairs.rs):
 // its two children's boxes quantized to 8 bits per coordinate on a grid over the node's own box,
-// and where each child leads. 10 of its 12 words are read per step, against 16 for two BvhNodes.
+// and where each child leads (a pair's index, or KAGE_BVH_LEAF | count << 28 | first triangle,
+// or KAGE_NO_HIT: no child). Two texels a step, against four for two BvhNodes.
 struct BvhPair {
-    vec4 origin; // xyz: the grid's origin (the node box's minimum), w: floatBitsToUint = the grid steps' biased exponents x | y << 8 | z << 16 (step 2^(e - 127))
-    uvec4 boxes; // x, y: the left child's minimum and maximum, z, w: the right child's, each 3 bytes (x, y, z) of grid steps
-    uvec4 refs; // x, y: the left and right child: a pair's index, or KAGE_BVH_LEAF | count << 28 | first triangle, or KAGE_NO_HIT (no child); zw: zero
+    uvec4 origin; // xyz: float bits of the grid's origin (the node box's minimum rounded down to a float whose lowest 8 mantissa bits are zero), those 8 bits holding the grid step's biased exponent along the axis (step 2^(e - 127)); w: the left child
+    uvec4 boxes; // xyz: along x, y and z, the children's corners in grid steps, a byte each from the lowest: the left child's minimum, its maximum, the right child's minimum, its maximum; w: the right child
 };
 
 // A triangle's object-space vertex positions (w unused), for the intersection test.

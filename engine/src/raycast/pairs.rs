@@ -1,8 +1,10 @@
 //! The bottom-level trees as the GPU traverses them: one [`BvhPair`] per interior node, its two
 //! children's boxes quantized to 8 bits per coordinate on a grid over the node's own box (as
 //! compressed wide BVHs do, Ylitie, Karras and Laine 2017, at width two). A step of the
-//! traversal then reads 10 words instead of two 8-word nodes: on lavapipe every word read is a
-//! gather over eight lanes, which is most of a step's cost (see BENCHMARKS.md, "Ray casting").
+//! traversal then reads two texels instead of two 2-texel nodes: on lavapipe every texel read
+//! is a gather over eight lanes, which is most of a step's cost (see BENCHMARKS.md, "Ray
+//! casting"). The grid's origin gives up the lowest 8 bits of its mantissa to hold the grid
+//! step's exponent, which costs a box at most about one f32 step of its coordinates.
 //!
 //! The quantized boxes are conservative in the shader's own arithmetic: each corner is
 //! `origin + q * step` with `step` a power of two, so `q * step` is exact and the one rounding
@@ -53,42 +55,51 @@ pub fn pairs(nodes: &[BvhNode], first_triangle: u32, base: u32) -> Result<Vec<Bv
             out.push(pair(
                 children.map(|c| node_bounds(&nodes[c])),
                 [reference(children[0])?, reference(children[1])?],
-            ));
+            )?);
         }
     }
     if out.is_empty() {
         // The root is a leaf, or the tree is empty: one pair of the root and nothing.
-        out.push(pair([node_bounds(&nodes[0]), Aabb::EMPTY], [reference(0)?, constants::NO_HIT]));
+        out.push(pair([node_bounds(&nodes[0]), Aabb::EMPTY], [reference(0)?, constants::NO_HIT])?);
     }
     Ok(out)
 }
 
 /// One pair: the children's boxes on a grid over their union, with their references.
-fn pair(children: [Aabb; 2], refs: [u32; 2]) -> BvhPair {
+fn pair(children: [Aabb; 2], refs: [u32; 2]) -> Result<BvhPair> {
     let union = children
         .iter()
         .zip(refs)
         .filter(|(_, r)| *r != constants::NO_HIT)
         .fold(Aabb::EMPTY, |u, (b, _)| u.union(*b));
-    let origin = if union.is_empty() { Vec3::ZERO } else { union.lo };
-    let mut exponents = [0u32; 3];
+    let lo = if union.is_empty() { Vec3::ZERO } else { union.lo };
+    let mut origin = [0u32; 4];
     let mut boxes = [0u32; 4];
     for axis in 0..3 {
-        let (exponent, quantized) =
-            quantize_axis(origin[axis], &children.map(|b| (b.lo[axis], b.hi[axis])), refs);
-        exponents[axis] = exponent;
-        for (c, (lo, hi)) in quantized.into_iter().enumerate() {
-            boxes[2 * c] |= lo << (8 * axis);
-            boxes[2 * c + 1] |= hi << (8 * axis);
+        let grid = grid_origin(lo[axis]).ok_or_else(|| {
+            Error::InvalidArgument(format!(
+                "a BVH box starts at {}, too near the largest f32 for the ray casting grid",
+                lo[axis]
+            ))
+        })?;
+        let (exponent, quantized) = quantize_axis(grid, &children.map(|b| (b.lo[axis], b.hi[axis])), refs);
+        origin[axis] = grid.to_bits() | exponent;
+        for (c, (q_lo, q_hi)) in quantized.into_iter().enumerate() {
+            boxes[axis] |= q_lo << (16 * c) | q_hi << (16 * c + 8);
         }
     }
-    BvhPair {
-        origin: origin
-            .extend(f32::from_bits(exponents[0] | exponents[1] << 8 | exponents[2] << 16))
-            .to_array(),
-        boxes,
-        refs: [refs[0], refs[1], 0, 0],
-    }
+    origin[3] = refs[0];
+    boxes[3] = refs[1];
+    Ok(BvhPair { origin, boxes })
+}
+
+/// The largest f32 at or below `lo` whose lowest 8 mantissa bits are zero (they hold the grid
+/// step's exponent); none past the most negative such f32.
+fn grid_origin(lo: f32) -> Option<f32> {
+    let truncated = f32::from_bits(lo.to_bits() & !0xff);
+    // Truncating moves a negative value up: the next one down is a unit of the 9th bit away.
+    let origin = if truncated <= lo { truncated } else { f32::from_bits((lo.to_bits() & !0xff) + 0x100) };
+    origin.is_finite().then_some(origin)
 }
 
 /// The biased exponent of the finest grid step along one axis on which every live child's
@@ -135,15 +146,19 @@ fn quantize_axis(origin: f32, children: &[(f32, f32); 2], refs: [u32; 2]) -> (u3
 /// A pair's child box `child` (0 or 1) as the shader dequantizes it.
 #[cfg(test)]
 pub fn child_box(pair: &BvhPair, child: usize) -> Aabb {
-    let origin = Vec3::from_slice(&pair.origin[..3]);
-    let exponents = pair.origin[3].to_bits();
-    let step =
-        Vec3::from_array(std::array::from_fn(|a| f32::from_bits(((exponents >> (8 * a)) & 0xff) << 23)));
-    let corner = |word: u32| {
-        let q = Vec3::from_array(std::array::from_fn(|a| ((word >> (8 * a)) & 0xff) as f32));
+    let origin = Vec3::from_array(std::array::from_fn(|a| f32::from_bits(pair.origin[a] & !0xff)));
+    let step = Vec3::from_array(std::array::from_fn(|a| f32::from_bits((pair.origin[a] & 0xff) << 23)));
+    let corner = |c: usize| {
+        let q = Vec3::from_array(std::array::from_fn(|a| ((pair.boxes[a] >> (8 * c)) & 0xff) as f32));
         origin + q * step
     };
-    Aabb { lo: corner(pair.boxes[2 * child]), hi: corner(pair.boxes[2 * child + 1]) }
+    Aabb { lo: corner(2 * child), hi: corner(2 * child + 1) }
+}
+
+/// Where a pair's child `child` (0 or 1) leads.
+#[cfg(test)]
+fn child_reference(pair: &BvhPair, child: usize) -> u32 {
+    [pair.origin[3], pair.boxes[3]][child]
 }
 
 #[cfg(test)]
@@ -196,7 +211,7 @@ mod tests {
                         slack.cmple(span * (4.0 / 255.0) + Vec3::splat(1e-2)).all(),
                         "{slack} over {span}"
                     );
-                    let reference = pair.refs[c];
+                    let reference = child_reference(pair, c);
                     let (child_index, child_count) = node_range(&tree.nodes[child]);
                     if child_count > 0 {
                         assert_eq!(reference, constants::BVH_LEAF | child_count << 28 | (100 + child_index));
@@ -206,7 +221,7 @@ mod tests {
                     }
                 }
                 if count > 0 {
-                    assert_eq!(pair.refs[1], constants::NO_HIT);
+                    assert_eq!(child_reference(pair, 1), constants::NO_HIT);
                 }
             }
             assert_eq!(leaves as usize, n, "every primitive in one leaf reached from the root");
@@ -214,10 +229,25 @@ mod tests {
     }
 
     #[test]
+    fn the_grid_origin_is_at_or_just_below_the_box_and_leaves_its_low_byte_free() {
+        let values =
+            [0.0f32, -0.0, 1.0, -1.0, 1.000_001, -1.000_001, 3.3e-39, -3.3e-39, 10_000.37, -10_000.37];
+        for lo in values {
+            let origin = grid_origin(lo).unwrap();
+            assert!(origin <= lo, "{origin} above {lo}");
+            assert_eq!(origin.to_bits() & 0xff, 0, "{origin} for {lo}");
+            // One unit of the 9th mantissa bit at most: 2^-15 of the value (or of the smallest normal).
+            let gap = f64::from(lo) - f64::from(origin);
+            assert!(gap <= f64::from(lo.abs().max(f32::MIN_POSITIVE)) * 2f64.powi(-15), "{origin} for {lo}");
+        }
+        assert_eq!(grid_origin(f32::MIN), None, "no f32 below the most negative one");
+    }
+
+    #[test]
     fn an_empty_tree_has_one_pair_of_no_children() {
         let tree = sah::build(&[], 4);
         let pairs = pairs(&tree.nodes, 0, 3).unwrap();
         assert_eq!(pairs.len(), 1);
-        assert_eq!(pairs[0].refs[..2], [constants::NO_HIT; 2]);
+        assert_eq!([0, 1].map(|c| child_reference(&pairs[0], c)), [constants::NO_HIT; 2]);
     }
 }
