@@ -9,9 +9,9 @@
 # Benchmark only, not part of CI: needs `pip install embreex numpy`.
 # Run by hand: bash scripts/embree-compare.sh [SCENE]   (default: the full Stanford bunny)
 # Environment: KAGE_DEVICE (device name substring), KAGE (the kage binary; default: build it),
-# ROUNDS (default 1): rounds of the precomputation, each followed at once by Embree's PRT rays,
-# whose ratios are printed with their median: a machine whose speed drifts from minute to
-# minute moves both sides of a round alike.
+# ROUNDS (default 1): rounds of the whole comparison, Kage's casts and precomputation each
+# followed at once by Embree's, whose ratios are printed with their median: a machine whose
+# speed drifts from minute to minute moves both sides of a round alike.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -25,25 +25,33 @@ device=()
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-"$KAGE" bench rays --scene "$scene" --export "$work" "${device[@]}" | tee "$work/kage.txt"
-"$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" | tee "$work/precompute-1.txt"
-python3 scripts/embree-rays.py "$work" | tee "$work/embree-1.txt"
-for round in $(seq 2 "${ROUNDS:-1}"); do
-  "$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" > "$work/precompute-$round.txt"
-  python3 scripts/embree-rays.py "$work" 5 --prt-only > "$work/embree-$round.txt"
+for round in $(seq 1 "${ROUNDS:-1}"); do
+  # The first round writes the rays every round casts (the same rays: the generator is seeded).
+  export_to=()
+  [ "$round" = 1 ] && export_to=(--export "$work")
+  "$KAGE" bench rays --scene "$scene" "${export_to[@]}" "${device[@]}" | tee "$work/kage-$round.txt"
+  python3 scripts/embree-rays.py "$work" 5 --rays-only | tee "$work/embree-rays-$round.txt"
+  "$KAGE" precompute --scene "$scene" --force --cache "$work/cache" "${device[@]}" | tee "$work/precompute-$round.txt"
+  python3 scripts/embree-rays.py "$work" 5 --prt-only | tee "$work/embree-$round.txt"
 done
 
 python3 - "$work" "${ROUNDS:-1}" <<'PY'
 import re, sys
 folder, rounds = sys.argv[1], int(sys.argv[2])
-kage = open(f"{folder}/kage.txt").read()
-embree = open(f"{folder}/embree-1.txt").read()
-print("\nKage over Embree (one thread), Mrays/s:")
+print("\nKage over Embree (one thread), Mrays/s, round by round:")
 for query in ["closest hit", "any hit"]:
-    k = re.search(rf"^{query}\s+\S+\s+(\S+)\s+\S+\s+(\S+)", kage, re.M)
-    for ray_set, value in [("coherent", float(k.group(1))), ("incoherent", float(k.group(2)))]:
-        e = float(re.search(rf"^{query}\s+{ray_set}\s+\S+\s+(\S+)", embree, re.M).group(1))
-        print(f"  {query:<12} {ray_set:<11} {value:8.3f} / {e:8.3f} = {value / e:.2f}x")
+    for column, ray_set in [(1, "coherent"), (2, "incoherent")]:
+        pairs = []
+        for r in range(1, rounds + 1):
+            kage = open(f"{folder}/kage-{r}.txt").read()
+            embree = open(f"{folder}/embree-rays-{r}.txt").read()
+            k = float(re.search(rf"^{query}\s+\S+\s+(\S+)\s+\S+\s+(\S+)", kage, re.M).group(column))
+            e = float(re.search(rf"^{query}\s+{ray_set}\s+\S+\s+(\S+)", embree, re.M).group(1))
+            pairs.append((k, e))
+        shown = ", ".join(f"{k:.3f} / {e:.3f}" for k, e in pairs)
+        ratios = sorted(k / e for k, e in pairs)
+        print(f"  {query:<12} {ray_set:<11} {shown}: median {ratios[len(ratios) // 2]:.2f}x, "
+              f"{ratios[0]:.2f}-{ratios[-1]:.2f}x")
 ratios = []
 for r in range(1, rounds + 1):
     precompute = open(f"{folder}/precompute-{r}.txt").read()

@@ -13,8 +13,9 @@ The last line casts the PRT precomputation's rays of every 16th vertex (`prt.f32
 hits against each ray's own group, as `kage precompute` casts them: its Mrays/s against the
 precomputation's.
 
-Usage: python3 scripts/embree-rays.py DIR [RUNS] [--prt-only]
-(--prt-only: the last line alone, for the paired rounds of scripts/embree-compare.sh)
+Usage: python3 scripts/embree-rays.py DIR [RUNS] [--rays-only | --prt-only]
+(--rays-only: all lines but the last; --prt-only: the last line alone; for the paired rounds of
+scripts/embree-compare.sh)
 """
 import os
 import sys
@@ -26,7 +27,8 @@ from embreex import mesh_construction, rtcore_scene
 
 def main():
     prt_only = "--prt-only" in sys.argv[1:]
-    args = [a for a in sys.argv[1:] if a != "--prt-only"]
+    rays_only = "--rays-only" in sys.argv[1:]
+    args = [a for a in sys.argv[1:] if a not in ("--prt-only", "--rays-only")]
     folder = args[0]
     runs = int(args[1]) if len(args) > 1 else 5
     os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
@@ -58,6 +60,8 @@ def main():
             hits = int(np.count_nonzero(np.asarray(result) != -1))
             print(f"{name:<12} {ray_set:<11} {seconds * 1e3:9.2f} {len(rays) / seconds * 1e-6:9.3f} {hits:9d}")
 
+    if rays_only:
+        return
     # The PRT rays: closest hits (the precomputation tells front from back hits), each against
     # its own group's triangles only, one Embree scene per group.
     groups = np.fromfile(os.path.join(folder, "triangle-groups.u32"), dtype="<u4")
