@@ -31,11 +31,11 @@ void cast_packet(uint first) {
     RayHit hits[KAGE_BVH_PACKET];
     uint in_list = 0u;
     for (int r = 0; r < KAGE_BVH_PACKET; ++r) {
-        uint i = min(first + uint(r), p.params.x - 1u);
-        dirs[r] = ray_at(i).direction.xyz;
+        CastRay ray = ray_at(min(first + uint(r), p.params.x - 1u));
+        dirs[r] = ray.direction.xyz;
         bool listed = first + uint(r) < p.params.x;
         // A negative tmax: the packet does not cast it.
-        hits[r] = RayHit(listed ? ray_at(i).origin.w : -1.0, KAGE_NO_HIT, 0u, vec2(0.0));
+        hits[r] = RayHit(listed ? ray.origin.w : -1.0, KAGE_NO_HIT, 0u, vec2(0.0));
         if (listed) in_list |= 1u << r;
     }
     bvh_closest_hits_packet(p.params.z, ray_at(first).origin.xyz, dirs, hits);
