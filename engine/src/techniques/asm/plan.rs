@@ -10,10 +10,12 @@
 //!   the model planned took (`Asm::timed`): tiles timed one by one at start-up and tiles
 //!   rendered back to back in a frame cost differently on some devices (4x on lavapipe).
 //! - Requests are taken by benefit/cost, best first, until what the taken ones planned (their
-//!   renders and those of the ancestors their evictions give slots back to) and the next one's
-//!   cost would pass the per-frame time budget; the best one is always taken, so that the
-//!   refinement progresses on a device slower than the budget assumes. The pool makes the
-//!   tiles between a request and its nearest resident ancestor resident without pages.
+//!   renders and those of the ancestors their evictions give slots back to, each tile once a
+//!   frame) and the next one's cost would pass the per-frame time budget. A request's
+//!   evictions are made only within the budget left after its own render; the best one's own
+//!   render is always made, so that the refinement progresses on a device slower than the
+//!   budget assumes. The pool makes the tiles between a request and its nearest resident
+//!   ancestor resident without pages.
 use super::pool::Slots;
 use super::tile::TileKey;
 
@@ -92,27 +94,30 @@ pub fn rescaled(scale: f64, predicted_ms: f64, measured_ms: f64) -> f64 {
 }
 
 /// Takes the requests to render this frame within `budget_ms`, the best benefit/cost first.
-/// `take(request)` takes one and returns the ms it planned by the model (its render and the
-/// renders its evictions need), or `None` where the tile could not be taken. The best is
-/// always taken; returns the requests taken, in order.
+/// `take(request, left)` takes one with `left` ms of the budget left, and returns the ms it
+/// planned by the model (its render and the renders its evictions need) and whether the tile
+/// was taken (one refused may have planned renders: evictions done before the pool gave up).
+/// The best is always tried; returns the requests taken, in order.
 pub fn plan(
     mut requests: Vec<Request>,
     model: &CostModel,
     budget_ms: f64,
-    mut take: impl FnMut(&Request) -> Option<f64>,
+    mut take: impl FnMut(&Request, f64) -> (f64, bool),
 ) -> Vec<Request> {
     let ratio = |r: &Request| r.benefit() / model.cost_ms(r.triangles);
     requests.retain(|r| r.benefit() > 0.0);
     requests.sort_by(|a, b| ratio(b).total_cmp(&ratio(a)).then(a.key.cmp(&b.key)));
     let mut spent = 0.0;
     let mut taken = Vec::new();
-    for r in requests {
-        if !taken.is_empty() && spent + model.cost_ms(r.triangles) > budget_ms {
+    for (i, r) in requests.into_iter().enumerate() {
+        if i > 0 && spent + model.cost_ms(r.triangles) > budget_ms {
             break;
         }
-        let Some(ms) = take(&r) else { continue };
+        let (ms, took) = take(&r, budget_ms - spent);
         spent += ms;
-        taken.push(r);
+        if took {
+            taken.push(r);
+        }
     }
     taken
 }
@@ -153,7 +158,7 @@ mod tests {
         ];
         let keys = |chosen: Vec<Request>| chosen.iter().map(|r| r.key.x).collect::<Vec<_>>();
         // Each take planned its tile's cost.
-        let render = |r: &Request| Some(model.cost_ms(r.triangles));
+        let render = |r: &Request, _| (model.cost_ms(r.triangles), true);
         // Ratios: 5, 20, 90.9: the big one first; then the 2 ms ones only if they fit.
         assert_eq!(keys(plan(requests.clone(), &model, 15.0, render)), vec![2, 1, 0]);
         assert_eq!(keys(plan(requests.clone(), &model, 13.0, render)), vec![2, 1]);
@@ -164,11 +169,25 @@ mod tests {
         // What a take planned beyond its tile (an eviction's render) counts: with the big one's
         // 11 ms, a 2 ms one fits in 14; with an eviction's 2 ms more, none does.
         assert_eq!(keys(plan(requests.clone(), &model, 14.0, render)), vec![2, 1]);
-        let evicting = |r: &Request| Some(model.cost_ms(r.triangles) + 2.0);
+        let evicting = |r: &Request, _| (model.cost_ms(r.triangles) + 2.0, true);
         assert_eq!(keys(plan(requests.clone(), &model, 14.0, evicting)), vec![2]);
         // A refused take is skipped, the next taken.
-        let refusing = |r: &Request| (r.key.x != 2).then(|| model.cost_ms(r.triangles));
-        assert_eq!(keys(plan(requests, &model, 15.0, refusing)), vec![1, 0]);
+        let refusing =
+            |r: &Request, _| if r.key.x == 2 { (0.0, false) } else { (model.cost_ms(r.triangles), true) };
+        assert_eq!(keys(plan(requests.clone(), &model, 15.0, refusing)), vec![1, 0]);
+        // The best refused after its evictions planned 12 ms: the next (2 ms) fits in 15, no
+        // more; in 13 none does.
+        let evicted =
+            |r: &Request, _| if r.key.x == 2 { (12.0, false) } else { (model.cost_ms(r.triangles), true) };
+        assert_eq!(keys(plan(requests.clone(), &model, 15.0, evicted)), vec![1]);
+        assert!(keys(plan(requests.clone(), &model, 13.0, evicted)).is_empty());
+        // Each take is told the budget left before it.
+        let mut lefts = Vec::new();
+        plan(requests, &model, 15.0, |r, left| {
+            lefts.push(left);
+            render(r, left)
+        });
+        assert_eq!(lefts, vec![15.0, 4.0, 2.0]);
     }
 
     #[test]

@@ -29,9 +29,10 @@
 //!
 //! Eviction follows the paper's least recently used order, per slot first: when pages run short,
 //! the wanted slots no pixel asked for or read (its own texels, or a descendant's lookup falling
-//! back to them) in `STALE_FRAMES` are given back, once a frame (a tile in view is looked up
-//! every frame, but in motion most of its slots fall out of use; without this a full pool
-//! refused nearly every request while moving). Then, among the evictable tiles (resident leaves
+//! back to them) in `STALE_FRAMES` are given back, the longest unseen first, as many as the
+//! insertion needs (a tile in view is looked up every frame, but in motion most of its slots
+//! fall out of use; without this a full pool refused nearly every request while moving). A
+//! tile renders at most once a frame ([`PagePool::merged`]). Then, among the evictable tiles (resident leaves
 //! other than the root: evicting a tile with resident children would cut them off from the
 //! lookup's descent) the least recently used one not used in the current frame goes first; if
 //! every evictable tile was used this frame, the one of least benefit goes, and only for a tile
@@ -189,8 +190,11 @@ pub struct PagePool {
     free: Vec<u32>,
     tiles: HashMap<TileKey, Resident>,
     ops: Vec<PageOp>,
-    /// The last frame stale slots were given back in.
+    /// The frame `stale_order` was made in.
     released: u64,
+    /// The tiles with stale slots when the frame first ran short of pages, the next to give
+    /// them back last ([`PagePool::release_stalest`]).
+    stale_order: Vec<TileKey>,
     /// Tiles down to this level keep every slot (see [`WHOLE_LEVELS`]).
     whole: u32,
 }
@@ -224,9 +228,10 @@ impl PagePool {
             tiles: HashMap::new(),
             ops: Vec::new(),
             released: 0,
+            stale_order: Vec::new(),
             whole,
         };
-        pool.commit(pool.chain(TileKey::ROOT, ALL_SLOTS, false), 0, f32::INFINITY);
+        pool.commit(pool.chain(TileKey::ROOT, ALL_SLOTS, false, None), 0, f32::INFINITY);
         Ok(pool)
     }
 
@@ -319,6 +324,31 @@ impl PagePool {
         std::mem::take(&mut self.ops)
     }
 
+    /// `ops` (queued in one frame, in order) with each tile rendered once: at its last render's
+    /// place, into the pages it holds now of the slots any of them stored. A page a tile gave
+    /// up between its renders went to a later render of another tile or stays free; one it
+    /// holds now was written by nothing after its last render. Evictions of several children
+    /// of one ancestor each queued a render of that ancestor (12 of one level-3 tile in a
+    /// frame of 28 renders after a camera turn).
+    pub fn merged(&self, ops: Vec<PageOp>) -> Vec<PageOp> {
+        let mut slots: HashMap<TileKey, Slots> = HashMap::new();
+        for op in &ops {
+            *slots.entry(op.key).or_default() |= op.stores.iter().fold(0, |m, (s, _)| m | 1 << s);
+        }
+        let mut merged: Vec<PageOp> = ops
+            .into_iter()
+            .rev()
+            .filter_map(|op| {
+                let slots = slots.remove(&op.key)?;
+                let stores: Vec<(u32, u32)> =
+                    self.stores(op.key).into_iter().filter(|(s, _)| slots & 1 << s != 0).collect();
+                (!stores.is_empty()).then_some(PageOp { key: op.key, stores })
+            })
+            .collect();
+        merged.reverse();
+        merged
+    }
+
     /// Notes that `slots` of `key` are asked for in `frame`; true if that needs no render: the
     /// tile stores them, or stores every slot while on trial (see [`PagePool::insert`]).
     /// With a `benefit`, that is the tile's now.
@@ -360,42 +390,75 @@ impl PagePool {
         }
     }
 
-    /// Gives back the wanted slots no pixel asked for or read in `STALE_FRAMES` (the paper's
-    /// least recently used tiles first, per slot), leaves left wanting nothing evicted.
-    fn release_stale(&mut self, frame: u64) {
-        let Some(before) = frame.checked_sub(STALE_FRAMES) else { return };
-        let mut keys: Vec<(TileKey, Slots)> = self
-            .tiles
-            .iter()
-            .filter(|(k, r)| k.level > self.whole && r.trial.is_none())
-            .map(|(k, r)| {
-                let stale = (0..SLOTS).filter(|&s| r.seen[s] < before).fold(0, |m, s| m | 1 << s);
-                (*k, r.wanted & stale)
-            })
-            .filter(|(_, stale)| *stale != 0)
-            .collect();
-        // Deepest first: a leaf's release may leave its parent a leaf.
-        keys.sort_by(|a, b| b.0.level.cmp(&a.0.level).then(a.0.cmp(&b.0)));
-        for (key, stale) in keys {
-            let Some(r) = self.tiles.get(&key) else { continue };
+    /// The tile's wanted slots no pixel asked for or read in `STALE_FRAMES` before `frame`,
+    /// with the last frame any of them was seen; `None` where it has none (or may not give them).
+    fn stale(&self, key: TileKey, frame: u64) -> Option<(Slots, u64)> {
+        let before = frame.checked_sub(STALE_FRAMES)?;
+        let r = self.tiles.get(&key).filter(|r| key.level > self.whole && r.trial.is_none())?;
+        let slots = (0..SLOTS).filter(|&s| r.seen[s] < before).fold(0, |m, s| m | 1 << s) & r.wanted;
+        let last = (0..SLOTS).filter(|&s| slots & 1 << s != 0).map(|s| r.seen[s]).max()?;
+        Some((slots, last))
+    }
+
+    /// Gives back the stale slots of one more tile (see [`PagePool::stale`]): the tiles whose
+    /// stale slots were seen longest ago first (the paper's least recently used order, per
+    /// slot), deeper ones first among those (a leaf's release may leave its parent a leaf); a
+    /// leaf left wanting nothing is evicted. Only as many as an insertion needs go, one tile at
+    /// a time: releasing every stale slot at once queued the renders of all their ancestors in
+    /// one frame (28 against the 7 a frame's time allowed after a camera turn). False when no
+    /// stale tile is left this frame.
+    fn release_stalest(&mut self, frame: u64, afford: &mut dyn FnMut(&[TileKey]) -> bool) -> bool {
+        if self.released < frame {
+            self.released = frame;
+            let mut keys: Vec<(u64, TileKey)> =
+                self.tiles.keys().filter_map(|&k| self.stale(k, frame).map(|(_, last)| (last, k))).collect();
+            keys.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.level.cmp(&b.1.level)).then(b.1.cmp(&a.1)));
+            self.stale_order = keys.into_iter().map(|(_, k)| k).collect();
+        }
+        // A tile whose release renders more than `afford` allows keeps its slots this frame.
+        while let Some(key) = self.stale_order.pop() {
+            // Noted since the list was made, or gone with a child's eviction.
+            let Some((stale, _)) = self.stale(key, frame) else { continue };
+            let r = self.tiles[&key];
             let wanted = r.wanted & !stale;
             if wanted == 0 && r.children == 0 {
-                self.evict(key, frame);
+                let (gone, chain) = self.eviction(key);
+                if afford(&self.renders(&chain)) {
+                    self.evict(gone, chain, frame);
+                    return true;
+                }
                 continue;
             }
-            let chain = self.chain(key, wanted, false);
-            let pages = self.pages_needed(&chain);
-            if pages <= 0 {
+            let chain = self.chain(key, wanted, false, None);
+            if self.pages_needed(&chain) < 0 && afford(&self.renders(&chain)) {
                 self.commit(chain, frame, r.benefit);
+                return true;
             }
         }
+        false
     }
 
     /// Makes `slots` of `key` wanted in `frame` with `benefit` (the refinement's), the tiles
     /// between it and its nearest resident ancestor resident without pages, evicting tiles if
     /// the pool is short of pages or nodes (see the module's rules), and queues the renders. A
     /// tile that stored nothing starts its trial ([`PagePool::end_trials`]).
+    #[cfg(test)]
     pub fn insert(&mut self, key: TileKey, slots: Slots, frame: u64, benefit: f32) -> Result<Insert> {
+        self.insert_within(key, slots, frame, benefit, &mut |_| true)
+    }
+
+    /// [`PagePool::insert`], each stale release and eviction done only where `afford` accepts
+    /// the tiles it would render (it is told them before): the time a frame's renders take is
+    /// bounded, the renders evictions cause included. Where none is accepted and pages are
+    /// short, the tile is refused; what was freed stays free.
+    pub fn insert_within(
+        &mut self,
+        key: TileKey,
+        slots: Slots,
+        frame: u64,
+        benefit: f32,
+        afford: &mut dyn FnMut(&[TileKey]) -> bool,
+    ) -> Result<Insert> {
         if key.level > crate::layouts::constants::ASM_MAX_LEVEL {
             return Err(Error::Internal(format!("ASM tile {key:?} is below the deepest level")));
         }
@@ -409,7 +472,7 @@ impl PagePool {
                 true => ALL_SLOTS,
                 false => self.tiles.get(&key).map_or(0, |r| r.wanted) | slots,
             };
-            let chain = self.chain(key, wanted, fresh);
+            let chain = self.chain(key, wanted, fresh, None);
             let new_tiles = chain.iter().filter(|s| !self.tiles.contains_key(&s.key)).count();
             let pages = self.pages_needed(&chain);
             let fits_pages = pages <= self.free.len() as i64;
@@ -422,15 +485,17 @@ impl PagePool {
                 }
                 return Ok(Insert::Inserted { evicted });
             }
-            if self.released < frame {
-                self.released = frame;
-                self.release_stale(frame);
+            if self.release_stalest(frame, afford) {
                 continue;
             }
             let Some(victim) = self.victim(key, frame, benefit) else {
                 return Ok(Insert::Refused);
             };
-            self.evict(victim, frame);
+            let (gone, chain) = self.eviction(victim);
+            if !afford(&self.renders(&chain)) {
+                return Ok(Insert::Refused);
+            }
+            self.evict(gone, chain, frame);
             evicted += 1;
         }
     }
@@ -451,7 +516,7 @@ impl PagePool {
                 true => ALL_SLOTS,
                 false => trial.asked | if plenty { trial.used } else { 0 },
             };
-            let chain = self.chain(key, keep, false);
+            let chain = self.chain(key, keep, false, None);
             let pages = self.pages_needed(&chain);
             // Uncovered slots of its ancestors could take more than it gives back: then later.
             if pages <= self.free.len() as i64 {
@@ -465,7 +530,8 @@ impl PagePool {
     /// change: a tile's cover depends on its children's.
     /// A tile on trial covers nothing of its parent's: the parent keeps those pages, so that
     /// the trial's end, where the tile keeps fewer slots, needs no render of the parent.
-    fn chain(&self, key: TileKey, wanted: Slots, on_trial: bool) -> Vec<Step> {
+    /// `gone`, where given, is a tile about to be evicted: as if not resident.
+    fn chain(&self, key: TileKey, wanted: Slots, on_trial: bool, gone: Option<TileKey>) -> Vec<Step> {
         let mut steps: Vec<Step> = Vec::new();
         let mut at = Some(key);
         while let Some(k) = at {
@@ -480,7 +546,7 @@ impl PagePool {
                         false => self.tiles.get(&c).is_some_and(|r| r.trial.is_some()),
                     };
                     match steps.last().filter(|s| s.key == c) {
-                        _ if trial => 0,
+                        _ if trial || gone == Some(c) => 0,
                         Some(s) => s.full,
                         None => self.tiles.get(&c).map_or(0, |r| r.full),
                     }
@@ -548,25 +614,42 @@ impl PagePool {
         }
     }
 
-    /// Evicts leaf `key`: its pages come free, its ancestors that wanted what it covered store
-    /// it again (renders queued), and ancestors left with no child and nothing wanted go too.
-    fn evict(&mut self, key: TileKey, frame: u64) {
-        let leaf = self.tiles.remove(&key).expect("the victim is resident");
-        self.free.extend(leaf.pages.iter().flatten());
+    /// What evicting leaf `key` does: the tiles that go (it, then the ancestors it leaves with
+    /// no child and nothing wanted), and the new states of the nearest one that stays and its
+    /// ancestors (those that wanted what the tiles going covered store it again).
+    fn eviction(&self, key: TileKey) -> (Vec<TileKey>, Vec<Step>) {
+        let mut gone = vec![key];
         let mut parent = key.parent().expect("the root is never evicted");
-        self.tiles.get_mut(&parent).expect("a resident tile's parent is resident").children -= 1;
         while parent != TileKey::ROOT {
-            let r = self.tiles[&parent];
-            if r.children > 0 || r.wanted != 0 {
+            let r = &self.tiles[&parent];
+            if r.children > 1 || r.wanted != 0 {
                 break;
             }
-            self.tiles.remove(&parent);
+            gone.push(parent);
             parent = parent.parent().expect("not the root");
-            self.tiles.get_mut(&parent).expect("a resident tile's parent is resident").children -= 1;
         }
+        let r = &self.tiles[&parent];
+        let chain = self.chain(parent, r.wanted, r.trial.is_some(), gone.last().copied());
+        (gone, chain)
+    }
+
+    /// Applies an [`PagePool::eviction`]: the tiles `gone` leave, their pages come free, and
+    /// `chain`'s renders are queued.
+    fn evict(&mut self, gone: Vec<TileKey>, chain: Vec<Step>, frame: u64) {
+        for key in &gone {
+            let r = self.tiles.remove(key).expect("the tiles going are resident");
+            self.free.extend(r.pages.iter().flatten());
+        }
+        let top = gone.last().expect("the victim goes").parent().expect("the root is never evicted");
+        self.tiles.get_mut(&top).expect("a resident tile's parent is resident").children -= 1;
         // The chain holds no new tile: `frame` and the benefit go nowhere.
-        let (wanted, on_trial) = (self.tiles[&parent].wanted, self.tiles[&parent].trial.is_some());
-        self.commit(self.chain(parent, wanted, on_trial), frame, 0.0);
+        self.commit(chain, frame, 0.0);
+    }
+
+    /// The tiles a chain of states renders: those that store slots they do not now.
+    fn renders(&self, chain: &[Step]) -> Vec<TileKey> {
+        let now = |key: &TileKey| self.tiles.get(key).map_or(0, |r| r.stored());
+        chain.iter().filter(|s| s.stored & !now(&s.key) != 0).map(|s| s.key).collect()
     }
 
     /// The tile to evict for `key`, if any may go.
@@ -698,6 +781,45 @@ mod tests {
         assert_eq!(pool.insert(c, bit(0, 0), frame, 1.0).unwrap(), Insert::Refused);
     }
 
+    /// A short pool gives back the stale slots seen longest ago, only as many as the insertion
+    /// needs: the tile seen later keeps its slots.
+    #[test]
+    fn stale_slots_go_stalest_first_and_no_more_than_needed() {
+        let mut pool = PagePool::keeping_whole(ROOT_PAGES + 4 + 15, PAGE_BYTES, 0).unwrap();
+        let (a, b, c) = (child(TileKey::ROOT, 0), child(TileKey::ROOT, 1), child(TileKey::ROOT, 2));
+        pool.insert(a, bit(0, 0) | bit(3, 3), 1, 1.0).unwrap();
+        pool.end_trials(1 + TRIAL_FRAMES);
+        pool.insert(b, bit(0, 0) | bit(3, 3), 3, 1.0).unwrap();
+        pool.end_trials(3 + TRIAL_FRAMES);
+        assert_eq!((pool.stores(a).len(), pool.stores(b).len(), in_use(&pool)), (2, 2, TILE_PAGES + 4));
+        // Both stale; c's trial takes 16 pages of 15 free: a's two (seen in frame 1) go.
+        let frame = 3 + STALE_FRAMES + 10;
+        assert_eq!(pool.insert(c, bit(0, 0), frame, 1.0).unwrap(), Insert::Inserted { evicted: 0 });
+        assert!(!pool.contains(a), "stale and wanting nothing else: evicted");
+        assert_eq!(pool.stores(b).len(), 2, "not needed: kept");
+    }
+
+    /// Renders of one tile queued in a frame become one, at the last's place, into the pages
+    /// it holds then; a tile no longer resident renders nothing.
+    #[test]
+    fn a_tile_renders_once_a_frame() {
+        let mut pool = PagePool::keeping_whole(64, PAGE_BYTES, 0).unwrap();
+        let a = child(TileKey::ROOT, 0);
+        pool.insert(a, ALL_SLOTS, 1, 1.0).unwrap();
+        let root = pool.stores(TileKey::ROOT);
+        let gone = child(TileKey::ROOT, 2);
+        let op = |key, stores: &[(u32, u32)]| PageOp { key, stores: stores.to_vec() };
+        let ops = vec![
+            op(TileKey::ROOT, &root[..2]),
+            op(a, &pool.stores(a)[..1]),
+            op(gone, &[(0, 99)]),
+            op(TileKey::ROOT, &[(0, 99), root[5]]),
+        ];
+        let merged = pool.merged(ops);
+        let root_slots = [root[0], root[1], root[5]];
+        assert_eq!(merged, vec![op(a, &pool.stores(a)[..1]), op(TileKey::ROOT, &root_slots)]);
+    }
+
     /// The tiles down to `WHOLE_LEVELS` keep every slot past their trial, stale or not; a tile
     /// below them keeps the slots asked for.
     #[test]
@@ -715,7 +837,7 @@ mod tests {
         }
         // 2000 pages, 1000 free: not half, so the deepest keeps the slot asked for alone.
         assert_eq!(pool.stores(key(WHOLE_LEVELS + 1)).len(), 1);
-        pool.release_stale(100);
+        while pool.release_stalest(100, &mut |_| true) {}
         for level in 1..=WHOLE_LEVELS {
             assert_eq!(pool.tiles[&key(level)].wanted, ALL_SLOTS, "level {level} after a release");
         }
@@ -797,6 +919,13 @@ mod tests {
             }
             trials += pool.tiles.values().filter(|r| r.trial.is_some_and(|t| t.ends <= frame)).count();
             pool.end_trials(frame);
+            // The frame's renders, one per tile, write only pages their tiles hold.
+            let taken = pool.take_ops();
+            let ops = pool.merged(taken);
+            for (i, op) in ops.iter().enumerate() {
+                assert!(ops[..i].iter().all(|o| o.key != op.key), "{:?} rendered twice", op.key);
+                assert!(op.stores.iter().all(|s| pool.stores(op.key).contains(s)), "{op:?}");
+            }
             assert!(in_use(&pool) <= u64::from(capacity) && pool.tiles.len() <= pool.max_tiles() as usize);
             assert!(pool.contains(TileKey::ROOT));
             let mut pages: Vec<u32> = Vec::new();

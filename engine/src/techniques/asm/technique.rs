@@ -53,7 +53,7 @@ use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
 use crate::techniques::{Technique, TechniqueStats};
 use glam::{Mat4, Vec3};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 /// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
@@ -766,31 +766,58 @@ impl Technique for Asm {
         requests.retain(|r| !self.pool.note(r.key, r.slots, self.frame, Some(r.benefit() as f32)));
         let requests = self.defer_extensions(requests);
         let model = self.cost.scaled(self.cost_scale);
-        let (frame, time_ms, view_proj) = (self.frame, self.time_budget_ms(), self.view_proj());
+        let (frame, time_ms) = (self.frame, self.time_budget_ms());
         self.evicted = 0;
-        let mut planned = Vec::new();
-        plan(requests, &model, time_ms, |request| {
-            // A parent evicted by an earlier insertion of this frame refuses its child (an error
-            // from the pool), as a pool with no page to free does: the child waits. The pool
-            // weighs tiles by benefit alone: an eviction trades pages, which every tile takes
-            // alike, where the plan's order trades milliseconds.
-            let Ok(Insert::Inserted { evicted }) =
-                self.pool.insert(request.key, request.slots, frame, request.benefit() as f32)
-            else {
-                return None;
+        let (mut ops, mut failed) = (Vec::new(), None);
+        // A tile renders once a frame (`PagePool::merged`): a render queued already is paid.
+        let mut queued = HashSet::new();
+        let (clusters, rects) = (&self.clusters, &self.cluster_rects);
+        let cost = |key: TileKey| model.cost_ms(draw_triangles(&tile_draws(clusters, rects, key)));
+        plan(requests, &model, time_ms, |request, left_ms| {
+            let own = if queued.contains(&request.key) { 0.0 } else { model.cost_ms(request.triangles) };
+            // The evictions' renders are made only in what the budget leaves after this one's.
+            let mut extra = 0.0;
+            let mut afford = |keys: &[TileKey]| {
+                let new: Vec<TileKey> = keys.iter().filter(|k| !queued.contains(*k)).copied().collect();
+                let ms: f64 = new.iter().map(|&k| cost(k)).sum();
+                let fits = own + extra + ms <= left_ms || ms == 0.0;
+                if fits {
+                    extra += ms;
+                    queued.extend(new);
+                }
+                fits
             };
-            self.evicted += evicted;
-            let (clusters, rects) = (&self.clusters, &self.cluster_rects);
-            let writes =
-                self.pool.take_ops().into_iter().map(|op| tile_write(op, &view_proj, clusters, rects));
-            let before = planned.len();
-            planned.extend(writes);
-            Some(planned[before..].iter().map(|w| model.cost_ms(draw_triangles(&w.draws))).sum())
+            // The pool weighs tiles by benefit alone: an eviction trades pages, which every
+            // tile takes alike, where the plan's order trades milliseconds.
+            let insert = self.pool.insert_within(
+                request.key,
+                request.slots,
+                frame,
+                request.benefit() as f32,
+                &mut afford,
+            );
+            let taken = self.pool.take_ops();
+            let ms =
+                extra + taken.iter().filter(|op| queued.insert(op.key)).map(|op| cost(op.key)).sum::<f64>();
+            ops.extend(taken);
+            match insert {
+                Ok(Insert::Inserted { evicted }) => {
+                    self.evicted += evicted;
+                    (ms, true)
+                }
+                Ok(_) => (ms, false),
+                Err(e) => {
+                    failed.get_or_insert(e);
+                    (ms, false)
+                }
+            }
         });
+        if let Some(e) = failed {
+            return Err(e);
+        }
         self.pool.end_trials(frame);
-        let ops = self.pool.take_ops();
-        planned.extend(self.writes(ops));
-        self.render = planned;
+        ops.extend(self.pool.take_ops());
+        self.render = self.writes(self.pool.merged(ops));
         self.planned_ms = self.render.iter().map(|w| self.cost.cost_ms(draw_triangles(&w.draws))).sum();
         self.write_table()?;
         self.lit_keys.clone_from(&self.table_keys);
