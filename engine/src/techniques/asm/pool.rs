@@ -113,7 +113,7 @@ struct Resident {
     full: Slots,
     /// Resident children.
     children: u8,
-    /// While a new tile stores every slot (see [`PagePool::insert`]).
+    /// While a new tile stores every slot (see [`PagePool::insert_within`]).
     trial: Option<Trial>,
     last_used: u64,
     benefit: f32,
@@ -135,7 +135,7 @@ pub struct PageOp {
     pub stores: Vec<(u32, u32)>,
 }
 
-/// What [`PagePool::insert`] did.
+/// What [`PagePool::insert_within`] did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Insert {
     /// The tile was resident with those slots already (now marked used).
@@ -350,7 +350,7 @@ impl PagePool {
     }
 
     /// Notes that `slots` of `key` are asked for in `frame`; true if that needs no render: the
-    /// tile stores them, or stores every slot while on trial (see [`PagePool::insert`]).
+    /// tile stores them, or stores every slot while on trial (see [`PagePool::insert_within`]).
     /// With a `benefit`, that is the tile's now.
     pub fn note(&mut self, key: TileKey, slots: Slots, frame: u64, benefit: Option<f32>) -> bool {
         let Some(r) = self.tiles.get_mut(&key) else { return false };
@@ -438,19 +438,20 @@ impl PagePool {
         false
     }
 
-    /// Makes `slots` of `key` wanted in `frame` with `benefit` (the refinement's), the tiles
-    /// between it and its nearest resident ancestor resident without pages, evicting tiles if
-    /// the pool is short of pages or nodes (see the module's rules), and queues the renders. A
-    /// tile that stored nothing starts its trial ([`PagePool::end_trials`]).
+    /// [`PagePool::insert_within`] with every render afforded.
     #[cfg(test)]
     pub fn insert(&mut self, key: TileKey, slots: Slots, frame: u64, benefit: f32) -> Result<Insert> {
         self.insert_within(key, slots, frame, benefit, &mut |_| true)
     }
 
-    /// [`PagePool::insert`], each stale release and eviction done only where `afford` accepts
-    /// the tiles it would render (it is told them before): the time a frame's renders take is
-    /// bounded, the renders evictions cause included. Where none is accepted and pages are
-    /// short, the tile is refused; what was freed stays free.
+    /// Makes `slots` of `key` wanted in `frame` with `benefit` (the refinement's), the tiles
+    /// between it and its nearest resident ancestor resident without pages, evicting tiles if
+    /// the pool is short of pages or nodes (see the module's rules), and queues the renders. A
+    /// tile that stored nothing starts its trial ([`PagePool::end_trials`]). Each stale
+    /// release and eviction is done only where `afford` accepts the tiles it would render (it
+    /// is told them before): the time a frame's renders take is bounded, the renders
+    /// evictions cause included. Where none is accepted and pages are short, the tile is
+    /// refused; what was freed stays free.
     pub fn insert_within(
         &mut self,
         key: TileKey,
