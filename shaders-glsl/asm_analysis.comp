@@ -67,7 +67,7 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     float inv = iw + dot(slope, centre - m.xy);
     if (inv <= 0.0) return false;
     float stored = asm_depth(page, texel);
-    return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, asm_texel_size(s, page.tile.x), vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0));
+    return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, asm_texel_size(s, page.tile.x), vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0), page.step);
 }
 
 // The stored depth at the centre of tile texel `texel`, a neighbour of texel t across its page's
@@ -118,7 +118,7 @@ void main() {
     float stored = asm_depth(page, t);
     // Lit, but the slope-scaled bias hides an occluder in front of the receiver's plane (a
     // coarse tile under grazing light): a finer tile's bias is narrower and shows the shadow.
-    bool lit = shadow_lit_past(s, stored, shadow_receiver_depth(s, m.z, p, ng, texel, push.bias));
+    bool lit = shadow_lit_past(s, stored, shadow_receiver_depth(s, m.z, p, ng, texel, push.bias, page.step));
     bool hidden = lit && occluded_at_plane(s, m, p, ng, mx, my, page);
     ivec2 at_slot = asm_slot(at_tile, m.xy);
     uint slot_bit = 1u << (at_slot.y * (KAGE_ASM_TILE_TEXELS / KAGE_ASM_PAGE_TEXELS) + at_slot.x);
@@ -137,7 +137,7 @@ void main() {
     // within a texel). Neighbours lie up to 1 + sqrt(2) texels from p: the slope term grows so.
     // The receiver's biased depths are computed once for all the texels.
     vec4 wide_bias = vec4(push.bias.x, push.bias.y * 2.5, push.bias.z, 0.0);
-    float wide = shadow_receiver_depth(s, m.z, p, ng, texel, wide_bias);
+    float wide = shadow_receiver_depth(s, m.z, p, ng, texel, wide_bias, page.step);
     bool centre = shadow_lit_past(s, stored, wide);
     bool edge = false;
     for (int j = -1; j <= 1; ++j) {

@@ -19,5 +19,5 @@ bool visible(uint k, vec3 p, vec3 ng) {
         ivec2 texel = clamp(shadow_footprint_texel(f, j), ivec2(0), ivec2(size - 1));
         stored[j] = texelFetch(shadow_maps, ivec3(texel, int(k)), 0).r;
     }
-    return shadow_footprint_visible(s, f, stored, shadow_receiver_depth(s, m.z, p, ng, s.map.z, draw.bias));
+    return shadow_footprint_visible(s, f, stored, shadow_receiver_depth(s, m.z, p, ng, s.map.z, draw.bias, 0.0));
 }

@@ -12,8 +12,8 @@
 layout(early_fragment_tests) in;
 layout(std430, set = 0, binding = 4) writeonly buffer AsmUsed { uint asm_used[]; };
 #ifdef ASM_ID_TEST
-// The polygon IDs, an atlas laid out as the depth pool's.
-layout(set = 0, binding = 5) uniform usampler2D asm_ids;
+// The polygon IDs: KAGE_ASM_PAGE_ID_TEXELS texels a page, in the depth pool's page order.
+layout(set = 0, binding = 5) uniform usamplerBuffer asm_ids;
 #endif
 
 #include "asm_lookup.glsl"
@@ -27,7 +27,8 @@ bool visible(uint k, vec3 p, vec3 ng) {
     AsmPage page = asm_page(at, m.xy);
     vec2 f = asm_texel_coords(page.tile, m.xy);
 #ifdef ASM_ID_TEST
-    if (texelFetch(asm_ids, asm_atlas_texel(page, ivec2(f)), 0).r == draw.params.y + uint(gl_PrimitiveID)) {
+    uint i = asm_page_texel(page, ivec2(f));
+    if (texelFetch(asm_ids, int(page.page * KAGE_ASM_PAGE_ID_TEXELS + i / 4u))[i & 3u] == draw.params.y + uint(gl_PrimitiveID)) {
         return true;
     }
 #endif
@@ -37,7 +38,7 @@ bool visible(uint k, vec3 p, vec3 ng) {
     for (int j = 0; j < 4; ++j) {
         stored[j] = asm_depth(page, shadow_footprint_texel(f, j));
     }
-    float receiver = shadow_receiver_depth(s, m.z, p, ng, asm_texel_size(s, page.tile.x), draw.bias);
+    float receiver = shadow_receiver_depth(s, m.z, p, ng, asm_texel_size(s, page.tile.x), draw.bias, page.step);
     return shadow_footprint_visible(s, f, stored, receiver);
 }
 

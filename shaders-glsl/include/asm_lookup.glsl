@@ -1,7 +1,8 @@
 // The adaptive shadow map's page table and its descent (engine/src/techniques/asm/page_table.rs),
-// shared by the lighting pass and the refinement analysis, with the page pool (an atlas of
-// pages, each one slot of a tile: a 4x4 grid of KAGE_ASM_PAGE_TEXELS squares). The including shader declares nothing else at set 0,
-// bindings 2 and 3.
+// shared by the lighting pass and the refinement analysis, with the page pool (pages of
+// KAGE_ASM_PAGE_DEPTH_TEXELS texels, each one slot of a tile: a 4x4 grid of
+// KAGE_ASM_PAGE_TEXELS squares; asm_pack.comp writes them). The including shader declares
+// nothing else at set 0, bindings 2 and 3.
 #ifndef KAGE_ASM_LOOKUP_GLSL
 #define KAGE_ASM_LOOKUP_GLSL
 
@@ -9,7 +10,7 @@
 
 #define ASM_DIRECTORY_SIDE (1u << KAGE_ASM_DIRECTORY_LEVEL)
 
-layout(set = 0, binding = 2) uniform sampler2D asm_pool;
+layout(set = 0, binding = 2) uniform usamplerBuffer asm_pool;
 // The page table as uvec4 texels: the directory (rows of ASM_DIRECTORY_SIDE entries, four to a
 // texel: node index | level << 24, the finest resident tile at or above the directory's level
 // over each of its tiles), then the nodes (an AsmNode is ASM_NODE_TEXELS texels: below[0..3],
@@ -55,16 +56,13 @@ AsmTile asm_descend(vec2 uv) {
     return at;
 }
 
-// The first atlas texel of the page in cell `cell` (column | row << 12, as AsmNode.pages).
-ivec2 asm_cell_origin(uint cell) {
-    return ivec2(cell & 0xfffu, (cell >> 12) & 0xfffu) * KAGE_ASM_PAGE_TEXELS;
-}
-
 // The stored slot that holds a point: its tile, and where its texels lie.
 struct AsmPage {
     uvec3 tile; // x: level, y, z: tile x, y at that level
     ivec2 slot; // the slot's first texel within the tile
-    ivec2 atlas; // the page's first texel in the atlas
+    uint page; // its index in the pool
+    float nearest; // its depths' span: the nearest depth and the step of its 16-bit values
+    float step;
 };
 
 // Light uv in the texel space of tile `tile` (level, x, y).
@@ -94,7 +92,10 @@ AsmPage asm_page(AsmTile at, vec2 uv) {
     uint entry = asm_node(at.node, ASM_NODE_PAGES + s.y)[s.x];
     uint up = entry >> 24;
     uvec3 tile = uvec3(at.level - up, xy >> up);
-    return AsmPage(tile, asm_slot(tile, uv) * KAGE_ASM_PAGE_TEXELS, asm_cell_origin(entry));
+    uint index = entry & 0xffffffu;
+    uvec4 span = texelFetch(asm_pool, int((index + 1u) * KAGE_ASM_PAGE_DEPTH_TEXELS) - 1);
+    ivec2 slot = asm_slot(tile, uv) * KAGE_ASM_PAGE_TEXELS;
+    return AsmPage(tile, slot, index, uintBitsToFloat(span.x), uintBitsToFloat(span.y));
 }
 
 // Tile texel `texel` kept in the page's slot (the texels beyond it are in other pages, or in
@@ -103,14 +104,19 @@ ivec2 asm_slot_texel(AsmPage page, ivec2 texel) {
     return clamp(texel, page.slot, page.slot + KAGE_ASM_PAGE_TEXELS - 1);
 }
 
-// The atlas texel of tile texel `texel`, kept in the page's slot.
-ivec2 asm_atlas_texel(AsmPage page, ivec2 texel) {
-    return page.atlas + asm_slot_texel(page, texel) - page.slot;
+// Where tile texel `texel`, kept in the page's slot, lies in the page: row by row.
+uint asm_page_texel(AsmPage page, ivec2 texel) {
+    ivec2 t = asm_slot_texel(page, texel) - page.slot;
+    return uint(t.y * KAGE_ASM_PAGE_TEXELS + t.x);
 }
 
-// The stored depth of tile texel `texel` (kept in the page's slot).
+// The stored Vulkan depth of tile texel `texel` (kept in the page's slot), to within half the
+// page's step.
 float asm_depth(AsmPage page, ivec2 texel) {
-    return texelFetch(asm_pool, asm_atlas_texel(page, texel), 0).r;
+    uint i = asm_page_texel(page, texel);
+    uint word = texelFetch(asm_pool, int(page.page * KAGE_ASM_PAGE_DEPTH_TEXELS + i / 8u))[(i / 2u) & 3u];
+    uint q = (word >> (16u * (i & 1u))) & 0xffffu;
+    return q == 0xffffu ? 1.0 : page.nearest + float(q) * page.step;
 }
 
 // The world size at unit depth of the texels of a tile at `level`.

@@ -110,11 +110,19 @@
 // tiles misclassified 18 % fewer pixels of the `asm` walkthrough than 128² (BENCHMARKS.md); 32²
 // little fewer again, at a frame cost over the paper's 1.74x.
 #define KAGE_ASM_TILE_TEXELS 64
-// Texels per side of a page of the pool: one slot of a tile's 4x4 (1 KiB of D32). A tile keeps
+// Texels per side of a page of the pool: one slot of a tile's 4x4. A tile keeps
 // pages only for the slots the analysis found eye pixels on shadow edges in and no finer tiles
 // cover (engine/src/techniques/asm/pool.rs): texels a thirty-second of the eye pixel put a
 // tile over a pixel or two, and most of its square holds no lookup.
 #define KAGE_ASM_PAGE_TEXELS 16
+// uvec4 texels of a depth page in the pool (asm_pack.comp): its depths row by row as 16-bit
+// fractions of the page's own depth span, eight to a texel, then the span's nearest depth and
+// step (float bits) in a texel of their own. Half the bytes of D32: twice the pages a budget holds.
+#define KAGE_ASM_PAGE_DEPTH_TEXELS 33
+// uvec4 texels of a page of polygon IDs (the ID test), four to a texel.
+#define KAGE_ASM_PAGE_ID_TEXELS 64
+// Workgroup of the ASM page packing (asm_pack.comp): a slot an invocation.
+#define KAGE_ASM_PACK_GROUP 64
 // The deepest quadtree level: 2^17 tiles per side, an effective 8,388,608² map (the paper
 // reports the equivalent of 524,288²).
 #define KAGE_ASM_MAX_LEVEL 17

@@ -293,13 +293,18 @@ struct LocalDrawPush {
 // (engine/src/techniques/asm/page_table.rs).
 struct AsmNode {
     uvec4 below[4]; // over cell (x & 3, y & 3) of the tile's grandchildren, below[y & 3][x & 3]: the grandchild's node index | 2 << 24 where it is resident, else the child's | 1 << 24 where that is, else 0
-    uvec4 pages[4]; // per slot (x, y) of the tile's 4x4, row y component x: the atlas cell (column | row << 12) of the page holding it | the levels up to the tile that stores it << 24 (0: this one), where no resident child covers the slot (else unused)
+    uvec4 pages[4]; // per slot (x, y) of the tile's 4x4, row y component x: the index of the page holding it in the pool | the levels up to the tile that stores it << 24 (0: this one), where no resident child covers the slot (else unused)
 };
 
 // Push constants of an ASM tile render with polygon IDs (asm_tile.vert/frag): one draw per mesh.
 struct AsmTilePush {
     mat4 transform; // object to the tile's clip space (the tile's view-projection times the model)
     uvec4 ids; // x: polygon ID of the mesh's first triangle (IDs start at 1; 0: no surface), y, z, w: unused
+};
+
+// Push constants of the ASM page packing (asm_pack.comp).
+struct AsmPackPush {
+    uvec4 count; // x: the slots listed; y, z, w: unused
 };
 
 // Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer is uint

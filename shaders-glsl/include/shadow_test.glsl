@@ -18,8 +18,9 @@ vec4 shadow_map_coords(ShadowLight s, vec3 p) {
 
 // The view depth a receiver at view depth w (point p, geometric normal ng) must not pass to be
 // lit, for texels of world size `texel` at unit depth. bias: x constant and y slope-scaled bias
-// in texels, z the largest slope (tan) the bias follows.
-float shadow_receiver_depth(ShadowLight s, float w, vec3 p, vec3 ng, float texel, vec4 bias) {
+// in texels, z the largest slope (tan) the bias follows. `step`: the stored depths' rounding
+// step (Vulkan depth) where they are stored coarser than D32 (ASM's pages), else 0.
+float shadow_receiver_depth(ShadowLight s, float w, vec3 p, vec3 ng, float texel, vec4 bias, float step) {
     float near = s.map.x, far = s.map.y;
     // The depth a surface spans inside one texel grows with the texel (w * texel in world
     // units) and with tan of the light's angle to the surface: the slope-scaled bias.
@@ -27,8 +28,9 @@ float shadow_receiver_depth(ShadowLight s, float w, vec3 p, vec3 ng, float texel
     float c = max(dot(ng, l), 1e-4);
     float slope = min(sqrt(max(1.0 - c * c, 0.0)) / c, bias.z);
     // Fine texels (deep ASM tiles) fall below the D32 depth's own resolution near the far plane:
-    // d(z)/d(d) = z^2 (far - near) / (near far), times 4 ulps of a depth near 1 (2^-24 each).
-    float resolution = w * w * (far - near) / (near * far) * 2.4e-7;
+    // d(z)/d(d) = z^2 (far - near) / (near far), times 4 ulps of a depth near 1 (2^-24 each),
+    // and half a step of depths stored coarser.
+    float resolution = w * w * (far - near) / (near * far) * (2.4e-7 + 0.5 * step);
     return w - w * texel * (bias.x + bias.y * slope) - resolution;
 }
 
@@ -40,8 +42,8 @@ bool shadow_lit_past(ShadowLight s, float stored, float receiver) {
 
 // Whether a receiver at view depth w is lit past a texel that stores Vulkan depth `stored`
 // (shadow_receiver_depth's arguments).
-bool shadow_depth_visible(ShadowLight s, float stored, float w, vec3 p, vec3 ng, float texel, vec4 bias) {
-    return shadow_lit_past(s, stored, shadow_receiver_depth(s, w, p, ng, texel, bias));
+bool shadow_depth_visible(ShadowLight s, float stored, float w, vec3 p, vec3 ng, float texel, vec4 bias, float step) {
+    return shadow_lit_past(s, stored, shadow_receiver_depth(s, w, p, ng, texel, bias, step));
 }
 
 // Hard shadows reconstructed between texel centres: the four texels around texel-space point f

@@ -418,8 +418,8 @@ fn the_budget_holds_every_byte_asm_allocates() {
         let asm = stats.asm.unwrap();
         let reported = asm.memory.total();
         assert_eq!(stats.shadow_memory_bytes, Some(reported));
-        // Used up to the pages the atlas's rows and columns leave over (under 1 %).
-        assert!(reported <= budget && reported as f64 > 0.99 * budget as f64, "{:?} of {budget}", asm.memory);
+        // Used up to a page and a node (528 + 140 bytes: its page-table record, flags, use mark).
+        assert!(reported <= budget && reported > budget - 700, "{:?} of {budget}", asm.memory);
         // What the unshadowed renderer does not allocate is ASM's: its buffers and images, each
         // rounded up by the allocator to at most 256 bytes.
         let beyond = total - plain;
@@ -431,6 +431,29 @@ fn the_budget_holds_every_byte_asm_allocates() {
             beyond >= reported && beyond <= reported + 16 * 256,
             "{beyond} allocated, {reported} reported"
         );
+    }
+}
+
+/// A budget past what the page table indexes (2^24 pages) or the device's texel buffers hold
+/// (`maxTexelBufferElements` texels of 16 bytes, 33 a page) is refused with an error naming the
+/// budget's pages and the limit, before the pages are allocated.
+#[test]
+fn a_budget_past_the_page_table_or_the_texel_buffers_is_refused() {
+    let ctx = Validated::new();
+    let scene = close_up(1);
+    let page_bytes = DEPTH_PAGE_BYTES;
+    let texel_pages = u64::from(ctx.info().max_texel_buffer_elements) * 16 / page_bytes;
+    // Twice 2^24 pages' bytes: the nodes and the rest take less than half.
+    let mut cases = vec![((2u64 << 24) * page_bytes, "the page table indexes fewer than 16777216")];
+    if texel_pages < 1 << 24 {
+        // A quarter more than those pages' bytes: the nodes take less.
+        cases.push(((texel_pages + 1) * page_bytes * 5 / 4, "maxTexelBufferElements"));
+    }
+    for (budget, says) in cases {
+        let technique = TechniqueDesc::Asm(settings(budget, AsmTest::Bias));
+        let options = RenderOptions { width: SIZE, height: SIZE, technique, transfer: None };
+        let err = Renderer::new(&ctx, &scene, &options).err().expect("the budget is refused").to_string();
+        assert!(err.contains("an ASM budget of") && err.contains(says), "{err}");
     }
 }
 

@@ -301,11 +301,11 @@ impl Image {
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
 
-    /// Records copies of `size`² squares of layer 0 into layer 0 of `dst` (the same format),
-    /// each from its first texel here to its first texel there, ordered after all earlier
-    /// commands on either image and before all later ones (the copies step into the transfer
-    /// layouts and back). Destination squares must not overlap.
-    pub fn record_copy_squares(&self, cmd: Cmd, dst: &Image, squares: &[([u32; 2], [u32; 2])], size: u32) {
+    /// Records copies of `size`² squares of layer 0 into `dst`, each from its first texel here
+    /// to a byte offset there (rows tightly packed), ordered after all earlier commands on the
+    /// image and before all later ones (the copies step into the transfer layout and back).
+    /// Destination ranges must not overlap.
+    pub fn record_copy_squares_to(&self, cmd: Cmd, dst: &Buffer, squares: &[([u32; 2], u64)], size: u32) {
         self.touched(cmd, false);
         dst.touched(cmd, true);
         let layer = vk::ImageSubresourceLayers {
@@ -314,35 +314,22 @@ impl Image {
             base_array_layer: 0,
             layer_count: 1,
         };
-        let offset = |[x, y]: [u32; 2]| vk::Offset3D { x: x as i32, y: y as i32, z: 0 };
-        let regions: Vec<vk::ImageCopy> = squares
+        let regions: Vec<vk::BufferImageCopy> = squares
             .iter()
-            .map(|&(from, to)| vk::ImageCopy {
-                src_subresource: layer,
-                src_offset: offset(from),
-                dst_subresource: layer,
-                dst_offset: offset(to),
-                extent: vk::Extent3D { width: size, height: size, depth: 1 },
+            .map(|&([x, y], offset)| {
+                vk::BufferImageCopy::default()
+                    .buffer_offset(offset)
+                    .image_subresource(layer)
+                    .image_offset(vk::Offset3D { x: x as i32, y: y as i32, z: 0 })
+                    .image_extent(vk::Extent3D { width: size, height: size, depth: 1 })
             })
             .collect();
-        let (general, src, to) = (
-            vk::ImageLayout::GENERAL,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-        );
-        record_layout_barriers(
-            &self.ctx,
-            cmd,
-            &[self.layout_barrier(general, src), dst.layout_barrier(general, to)],
-        );
-        // SAFETY: recording command buffer; both images are alive until the submission completes
-        // and were just moved to the layouts named.
-        unsafe { self.ctx.device.cmd_copy_image(cmd.raw, self.raw, src, dst.raw, to, &regions) }
-        record_layout_barriers(
-            &self.ctx,
-            cmd,
-            &[self.layout_barrier(src, general), dst.layout_barrier(to, general)],
-        );
+        let (general, src) = (vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        record_layout_barriers(&self.ctx, cmd, &[self.layout_barrier(general, src)]);
+        // SAFETY: recording command buffer; the image and buffer are alive until the submission
+        // completes, and the image was just moved to `src`.
+        unsafe { self.ctx.device.cmd_copy_image_to_buffer(cmd.raw, self.raw, src, dst.raw, &regions) }
+        record_layout_barriers(&self.ctx, cmd, &[self.layout_barrier(src, general)]);
     }
 
     /// Fills the image (every level) from tightly packed texels through a staging buffer.

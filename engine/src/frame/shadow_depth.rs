@@ -63,8 +63,7 @@ impl ShadowMaps {
             &[],
             size_of::<ShadowDepthPush>(),
         )?;
-        // TRANSFER_SRC: the ASM's scratch tile is copied into its pages.
-        let usage = ImageUsage::DEPTH_ATTACHMENT | ImageUsage::SAMPLED | ImageUsage::TRANSFER_SRC;
+        let usage = ImageUsage::DEPTH_ATTACHMENT | ImageUsage::SAMPLED;
         let maps_name = format!("{name}.maps");
         let desc = ImageDesc::square_array(&maps_name, size, layers, DEPTH_FORMAT, usage);
         Ok(ShadowMaps {

@@ -16,7 +16,7 @@ const WORD: u64 = 4;
 /// The bytes of each part of the technique's memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AsmMemory {
-    /// The atlas of pages (depth, and polygon IDs with the ID test).
+    /// The pages (16-bit depths, and polygon IDs with the ID test).
     pub pages: u64,
     /// The scratch every tile renders into before its pages are copied out.
     pub scratch: u64,
@@ -51,10 +51,10 @@ impl AsmMemory {
     /// `budget`; an error naming the fixed parts when not even the root tile fits.
     pub fn within(budget: u64, page_bytes: u64, edges: u32) -> Result<(u32, AsmMemory)> {
         let fixed = AsmMemory::of(0, page_bytes, edges).total();
-        // A pool of N pages has N / 2 nodes: two pages carry a node's bytes.
-        let per_node = AsmMemory::of(2, page_bytes, edges).total() - fixed - 2 * page_bytes;
-        let estimate = budget.saturating_sub(fixed) * 2 / (2 * page_bytes + per_node);
-        // The estimate spreads a node over 2 pages; the exact count is a page or two away.
+        // A pool of N pages has N / 4 nodes: four pages carry a node's bytes.
+        let per_node = AsmMemory::of(4, page_bytes, edges).total() - fixed - 4 * page_bytes;
+        let estimate = budget.saturating_sub(fixed) * 4 / (4 * page_bytes + per_node);
+        // The estimate spreads a node over 4 pages; the exact count is a few pages away.
         let fits = |pages: u32| AsmMemory::of(pages, page_bytes, edges).total() <= budget;
         let mut pages = u32::try_from(estimate).unwrap_or(u32::MAX - 1);
         while fits(pages + 1) {

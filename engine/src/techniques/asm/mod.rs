@@ -12,8 +12,9 @@
 //!   resident tile keeps pages only for the slots the analysis asked for that its resident
 //!   children do not cover (a new tile all of them for a few frames, its trial); as many pages
 //!   as a byte budget holds (never more), least-recently-used eviction of leaf tiles.
-//! - [`pages`]: the pool on the GPU: the atlas of pages, and the tile renders (through a
-//!   scratch target, each drawing only the triangle clusters over its square) that fill them.
+//! - [`pages`]: the pool on the GPU: pages of 16-bit depths over each slot's own span, and the
+//!   tile renders (through a scratch target, each drawing only the triangle clusters over its
+//!   square, then packed) that fill them.
 //! - [`page_table`]: the resident tree flattened into `AsmNode` records for the GPU lookup
 //!   (shaders-glsl/include/layouts.glsl) behind a directory of one level's tiles: start at the
 //!   directory's tile and descend, two levels a step, while the tile holding the point is

@@ -10,7 +10,6 @@
 //! A directory comes first in the buffer: one entry per tile of level
 //! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
 //! that the descent starts there instead of at the root.
-use super::pages::AtlasLayout;
 use super::pool::{PagePool, SLOT_SIDE};
 use super::tile::TileKey;
 use crate::error::{Error, Result};
@@ -25,6 +24,14 @@ pub const DIRECTORY_BYTES: u64 = 4 * DIRECTORY_SIDE as u64 * DIRECTORY_SIDE as u
 /// The levels-down field of a directory entry (its tile's level) and of a node's `below`
 /// entries (1 or 2), above the node index.
 const LEVEL_SHIFT: u32 = 24;
+
+/// A page's index as a node's `pages` entry holds it, below the levels-up field.
+fn page_entry(page: u32) -> Result<u32> {
+    if page >= 1 << LEVEL_SHIFT {
+        return Err(Error::Internal(format!("ASM page {page} past the page table's 24-bit page index")));
+    }
+    Ok(page)
+}
 
 /// What the page-table buffer holds: the directory (row by row, `node | level << 24`), then
 /// the nodes; and each node's tile, for the host.
@@ -47,9 +54,8 @@ impl PageTable {
     }
 }
 
-/// The page table of `pool`'s resident tiles, root first, their pages' cells in an atlas laid
-/// out as `layout`.
-pub fn build(pool: &PagePool, layout: &AtlasLayout) -> Result<PageTable> {
+/// The page table of `pool`'s resident tiles, root first.
+pub fn build(pool: &PagePool) -> Result<PageTable> {
     // Per slot: its page, or the nearest ancestor's that holds it, with the levels up; a slot
     // under a resident child is never read (the descent goes on): 0 stands in.
     let node = |key: TileKey| -> Result<AsmNode> {
@@ -63,11 +69,11 @@ pub fn build(pool: &PagePool, layout: &AtlasLayout) -> Result<PageTable> {
             let half = SLOT_SIDE / 2;
             let under = children.is_some_and(|c| pool.contains(c[((x / half) + 2 * (y / half)) as usize]));
             *entry = match (pages[slot], under) {
-                (Some(page), _) => layout.cell(page),
+                (Some(page), _) => page_entry(page)?,
                 (None, true) => 0,
                 (None, false) => {
                     let (page, up) = pool.holder(key, slot as u32)?;
-                    layout.cell(page) | up << LEVEL_SHIFT
+                    page_entry(page)? | up << LEVEL_SHIFT
                 }
             };
         }
@@ -121,7 +127,6 @@ mod tests {
     use super::*;
     use crate::techniques::asm::pool::DEPTH_PAGE_BYTES as PAGE_BYTES;
     use crate::techniques::asm::pool::SLOT_SIDE;
-    const LAYOUT: AtlasLayout = AtlasLayout { columns: 16, rows: 16 };
 
     /// asm_lookup.glsl reads the table as 16-byte texels: the directory four entries to a
     /// texel, each node eight (below's four rows, then pages': ASM_NODE_TEXELS, ASM_NODE_PAGES).
@@ -177,7 +182,7 @@ mod tests {
         for level in 1..=4 {
             pool.insert(TileKey::containing(uv, level).unwrap(), 1, 1, 1.0).unwrap();
         }
-        let table = build(&pool, &LAYOUT).unwrap();
+        let table = build(&pool).unwrap();
         assert_eq!(table.nodes.len(), 5);
         assert_eq!(lookup(&table, uv), TileKey::containing(uv, 4).unwrap());
         // A point in the same level-2 tile but another level-3 one gets the level-2 tile.
@@ -197,11 +202,11 @@ mod tests {
                     continue;
                 }
                 let expected = match pages[slot] {
-                    Some(page) => LAYOUT.cell(page),
+                    Some(page) => page,
                     None => {
                         let (page, up) = pool.holder(*key, slot as u32).unwrap();
                         assert!(up > 0 && pool.pages(TileKey::ROOT).is_some());
-                        LAYOUT.cell(page) | up << LEVEL_SHIFT
+                        page | up << LEVEL_SHIFT
                     }
                 };
                 assert_eq!(entry, expected, "{key:?} slot {slot}");
@@ -217,7 +222,7 @@ mod tests {
         }
         let grandchild = TileKey::ROOT.children().unwrap()[2].children().unwrap()[1];
         pool.insert(grandchild, 1, 1, 1.0).unwrap();
-        let table = build(&pool, &LAYOUT).unwrap();
+        let table = build(&pool).unwrap();
         assert_eq!(table.nodes.len(), 6);
         let mut named = [0; 3];
         for (at, (node, key)) in table.nodes.iter().zip(&table.keys).enumerate() {
@@ -268,7 +273,7 @@ mod tests {
                 pool.insert(child, 1, 1, 1.0).unwrap();
             }
         }
-        let table = build(&pool, &LAYOUT).unwrap();
+        let table = build(&pool).unwrap();
         assert_eq!(table.bytes().len() as u64, PageTable::buffer_bytes(table.nodes.len() as u32));
         // A lattice of points finer than the deepest tiles near the chains, coarser elsewhere.
         let mut reached_deep = 0;

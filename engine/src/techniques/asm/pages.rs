@@ -1,86 +1,59 @@
-//! The GPU side of the page pool ([`super::pool`]): the atlas every page lives in, and the
-//! recording of the pool's page operations. Pages are slots of tiles and need not lie side
-//! by side in the atlas, so every page write goes through a scratch target of
-//! [`SCRATCH_TILES`] tiles side by side: tiles render into it whole, in one rendering scope,
-//! and their stored slots are copied out together (a CPU rasterizer waits at every barrier
-//! and pays for every scope, so a copy and a scope per tile cost more than the tile's
-//! triangles). The scratch counts in the budget.
+//! The GPU side of the page pool ([`super::pool`]): the pages in texel buffers, and the
+//! recording of the pool's page operations. Pages are slots of tiles and need not lie side by
+//! side, so every page write goes through a scratch target of tiles side by side: tiles render
+//! into it whole, in one rendering scope, then `asm_pack.comp` packs their stored slots into
+//! 16-bit pages (half of D32's bytes: twice the pages a budget holds) and they are copied out
+//! together. A CPU rasterizer waits at every barrier and pays for every scope and dispatch,
+//! whatever the work (104 tiles of no triangles storing 16 slots each took 4.1–4.9 ms in
+//! batches of 4 tiles, 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
+//! larger scratch was slower again: 6² tiles rendered a third fewer tiles a frame than 3² (146
+//! against 217–226 at the `asm` scene's grating at 16 MiB; llvmpipe, 2 Zen 3 cores). So the
+//! scratch is [`SCRATCH_SIDE`]² tiles. It counts in the budget.
 //!
-//! The polygon-ID test keeps a second atlas and scratch, of IDs, laid out as the depth ones.
-use super::pool::{SLOT_SIDE, TILE_PAGES};
+//! The polygon-ID test keeps a second buffer of pages, of IDs, in the same page order, filled
+//! from an ID scratch laid out as the depth one.
+use super::pool::{DEPTH_PAGE_BYTES, ID_PAGE_BYTES, SLOT_SIDE, TILE_PAGES};
 use super::tile::TileKey;
 use crate::backend::{
-    Binding, Cmd, Context, Depth, DepthTest, Edge, Format, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
-    ImageUsage, Sampler, Target, Topology,
+    Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Cmd, ComputePipeline, Context, Depth, DepthTest,
+    Edge, Format, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, ImageUsage, Sampler, Target, TexelBuffer,
+    Topology,
 };
 use crate::error::{Error, Result};
 use crate::frame::gpu_scene::MESH_POSITIONS;
 use crate::frame::shadow_depth::ShadowMaps;
 use crate::frame::{GpuScene, DEPTH_FORMAT};
-use crate::layouts::constants::{ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
-use crate::layouts::{bytes_of, spirv, AsmTilePush};
+use crate::layouts::constants::{ASM_PACK_GROUP, ASM_PAGE_TEXELS, ASM_TILE_TEXELS};
+use crate::layouts::{bytes_of, spirv, AsmPackPush, AsmTilePush};
 use glam::Mat4;
+use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
 /// The ID test's polygon IDs.
 const ID_FORMAT: Format = Format::R32_UINT;
-/// Most pages per atlas row: 16384 texels, the largest image side of lavapipe and NVIDIA.
-const MAX_COLUMNS: u32 = 16384 / ASM_PAGE_TEXELS;
-/// Tiles the scratch holds: renders between two copies into the atlas.
-pub const SCRATCH_TILES: u32 = 4;
-/// Texels a side of the scratch: its tiles 2 × 2.
-const SCRATCH_SIDE: u32 = 2 * ASM_TILE_TEXELS;
+/// Tiles a side of the scratch: 9 tiles between two packings.
+const SCRATCH_SIDE: u32 = 3;
+/// Tiles a batch renders between two packings: the scratch's.
+pub const BATCH_TILES: usize = (SCRATCH_SIDE * SCRATCH_SIDE) as usize;
+/// Slots of the scratch.
+const SCRATCH_SLOTS: u64 = (SCRATCH_SIDE * SCRATCH_SIDE) as u64 * TILE_PAGES;
+/// Bytes of a slot of the D32 depth scratch (and of the ID scratch).
+const SLOT_TEXEL_BYTES: u64 = 4 * ASM_PAGE_TEXELS as u64 * ASM_PAGE_TEXELS as u64;
+/// Bytes of a slot's entry in the packing's list.
+const SLOT_ENTRY_BYTES: u64 = 4;
+/// Pages an index of the page table holds: 24 bits (`page_table`).
+const MAX_PAGES: u32 = 1 << 24;
 
-/// Bytes of the scratch for pages of `page_bytes`.
+/// Bytes of the scratch for pages of `page_bytes`: per slot its D32 depth (and with the ID test,
+/// whose pages are larger, its IDs), its packed page and its entry in the packing's list.
 pub fn scratch_bytes(page_bytes: u64) -> u64 {
-    u64::from(SCRATCH_TILES) * TILE_PAGES * page_bytes
-}
-
-/// How the atlas lays its pages out: row by row, `columns` to a row.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct AtlasLayout {
-    pub columns: u32,
-    pub rows: u32,
-}
-
-impl AtlasLayout {
-    /// The atlas of the most pages of `page_bytes` that fit in `bytes` (rows and columns as
-    /// near equal as that count allows, so that its sides stay small); an error below one
-    /// tile's pages.
-    pub fn within(bytes: u64, page_bytes: u64) -> Result<AtlasLayout> {
-        let pages = u32::try_from(bytes / page_bytes).unwrap_or(u32::MAX);
-        if u64::from(pages) < TILE_PAGES {
-            return Err(Error::InvalidArgument(format!(
-                "{bytes} bytes hold no ASM tile: a tile takes {} bytes",
-                TILE_PAGES * page_bytes
-            )));
-        }
-        let square = (f64::from(pages).sqrt().ceil() as u32).min(MAX_COLUMNS);
-        let best = (square..=MAX_COLUMNS.min(pages).max(square))
-            .map(|columns| AtlasLayout { columns, rows: pages / columns })
-            .max_by_key(|l| (l.pages(), std::cmp::Reverse(l.columns)))
-            .expect("the range holds `square`");
-        Ok(best)
-    }
-
-    pub fn pages(&self) -> u32 {
-        self.columns * self.rows
-    }
-
-    /// The page's cell in the atlas as `AsmNode.pages` holds it: column | row << 12 (at most
-    /// `MAX_COLUMNS` of each, the largest image side over a page's).
-    pub fn cell(&self, page: u32) -> u32 {
-        (page % self.columns) | ((page / self.columns) << 12)
-    }
-
-    /// The page's first texel in the atlas.
-    fn origin(&self, page: u32) -> [u32; 2] {
-        [page % self.columns * ASM_PAGE_TEXELS, page / self.columns * ASM_PAGE_TEXELS]
-    }
+    let ids = u64::from(page_bytes > DEPTH_PAGE_BYTES);
+    SCRATCH_SLOTS * (SLOT_TEXEL_BYTES * (1 + ids) + DEPTH_PAGE_BYTES + SLOT_ENTRY_BYTES)
 }
 
 /// A tile render of this frame (`super::pool::PageOp`): the square of `key`, its slots
 /// `stores` names stored in their pages.
+#[derive(Clone)]
 pub struct TileWrite {
     pub key: TileKey,
     /// (slot, page) pairs.
@@ -92,7 +65,7 @@ pub struct TileWrite {
 }
 
 struct IdPages {
-    atlas: Image,
+    pages: TexelBuffer,
     scratch: Image,
     /// Renders a tile's depth and IDs.
     tile: GraphicsPipeline,
@@ -101,69 +74,88 @@ struct IdPages {
 }
 
 pub struct PageStore {
-    layout: AtlasLayout,
-    atlas: Image,
-    /// One tile of depth, rendered with the shadow-depth pipeline.
+    pages: u32,
+    /// The depth pages, as `asm_pack.comp` lays them out.
+    depth: TexelBuffer,
+    /// Tiles of depth, rendered with the shadow-depth pipeline.
     scratch: ShadowMaps,
+    /// The slots of the scratch a packing packs (`asm_pack.comp`).
+    slots: Buffer,
+    /// A batch's packed pages, before they are copied to theirs.
+    packed: Buffer,
+    pack: ComputePipeline,
     ids: Option<IdPages>,
+    /// Reads the scratch in the packing.
     nearest: Sampler,
 }
 
 impl PageStore {
-    /// The atlas of at most `most_pages` pages of `page_bytes` (the budget's share,
-    /// [`super::memory::AsmMemory::within`]) and the scratch; with polygon IDs when `ids`
-    /// (`page_bytes` then counts a depth and an ID per texel).
-    pub fn new(
-        ctx: &Arc<Context>,
-        gpu: &GpuScene,
-        most_pages: u32,
-        page_bytes: u64,
-        ids: bool,
-    ) -> Result<PageStore> {
-        let layout = AtlasLayout::within(u64::from(most_pages) * page_bytes, page_bytes)?;
-        let (width, height) = (layout.columns * ASM_PAGE_TEXELS, layout.rows * ASM_PAGE_TEXELS);
-        let atlas_usage = ImageUsage::SAMPLED | ImageUsage::TRANSFER_DST;
-        let atlas = |name, format| {
-            let desc = ImageDesc {
-                name,
-                width,
-                height,
-                layers: 1,
-                levels: 1,
-                array: false,
-                format,
-                usage: atlas_usage,
-            };
-            Image::new(ctx, &desc).map_err(|e| match e {
-                Error::InvalidArgument(e) => {
-                    Error::InvalidArgument(format!("an ASM budget of {} pages: {e}", layout.pages()))
+    /// `pages` pages (the budget's share, [`super::memory::AsmMemory::within`]) and the
+    /// scratch; with polygon IDs when `ids`.
+    pub fn new(ctx: &Arc<Context>, gpu: &GpuScene, pages: u32, ids: bool) -> Result<PageStore> {
+        if pages >= MAX_PAGES {
+            return Err(Error::InvalidArgument(format!(
+                "an ASM budget of {pages} pages: the page table indexes fewer than {MAX_PAGES}"
+            )));
+        }
+        let buffer = |name, page_bytes| {
+            TexelBuffer::new(ctx, name, u64::from(pages) * page_bytes, MemoryLocation::GpuOnly).map_err(|e| {
+                match e {
+                    Error::OutOfDeviceMemoryFor { reason, .. } => {
+                        Error::InvalidArgument(format!("an ASM budget of {pages} pages: {reason}"))
+                    }
+                    e => e,
                 }
-                e => e,
             })
         };
-        let depth_atlas = atlas("asm.atlas", DEPTH_FORMAT)?;
-        let ids = if ids { Some(IdPages::new(ctx, gpu, atlas("asm.id_atlas", ID_FORMAT)?)?) } else { None };
+        let depth = buffer("asm.pages", DEPTH_PAGE_BYTES)?;
+        let ids = match ids {
+            true => Some(IdPages::new(ctx, gpu, buffer("asm.id_pages", ID_PAGE_BYTES - DEPTH_PAGE_BYTES)?)?),
+            false => None,
+        };
+        let storage = |name, size, usage| {
+            Buffer::new(ctx, &BufferDesc { name, size, usage, location: MemoryLocation::GpuOnly })
+        };
+        let pack = ComputePipeline::new(
+            ctx,
+            "asm.pack",
+            spirv::ASM_PACK_COMP,
+            &[BindingKind::SampledImage, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            size_of::<AsmPackPush>() as u32,
+        )?;
         Ok(PageStore {
-            layout,
-            atlas: depth_atlas,
-            scratch: ShadowMaps::new(ctx, "asm.scratch", SCRATCH_SIDE, 1)?,
+            pages,
+            depth,
+            scratch: ShadowMaps::new(ctx, "asm.scratch", SCRATCH_SIDE * ASM_TILE_TEXELS, 1)?,
+            slots: storage(
+                "asm.pack_slots",
+                SCRATCH_SLOTS * SLOT_ENTRY_BYTES,
+                BufferUsage::STORAGE | BufferUsage::TRANSFER_DST,
+            )?,
+            packed: storage(
+                "asm.packed",
+                SCRATCH_SLOTS * DEPTH_PAGE_BYTES,
+                BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
+            )?,
+            pack,
             ids,
-            nearest: Sampler::new(ctx, "asm.pages_sampler", false, Edge::Clamp, Edge::Clamp)?,
+            nearest: Sampler::new(ctx, "asm.scratch_sampler", false, Edge::Clamp, Edge::Clamp)?,
         })
     }
 
-    pub fn layout(&self) -> AtlasLayout {
-        self.layout
+    /// Pages the store holds.
+    pub fn pages(&self) -> u32 {
+        self.pages
     }
 
-    /// The depth atlas as the lookups sample it.
+    /// The depth pages as the lookups read them.
     pub fn depth_binding(&self) -> Binding<'_> {
-        Binding::Sampled(&self.atlas, &self.nearest)
+        Binding::Texel(&self.depth)
     }
 
-    /// The ID atlas as the lookups sample it, for the ID test.
+    /// The ID pages as the lookups read them, for the ID test.
     pub fn id_binding(&self) -> Option<Binding<'_>> {
-        self.ids.as_ref().map(|ids| Binding::Sampled(&ids.atlas, &self.nearest))
+        self.ids.as_ref().map(|ids| Binding::Texel(&ids.pages))
     }
 
     /// The polygon ID of the first triangle of mesh `mesh` of group `group` (0 without IDs).
@@ -173,27 +165,24 @@ impl PageStore {
 
     /// Records `writes` in order, one debug label each.
     pub fn record(&self, ctx: &Context, cmd: Cmd, scene: &GpuScene, writes: &[TileWrite]) {
-        for batch in writes.chunks(SCRATCH_TILES as usize) {
+        for batch in writes.chunks(BATCH_TILES) {
             self.begin_batch(ctx, cmd);
-            // Squares of the scratch to store (their first texel), with their pages.
-            let mut squares: Vec<([u32; 2], u32)> = Vec::new();
+            // Slots of the scratch to store, with their pages.
+            let mut squares: Vec<(u32, u32)> = Vec::new();
             for (i, write) in batch.iter().enumerate() {
                 let key = write.key;
                 ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
-                let at = [i as u32 % 2 * ASM_TILE_TEXELS, i as u32 / 2 * ASM_TILE_TEXELS];
-                ctx.restrict_to_square(cmd, at, ASM_TILE_TEXELS);
+                let (x, y) = (i as u32 % SCRATCH_SIDE, i as u32 / SCRATCH_SIDE);
+                ctx.restrict_to_square(cmd, [x * ASM_TILE_TEXELS, y * ASM_TILE_TEXELS], ASM_TILE_TEXELS);
                 self.draw_tile(ctx, cmd, scene, write);
                 for &(slot, page) in &write.stores {
-                    let from = [
-                        at[0] + slot % SLOT_SIDE * ASM_PAGE_TEXELS,
-                        at[1] + slot / SLOT_SIDE * ASM_PAGE_TEXELS,
-                    ];
-                    squares.push((from, page));
+                    let (sx, sy) = (x * SLOT_SIDE + slot % SLOT_SIDE, y * SLOT_SIDE + slot / SLOT_SIDE);
+                    squares.push((sx + sy * SCRATCH_SIDE * SLOT_SIDE, page));
                 }
                 ctx.end_label(cmd);
             }
             ctx.end_rendering(cmd);
-            self.store(cmd, squares);
+            self.store(ctx, cmd, &squares);
         }
     }
 
@@ -222,32 +211,56 @@ impl PageStore {
         }
     }
 
-    /// Copies squares of the scratch (each with the page it goes to) into the atlases. A page
-    /// written twice keeps the later square: a slot given back by a tile and taken by another
-    /// rendered after it in the same batch.
-    fn store(&self, cmd: Cmd, pending: Vec<([u32; 2], u32)>) {
+    /// Packs slots of the scratch (each with the page it goes to) and copies them into the
+    /// pages. A page written twice keeps the later slot: a slot given back by a tile and taken
+    /// by another rendered after it in the same batch.
+    fn store(&self, ctx: &Context, cmd: Cmd, pending: &[(u32, u32)]) {
         let mut seen = std::collections::HashSet::new();
-        let mut squares: Vec<([u32; 2], [u32; 2])> = pending
-            .into_iter()
-            .rev()
-            .filter(|(_, page)| seen.insert(*page))
-            .map(|(from, page)| (from, self.layout.origin(page)))
-            .collect();
+        let squares: Vec<(u32, u32)> =
+            pending.iter().rev().filter(|(_, page)| seen.insert(*page)).copied().collect();
         if squares.is_empty() {
             return;
         }
-        squares.reverse();
-        self.scratch.image().record_copy_squares(cmd, &self.atlas, &squares, ASM_PAGE_TEXELS);
+        let slots: Vec<u8> = squares.iter().flat_map(|(slot, _)| slot.to_ne_bytes()).collect();
+        self.slots.record_update(cmd, 0, &slots);
+        // The scratch's depths drawn and the list written before the packing reads them.
+        ctx.full_barrier(cmd);
+        let count = squares.len() as u32;
+        let push = AsmPackPush { count: [count, 0, 0, 0] };
+        let bindings = [
+            Binding::Sampled(self.scratch.image(), &self.nearest),
+            Binding::Storage(&self.slots),
+            Binding::Storage(&self.packed),
+        ];
+        self.pack.dispatch(cmd, &bindings, bytes_of(&push), [count.div_ceil(ASM_PACK_GROUP), 1, 1]);
+        // Packed before they are copied.
+        ctx.full_barrier(cmd);
+        let page_at = |page: u32, bytes: u64| u64::from(page) * bytes;
+        let regions: Vec<(u64, u64, u64)> = squares
+            .iter()
+            .enumerate()
+            .map(|(k, &(_, page))| {
+                (page_at(k as u32, DEPTH_PAGE_BYTES), page_at(page, DEPTH_PAGE_BYTES), DEPTH_PAGE_BYTES)
+            })
+            .collect();
+        self.packed.record_copy_regions(cmd, self.depth.buffer(), &regions);
         if let Some(ids) = &self.ids {
-            ids.scratch.record_copy_squares(cmd, &ids.atlas, &squares, ASM_PAGE_TEXELS);
+            let side = SCRATCH_SIDE * SLOT_SIDE;
+            let from = |slot: u32| [slot % side * ASM_PAGE_TEXELS, slot / side * ASM_PAGE_TEXELS];
+            let squares: Vec<([u32; 2], u64)> = squares
+                .iter()
+                .map(|&(slot, page)| (from(slot), page_at(page, ID_PAGE_BYTES - DEPTH_PAGE_BYTES)))
+                .collect();
+            ids.scratch.record_copy_squares_to(cmd, ids.pages.buffer(), &squares, ASM_PAGE_TEXELS);
         }
     }
 }
 
 impl IdPages {
-    fn new(ctx: &Arc<Context>, gpu: &GpuScene, atlas: Image) -> Result<IdPages> {
+    fn new(ctx: &Arc<Context>, gpu: &GpuScene, pages: TexelBuffer) -> Result<IdPages> {
         let usage = ImageUsage::COLOR_ATTACHMENT | ImageUsage::TRANSFER_SRC;
-        let desc = ImageDesc::square_array("asm.id_scratch", SCRATCH_SIDE, 1, ID_FORMAT, usage);
+        let desc =
+            ImageDesc::square_array("asm.id_scratch", SCRATCH_SIDE * ASM_TILE_TEXELS, 1, ID_FORMAT, usage);
         let tile = GraphicsPipeline::new(
             ctx,
             &GraphicsDesc {
@@ -279,25 +292,27 @@ impl IdPages {
             of_group[mesh.mesh] = next;
             next += mesh.index_count / 3;
         }
-        Ok(IdPages { atlas, scratch: Image::new(ctx, &desc)?, tile, first })
+        Ok(IdPages { pages, scratch: Image::new(ctx, &desc)?, tile, first })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layouts::constants::{ASM_PAGE_DEPTH_TEXELS, ASM_PAGE_ID_TEXELS};
 
+    /// asm_pack.comp and asm_lookup.glsl read a depth page as 16-byte texels: a slot's 16-bit
+    /// depths eight to a texel, then one texel for the span; an ID page four IDs to a texel.
     #[test]
-    fn the_atlas_holds_what_the_bytes_allow_near_square() {
-        let page = 4096;
-        for (pages, expected) in [(16, (4, 4)), (1020, (34, 30)), (4092, (66, 62)), (1021, (1021, 1))] {
-            let layout = AtlasLayout::within(pages * page + page / 2, page).unwrap();
-            assert_eq!((layout.columns, layout.rows), expected, "{pages} pages");
-            assert!(u64::from(layout.pages()) <= pages && layout.rows <= layout.columns);
-        }
-        assert!(AtlasLayout::within((TILE_PAGES - 1) * page, page).is_err());
-        let layout = AtlasLayout { columns: 34, rows: 30 };
-        assert_eq!(layout.cell(35), 1 | 1 << 12);
-        assert_eq!(layout.origin(35), [ASM_PAGE_TEXELS, ASM_PAGE_TEXELS]);
+    fn a_page_holds_its_slot_as_the_shaders_lay_it_out() {
+        let slot_texels = u64::from(ASM_PAGE_TEXELS * ASM_PAGE_TEXELS);
+        assert_eq!(u64::from(ASM_PAGE_DEPTH_TEXELS - 1) * 8, slot_texels);
+        assert_eq!(DEPTH_PAGE_BYTES, 2 * slot_texels + 16);
+        assert_eq!(u64::from(ASM_PAGE_ID_TEXELS) * 4, slot_texels);
+        assert_eq!(ID_PAGE_BYTES - DEPTH_PAGE_BYTES, SLOT_TEXEL_BYTES);
+        // The scratch: a D32 depth (and ID) per texel of its slots, a packed page and a list
+        // entry per slot.
+        assert_eq!(scratch_bytes(DEPTH_PAGE_BYTES), SCRATCH_SLOTS * (1024 + 528 + 4));
+        assert_eq!(scratch_bytes(ID_PAGE_BYTES), SCRATCH_SLOTS * (2048 + 528 + 4));
     }
 }

@@ -27,7 +27,7 @@
 use super::light_view::{tile_view_proj, UvRect};
 use super::memory::{self, edge_records, AsmMemory};
 use super::page_table;
-use super::pages::{PageStore, TileWrite};
+use super::pages::{PageStore, TileWrite, BATCH_TILES};
 use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{
     parent_slots, Insert, PageOp, PagePool, Slots, ANALYSIS_PHASES, DEPTH_PAGE_BYTES, ID_PAGE_BYTES,
@@ -326,22 +326,21 @@ impl Asm {
         }
         let page_bytes = settings.test.page_bytes();
         let edge_capacity = edge_records(size);
-        let (most_pages, _) = AsmMemory::within(settings.budget_bytes(), page_bytes, edge_capacity)?;
-        let pages = PageStore::new(ctx, gpu, most_pages, page_bytes, ids)?;
-        let pool = PagePool::new(pages.layout().pages(), page_bytes)?;
+        let (most_pages, memory) = AsmMemory::within(settings.budget_bytes(), page_bytes, edge_capacity)?;
+        let pages = PageStore::new(ctx, gpu, most_pages, ids)?;
+        let pool = PagePool::new(most_pages, page_bytes)?;
         let nodes = pool.max_tiles();
-        let memory = AsmMemory::of(pages.layout().pages(), page_bytes, edge_capacity);
         let mut bindings = vec![
             BindingKind::UniformBuffer,
             BindingKind::UniformBuffer,
-            BindingKind::SampledImage,
+            BindingKind::TexelBuffer,
             BindingKind::TexelBuffer,
             BindingKind::StorageBuffer,
         ];
         let fragment = match settings.test {
             AsmTest::Bias => spirv::ASM_LIGHTS_FRAG,
             AsmTest::Id => {
-                bindings.push(BindingKind::SampledImage);
+                bindings.push(BindingKind::TexelBuffer);
                 spirv::ASM_LIGHTS_ID_FRAG
             }
         };
@@ -360,7 +359,7 @@ impl Asm {
             &[
                 BindingKind::UniformBuffer,
                 BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
+                BindingKind::TexelBuffer,
                 BindingKind::TexelBuffer,
                 BindingKind::SampledImage,
                 BindingKind::StorageBuffer,
@@ -431,7 +430,9 @@ impl Asm {
     /// different numbers of triangles on this device (the root, and tiles of levels 1 to 3
     /// along the view's diagonals), each rendered twice and the second timing kept (the first
     /// pays for cold caches), each stored into pages as a frame's tiles are (into the root's,
-    /// which the first frame renders again). Without timestamps the model stays at 1 ms per
+    /// which the first frame renders again), and each in a batch of as many renders of it as
+    /// the scratch holds: a frame's renders share their batches' packing and copies, whose cost
+    /// a tile rendered alone would pay whole. Without timestamps the model stays at 1 ms per
     /// tile.
     fn calibrate(&self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
         if ctx.info().timestamp_period_ns.is_none() {
@@ -457,21 +458,19 @@ impl Asm {
                 tile_write(PageOp { key, stores: stores.clone() }, &view_proj, &self.clusters, &rects)
             })
             .collect();
+        let batches: Vec<Vec<TileWrite>> = renders.iter().map(|t| vec![t.clone(); BATCH_TILES]).collect();
         let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
         let mut samples = Vec::new();
         for round in 0..2 {
-            let passes = renders
+            let passes = batches
                 .iter()
-                .map(|t| {
-                    Pass::new("asm_calibration", move |cmd| {
-                        self.pages.record(ctx, cmd, gpu, std::slice::from_ref(t))
-                    })
-                })
+                .map(|b| Pass::new("asm_calibration", move |cmd| self.pages.record(ctx, cmd, gpu, b)))
                 .collect();
             let timings = executor.run(passes)?;
             if round == 1 {
                 for (t, timing) in renders.iter().zip(timings) {
-                    samples.push((draw_triangles(&t.draws), timing.gpu_ms.unwrap_or(0.0)));
+                    samples
+                        .push((draw_triangles(&t.draws), timing.gpu_ms.unwrap_or(0.0) / BATCH_TILES as f64));
                 }
             }
         }
@@ -609,7 +608,7 @@ impl Asm {
 
     /// Rebuilds the page table from the pool and uploads it.
     fn write_table(&mut self) -> Result<()> {
-        let table = page_table::build(&self.pool, &self.pages.layout())?;
+        let table = page_table::build(&self.pool)?;
         self.table.write(0, &table.bytes())?;
         self.table_keys = table.keys;
         Ok(())
@@ -696,7 +695,7 @@ impl Technique for Asm {
         if reset {
             // The light moved (or the depth range changed): every tile's depths are stale. The
             // new pool queues the root's render.
-            self.pool = PagePool::new(self.pages.layout().pages(), self.settings.test.page_bytes())?;
+            self.pool = PagePool::new(self.pages.pages(), self.settings.test.page_bytes())?;
             self.deferred.clear();
         } else {
             let moved: Vec<UvRect> = (0..rects.len())
