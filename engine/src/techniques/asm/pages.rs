@@ -8,7 +8,7 @@
 //! batches of 4 tiles, 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
 //! larger scratch was slower again: 6² tiles rendered a third fewer tiles a frame than 3² (146
 //! against 217–226 at the `asm` scene's grating at 16 MiB; llvmpipe, 2 Zen 3 cores). So the
-//! scratch is [`SCRATCH_SIDE`]² tiles. It counts in the budget.
+//! scratch is `SCRATCH_SIDE`² tiles. It counts in the budget.
 //!
 //! The polygon-ID test keeps a second buffer of pages, of IDs, in the same page order, filled
 //! from an ID scratch laid out as the depth one.
