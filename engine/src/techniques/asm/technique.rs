@@ -280,6 +280,8 @@ pub struct Asm {
     transforms: Vec<Mat4>,
     group_rects: Vec<UvRect>,
     cluster_rects: Vec<Vec<UvRect>>,
+    /// The index runs of the tiles this frame renders or weighs, each found once a frame.
+    draws: FrameDraws,
     /// The tile of each node of the page table the analysis descends.
     table_keys: Vec<TileKey>,
     /// Resident tiles a moving group made stale, rendered before the analysis.
@@ -414,6 +416,7 @@ impl Asm {
             transforms: Vec::new(),
             group_rects: Vec::new(),
             cluster_rects: Vec::new(),
+            draws: FrameDraws::default(),
             table_keys: Vec::new(),
             refresh: Vec::new(),
             render: Vec::new(),
@@ -455,7 +458,8 @@ impl Asm {
         let renders: Vec<TileWrite> = keys
             .iter()
             .map(|&key| {
-                tile_write(PageOp { key, stores: stores.clone() }, &view_proj, &self.clusters, &rects)
+                let draws = tile_draws(&self.clusters, &rects, key);
+                tile_write(PageOp { key, stores: stores.clone() }, &view_proj, draws)
             })
             .collect();
         let batches: Vec<Vec<TileWrite>> = renders.iter().map(|t| vec![t.clone(); BATCH_TILES]).collect();
@@ -489,9 +493,15 @@ impl Asm {
     }
 
     /// Queued renders as this frame records them.
-    fn writes(&self, ops: Vec<PageOp>) -> Vec<TileWrite> {
+    fn writes(&mut self, ops: Vec<PageOp>) -> Vec<TileWrite> {
         let view_proj = self.view_proj();
-        ops.into_iter().map(|op| tile_write(op, &view_proj, &self.clusters, &self.cluster_rects)).collect()
+        let (draws, clusters, rects) = (&mut self.draws, &self.clusters, &self.cluster_rects);
+        ops.into_iter()
+            .map(|op| {
+                let runs = draws.of(clusters, rects, op.key).to_vec();
+                tile_write(op, &view_proj, runs)
+            })
+            .collect()
     }
 
     /// This frame's tile rendering time: `time_ms`, or `time_share` of the other passes' time
@@ -570,7 +580,7 @@ impl Asm {
         Ok(asked
             .into_iter()
             .map(|(key, (slots, edge_pixels, missing_levels))| {
-                let triangles = draw_triangles(&tile_draws(&self.clusters, &self.cluster_rects, key));
+                let triangles = draw_triangles(self.draws.of(&self.clusters, &self.cluster_rects, key));
                 Request { key, slots, edge_pixels, missing_levels, triangles }
             })
             .collect())
@@ -643,20 +653,31 @@ fn tile_draws(
     draws
 }
 
-/// A queued render as the GPU records it: the tile's cropped projection (of the light's
-/// `view_proj`) and the clusters (bounds `rects`) it draws.
-fn tile_write(
-    op: PageOp,
-    view_proj: &Mat4,
-    clusters: &[(usize, Vec<Cluster>)],
-    rects: &[Vec<UvRect>],
-) -> TileWrite {
-    TileWrite {
-        key: op.key,
-        view_proj: tile_view_proj(view_proj, op.key),
-        draws: tile_draws(clusters, rects, op.key),
-        stores: op.stores,
+/// Each tile's index runs ([`tile_draws`]) under this frame's cluster bounds, found once: a
+/// tile's are needed for its request's cost, its evictions' and its render.
+#[derive(Default)]
+struct FrameDraws(HashMap<TileKey, Vec<(usize, u32, u32)>>);
+
+impl FrameDraws {
+    /// Forgets every tile's runs: the clusters' bounds are a new frame's.
+    fn clear(&mut self) {
+        self.0.clear();
     }
+
+    fn of(
+        &mut self,
+        clusters: &[(usize, Vec<Cluster>)],
+        rects: &[Vec<UvRect>],
+        key: TileKey,
+    ) -> &[(usize, u32, u32)] {
+        self.0.entry(key).or_insert_with(|| tile_draws(clusters, rects, key))
+    }
+}
+
+/// A queued render as the GPU records it: the tile's cropped projection (of the light's
+/// `view_proj`) and the index runs it draws.
+fn tile_write(op: PageOp, view_proj: &Mat4, draws: Vec<(usize, u32, u32)>) -> TileWrite {
+    TileWrite { key: op.key, view_proj: tile_view_proj(view_proj, op.key), draws, stores: op.stores }
 }
 
 /// The benefit of a slot asked for to keep a pixel's texels from coming from more than one level
@@ -715,6 +736,7 @@ impl Technique for Asm {
         self.transforms = state.transforms.to_vec();
         self.group_rects = rects;
         self.cluster_rects = self.cluster_rects_for(&view_proj, state.transforms);
+        self.draws.clear();
         let ops = self.pool.take_ops();
         self.refresh = self.writes(ops);
         if reset {
@@ -770,8 +792,8 @@ impl Technique for Asm {
         let (mut ops, mut failed) = (Vec::new(), None);
         // A tile renders once a frame (`PagePool::merged`): a render queued already is paid.
         let mut queued = HashSet::new();
-        let (clusters, rects) = (&self.clusters, &self.cluster_rects);
-        let cost = |key: TileKey| model.cost_ms(draw_triangles(&tile_draws(clusters, rects, key)));
+        let (draws, clusters, rects) = (&mut self.draws, &self.clusters, &self.cluster_rects);
+        let mut cost = |key: TileKey| model.cost_ms(draw_triangles(draws.of(clusters, rects, key)));
         plan(requests, &model, time_ms, |request, left_ms| {
             let own = if queued.contains(&request.key) { 0.0 } else { model.cost_ms(request.triangles) };
             // The evictions' renders are made only in what the budget leaves after this one's.
