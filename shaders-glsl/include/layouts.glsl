@@ -308,11 +308,12 @@ struct AsmPackPush {
 };
 
 // Push constants of the ASM refinement analysis (asm_analysis.comp). Its output buffer is uint
-// words: `[0]` the number of edge records written; `[1, 1 + size.z)` a used flag per page table
-// node (a pixel's lookup ended there); then up to size.w edge records of KAGE_ASM_EDGE_WORDS
-// words, one per eye pixel on a shadow edge short of resolution: the node of the finest resident
-// tile holding it | the levels finer than that tile it needs (at least 1) << 24, then its place
-// in that tile, x | y << 16, in units of 2^-KAGE_ASM_EDGE_CELL_BITS of the tile's side.
+// words: `[0]` the number of edge records written; then two words per page table node (up to
+// size.z), the slots of its 4x4 (bit x + 4y) where a pixel's lookup ended: the first those it
+// read from a tile two levels up or more | those on a shadow edge its own texels resolve << 16,
+// the second those it read from its own texels | those it read from an ancestor's << 16; then
+// up to size.w edge records of KAGE_ASM_EDGE_WORDS words, one per eye pixel on a shadow edge
+// short of resolution (their layout where constants.glsl defines KAGE_ASM_EDGE_WORDS).
 struct AsmAnalysisPush {
     uvec4 size; // x: width, y: height (pixels), z: most page table nodes, w: most edge records
     uvec4 phase; // x: the pixel of each 2x2 block analysed this frame (x + 2y), y, z, w: unused
