@@ -6,8 +6,8 @@
 // slot's span over 65534: within a slot on one surface far finer than D32 near the far plane,
 // across a silhouette the span's. The lookups allow half a step in their bias (asm_lookup.glsl).
 //
-// One invocation packs a whole slot, with no shared memory or barrier: on llvmpipe a packing
-// costs its dispatch, not its arithmetic (one that returned at once took as long).
+// One invocation packs a whole slot, with no shared memory or barrier (llvmpipe runs a
+// workgroup's barriers as coroutine switches; vendor-notes.md).
 #include "layouts.glsl"
 
 layout(local_size_x = KAGE_ASM_PACK_GROUP) in;

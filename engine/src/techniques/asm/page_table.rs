@@ -24,10 +24,12 @@ pub const DIRECTORY_BYTES: u64 = 4 * DIRECTORY_SIDE as u64 * DIRECTORY_SIDE as u
 /// The levels-down field of a directory entry (its tile's level) and of a node's `below`
 /// entries (1 or 2), above the node index.
 const LEVEL_SHIFT: u32 = 24;
+/// Pages a `pages` entry can index, below the levels-up field.
+pub const MAX_PAGES: u32 = 1 << LEVEL_SHIFT;
 
 /// A page's index as a node's `pages` entry holds it, below the levels-up field.
 fn page_entry(page: u32) -> Result<u32> {
-    if page >= 1 << LEVEL_SHIFT {
+    if page >= MAX_PAGES {
         return Err(Error::Internal(format!("ASM page {page} past the page table's 24-bit page index")));
     }
     Ok(page)

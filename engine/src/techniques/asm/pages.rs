@@ -3,16 +3,17 @@
 //! side, so every page write goes through a scratch target of tiles side by side: tiles render
 //! into it whole, in one rendering scope, then `asm_pack.comp` packs their stored slots into
 //! 16-bit pages (half of D32's bytes: twice the pages a budget holds) and they are copied out
-//! together. A CPU rasterizer waits at every barrier and pays for every scope and dispatch,
-//! whatever the work (104 tiles of no triangles storing 16 slots each took 4.1–4.9 ms in
-//! batches of 4 tiles, 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
+//! together. A CPU rasterizer waits at every barrier and pays for every scope and dispatch
+//! (104 tiles of no triangles storing 16 slots each took 4.1–4.9 ms in batches of 4 tiles,
+//! 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
 //! larger scratch was slower again: 6² tiles rendered a third fewer tiles a frame than 3² (146
 //! against 217–226 at the `asm` scene's grating at 16 MiB; llvmpipe, 2 Zen 3 cores). So the
 //! scratch is `SCRATCH_SIDE`² tiles. It counts in the budget.
 //!
 //! The polygon-ID test keeps a second buffer of pages, of IDs, in the same page order, filled
 //! from an ID scratch laid out as the depth one.
-use super::pool::{DEPTH_PAGE_BYTES, ID_PAGE_BYTES, SLOT_SIDE, TILE_PAGES};
+use super::page_table::MAX_PAGES;
+use super::pool::{DEPTH_PAGE_BYTES, PAGE_ID_BYTES, SLOT_SIDE, TILE_PAGES};
 use super::tile::TileKey;
 use crate::backend::{
     Binding, BindingKind, Buffer, BufferDesc, BufferUsage, Cmd, ComputePipeline, Context, Depth, DepthTest,
@@ -41,8 +42,6 @@ const SCRATCH_SLOTS: u64 = (SCRATCH_SIDE * SCRATCH_SIDE) as u64 * TILE_PAGES;
 const SLOT_TEXEL_BYTES: u64 = 4 * ASM_PAGE_TEXELS as u64 * ASM_PAGE_TEXELS as u64;
 /// Bytes of a slot's entry in the packing's list.
 const SLOT_ENTRY_BYTES: u64 = 4;
-/// Pages an index of the page table holds: 24 bits (`page_table`).
-const MAX_PAGES: u32 = 1 << 24;
 
 /// Bytes of the scratch for pages of `page_bytes`: per slot its D32 depth (and with the ID test,
 /// whose pages are larger, its IDs), its packed page and its entry in the packing's list.
@@ -110,7 +109,7 @@ impl PageStore {
         };
         let depth = buffer("asm.pages", DEPTH_PAGE_BYTES)?;
         let ids = match ids {
-            true => Some(IdPages::new(ctx, gpu, buffer("asm.id_pages", ID_PAGE_BYTES - DEPTH_PAGE_BYTES)?)?),
+            true => Some(IdPages::new(ctx, gpu, buffer("asm.id_pages", PAGE_ID_BYTES)?)?),
             false => None,
         };
         let storage = |name, size, usage| {
@@ -247,10 +246,8 @@ impl PageStore {
         if let Some(ids) = &self.ids {
             let side = SCRATCH_SIDE * SLOT_SIDE;
             let from = |slot: u32| [slot % side * ASM_PAGE_TEXELS, slot / side * ASM_PAGE_TEXELS];
-            let squares: Vec<([u32; 2], u64)> = squares
-                .iter()
-                .map(|&(slot, page)| (from(slot), page_at(page, ID_PAGE_BYTES - DEPTH_PAGE_BYTES)))
-                .collect();
+            let squares: Vec<([u32; 2], u64)> =
+                squares.iter().map(|&(slot, page)| (from(slot), page_at(page, PAGE_ID_BYTES))).collect();
             ids.scratch.record_copy_squares_to(cmd, ids.pages.buffer(), &squares, ASM_PAGE_TEXELS);
         }
     }
@@ -300,6 +297,7 @@ impl IdPages {
 mod tests {
     use super::*;
     use crate::layouts::constants::{ASM_PAGE_DEPTH_TEXELS, ASM_PAGE_ID_TEXELS};
+    use crate::techniques::asm::pool::ID_PAGE_BYTES;
 
     /// asm_pack.comp and asm_lookup.glsl read a depth page as 16-byte texels: a slot's 16-bit
     /// depths eight to a texel, then one texel for the span; an ID page four IDs to a texel.
@@ -309,7 +307,7 @@ mod tests {
         assert_eq!(u64::from(ASM_PAGE_DEPTH_TEXELS - 1) * 8, slot_texels);
         assert_eq!(DEPTH_PAGE_BYTES, 2 * slot_texels + 16);
         assert_eq!(u64::from(ASM_PAGE_ID_TEXELS) * 4, slot_texels);
-        assert_eq!(ID_PAGE_BYTES - DEPTH_PAGE_BYTES, SLOT_TEXEL_BYTES);
+        assert_eq!(PAGE_ID_BYTES, SLOT_TEXEL_BYTES);
         // The scratch: a D32 depth (and ID) per texel of its slots, a packed page and a list
         // entry per slot.
         assert_eq!(scratch_bytes(DEPTH_PAGE_BYTES), SCRATCH_SLOTS * (1024 + 528 + 4));

@@ -54,8 +54,10 @@ const TRIAL_FRAMES: u64 = ANALYSIS_PHASES;
 /// Bytes of one page for the depth test with bias: a slot's depths, 16 bits each, and their span
 /// (`asm_pack.comp`).
 pub const DEPTH_PAGE_BYTES: u64 = 16 * ASM_PAGE_DEPTH_TEXELS as u64;
-/// Bytes of one page for the polygon-ID test: the depth page and a 32-bit polygon ID per texel.
-pub const ID_PAGE_BYTES: u64 = DEPTH_PAGE_BYTES + 16 * ASM_PAGE_ID_TEXELS as u64;
+/// Bytes of a slot's polygon IDs, 32 bits a texel (the ID test's second buffer of pages).
+pub const PAGE_ID_BYTES: u64 = 16 * ASM_PAGE_ID_TEXELS as u64;
+/// Bytes of one page for the polygon-ID test: the depth page and the slot's polygon IDs.
+pub const ID_PAGE_BYTES: u64 = DEPTH_PAGE_BYTES + PAGE_ID_BYTES;
 /// Slots per side of a tile.
 pub const SLOT_SIDE: u32 = ASM_TILE_TEXELS / ASM_PAGE_TEXELS;
 /// Slots of a tile: the root's pages.
