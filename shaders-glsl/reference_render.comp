@@ -4,7 +4,8 @@
 // either). Environment mode adds `frame.w` Monte Carlo samples of the reflected radiance
 // albedo / pi * E (see reference.glsl) to each pixel's statistics; a ray that misses shows the
 // environment bilinearly filtered, as the raster background does. Local mode is deterministic:
-// point and spot lights with hard shadows, one shadow ray each, black background; it also
+// point and spot lights with hard shadows, one shadow ray each, black background (and
+// coverage 0 there, see ReferenceAccum); it also
 // records the lowest and highest luminance the pixel takes when its primary ray moves by the
 // rasterizer's sub-pixel precision along x or y (edge ties, see metrics.rs).
 #include "constants.glsl"
@@ -34,10 +35,11 @@ vec3 primary_dir(vec2 at) {
     return normalize(eye_ray(p.eye_rays, eye_ndc(at, vec2(p.frame.xy))));
 }
 
-// Local lighting seen along a primary ray: black where it misses.
-vec3 local_radiance(vec3 dir) {
+// Local lighting seen along a primary ray, and 1 where it meets a surface: black and 0 where it
+// misses.
+vec4 local_radiance(vec3 dir) {
     RayHit hit = bvh_closest_hit(p.camera_pos.xyz, dir, REFERENCE_FAR);
-    return hit.instance == KAGE_NO_HIT ? vec3(0.0) : local_lighting(bvh_surface(hit, dir));
+    return hit.instance == KAGE_NO_HIT ? vec4(0.0) : vec4(local_lighting(bvh_surface(hit, dir)), 1.0);
 }
 
 void main() {
@@ -53,16 +55,16 @@ void main() {
     if (p.params.x == 1u) {
         // Deterministic: one sample is the value. The rasterizer places vertices to
         // 1 / 2^params.w px, so the pixel is also seen from that far to each side.
-        vec3 value = local_radiance(dir);
+        vec4 value = local_radiance(dir);
         float step = 1.0 / float(1u << p.params.w);
-        float lowest = luminance(value), highest = lowest;
+        float lowest = luminance(value.rgb), highest = lowest;
         for (uint k = 0u; k < 4u; ++k) {
             vec2 offset = vec2[4](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1))[k] * step;
-            float l = luminance(local_radiance(primary_dir(centre + offset)));
+            float l = luminance(local_radiance(primary_dir(centre + offset)).rgb);
             lowest = min(lowest, l);
             highest = max(highest, l);
         }
-        accum[index] = ReferenceAccum(vec4(value, lowest), vec4(0.0, 0.0, 0.0, highest));
+        accum[index] = ReferenceAccum(vec4(value.rgb, lowest), vec4(value.a, 0.0, 0.0, highest));
         return;
     }
     RayHit hit = bvh_closest_hit(origin, dir, REFERENCE_FAR);

@@ -102,10 +102,10 @@ fn format_of(path: &Path) -> Option<Format> {
 /// Writes `image` in the format named by `path`'s extension (case-insensitive):
 /// - `.png`: each channel multiplied by `exposure`, tonemapped and sRGB-encoded by
 ///   [`tonemap_srgb8`], 8-bit RGB;
-/// - `.exr`: the linear radiance as 32-bit float RGB; `exposure` is ignored, the file holds
-///   what was rendered.
+/// - `.exr`: the linear radiance as 32-bit float RGBA (alpha: coverage, 0 where a local-light
+///   reference shows no surface); `exposure` is ignored, the file holds what was rendered.
 ///
-/// Alpha is dropped in both. NaN or infinite pixels are refused rather than written, since they
+/// PNG drops alpha. NaN or infinite pixels are refused rather than written, since they
 /// mean the render went wrong.
 pub fn write(path: impl AsRef<Path>, image: &RgbaF32Image, exposure: f32) -> Result<(), ImageIoError> {
     let path = path.as_ref();
@@ -145,9 +145,9 @@ pub fn write_rgb8_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Resul
 
 fn write_exr(path: &Path, image: &RgbaF32Image) -> Result<(), ImageIoError> {
     let width = image.width as usize;
-    exr::prelude::write_rgb_file(path, width, image.height as usize, |x, y| {
-        let [r, g, b, _] = image.pixels[y * width + x];
-        (r, g, b)
+    exr::prelude::write_rgba_file(path, width, image.height as usize, |x, y| {
+        let [r, g, b, a] = image.pixels[y * width + x];
+        (r, g, b, a)
     })
     .map_err(|error| ImageIoError::Exr { path: path.to_owned(), error })
 }
@@ -278,8 +278,9 @@ mod tests {
         let pixels = (0..width * height)
             .map(|i| {
                 let t = i as f32;
-                // Values that are not exactly representable in half, to catch a lossy path.
-                [t * 0.123_456_7, 1.0 / (t + 3.0), (t * 0.7).sin().abs() * 1e3, 1.0]
+                // Values that are not exactly representable in half, to catch a lossy path; an
+                // alpha of 0, 0.5 or 1 (coverage), which EXR keeps.
+                [t * 0.123_456_7, 1.0 / (t + 3.0), (t * 0.7).sin().abs() * 1e3, (i % 3) as f32 * 0.5]
             })
             .collect();
         RgbaF32Image { width, height, pixels }

@@ -130,7 +130,7 @@ struct CastPush {
 // accurate where a raw sum of squares would cancel.
 struct ReferenceAccum {
     vec4 mean; // rgb: mean of the samples so far, w: local mode: the lowest luminance at the edge-tie offsets
-    vec4 m2; // rgb: sum of squared deviations from the mean, w: local mode: the highest one
+    vec4 m2; // rgb: sum of squared deviations from the mean (local mode: x 1 where the primary ray meets a surface, 0 where it misses), w: local mode: the highest one
 };
 
 // A point or spot light as the reference's --light local mode reads it.

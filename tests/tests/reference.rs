@@ -204,8 +204,11 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
         // Deterministic: only f32 rounding (a few ulps) separates it from the formula.
         assert!((got - expected).abs() <= 1e-6 * expected, "channel {k}: {got} vs {expected}");
     }
-    // Background is black: the top-left pixel sees the sky above the horizon.
+    // Background is black: the top-left pixel sees the sky above the horizon, and no surface
+    // (coverage 0, the image's alpha), where the centre sees the floor.
     assert_eq!(lit.mean[0], [0.0; 3]);
+    let centre = ((size / 2) * size + size / 2) as usize;
+    assert_eq!((lit.local_coverage[0], lit.local_coverage[centre]), (0.0, 1.0));
 
     scene.groups.push(group(
         "blocker",
@@ -214,6 +217,8 @@ fn local_point_light_is_exact_and_a_blocker_makes_it_zero() {
     ));
     let shadowed = render(&ctx, &scene, size, LightMode::Local, 0, 1);
     assert_eq!(centre_rgb(&shadowed), [0.0; 3]);
+    // Black there too, but a surface in shadow, not the sky.
+    assert_eq!(shadowed.local_coverage[centre], 1.0);
 }
 
 #[test]

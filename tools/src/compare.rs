@@ -110,6 +110,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 "fraction": s.fraction,
                 "differing_pixels": s.differing,
                 "lit_in_a_only": s.lit_in_render_only,
+                "no_surface_in_b": s.no_surface,
                 "edge_ties": edges.as_ref().map(|_| s.at_edges),
                 "lit_above": s.threshold,
             })),
@@ -137,6 +138,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 "shadow mismatch  {:.6e}   ({} pixels lit in one image only, {} of them lit in A only; lit above {:.3e} = {relative} x B's brightest)",
                 s.fraction, s.differing, s.lit_in_render_only, s.threshold
             );
+            if s.no_surface > 0 {
+                println!(
+                    "no surface       {} pixels where B shows no surface (alpha 0: not compared)",
+                    s.no_surface
+                );
+            }
             match &edges {
                 Some(edges) => println!(
                     "edge ties        {} more pixels lit in one image only lie within 1/{} px of an edge (not counted)",

@@ -163,7 +163,9 @@ enum Command {
     /// image; `--shadow-mismatch` adds the fraction of pixels lit in one image and shadowed in the
     /// other (lit: luminance above T × B's brightest pixel, default 10⁻⁴), for a local-light render
     /// (`--technique shadowmap` or `asm`) against `kage reference --light local` of the same scene
-    /// and size, and `--mismatch-image` shows where (red: lit in A only, blue: lit in B only);
+    /// and size, leaving out the pixels where B shows no surface (its alpha 0: the sky a local
+    /// reference leaves black), and `--mismatch-image` shows where (red: lit in A only, blue: lit
+    /// in B only, black: no surface in B);
     /// `--edges` takes B's edge ties (`kage reference --light local --edges`: pixels where an edge
     /// passes closer to the centre than the device's sub-pixel precision, 1/256 px on lavapipe, so
     /// that no raster render can be told right or wrong there) and counts them apart (yellow in the

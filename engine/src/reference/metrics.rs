@@ -2,7 +2,9 @@
 //! they differ. Used by `kage compare`, the tests and the benchmarks.
 //!
 //! Every metric is taken over all pixels and the three colour channels together (alpha is
-//! ignored): each pixel contributes three absolute errors |a − b|.
+//! ignored): each pixel contributes three absolute errors |a − b|. The shadow mismatch alone
+//! reads the reference's alpha: it leaves out the pixels where a local-light reference shows
+//! no surface (alpha 0), whose background only a raster render draws.
 use super::env_sampling::luminance;
 use crate::error::{Error, Result};
 use crate::imageio::RgbaF32Image;
@@ -81,8 +83,11 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 pub struct ShadowMismatch {
     /// `differing` / all pixels.
     pub fraction: f64,
-    /// Pixels lit in one image and shadowed in the other, edge ties apart.
+    /// Pixels lit in one image and shadowed in the other, edge ties and pixels with no surface
+    /// apart.
     pub differing: usize,
+    /// Pixels where the reference shows no surface (alpha 0): not compared.
+    pub no_surface: usize,
     /// Pixels lit in one image only that are edge ties ([`EdgeTies`]): not in `differing`.
     pub at_edges: usize,
     /// Of those, pixels the render lights and the reference shadows (light leaks).
@@ -151,10 +156,16 @@ pub fn shadow_mismatch(
 ) -> Result<ShadowMismatch> {
     check_sizes(a, b)?;
     let threshold = lit_threshold(b, relative_threshold)?;
-    let (mut differing, mut at_edges, mut lit_in_render_only) = (0, 0, 0);
-    for ((lit_a, lit_b), tie) in
-        lit_states(a, threshold).zip(lit_states(b, threshold)).zip(ties(a, edges, threshold)?)
+    let (mut differing, mut at_edges, mut lit_in_render_only, mut no_surface) = (0, 0, 0, 0);
+    for (((lit_a, lit_b), tie), surface) in lit_states(a, threshold)
+        .zip(lit_states(b, threshold))
+        .zip(ties(a, edges, threshold)?)
+        .zip(surfaces(b))
     {
+        if !surface {
+            no_surface += 1;
+            continue;
+        }
         let counted = lit_a != lit_b && !tie;
         differing += usize::from(counted);
         at_edges += usize::from(lit_a != lit_b && tie);
@@ -163,10 +174,16 @@ pub fn shadow_mismatch(
     Ok(ShadowMismatch {
         fraction: differing as f64 / a.pixels.len() as f64,
         differing,
+        no_surface,
         at_edges,
         lit_in_render_only,
         threshold,
     })
+}
+
+/// Per pixel of the reference, row-major, whether it shows a surface (alpha above 0).
+fn surfaces(reference: &RgbaF32Image) -> impl Iterator<Item = bool> + '_ {
+    reference.pixels.iter().map(|p| p[3] > 0.0)
 }
 
 /// Per pixel of `image`, whether it is an edge tie (never without `edges`).
@@ -298,8 +315,8 @@ pub fn diff_image(a: &RgbaF32Image, b: &RgbaF32Image) -> Result<DiffImage> {
 
 /// Where `a` and the reference `b` disagree on lit and shadowed (as [`shadow_mismatch`]
 /// counts): red where only `a` is lit (a leak), blue where only `b` is, yellow where they
-/// disagree on an edge tie, light grey where both are lit and dark grey where both are
-/// shadowed. `scale` is the luminance threshold.
+/// disagree on an edge tie, light grey where both are lit, dark grey where both are shadowed
+/// and black where the reference shows no surface. `scale` is the luminance threshold.
 pub fn shadow_mismatch_image(
     a: &RgbaF32Image,
     b: &RgbaF32Image,
@@ -311,12 +328,14 @@ pub fn shadow_mismatch_image(
     let rgb = lit_states(a, threshold)
         .zip(lit_states(b, threshold))
         .zip(ties(a, edges, threshold)?)
-        .flat_map(|states| match states {
-            ((true, false), true) | ((false, true), true) => [240, 210, 40],
-            ((true, false), false) => [230, 40, 40],
-            ((false, true), false) => [40, 110, 255],
-            ((true, true), _) => [170, 170, 170],
-            ((false, false), _) => [50, 50, 50],
+        .zip(surfaces(b))
+        .flat_map(|(states, surface)| match (states, surface) {
+            (_, false) => [0, 0, 0],
+            (((true, false), true) | ((false, true), true), _) => [240, 210, 40],
+            (((true, false), false), _) => [230, 40, 40],
+            (((false, true), false), _) => [40, 110, 255],
+            (((true, true), _), _) => [170, 170, 170],
+            (((false, false), _), _) => [50, 50, 50],
         })
         .collect();
     Ok(DiffImage { width: a.width, height: a.height, rgb, scale: threshold })
@@ -399,6 +418,21 @@ mod tests {
         assert_eq!(colours.iter().filter(|c| **c == red || **c == blue).count(), m.differing);
         assert_eq!((colours[1], colours[4]), (&[170u8, 170, 170][..], &[50u8, 50, 50][..]));
         assert_eq!((picture.width, picture.height, picture.scale), (4, 2, 0.5));
+    }
+
+    /// A local reference's sky (alpha 0, black) against a render's environment there (lit):
+    /// left out of the count and black in the picture, whatever the render shows.
+    #[test]
+    fn pixels_where_the_reference_shows_no_surface_are_left_out() {
+        let mut reference = image(4, 1, &[0.0, 2.0, 0.0, 0.0]);
+        let render = image(4, 1, &[0.9, 2.0, 0.9, 0.0]);
+        assert_eq!(shadow_mismatch(&render, &reference, 0.25, None).unwrap().differing, 2);
+        reference.pixels[0][3] = 0.0;
+        let m = shadow_mismatch(&render, &reference, 0.25, None).unwrap();
+        assert_eq!((m.differing, m.no_surface, m.lit_in_render_only), (1, 1, 1));
+        assert_eq!(m.fraction, 0.25);
+        let picture = shadow_mismatch_image(&render, &reference, 0.25, None).unwrap();
+        assert_eq!((&picture.rgb[0..3], &picture.rgb[6..9]), (&[0u8, 0, 0][..], &[230u8, 40, 40][..]));
     }
 
     #[test]

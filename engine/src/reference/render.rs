@@ -19,8 +19,9 @@ use std::sync::Arc;
 
 /// The version of the reference's output, for caches of references on disk: bump it when the
 /// same scene, camera and options give another image. 3: primary rays from the camera's basis,
-/// not unprojected through the inverse view-projection in float (1/50 px apart).
-pub const OUTPUT_VERSION: u32 = 3;
+/// not unprojected through the inverse view-projection in float (1/50 px apart); 4: a local
+/// reference's alpha 0 where it shows no surface.
+pub const OUTPUT_VERSION: u32 = 4;
 
 /// Which light the reference renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,7 +128,8 @@ impl ReferenceRenderer {
         Statistics::read(&self.accum, self.samples)
     }
 
-    /// The image so far: linear radiance, row 0 at the top, alpha 1.
+    /// The image so far: linear radiance, row 0 at the top; alpha 1, but 0 in local mode where
+    /// the pixel shows no surface (black there, where a raster render shows the environment).
     pub fn image(&self) -> Result<RgbaF32Image> {
         Ok(self.to_image(&self.statistics()?))
     }
@@ -148,7 +150,15 @@ impl ReferenceRenderer {
         RgbaF32Image {
             width: self.options.width,
             height: self.options.height,
-            pixels: statistics.mean.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect(),
+            pixels: match self.options.light {
+                LightMode::Local => statistics
+                    .mean
+                    .iter()
+                    .zip(&statistics.local_coverage)
+                    .map(|(&[r, g, b], &a)| [r, g, b, a])
+                    .collect(),
+                LightMode::Environment => statistics.mean.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect(),
+            },
         }
     }
 }

@@ -39,6 +39,9 @@ pub struct Statistics {
     /// The local-light reference's lowest and highest luminance per pixel at the edge-tie
     /// offsets ([`super::EdgeTies`]); zeros from the other modes.
     pub luminance_range: Vec<[f32; 2]>,
+    /// The local-light reference's coverage per pixel: 1 where its primary ray meets a surface,
+    /// 0 where it shows none; the other modes' first sums of squares, no coverage.
+    pub local_coverage: Vec<f32>,
 }
 
 impl Statistics {
@@ -50,13 +53,14 @@ impl Statistics {
         let items = floats.chunks_exact(8);
         let mean = items.clone().map(|a| [a[0], a[1], a[2]]).collect();
         let luminance_range = items.clone().map(|a| [a[3], a[7]]).collect();
+        let local_coverage = items.clone().map(|a| a[4]).collect();
         let standard_error = (samples >= 2).then(|| {
             let n = f64::from(samples);
             items
                 .map(|a| [a[4], a[5], a[6]].map(|m2| (f64::from(m2.max(0.0)) / (n - 1.0) / n).sqrt() as f32))
                 .collect()
         });
-        Ok(Statistics { samples, mean, standard_error, luminance_range })
+        Ok(Statistics { samples, mean, standard_error, luminance_range, local_coverage })
     }
 
     /// The noise left in the estimate, relative: the RMS over items and channels of the standard
