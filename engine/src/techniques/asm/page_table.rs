@@ -10,12 +10,16 @@
 //! A directory comes first in the buffer: one entry per tile of level
 //! `ASM_DIRECTORY_LEVEL`, naming the finest resident tile at or above that level over it, so
 //! that the descent starts there instead of at the root.
-use super::pool::{PagePool, SLOT_SIDE};
+use super::pool::{parent_slot, PagePool, SLOTS, SLOT_SIDE};
 use super::tile::TileKey;
 use crate::error::{Error, Result};
 use crate::layouts::constants::ASM_DIRECTORY_LEVEL;
 use crate::layouts::{bytes_of_slice, AsmNode};
 use std::collections::VecDeque;
+
+/// Per slot of a tile: the page and levels up of the nearest tile at or above it that stores the
+/// slot's point (what `PagePool::holding` finds walking up), `None` where none does.
+type Held = [Option<(u32, u32)>; SLOTS];
 
 /// Entries of the directory per side.
 pub const DIRECTORY_SIDE: u32 = 1 << ASM_DIRECTORY_LEVEL;
@@ -46,8 +50,11 @@ pub struct PageTable {
 impl PageTable {
     /// The buffer's bytes, as `asm_lookup.glsl`'s `PageTable` block reads them.
     pub fn bytes(&self) -> Vec<u8> {
-        let directory = self.directory.iter().flat_map(|e| e.to_ne_bytes());
-        directory.chain(bytes_of_slice(&self.nodes).iter().copied()).collect()
+        let nodes = bytes_of_slice(&self.nodes);
+        let mut bytes = Vec::with_capacity(DIRECTORY_BYTES as usize + nodes.len());
+        bytes.extend(self.directory.iter().flat_map(|e| e.to_ne_bytes()));
+        bytes.extend_from_slice(nodes);
+        bytes
     }
 
     /// Bytes of a table of up to `nodes` nodes.
@@ -58,35 +65,48 @@ impl PageTable {
 
 /// The page table of `pool`'s resident tiles, root first.
 pub fn build(pool: &PagePool) -> Result<PageTable> {
-    // Per slot: its page, or the nearest ancestor's that holds it, with the levels up; a slot
-    // under a resident child is never read (the descent goes on): 0 stands in.
-    let node = |key: TileKey| -> Result<AsmNode> {
+    // Per slot: its page, or the nearest ancestor's that holds it, with the levels up (handed
+    // down from the parent, so that no slot walks up the tree: the host builds this table every
+    // frame); a slot under a resident child is never read (the descent goes on): 0 stands in.
+    let node = |key: TileKey, above: &Held| -> Result<(AsmNode, Held, [bool; 4])> {
         let pages = pool
             .pages(key)
             .ok_or_else(|| Error::Internal(format!("ASM tile {key:?} listed but not resident")))?;
         let children = key.children();
+        let resident = std::array::from_fn(|q| children.is_some_and(|c| pool.contains(c[q])));
+        let mut held: Held = [None; SLOTS];
         let mut entries = [[0u32; 4]; 4];
         for (slot, entry) in entries.as_flattened_mut().iter_mut().enumerate() {
+            held[slot] = match pages[slot] {
+                Some(page) => Some((page, 0)),
+                None => above[slot].map(|(page, up)| (page, up + 1)),
+            };
             let (x, y) = (slot as u32 % SLOT_SIDE, slot as u32 / SLOT_SIDE);
             let half = SLOT_SIDE / 2;
-            let under = children.is_some_and(|c| pool.contains(c[((x / half) + 2 * (y / half)) as usize]));
-            *entry = match (pages[slot], under) {
-                (Some(page), _) => page_entry(page)?,
-                (None, true) => 0,
+            *entry = match (held[slot], resident[((x / half) + 2 * (y / half)) as usize]) {
+                (Some((page, 0)), _) => page_entry(page)?,
+                (_, true) => 0,
+                (Some((page, up)), false) => page_entry(page)? | up << LEVEL_SHIFT,
                 (None, false) => {
-                    let (page, up) = pool.holder(key, slot as u32)?;
-                    page_entry(page)? | up << LEVEL_SHIFT
+                    return Err(Error::Internal(format!(
+                        "no resident tile at or above ASM tile {key:?} stores its slot {slot}"
+                    )))
                 }
             };
         }
-        Ok(AsmNode { below: [[0; 4]; 4], pages: entries })
+        Ok((AsmNode { below: [[0; 4]; 4], pages: entries }, held, resident))
     };
-    let (mut nodes, mut keys) = (vec![node(TileKey::ROOT)?], vec![TileKey::ROOT]);
+    // What a child's slots inherit: the holder of the parent's slot over each.
+    let handed_down = |child: TileKey, held: &Held| -> Held {
+        std::array::from_fn(|slot| held[parent_slot(child, slot as u32) as usize])
+    };
+    let (root, held, resident) = node(TileKey::ROOT, &[None; SLOTS])?;
+    let (mut nodes, mut keys) = (vec![root], vec![TileKey::ROOT]);
     // Each node's resident children (node indices, 0: none), for the `below` entries.
     let mut children = vec![[0u32; 4]];
     let mut directory = vec![0u32; (DIRECTORY_SIDE * DIRECTORY_SIDE) as usize];
-    let mut queue = VecDeque::from([(TileKey::ROOT, 0usize)]);
-    while let Some((key, at)) = queue.pop_front() {
+    let mut queue = VecDeque::from([(TileKey::ROOT, 0usize, held, resident)]);
+    while let Some((key, at, held, resident)) = queue.pop_front() {
         // Breadth first: a finer tile overwrites its ancestors' entries.
         if key.level <= ASM_DIRECTORY_LEVEL {
             let span = 1 << (ASM_DIRECTORY_LEVEL - key.level);
@@ -97,14 +117,13 @@ pub fn build(pool: &PagePool) -> Result<PageTable> {
             }
         }
         let Some(tiles) = key.children() else { continue };
-        for (q, child) in tiles.into_iter().enumerate() {
-            if pool.contains(child) {
-                children[at][q] = nodes.len() as u32;
-                queue.push_back((child, nodes.len()));
-                nodes.push(node(child)?);
-                keys.push(child);
-                children.push([0; 4]);
-            }
+        for (q, child) in tiles.into_iter().enumerate().filter(|(q, _)| resident[*q]) {
+            let (record, child_held, child_resident) = node(child, &handed_down(child, &held))?;
+            children[at][q] = nodes.len() as u32;
+            queue.push_back((child, nodes.len(), child_held, child_resident));
+            nodes.push(record);
+            keys.push(child);
+            children.push([0; 4]);
         }
     }
     // Children come after their parents: each node's grandchildren are known by now.

@@ -214,7 +214,7 @@ impl PageStore {
     /// pages. A page written twice keeps the later slot: a slot given back by a tile and taken
     /// by another rendered after it in the same batch.
     fn store(&self, ctx: &Context, cmd: Cmd, pending: &[(u32, u32)]) {
-        let mut seen = std::collections::HashSet::new();
+        let mut seen = rustc_hash::FxHashSet::default();
         let squares: Vec<(u32, u32)> =
             pending.iter().rev().filter(|(_, page)| seen.insert(*page)).copied().collect();
         if squares.is_empty() {

@@ -43,8 +43,8 @@ use crate::error::{Error, Result};
 use crate::layouts::constants::{
     ASM_PAGE_DEPTH_TEXELS, ASM_PAGE_ID_TEXELS, ASM_PAGE_TEXELS, ASM_TILE_TEXELS,
 };
+use rustc_hash::FxHashMap;
 use std::collections::hash_map::Entry;
-use std::collections::HashMap;
 
 /// Frames the analysis takes to see every eye pixel (one of each 2×2 block a frame): a trial's
 /// length.
@@ -62,7 +62,8 @@ pub const ID_PAGE_BYTES: u64 = DEPTH_PAGE_BYTES + PAGE_ID_BYTES;
 pub const SLOT_SIDE: u32 = ASM_TILE_TEXELS / ASM_PAGE_TEXELS;
 /// Slots of a tile: the root's pages.
 pub const TILE_PAGES: u64 = SLOT_SIDE as u64 * SLOT_SIDE as u64;
-const SLOTS: usize = TILE_PAGES as usize;
+/// [`TILE_PAGES`] as an array length.
+pub const SLOTS: usize = TILE_PAGES as usize;
 
 /// Tiles down to this level keep every slot, never trimmed at a trial's end nor given back
 /// stale. With slots alone a pixel where no edge asked for texels before reads a far ancestor's
@@ -167,9 +168,14 @@ fn slot_texel(key: TileKey, slot: u32) -> [u64; 2] {
     [at(key.x, slot % SLOT_SIDE), at(key.y, slot / SLOT_SIDE)]
 }
 
+/// The slot of `key`'s parent over slot `slot` of `key`.
+pub fn parent_slot(key: TileKey, slot: u32) -> u32 {
+    slot_at(slot_texel(key, slot), 1)
+}
+
 /// The slots of `key`'s parent over `slots` of `key`.
 pub fn parent_slots(key: TileKey, slots: Slots) -> Slots {
-    (0..SLOTS as u32).filter(|s| slots & 1 << s != 0).fold(0, |m, s| m | 1 << slot_at(slot_texel(key, s), 1))
+    (0..SLOTS as u32).filter(|s| slots & 1 << s != 0).fold(0, |m, s| m | 1 << parent_slot(key, s))
 }
 
 /// The slots of a tile covered where its children give `full` (per quadrant, as
@@ -194,7 +200,7 @@ pub struct PagePool {
     capacity: u32,
     page_bytes: u64,
     free: Vec<u32>,
-    tiles: HashMap<TileKey, Resident>,
+    tiles: FxHashMap<TileKey, Resident>,
     ops: Vec<PageOp>,
     /// The frame `stale_order` was made in.
     released: u64,
@@ -231,7 +237,7 @@ impl PagePool {
             capacity,
             page_bytes,
             free: (0..capacity).rev().collect(),
-            tiles: HashMap::new(),
+            tiles: FxHashMap::default(),
             ops: Vec::new(),
             released: 0,
             stale_order: Vec::new(),
@@ -283,9 +289,9 @@ impl PagePool {
         self.tiles.iter().map(|(k, r)| (*k, r.pages))
     }
 
-    /// The page and the levels up to its tile of the nearest tile at or above resident `key`
-    /// that stores the point of `key`'s slot `slot` (the root wants every slot, and a slot
-    /// stored nowhere below is covered nowhere above, so one is always found).
+    /// [`PagePool::holding`]'s page and levels up, as `page_table::build` must find them: the
+    /// tests' oracle for the holders the build hands down.
+    #[cfg(test)]
     pub fn holder(&self, key: TileKey, slot: u32) -> Result<(u32, u32)> {
         let (_, _, page, up) = self.holding(key, slot).ok_or_else(|| {
             Error::Internal(format!("no resident tile at or above ASM tile {key:?} stores its slot {slot}"))
@@ -293,7 +299,10 @@ impl PagePool {
         Ok((page, up))
     }
 
-    /// [`PagePool::holder`]'s tile and its slot too; `None` where the tiles break the rules.
+    /// The nearest tile at or above resident `key` that stores the point of `key`'s slot
+    /// `slot`: the tile, its slot over the point, its page and the levels up to it (the root
+    /// wants every slot, and a slot stored nowhere below is covered nowhere above, so one is
+    /// always found); `None` where the tiles break the rules.
     fn holding(&self, key: TileKey, slot: u32) -> Option<(TileKey, usize, u32, u32)> {
         let texel = slot_texel(key, slot);
         let mut at = Some(key);
@@ -338,7 +347,7 @@ impl PagePool {
     /// of one ancestor each queued a render of that ancestor (12 of one level-3 tile in a
     /// frame of 28 renders after a camera turn).
     pub fn merged(&self, ops: Vec<PageOp>) -> Vec<PageOp> {
-        let mut slots: HashMap<TileKey, Slots> = HashMap::new();
+        let mut slots: FxHashMap<TileKey, Slots> = FxHashMap::default();
         for op in &ops {
             *slots.entry(op.key).or_default() |= op.stores.iter().fold(0, |m, (s, _)| m | 1 << s);
         }

@@ -53,7 +53,7 @@ use crate::scene::{Light, Scene};
 use crate::techniques::shadow_map::{shadow_light, DEPTH_BIAS};
 use crate::techniques::{Technique, TechniqueStats};
 use glam::{Mat4, Vec3};
-use std::collections::{HashMap, HashSet};
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::Arc;
 
 /// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
@@ -292,7 +292,7 @@ pub struct Asm {
     evicted: usize,
     stats: AsmStats,
     /// Requests for more slots of tiles rendered already, gathered since the frame given.
-    deferred: HashMap<TileKey, (Request, u64)>,
+    deferred: FxHashMap<TileKey, (Request, u64)>,
 }
 
 impl Asm {
@@ -421,7 +421,7 @@ impl Asm {
             refresh: Vec::new(),
             render: Vec::new(),
             evicted: 0,
-            deferred: HashMap::new(),
+            deferred: FxHashMap::default(),
             // The memory is known from the start, before the first frame's statistics.
             stats: AsmStats { memory, budget_bytes: settings.budget_bytes(), ..Default::default() },
         };
@@ -538,7 +538,7 @@ impl Asm {
         }
         let words = read_words(&self.requests)?;
         let nodes = self.pool.max_tiles() as usize;
-        let mut asked: HashMap<TileKey, (Slots, u32, u32)> = HashMap::new();
+        let mut asked: FxHashMap<TileKey, (Slots, u32, u32)> = FxHashMap::default();
         for (node, &key) in self.table_keys.iter().enumerate() {
             let (word, used) = (words[1 + 2 * node], words[2 + 2 * node]);
             if word | used != 0 {
@@ -656,7 +656,7 @@ fn tile_draws(
 /// Each tile's index runs ([`tile_draws`]) under this frame's cluster bounds, found once: a
 /// tile's are needed for its request's cost, its evictions' and its render.
 #[derive(Default)]
-struct FrameDraws(HashMap<TileKey, Vec<(usize, u32, u32)>>);
+struct FrameDraws(FxHashMap<TileKey, Vec<(usize, u32, u32)>>);
 
 impl FrameDraws {
     /// Forgets every tile's runs: the clusters' bounds are a new frame's.
@@ -791,7 +791,7 @@ impl Technique for Asm {
         self.evicted = 0;
         let (mut ops, mut failed) = (Vec::new(), None);
         // A tile renders once a frame (`PagePool::merged`): a render queued already is paid.
-        let mut queued = HashSet::new();
+        let mut queued = FxHashSet::default();
         let (draws, clusters, rects) = (&mut self.draws, &self.clusters, &self.cluster_rects);
         let mut cost = |key: TileKey| model.cost_ms(draw_triangles(draws.of(clusters, rects, key)));
         plan(requests, &model, time_ms, |request, left_ms| {

@@ -311,10 +311,15 @@ fn walk(
         let slow = motion.is_some_and(|m| m > 0.0 && m <= args.slow_px);
         bar.message(format!("frame {i}: rendering"));
         let mut timings = vec![Vec::new(); n];
+        // Wall-clock ms of each render call: the GPU's passes and all the host does between
+        // and around them (an adaptive map's planning waits on its analysis, and the GPU on it).
+        let mut wall_ms = vec![0.0; n];
         for k in 0..n {
             let c = (i + k) % n;
             renderers[c].set_camera(frame.camera)?;
+            let start = std::time::Instant::now();
             timings[c] = renderers[c].render()?;
+            wall_ms[c] = start.elapsed().as_secs_f64() * 1e3;
         }
         let images: Vec<RgbaF32Image> = renderers.iter().map(|r| r.image()).collect::<kage::Result<_>>()?;
         let frame_ms = |c: usize| kage::pass::frame_ms(&timings[c]).unwrap_or(0.0);
@@ -340,6 +345,8 @@ fn walk(
                 edge_ties: mismatch.at_edges,
                 frame_ms: frame_ms(c),
                 ratio: frame_ms(c) / frame_ms(0),
+                wall_ms: wall_ms[c],
+                wall_ratio: wall_ms[c] / wall_ms[0],
                 flips,
             };
             series[c].add(&row, &timings[c]);

@@ -29,6 +29,10 @@ pub struct FrameRow {
     /// GPU ms of the frame's passes, and that over the first configuration's in this frame.
     pub frame_ms: f64,
     pub ratio: f64,
+    /// Wall-clock ms of the frame's render call (GPU passes, host work and waits), and that
+    /// over the first configuration's in this frame.
+    pub wall_ms: f64,
+    pub wall_ratio: f64,
     /// The flips from the previous frame, where the camera moves slowly.
     pub flips: Option<ShadowFlips>,
 }
@@ -42,6 +46,8 @@ pub struct Series {
     /// The errors while resting at each keyframe, from the arriving frame on.
     rests: BTreeMap<usize, Vec<f64>>,
     ratios: Vec<f64>,
+    walls: Vec<f64>,
+    wall_ratios: Vec<f64>,
     /// Spurious flips per slow frame pair, fractions of the pixels.
     flips: Vec<f64>,
 }
@@ -56,6 +62,9 @@ pub struct Summary {
     pub frame_ms: f64,
     /// The median over frames of the frame time over the first configuration's.
     pub ratio: f64,
+    /// The median wall-clock frame, and the median of its ratio as for `ratio`.
+    pub wall_ms: f64,
+    pub wall_ratio: f64,
     pub passes: Vec<TimingRow>,
     pub flips_mean: Option<f64>,
     pub slow_pairs: usize,
@@ -75,6 +84,8 @@ impl Series {
             self.rests.entry(k).or_default().push(row.error);
         }
         self.ratios.push(row.ratio);
+        self.walls.push(row.wall_ms);
+        self.wall_ratios.push(row.wall_ratio);
         self.flips.extend(row.flips.map(|f| f.fraction));
     }
 
@@ -90,6 +101,8 @@ impl Series {
             error_at_rest: mean(&at_rest),
             frame_ms: self.timing.frame_median_ms(),
             ratio: median(&self.ratios),
+            wall_ms: median(&self.walls),
+            wall_ratio: median(&self.wall_ratios),
             passes: self.timing.rows(),
             flips_mean: mean(&self.flips),
             slow_pairs: self.flips.len(),
@@ -121,12 +134,22 @@ pub fn print(configs: &[Config], summaries: &[Summary], slow_px: f32) {
     let optional =
         |v: Option<f64>, digits: usize| v.map_or_else(|| "-".to_string(), |v| format!("{v:.digits$}"));
     println!(
-        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>10} {:>12}",
-        "config", "shadow MiB", "error", "max", "at rest", "frame ms", "ratio", "flips", "converged"
+        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9} {:>7} {:>10} {:>12}",
+        "config",
+        "shadow MiB",
+        "error",
+        "max",
+        "at rest",
+        "frame ms",
+        "ratio",
+        "wall ms",
+        "ratio",
+        "flips",
+        "converged"
     );
     for (config, s) in configs.iter().zip(summaries) {
         println!(
-            "{:<18} {:>10} {:>10.5} {:>10.5} {:>10} {:>10.3} {:>7.3} {:>10} {:>12}",
+            "{:<18} {:>10} {:>10.5} {:>10.5} {:>10} {:>10.3} {:>7.3} {:>9.3} {:>7.3} {:>10} {:>12}",
             config.name,
             mib(s.shadow_bytes),
             s.error_mean,
@@ -134,12 +157,14 @@ pub fn print(configs: &[Config], summaries: &[Summary], slow_px: f32) {
             optional(s.error_at_rest, 5),
             s.frame_ms,
             s.ratio,
+            s.wall_ms,
+            s.wall_ratio,
             optional(s.flips_mean, 6),
             converged_text(s)
         );
     }
     println!(
-        "error: fraction of pixels lit in one of render and reference only, mean and max over the walkthrough's samples; at rest: after the frames held at each keyframe; frame ms: median GPU time; ratio: median over frames of the frame time over {}'s in the same frame; flips: mean fraction of pixels flipping where the reference does not, over the {} frame pairs moving by at most {slow_px} px; converged: frames until the error stops falling at rest (the slowest keyframe)",
+        "error: fraction of pixels lit in one of render and reference only, mean and max over the walkthrough's samples; at rest: after the frames held at each keyframe; frame ms: median GPU time; ratio: median over frames of the frame time over {}'s in the same frame; wall ms: median wall-clock time of the frame's render call (the GPU's passes, the host's work and the waits between them), its ratio as the GPU's; flips: mean fraction of pixels flipping where the reference does not, over the {} frame pairs moving by at most {slow_px} px; converged: frames until the error stops falling at rest (the slowest keyframe)",
         configs[0].name,
         summaries.first().map_or(0, |s| s.slow_pairs)
     );
@@ -164,7 +189,7 @@ pub fn write(
 ) -> Result<Vec<PathBuf>> {
     let optional = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:.6}"));
     let mut frames = String::from(
-        "frame,t,rest,extra,motion_px,config,technique,value,error,leaks,edge_ties,frame_ms,ratio,flips_render,flips_reference,flips_spurious\n",
+        "frame,t,rest,extra,motion_px,config,technique,value,error,leaks,edge_ties,frame_ms,ratio,wall_ms,wall_ratio,flips_render,flips_reference,flips_spurious\n",
     );
     for r in rows {
         let c = &configs[r.config];
@@ -173,7 +198,7 @@ pub fn write(
             .map_or_else(|| ",,".to_string(), |f| format!("{},{},{}", f.render, f.reference, f.spurious));
         writeln!(
             frames,
-            "{},{:.5},{},{},{},{},{},{},{:.6},{},{},{:.4},{:.4},{flips}",
+            "{},{:.5},{},{},{},{},{},{},{:.6},{},{},{:.4},{:.4},{:.4},{:.4},{flips}",
             r.frame,
             r.t,
             r.rest.map_or_else(String::new, |k| k.to_string()),
@@ -186,7 +211,9 @@ pub fn write(
             r.leaks,
             r.edge_ties,
             r.frame_ms,
-            r.ratio
+            r.ratio,
+            r.wall_ms,
+            r.wall_ratio
         )
         .expect("writing to a String");
     }
@@ -198,7 +225,7 @@ pub fn write(
         }
     }
     let mut summary = String::from(
-        "scene,config,technique,value,shadow_bytes,error_mean,error_max,error_at_rest,frame_ms,ratio,flips_mean,slow_pairs,converged_after",
+        "scene,config,technique,value,shadow_bytes,error_mean,error_max,error_at_rest,frame_ms,ratio,wall_ms,wall_ratio,flips_mean,slow_pairs,converged_after",
     );
     for pass in &passes {
         write!(summary, ",ms_{pass}").expect("writing to a String");
@@ -211,7 +238,7 @@ pub fn write(
         };
         write!(
             summary,
-            "{scene},{},{},{},{},{:.6},{:.6},{},{:.4},{:.4},{},{},{converged}",
+            "{scene},{},{},{},{},{:.6},{:.6},{},{:.4},{:.4},{:.4},{:.4},{},{},{converged}",
             c.name,
             c.kind,
             c.value,
@@ -221,6 +248,8 @@ pub fn write(
             optional(s.error_at_rest),
             s.frame_ms,
             s.ratio,
+            s.wall_ms,
+            s.wall_ratio,
             optional(s.flips_mean),
             s.slow_pairs
         )
