@@ -35,10 +35,13 @@ enum Command {
     /// [--device NAME]: renders W warm-up frames (default 2: a pipeline's first frames include its
     /// shader compilation on lavapipe; the one-time SH projection runs in the first, so `--warmup
     /// 0` shows it), then N timed frames offscreen (default 512×512, `kage.png`), writes the last,
-    /// prints the per-pass GPU time table (median, min, max) and the median frame time (from the
+    /// prints the per-pass GPU time table (median, min, max), the median frame time (from the
     /// frame's first pass's start to its last pass's end on the device, the time between passes
-    /// included); `--timings` writes the same as JSON: `{"device", "frames", "passes": [{"name",
-    /// "median_ms", "min_ms", "max_ms", "frames"}], "frame_median_ms"}`; `--trace` writes every
+    /// included but not the host's planning between `asm`'s two submissions, which its line
+    /// gives) and the median wall-clock frame (the render call: the GPU's passes, the host's
+    /// work and the waits); `--timings` writes the same as JSON: `{"device", "frames", "passes":
+    /// [{"name", "median_ms", "min_ms", "max_ms", "frames"}], "frame_median_ms",
+    /// "frame_wall_median_ms"}`; `--trace` writes every
     /// frame as a timeline in the Chrome trace event format (open it in Perfetto or
     /// chrome://tracing): one event per frame on a CPU track, one per pass and frame on a GPU track
     /// from the device's timestamps, both on the host's monotonic clock where the device reads its

@@ -105,6 +105,8 @@ fn render_writes_png_exr_and_timings() {
         }
     }
     assert!(json["frame_median_ms"].as_f64().is_some_and(|ms| ms > 0.0));
+    // The render call waits for its passes: its wall clock holds their GPU time.
+    assert!(json["frame_wall_median_ms"].as_f64() >= json["frame_median_ms"].as_f64(), "{json}");
 }
 
 #[test]

@@ -55,6 +55,7 @@ use crate::techniques::{Technique, TechniqueStats};
 use glam::{Mat4, Vec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::Arc;
+use std::time::Instant;
 
 /// Bytes in a megabyte of `--asm-budget-mb` (MiB, as the paper's 16 MB for a 2048² D32 map).
 pub const MB: u64 = 1 << 20;
@@ -227,6 +228,10 @@ pub struct AsmStats {
     pub evicted: usize,
     /// The cost model fitted at start-up: ms per triangle and per tile.
     pub cost: (f64, f64),
+    /// Host ms of the last frame's planning: its update, and between the two submissions the
+    /// analysis read back, the renders planned and the page table rebuilt, while the device
+    /// waits (no pass timing holds it).
+    pub plan_ms: f64,
 }
 
 impl AsmStats {
@@ -293,6 +298,8 @@ pub struct Asm {
     stats: AsmStats,
     /// Requests for more slots of tiles rendered already, gathered since the frame given.
     deferred: FxHashMap<TileKey, (Request, u64)>,
+    /// Host ms this frame's `update` took, for [`AsmStats::plan_ms`].
+    update_ms: f64,
 }
 
 impl Asm {
@@ -422,6 +429,7 @@ impl Asm {
             render: Vec::new(),
             evicted: 0,
             deferred: FxHashMap::default(),
+            update_ms: 0.0,
             // The memory is known from the start, before the first frame's statistics.
             stats: AsmStats { memory, budget_bytes: settings.budget_bytes(), ..Default::default() },
         };
@@ -697,6 +705,11 @@ fn box_rect(view_proj: &Mat4, transform: &Mat4, min: Vec3, max: Vec3) -> UvRect 
     UvRect::of_box(view_proj, lo, hi)
 }
 
+/// Milliseconds since `start`.
+fn ms_since(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
 /// A host-readable buffer's contents as native-endian words.
 fn read_words(buffer: &Buffer) -> Result<Vec<u32>> {
     Ok(buffer.read()?.chunks_exact(4).map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect())
@@ -704,6 +717,7 @@ fn read_words(buffer: &Buffer) -> Result<Vec<u32>> {
 
 impl Technique for Asm {
     fn update(&mut self, state: &FrameState) -> Result<()> {
+        let start = Instant::now();
         self.frame += 1;
         // The renderer keeps the scene's light count (Renderer::set_light replaces, never adds),
         // and `new` accepted exactly one.
@@ -745,6 +759,7 @@ impl Technique for Asm {
             self.write_table()?;
         }
         self.records.write(0, bytes_of(&record))?;
+        self.update_ms = ms_since(start);
         Ok(())
     }
 
@@ -783,6 +798,7 @@ impl Technique for Asm {
     }
 
     fn analysed(&mut self) -> Result<()> {
+        let start = Instant::now();
         let mut requests = self.read_requests()?;
         requests.retain(|r| !self.pool.note(r.key, r.slots, self.frame, Some(r.benefit() as f32)));
         let requests = self.defer_extensions(requests);
@@ -852,6 +868,7 @@ impl Technique for Asm {
             rendered: self.render.iter().map(|w| w.key).collect(),
             evicted: self.evicted,
             cost: (model.ms_per_triangle, model.ms_per_tile),
+            plan_ms: self.update_ms + ms_since(start),
         };
         Ok(())
     }
