@@ -12,6 +12,7 @@
 //! that the descent starts there instead of at the root.
 use super::pool::{parent_slot, PagePool, SLOTS, SLOT_SIDE};
 use super::tile::TileKey;
+use crate::backend::TexelBuffer;
 use crate::error::{Error, Result};
 use crate::layouts::constants::ASM_DIRECTORY_LEVEL;
 use crate::layouts::{bytes_of_slice, AsmNode};
@@ -48,13 +49,13 @@ pub struct PageTable {
 }
 
 impl PageTable {
-    /// The buffer's bytes, as `asm_lookup.glsl`'s `PageTable` block reads them.
-    pub fn bytes(&self) -> Vec<u8> {
-        let nodes = bytes_of_slice(&self.nodes);
-        let mut bytes = Vec::with_capacity(DIRECTORY_BYTES as usize + nodes.len());
-        bytes.extend(self.directory.iter().flat_map(|e| e.to_ne_bytes()));
-        bytes.extend_from_slice(nodes);
-        bytes
+    /// Writes the table into `buffer` as `asm_lookup.glsl`'s `PageTable` block reads it: the
+    /// directory, then the nodes straight from their array (no copy of the whole table: the host
+    /// writes it every frame).
+    pub fn write(&self, buffer: &mut TexelBuffer) -> Result<()> {
+        let directory: Vec<u8> = self.directory.iter().flat_map(|e| e.to_ne_bytes()).collect();
+        buffer.write(0, &directory)?;
+        buffer.write(DIRECTORY_BYTES, bytes_of_slice(&self.nodes))
     }
 
     /// Bytes of a table of up to `nodes` nodes.
@@ -295,7 +296,7 @@ mod tests {
             }
         }
         let table = build(&pool).unwrap();
-        assert_eq!(table.bytes().len() as u64, PageTable::buffer_bytes(table.nodes.len() as u32));
+        assert_eq!(table.directory.len() as u64 * 4, DIRECTORY_BYTES);
         // A lattice of points finer than the deepest tiles near the chains, coarser elsewhere.
         let mut reached_deep = 0;
         for centre in [[0.3f32, 0.6], [0.71, 0.12], [0.5, 0.5]] {

@@ -627,7 +627,7 @@ impl Asm {
     /// Rebuilds the page table from the pool and uploads it.
     fn write_table(&mut self) -> Result<()> {
         let table = page_table::build(&self.pool)?;
-        self.table.write(0, &table.bytes())?;
+        table.write(&mut self.table)?;
         self.table_keys = table.keys;
         Ok(())
     }
