@@ -549,9 +549,11 @@ impl Asm {
         let mut asked: FxHashMap<TileKey, (Slots, u32, u32)> = FxHashMap::default();
         for (node, &key) in self.table_keys.iter().enumerate() {
             let (word, used) = (words[1 + 2 * node], words[2 + 2 * node]);
-            if word | used != 0 {
-                self.pool.touch(key, self.frame);
+            // No pixel of this frame's landed in the tile: nothing to note (most of them).
+            if word | used == 0 {
+                continue;
             }
+            self.pool.touch(key, self.frame);
             self.pool.note_used(key, used as Slots, self.frame);
             self.pool.note_read_above(key, (used >> 16) as Slots, self.frame);
             // Slots on edges its own texels resolve: kept when a trial ends.
