@@ -12,7 +12,8 @@
 
 layout(local_size_x = KAGE_ASM_PACK_GROUP) in;
 layout(set = 0, binding = 0) uniform sampler2DArray scratch;
-// The slots to pack, one per invocation: slot x + y * n of the scratch's n x n.
+// The slots to pack, one per invocation: slot x + y * n of layer l of the scratch's n x n, as
+// x + y * n + l * n * n.
 layout(std430, set = 0, binding = 1) readonly buffer Slots { uint slots[]; };
 // Their pages, in the list's order.
 layout(std430, set = 0, binding = 2) writeonly buffer Packed { uvec4 packed[]; };
@@ -26,14 +27,14 @@ void main() {
     uint k = gl_GlobalInvocationID.x;
     if (k >= push.count.x) return;
     uint side = uint(textureSize(scratch, 0).x / KAGE_ASM_PAGE_TEXELS);
-    uint slot = slots[k];
+    uint layer = slots[k] / (side * side), slot = slots[k] % (side * side);
     ivec2 origin = ivec2(slot % side, slot / side) * KAGE_ASM_PAGE_TEXELS;
     // Depths are non-negative: the span from the nearest covered texel to the farthest. Each
     // texel is fetched once.
     float depths[KAGE_ASM_PAGE_TEXELS * KAGE_ASM_PAGE_TEXELS];
     float nearest = 1.0, farthest = 0.0;
     for (int i = 0; i < KAGE_ASM_PAGE_TEXELS * KAGE_ASM_PAGE_TEXELS; ++i) {
-        float d = texelFetch(scratch, ivec3(origin + ivec2(i % KAGE_ASM_PAGE_TEXELS, i / KAGE_ASM_PAGE_TEXELS), 0), 0).r;
+        float d = texelFetch(scratch, ivec3(origin + ivec2(i % KAGE_ASM_PAGE_TEXELS, i / KAGE_ASM_PAGE_TEXELS), layer), 0).r;
         depths[i] = d;
         if (d < 1.0) {
             nearest = min(nearest, d);

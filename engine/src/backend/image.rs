@@ -301,22 +301,22 @@ impl Image {
         self.transition(cmd, src, vk::ImageLayout::GENERAL);
     }
 
-    /// Records copies of `size`² squares of layer 0 into `dst`, each from its first texel here
+    /// Records copies of `size`² squares into `dst`, each from its first texel here (x, y, layer)
     /// to a byte offset there (rows tightly packed), ordered after all earlier commands on the
     /// image and before all later ones (the copies step into the transfer layout and back).
     /// Destination ranges must not overlap.
-    pub fn record_copy_squares_to(&self, cmd: Cmd, dst: &Buffer, squares: &[([u32; 2], u64)], size: u32) {
+    pub fn record_copy_squares_to(&self, cmd: Cmd, dst: &Buffer, squares: &[([u32; 3], u64)], size: u32) {
         self.touched(cmd, false);
         dst.touched(cmd, true);
-        let layer = vk::ImageSubresourceLayers {
-            aspect_mask: self.format.aspect(),
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
         let regions: Vec<vk::BufferImageCopy> = squares
             .iter()
-            .map(|&([x, y], offset)| {
+            .map(|&([x, y, layer], offset)| {
+                let layer = vk::ImageSubresourceLayers {
+                    aspect_mask: self.format.aspect(),
+                    mip_level: 0,
+                    base_array_layer: layer,
+                    layer_count: 1,
+                };
                 vk::BufferImageCopy::default()
                     .buffer_offset(offset)
                     .image_subresource(layer)

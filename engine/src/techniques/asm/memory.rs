@@ -4,7 +4,7 @@
 //! edge records, [`edge_records`]); the rest grows with the pool: its pages, and per tile
 //! a page-table node, a use mark and a request flag. The pool gets what the fixed parts leave.
 use super::page_table::PageTable;
-use super::pages::scratch_bytes;
+use super::pages::{scratch_bytes, scratch_layers};
 use super::pool::{max_tiles, TILE_PAGES};
 use crate::error::{Error, Result};
 use crate::layouts::constants::{self, MAX_LOCAL_LIGHTS};
@@ -20,6 +20,8 @@ pub struct AsmMemory {
     pub pages: u64,
     /// The scratch every tile renders into before its pages are copied out.
     pub scratch: u64,
+    /// The scratch's layers ([`scratch_layers`]), counted in `scratch`.
+    pub scratch_layers: u32,
     /// The page table: the directory and a node per tile.
     pub page_table: u64,
     /// The analysis's requests (a counter, a flag per node, an edge record per analysed pixel)
@@ -34,28 +36,32 @@ impl AsmMemory {
         self.pages + self.scratch + self.page_table + self.analysis + self.lights
     }
 
-    /// The parts for a pool of `pages` pages of `page_bytes`, its nodes ([`max_tiles`]), and
-    /// `edges` edge records of the analysis ([`edge_records`]).
-    pub fn of(pages: u32, page_bytes: u64, edges: u32) -> AsmMemory {
+    /// The parts for a pool of `pages` pages of `page_bytes`, its nodes ([`max_tiles`]),
+    /// `edges` edge records of the analysis ([`edge_records`]) and a scratch of `layers` layers.
+    pub fn of(pages: u32, page_bytes: u64, edges: u32, layers: u32) -> AsmMemory {
         let nodes = max_tiles(pages);
         AsmMemory {
             pages: u64::from(pages) * page_bytes,
-            scratch: scratch_bytes(page_bytes),
+            scratch: scratch_bytes(page_bytes, layers),
+            scratch_layers: layers,
             page_table: PageTable::buffer_bytes(nodes),
             analysis: requests_bytes(nodes, edges) + used_bytes(nodes),
             lights: lights_bytes(),
         }
     }
 
-    /// The most pages of `page_bytes` whose memory, with everything else, stays within
-    /// `budget`; an error naming the fixed parts when not even the root tile fits.
+    /// The most pages of `page_bytes` whose memory, with everything else (a scratch of
+    /// [`scratch_layers`] layers), stays within `budget`; an error naming the fixed parts when
+    /// not even the root tile fits.
     pub fn within(budget: u64, page_bytes: u64, edges: u32) -> Result<(u32, AsmMemory)> {
-        let fixed = AsmMemory::of(0, page_bytes, edges).total();
+        let layers = scratch_layers(budget, page_bytes);
+        let of = |pages: u32| AsmMemory::of(pages, page_bytes, edges, layers);
+        let fixed = of(0).total();
         // A pool of N pages has N / 4 nodes: four pages carry a node's bytes.
-        let per_node = AsmMemory::of(4, page_bytes, edges).total() - fixed - 4 * page_bytes;
+        let per_node = of(4).total() - fixed - 4 * page_bytes;
         let estimate = budget.saturating_sub(fixed) * 4 / (4 * page_bytes + per_node);
         // The estimate spreads a node over 4 pages; the exact count is a few pages away.
-        let fits = |pages: u32| AsmMemory::of(pages, page_bytes, edges).total() <= budget;
+        let fits = |pages: u32| of(pages).total() <= budget;
         let mut pages = u32::try_from(estimate).unwrap_or(u32::MAX - 1);
         while fits(pages + 1) {
             pages += 1;
@@ -69,7 +75,7 @@ impl AsmMemory {
                 TILE_PAGES * page_bytes
             )));
         }
-        Ok((pages, AsmMemory::of(pages, page_bytes, edges)))
+        Ok((pages, of(pages)))
     }
 }
 
@@ -110,9 +116,10 @@ mod tests {
             let (pages, memory) = AsmMemory::within(budget, DEPTH_PAGE_BYTES, edges).unwrap();
             assert!(memory.total() <= budget, "{memory:?} over {budget}");
             // One more page would not fit: the budget is used up to a page and a node.
-            assert!(AsmMemory::of(pages + 1, DEPTH_PAGE_BYTES, edges).total() > budget);
+            let layers = memory.scratch_layers;
+            assert!(AsmMemory::of(pages + 1, DEPTH_PAGE_BYTES, edges, layers).total() > budget);
             // The least budget for an image of these pixels holds the root exactly.
-            let least = AsmMemory::of(TILE_PAGES as u32, DEPTH_PAGE_BYTES, edges).total();
+            let least = AsmMemory::of(TILE_PAGES as u32, DEPTH_PAGE_BYTES, edges, 1).total();
             assert_eq!(AsmMemory::within(least, DEPTH_PAGE_BYTES, edges).unwrap().0, TILE_PAGES as u32);
             assert_eq!(memory.pages, u64::from(pages) * DEPTH_PAGE_BYTES);
             assert!(memory.scratch > 0 && memory.page_table >= DIRECTORY_BYTES && memory.analysis > 0);

@@ -7,8 +7,12 @@
 //! (104 tiles of no triangles storing 16 slots each took 4.1–4.9 ms in batches of 4 tiles,
 //! 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
 //! larger scratch was slower again: 6² tiles rendered a third fewer tiles a frame than 3² (146
-//! against 217–226 at the `asm` scene's grating at 16 MiB; llvmpipe, 2 Zen 3 cores). So the
-//! scratch is `SCRATCH_SIDE`² tiles. It counts in the budget.
+//! against 217–226 at the `asm` scene's grating at 16 MiB; llvmpipe, 2 Zen 3 cores). So a
+//! batch is `SCRATCH_SIDE`² tiles in one scope, and the scratch has layers, a batch each
+//! ([`scratch_layers`]): the packing waits for every tile drawn before it, but the batches
+//! between two packings are scopes of their own, and llvmpipe bins one while it rasterizes
+//! the one before (4 layers: 20–29 % more tiles in the same milliseconds; one scope of
+//! as many tiles bins them all before it rasterizes any). The scratch counts in the budget.
 //!
 //! The polygon-ID test keeps a second buffer of pages, of IDs, in the same page order, filled
 //! from an ID scratch laid out as the depth one.
@@ -32,22 +36,34 @@ use std::sync::Arc;
 
 /// The ID test's polygon IDs.
 const ID_FORMAT: Format = Format::R32_UINT;
-/// Tiles a side of the scratch: 9 tiles between two packings.
+/// Tiles a side of a layer of the scratch: 9 tiles a batch.
 const SCRATCH_SIDE: u32 = 3;
-/// Tiles a batch renders between two packings: the scratch's.
-pub const BATCH_TILES: usize = (SCRATCH_SIDE * SCRATCH_SIDE) as usize;
-/// Slots of the scratch.
-const SCRATCH_SLOTS: u64 = (SCRATCH_SIDE * SCRATCH_SIDE) as u64 * TILE_PAGES;
+/// Tiles a batch renders: a layer of the scratch.
+const BATCH_TILES: usize = (SCRATCH_SIDE * SCRATCH_SIDE) as usize;
+/// Slots of a layer of the scratch.
+const LAYER_SLOTS: u64 = (SCRATCH_SIDE * SCRATCH_SIDE) as u64 * TILE_PAGES;
+/// The most layers of the scratch: past 8 a packing's wait is spread over 72 tiles or more.
+const MAX_SCRATCH_LAYERS: u32 = 8;
+/// The share of the budget the scratch's layers may take (one in 16; one layer whatever the budget).
+const SCRATCH_SHARE: u64 = 16;
 /// Bytes of a slot of the D32 depth scratch (and of the ID scratch).
 const SLOT_TEXEL_BYTES: u64 = 4 * ASM_PAGE_TEXELS as u64 * ASM_PAGE_TEXELS as u64;
 /// Bytes of a slot's entry in the packing's list.
 const SLOT_ENTRY_BYTES: u64 = 4;
 
-/// Bytes of the scratch for pages of `page_bytes`: per slot its D32 depth (and with the ID test,
-/// whose pages are larger, its IDs), its packed page and its entry in the packing's list.
-pub fn scratch_bytes(page_bytes: u64) -> u64 {
+/// Bytes of a scratch of `layers` layers for pages of `page_bytes`: per slot its D32 depth (and
+/// with the ID test, whose pages are larger, its IDs), its packed page and its entry in the
+/// packing's list.
+pub fn scratch_bytes(page_bytes: u64, layers: u32) -> u64 {
     let ids = u64::from(page_bytes > DEPTH_PAGE_BYTES);
-    SCRATCH_SLOTS * (SLOT_TEXEL_BYTES * (1 + ids) + DEPTH_PAGE_BYTES + SLOT_ENTRY_BYTES)
+    u64::from(layers) * LAYER_SLOTS * (SLOT_TEXEL_BYTES * (1 + ids) + DEPTH_PAGE_BYTES + SLOT_ENTRY_BYTES)
+}
+
+/// The scratch's layers under a budget of `budget` bytes: as many as a sixteenth of it holds,
+/// at least one and at most `MAX_SCRATCH_LAYERS` (16 MiB: 4 layers, 0.86 MiB; 4 MiB: 1).
+pub fn scratch_layers(budget: u64, page_bytes: u64) -> u32 {
+    let layers = budget / SCRATCH_SHARE / scratch_bytes(page_bytes, 1);
+    layers.clamp(1, u64::from(MAX_SCRATCH_LAYERS)) as u32
 }
 
 /// A tile render of this frame (`super::pool::PageOp`): the square of `key`, its slots
@@ -74,6 +90,8 @@ struct IdPages {
 
 pub struct PageStore {
     pages: u32,
+    /// Batches between two packings: the scratch's layers.
+    layers: u32,
     /// The depth pages, as `asm_pack.comp` lays them out.
     depth: TexelBuffer,
     /// Tiles of depth, rendered with the shadow-depth pipeline.
@@ -89,9 +107,9 @@ pub struct PageStore {
 }
 
 impl PageStore {
-    /// `pages` pages (the budget's share, [`super::memory::AsmMemory::within`]) and the
-    /// scratch; with polygon IDs when `ids`.
-    pub fn new(ctx: &Arc<Context>, gpu: &GpuScene, pages: u32, ids: bool) -> Result<PageStore> {
+    /// `pages` pages (the budget's share, [`super::memory::AsmMemory::within`]) and a scratch
+    /// of `layers` layers; with polygon IDs when `ids`.
+    pub fn new(ctx: &Arc<Context>, gpu: &GpuScene, pages: u32, layers: u32, ids: bool) -> Result<PageStore> {
         if pages >= MAX_PAGES {
             return Err(Error::InvalidArgument(format!(
                 "an ASM budget of {pages} pages: the page table indexes fewer than {MAX_PAGES}"
@@ -109,7 +127,7 @@ impl PageStore {
         };
         let depth = buffer("asm.pages", DEPTH_PAGE_BYTES)?;
         let ids = match ids {
-            true => Some(IdPages::new(ctx, gpu, buffer("asm.id_pages", PAGE_ID_BYTES)?)?),
+            true => Some(IdPages::new(ctx, gpu, buffer("asm.id_pages", PAGE_ID_BYTES)?, layers)?),
             false => None,
         };
         let storage = |name, size, usage| {
@@ -122,18 +140,20 @@ impl PageStore {
             &[BindingKind::SampledImage, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
             size_of::<AsmPackPush>() as u32,
         )?;
+        let slots = u64::from(layers) * LAYER_SLOTS;
         Ok(PageStore {
             pages,
+            layers,
             depth,
-            scratch: ShadowMaps::new(ctx, "asm.scratch", SCRATCH_SIDE * ASM_TILE_TEXELS, 1)?,
+            scratch: ShadowMaps::new(ctx, "asm.scratch", SCRATCH_SIDE * ASM_TILE_TEXELS, layers)?,
             slots: storage(
                 "asm.pack_slots",
-                SCRATCH_SLOTS * SLOT_ENTRY_BYTES,
+                slots * SLOT_ENTRY_BYTES,
                 BufferUsage::STORAGE | BufferUsage::TRANSFER_DST,
             )?,
             packed: storage(
                 "asm.packed",
-                SCRATCH_SLOTS * DEPTH_PAGE_BYTES,
+                slots * DEPTH_PAGE_BYTES,
                 BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
             )?,
             pack,
@@ -145,6 +165,11 @@ impl PageStore {
     /// Pages the store holds.
     pub fn pages(&self) -> u32 {
         self.pages
+    }
+
+    /// Tiles rendered between two packings: a batch in each layer of the scratch.
+    pub fn packing_tiles(&self) -> usize {
+        BATCH_TILES * self.layers as usize
     }
 
     /// The depth pages as the lookups read them.
@@ -162,34 +187,40 @@ impl PageStore {
         self.ids.as_ref().map_or(0, |ids| ids.first[group][mesh])
     }
 
-    /// Records `writes` in order, one debug label each.
+    /// Records `writes` in order, one debug label each: a batch a layer of the scratch, and a
+    /// packing when every layer is drawn.
     pub fn record(&self, ctx: &Context, cmd: Cmd, scene: &GpuScene, writes: &[TileWrite]) {
-        for batch in writes.chunks(BATCH_TILES) {
-            self.begin_batch(ctx, cmd);
-            // Slots of the scratch to store, with their pages.
+        for packing in writes.chunks(self.packing_tiles()) {
+            // Slots of the scratch to store (numbered layer after layer), with their pages.
             let mut squares: Vec<(u32, u32)> = Vec::new();
-            for (i, write) in batch.iter().enumerate() {
-                let key = write.key;
-                ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
-                let (x, y) = (i as u32 % SCRATCH_SIDE, i as u32 / SCRATCH_SIDE);
-                ctx.restrict_to_square(cmd, [x * ASM_TILE_TEXELS, y * ASM_TILE_TEXELS], ASM_TILE_TEXELS);
-                self.draw_tile(ctx, cmd, scene, write);
-                for &(slot, page) in &write.stores {
-                    let (sx, sy) = (x * SLOT_SIDE + slot % SLOT_SIDE, y * SLOT_SIDE + slot / SLOT_SIDE);
-                    squares.push((sx + sy * SCRATCH_SIDE * SLOT_SIDE, page));
+            for (layer, batch) in packing.chunks(BATCH_TILES).enumerate() {
+                let layer = layer as u32;
+                self.begin_batch(ctx, cmd, layer);
+                let first_slot = layer * LAYER_SLOTS as u32;
+                for (i, write) in batch.iter().enumerate() {
+                    let key = write.key;
+                    ctx.begin_label(cmd, &format!("asm_tile L{} ({}, {})", key.level, key.x, key.y));
+                    let (x, y) = (i as u32 % SCRATCH_SIDE, i as u32 / SCRATCH_SIDE);
+                    ctx.restrict_to_square(cmd, [x * ASM_TILE_TEXELS, y * ASM_TILE_TEXELS], ASM_TILE_TEXELS);
+                    self.draw_tile(ctx, cmd, scene, write);
+                    for &(slot, page) in &write.stores {
+                        let (sx, sy) = (x * SLOT_SIDE + slot % SLOT_SIDE, y * SLOT_SIDE + slot / SLOT_SIDE);
+                        squares.push((first_slot + sx + sy * SCRATCH_SIDE * SLOT_SIDE, page));
+                    }
+                    ctx.end_label(cmd);
                 }
-                ctx.end_label(cmd);
+                ctx.end_rendering(cmd);
             }
-            ctx.end_rendering(cmd);
             self.store(ctx, cmd, &squares);
         }
     }
 
-    /// Opens the rendering scope of a batch: the scratch cleared, depth and IDs for the ID test.
-    fn begin_batch(&self, ctx: &Context, cmd: Cmd) {
-        let Some(ids) = &self.ids else { return self.scratch.begin(ctx, cmd, 0) };
-        let color = Target { image: &ids.scratch, layer: 0 };
-        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(0))));
+    /// Opens the rendering scope of a batch: `layer` of the scratch cleared, depth and IDs for
+    /// the ID test.
+    fn begin_batch(&self, ctx: &Context, cmd: Cmd, layer: u32) {
+        let Some(ids) = &self.ids else { return self.scratch.begin(ctx, cmd, layer) };
+        let color = Target { image: &ids.scratch, layer };
+        ctx.begin_rendering(cmd, Some(color), Some([0.0; 4]), Some(Depth::Clear(self.scratch.target(layer))));
         ids.tile.bind(cmd, &[]);
     }
 
@@ -212,7 +243,7 @@ impl PageStore {
 
     /// Packs slots of the scratch (each with the page it goes to) and copies them into the
     /// pages. A page written twice keeps the later slot: a slot given back by a tile and taken
-    /// by another rendered after it in the same batch.
+    /// by another rendered after it in the same packing.
     fn store(&self, ctx: &Context, cmd: Cmd, pending: &[(u32, u32)]) {
         let mut seen = rustc_hash::FxHashSet::default();
         let squares: Vec<(u32, u32)> =
@@ -245,8 +276,11 @@ impl PageStore {
         self.packed.record_copy_regions(cmd, self.depth.buffer(), &regions);
         if let Some(ids) = &self.ids {
             let side = SCRATCH_SIDE * SLOT_SIDE;
-            let from = |slot: u32| [slot % side * ASM_PAGE_TEXELS, slot / side * ASM_PAGE_TEXELS];
-            let squares: Vec<([u32; 2], u64)> =
+            let from = |slot: u32| {
+                let (layer, slot) = (slot / LAYER_SLOTS as u32, slot % LAYER_SLOTS as u32);
+                [slot % side * ASM_PAGE_TEXELS, slot / side * ASM_PAGE_TEXELS, layer]
+            };
+            let squares: Vec<([u32; 3], u64)> =
                 squares.iter().map(|&(slot, page)| (from(slot), page_at(page, PAGE_ID_BYTES))).collect();
             ids.scratch.record_copy_squares_to(cmd, ids.pages.buffer(), &squares, ASM_PAGE_TEXELS);
         }
@@ -254,10 +288,15 @@ impl PageStore {
 }
 
 impl IdPages {
-    fn new(ctx: &Arc<Context>, gpu: &GpuScene, pages: TexelBuffer) -> Result<IdPages> {
+    fn new(ctx: &Arc<Context>, gpu: &GpuScene, pages: TexelBuffer, layers: u32) -> Result<IdPages> {
         let usage = ImageUsage::COLOR_ATTACHMENT | ImageUsage::TRANSFER_SRC;
-        let desc =
-            ImageDesc::square_array("asm.id_scratch", SCRATCH_SIDE * ASM_TILE_TEXELS, 1, ID_FORMAT, usage);
+        let desc = ImageDesc::square_array(
+            "asm.id_scratch",
+            SCRATCH_SIDE * ASM_TILE_TEXELS,
+            layers,
+            ID_FORMAT,
+            usage,
+        );
         let tile = GraphicsPipeline::new(
             ctx,
             &GraphicsDesc {
@@ -310,7 +349,21 @@ mod tests {
         assert_eq!(PAGE_ID_BYTES, SLOT_TEXEL_BYTES);
         // The scratch: a D32 depth (and ID) per texel of its slots, a packed page and a list
         // entry per slot.
-        assert_eq!(scratch_bytes(DEPTH_PAGE_BYTES), SCRATCH_SLOTS * (1024 + 528 + 4));
-        assert_eq!(scratch_bytes(ID_PAGE_BYTES), SCRATCH_SLOTS * (2048 + 528 + 4));
+        assert_eq!(scratch_bytes(DEPTH_PAGE_BYTES, 1), LAYER_SLOTS * (1024 + 528 + 4));
+        assert_eq!(scratch_bytes(ID_PAGE_BYTES, 3), 3 * LAYER_SLOTS * (2048 + 528 + 4));
+    }
+
+    /// A sixteenth of the budget in layers: none beyond the first at 4 MiB, whose pages are
+    /// short, 4 at 16 MiB, never more than 8.
+    #[test]
+    fn the_scratch_takes_layers_within_a_sixteenth_of_the_budget() {
+        let mib = 1u64 << 20;
+        for (budget, layers) in [(mib, 1), (4 * mib, 1), (8 * mib, 2), (16 * mib, 4), (256 * mib, 8)] {
+            assert_eq!(scratch_layers(budget, DEPTH_PAGE_BYTES), layers, "{budget} bytes");
+            if layers > 1 {
+                assert!(scratch_bytes(DEPTH_PAGE_BYTES, layers) <= budget / SCRATCH_SHARE);
+            }
+        }
+        assert_eq!(scratch_layers(16 * mib, ID_PAGE_BYTES), 2);
     }
 }

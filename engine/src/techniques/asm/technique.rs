@@ -27,7 +27,7 @@
 use super::light_view::{tile_view_proj, UvRect};
 use super::memory::{self, edge_records, AsmMemory};
 use super::page_table;
-use super::pages::{PageStore, TileWrite, BATCH_TILES};
+use super::pages::{PageStore, TileWrite};
 use super::plan::{plan, rescaled, CostModel, Request};
 use super::pool::{
     parent_slots, Insert, PageOp, PagePool, Slots, ANALYSIS_PHASES, DEPTH_PAGE_BYTES, ID_PAGE_BYTES,
@@ -88,7 +88,7 @@ impl AsmTest {
     /// everything else the technique allocates ([`AsmMemory`]); (0, 0) gives the part no image
     /// size changes.
     pub fn least_budget_bytes(self, size: (u32, u32)) -> u64 {
-        AsmMemory::of(TILE_PAGES as u32, self.page_bytes(), edge_records(size)).total()
+        AsmMemory::of(TILE_PAGES as u32, self.page_bytes(), edge_records(size), 1).total()
     }
 }
 
@@ -336,7 +336,7 @@ impl Asm {
         let page_bytes = settings.test.page_bytes();
         let edge_capacity = edge_records(size);
         let (most_pages, memory) = AsmMemory::within(settings.budget_bytes(), page_bytes, edge_capacity)?;
-        let pages = PageStore::new(ctx, gpu, most_pages, ids)?;
+        let pages = PageStore::new(ctx, gpu, most_pages, memory.scratch_layers, ids)?;
         let pool = PagePool::new(most_pages, page_bytes)?;
         let nodes = pool.max_tiles();
         let mut bindings = vec![
@@ -441,9 +441,9 @@ impl Asm {
     /// different numbers of triangles on this device (the root, and tiles of levels 1 to 3
     /// along the view's diagonals), each rendered twice and the second timing kept (the first
     /// pays for cold caches), each stored into pages as a frame's tiles are (into the root's,
-    /// which the first frame renders again), and each in a batch of as many renders of it as
-    /// the scratch holds: a frame's renders share their batches' packing and copies, whose cost
-    /// a tile rendered alone would pay whole. Without timestamps the model stays at 1 ms per
+    /// which the first frame renders again), and each in as many renders of it as a packing
+    /// takes (a batch in each layer of the scratch): a frame's renders share their packings and
+    /// copies, whose cost a tile rendered alone would pay whole. Without timestamps the model stays at 1 ms per
     /// tile.
     fn calibrate(&self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
         if ctx.info().timestamp_period_ns.is_none() {
@@ -470,7 +470,8 @@ impl Asm {
                 tile_write(PageOp { key, stores: stores.clone() }, &view_proj, draws)
             })
             .collect();
-        let batches: Vec<Vec<TileWrite>> = renders.iter().map(|t| vec![t.clone(); BATCH_TILES]).collect();
+        let tiles = self.pages.packing_tiles();
+        let batches: Vec<Vec<TileWrite>> = renders.iter().map(|t| vec![t.clone(); tiles]).collect();
         let mut executor = FrameExecutor::new(ctx, "asm.calibration")?;
         let mut samples = Vec::new();
         for round in 0..2 {
@@ -481,8 +482,7 @@ impl Asm {
             let timings = executor.run(passes)?;
             if round == 1 {
                 for (t, timing) in renders.iter().zip(timings) {
-                    samples
-                        .push((draw_triangles(&t.draws), timing.gpu_ms.unwrap_or(0.0) / BATCH_TILES as f64));
+                    samples.push((draw_triangles(&t.draws), timing.gpu_ms.unwrap_or(0.0) / tiles as f64));
                 }
             }
         }
