@@ -1,6 +1,6 @@
 #version 460
 // ASM page packing: a slot of the tile scratch (engine/src/techniques/asm/pages.rs) becomes a
-// depth page of the pool (KAGE_ASM_PAGE_DEPTH_TEXELS). Its depths are stored as 16-bit steps
+// depth page of the pool (KAGE_ASM_PAGE_DEPTH_TEXELS), written in place. Its depths are stored as 16-bit steps
 // over the slot's own span, from the nearest depth drawn to the farthest; texels nothing covers
 // keep the clear depth as 0xffff. A page so takes half the bytes of D32, and a step is the
 // slot's span over 65534: within a slot on one surface far finer than D32 near the far plane,
@@ -12,11 +12,12 @@
 
 layout(local_size_x = KAGE_ASM_PACK_GROUP) in;
 layout(set = 0, binding = 0) uniform sampler2DArray scratch;
-// The slots to pack, one per invocation: slot x + y * n of layer l of the scratch's n x n, as
-// x + y * n + l * n * n.
-layout(std430, set = 0, binding = 1) readonly buffer Slots { uint slots[]; };
-// Their pages, in the list's order.
-layout(std430, set = 0, binding = 2) writeonly buffer Packed { uvec4 packed[]; };
+// The slots to pack, one per invocation, each with its page: slot x + y * n of layer l of the
+// scratch's n x n, as x + y * n + l * n * n.
+layout(std430, set = 0, binding = 1) readonly buffer Slots { uvec2 slots[]; };
+// The pool's depth pages (the lookups read them as a usamplerBuffer). A storage texel buffer,
+// not a storage buffer: its bound is maxTexelBufferElements texels.
+layout(set = 0, binding = 2, rgba32ui) uniform writeonly uimageBuffer pages;
 layout(push_constant) uniform Push { AsmPackPush push; };
 
 #define EMPTY 0xffffu
@@ -27,7 +28,7 @@ void main() {
     uint k = gl_GlobalInvocationID.x;
     if (k >= push.count.x) return;
     uint side = uint(textureSize(scratch, 0).x / KAGE_ASM_PAGE_TEXELS);
-    uint layer = slots[k] / (side * side), slot = slots[k] % (side * side);
+    uint layer = slots[k].x / (side * side), slot = slots[k].x % (side * side);
     ivec2 origin = ivec2(slot % side, slot / side) * KAGE_ASM_PAGE_TEXELS;
     // Depths are non-negative: the span from the nearest covered texel to the farthest. Each
     // texel is fetched once.
@@ -42,9 +43,8 @@ void main() {
         }
     }
     float step = max(farthest - nearest, 0.0) / STEPS;
-    // A texel of eight depths at a time: llvmpipe stores a storage buffer lane by lane, so
-    // fewer, wider stores.
-    uint base = k * KAGE_ASM_PAGE_DEPTH_TEXELS;
+    // A texel of eight depths at a time: fewer, wider stores.
+    int base = int(slots[k].y * KAGE_ASM_PAGE_DEPTH_TEXELS);
     for (int t = 0; t < KAGE_ASM_PAGE_DEPTH_TEXELS - 1; ++t) {
         uvec4 texel;
         for (int w = 0; w < 4; ++w) {
@@ -56,7 +56,7 @@ void main() {
             }
             texel[w] = pair;
         }
-        packed[base + uint(t)] = texel;
+        imageStore(pages, base + t, texel);
     }
-    packed[base + uint(KAGE_ASM_PAGE_DEPTH_TEXELS - 1)] = uvec4(floatBitsToUint(nearest), floatBitsToUint(step), 0u, 0u);
+    imageStore(pages, base + KAGE_ASM_PAGE_DEPTH_TEXELS - 1, uvec4(floatBitsToUint(nearest), floatBitsToUint(step), 0u, 0u));
 }

@@ -262,7 +262,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     drop(bar);
     if let Some(stats) = renderer.stats().asm {
         println!(
-            "asm: {} tiles resident, {:.2} of {:.2} MB in use (allocated {:.2}: pages {:.2}, scratch {:.2} in {} layers, page table {:.2}, analysis {:.2}, lights {:.3}), deepest level {} (the texels of a {}² map), {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms; planning on the host {:.2} ms a frame (median; the device waits for it between the two submissions)",
+            "asm: {} tiles resident, {:.2} of {:.2} MB in use (allocated {:.2}: pages {:.2}, scratch {:.2} ({} layer{}), page table {:.2}, analysis {:.2}, lights {:.3}), deepest level {} (the texels of a {}² map), {} tiles rendered in the last frame; tile cost {:.2e} ms/triangle + {:.3} ms; planning on the host {:.2} ms a frame (median; the device waits for it between the two submissions)",
             stats.resident_tiles,
             stats.bytes_used as f64 / MB as f64,
             stats.budget_bytes as f64 / MB as f64,
@@ -270,6 +270,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             stats.memory.pages as f64 / MB as f64,
             stats.memory.scratch as f64 / MB as f64,
             stats.memory.scratch_layers,
+            if stats.memory.scratch_layers == 1 { "" } else { "s" },
             stats.memory.page_table as f64 / MB as f64,
             stats.memory.analysis as f64 / MB as f64,
             stats.memory.lights as f64 / MB as f64,

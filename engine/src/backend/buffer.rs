@@ -164,19 +164,6 @@ impl Buffer {
         })
     }
 
-    /// Records copies of byte ranges of this buffer into `dst`, each (source offset, destination
-    /// offset, bytes). Destination ranges must not overlap.
-    pub fn record_copy_regions(&self, cmd: Cmd, dst: &Buffer, regions: &[(u64, u64, u64)]) {
-        self.touched(cmd, false);
-        dst.touched(cmd, true);
-        let regions: Vec<vk::BufferCopy> = regions
-            .iter()
-            .map(|&(src_offset, dst_offset, size)| vk::BufferCopy { src_offset, dst_offset, size })
-            .collect();
-        // SAFETY: recording command buffer; both buffers are alive until the submission completes.
-        unsafe { self.ctx.device.cmd_copy_buffer(cmd.raw, self.raw, dst.raw, &regions) }
-    }
-
     /// Records writing `data` (at most 65536 bytes, a multiple of 4; it needs `TRANSFER_DST`
     /// usage) at `offset`, the bytes carried in the command buffer: a list that changes between
     /// the commands of one submission.

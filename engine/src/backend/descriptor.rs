@@ -13,6 +13,8 @@ pub enum BindingKind {
     SampledImage,
     StorageImage,
     TexelBuffer,
+    /// A texel buffer the shader writes (`imageBuffer`).
+    StorageTexelBuffer,
 }
 
 impl BindingKind {
@@ -23,6 +25,7 @@ impl BindingKind {
             BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
             BindingKind::TexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
+            BindingKind::StorageTexelBuffer => vk::DescriptorType::STORAGE_TEXEL_BUFFER,
         }
     }
 }
@@ -35,6 +38,7 @@ pub enum Binding<'a> {
     Sampled(&'a Image, &'a Sampler),
     StorageImage(&'a Image),
     Texel(&'a TexelBuffer),
+    StorageTexel(&'a TexelBuffer),
 }
 
 impl Binding<'_> {
@@ -45,6 +49,7 @@ impl Binding<'_> {
             Binding::Sampled(..) => BindingKind::SampledImage,
             Binding::StorageImage(_) => BindingKind::StorageImage,
             Binding::Texel(_) => BindingKind::TexelBuffer,
+            Binding::StorageTexel(_) => BindingKind::StorageTexelBuffer,
         }
     }
 }
@@ -94,6 +99,7 @@ pub(super) fn push_descriptors_from(
             Binding::Sampled(image, _) => image.touched(cmd, false),
             Binding::StorageImage(image) => image.touched(cmd, written),
             Binding::Texel(texels) => texels.buffer().touched(cmd, false),
+            Binding::StorageTexel(texels) => texels.buffer().touched(cmd, written),
         }
     }
     // A push with no writes is invalid (descriptorWriteCount must be at least 1): pipelines
@@ -129,7 +135,7 @@ pub(super) fn push_descriptors_from(
     let texel_views: Vec<[vk::BufferView; 1]> = bindings
         .iter()
         .map(|b| match b {
-            Binding::Texel(texels) => [texels.view],
+            Binding::Texel(texels) | Binding::StorageTexel(texels) => [texels.view],
             _ => [vk::BufferView::null()],
         })
         .collect();
@@ -142,7 +148,7 @@ pub(super) fn push_descriptors_from(
                 .descriptor_type(b.kind().descriptor_type());
             match b {
                 Binding::Uniform(_) | Binding::Storage(_) => write.buffer_info(&buffer_infos[i]),
-                Binding::Texel(_) => write.texel_buffer_view(&texel_views[i]),
+                Binding::Texel(_) | Binding::StorageTexel(_) => write.texel_buffer_view(&texel_views[i]),
                 Binding::Sampled(..) | Binding::StorageImage(_) => write.image_info(&image_infos[i]),
             }
         })

@@ -106,13 +106,19 @@ pub fn descriptor_bindings(words: &[u32]) -> Result<Vec<Used>, String> {
                 }
             }
             (STORAGE_UNIFORM_CONSTANT, Some((OP_TYPE_IMAGE, ops))) if ops.get(5) == Some(&IMAGE_STORAGE) => {
-                BindingKind::StorageImage
+                match ops.get(1) == Some(&DIM_BUFFER) {
+                    true => BindingKind::StorageTexelBuffer,
+                    false => BindingKind::StorageImage,
+                }
             }
             _ => return Err(format!("binding {binding}: a descriptor of a kind Kage does not use")),
         };
         let readonly = has(id, DECORATION_NON_WRITABLE)
             || members.get(&pointee).is_some_and(|&(count, read_only)| count > 0 && read_only == count);
-        let written = matches!(kind, BindingKind::StorageBuffer | BindingKind::StorageImage) && !readonly;
+        let written = matches!(
+            kind,
+            BindingKind::StorageBuffer | BindingKind::StorageImage | BindingKind::StorageTexelBuffer
+        ) && !readonly;
         found.push(Used { binding, kind, written });
     }
     found.sort_by_key(|u| u.binding);
@@ -145,7 +151,9 @@ pub fn check(shader: &str, declared: &[BindingKind], used: &[Used]) -> Result<()
 mod tests {
     use super::*;
     use crate::layouts::{constants, spirv};
-    use BindingKind::{SampledImage, StorageBuffer, StorageImage, TexelBuffer, UniformBuffer};
+    use BindingKind::{
+        SampledImage, StorageBuffer, StorageImage, StorageTexelBuffer, TexelBuffer, UniformBuffer,
+    };
 
     fn used(spirv: &[u8]) -> Vec<Used> {
         descriptor_bindings(&ash::util::read_spv(&mut std::io::Cursor::new(spirv)).unwrap()).unwrap()
@@ -168,6 +176,11 @@ mod tests {
                 (2, StorageBuffer, true),
                 (3, StorageImage, true)
             ]
+        );
+        // ASM's packing reads the scratch and its list of slots and pages, and writes pages.
+        assert_eq!(
+            kinds(spirv::ASM_PACK_COMP),
+            [(0, SampledImage, false), (1, StorageBuffer, false), (2, StorageTexelBuffer, true)]
         );
         // The ray caster reads the BVH's traversal data, triangle attributes and rays as texel
         // buffers, its albedo maps as storage buffers, and writes only its results.

@@ -1,4 +1,7 @@
-//! Read-only buffers of RGBA32UI texels, bound as uniform texel buffers (`usamplerBuffer`).
+//! Buffers of RGBA32UI texels, read as uniform texel buffers (`usamplerBuffer`) and, where a
+//! shader writes them (ASM's page packing), bound as storage texel buffers (`uimageBuffer`):
+//! their size limit is `maxTexelBufferElements` texels, not `maxStorageBufferRange` bytes
+//! (128 MiB on lavapipe, less than a 256 MiB ASM budget's pages).
 //!
 //! Why not storage buffers: llvmpipe (Mesa 22.3) reads a storage buffer at a per-lane address
 //! one lane and one word at a time, each behind a branch on the lane's mask and the buffer's
@@ -38,7 +41,12 @@ impl TexelBuffer {
                 reason: format!("{texels} texels, more than the device's maxTexelBufferElements ({max})"),
             });
         }
-        let usage = BufferUsage::UNIFORM_TEXEL | BufferUsage::TRANSFER_SRC | BufferUsage::TRANSFER_DST;
+        // RGBA32UI supports storage texel buffers on every device (a format feature Vulkan
+        // requires).
+        let usage = BufferUsage::UNIFORM_TEXEL
+            | BufferUsage::STORAGE_TEXEL
+            | BufferUsage::TRANSFER_SRC
+            | BufferUsage::TRANSFER_DST;
         let buffer = Buffer::new(ctx, &BufferDesc { name, size: bytes, usage, location })?;
         let info = vk::BufferViewCreateInfo::default()
             .buffer(buffer.raw)

@@ -10,6 +10,7 @@ impl BufferUsage {
     pub const STORAGE: BufferUsage = BufferUsage(vk::BufferUsageFlags::STORAGE_BUFFER);
     pub const UNIFORM: BufferUsage = BufferUsage(vk::BufferUsageFlags::UNIFORM_BUFFER);
     pub const UNIFORM_TEXEL: BufferUsage = BufferUsage(vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER);
+    pub const STORAGE_TEXEL: BufferUsage = BufferUsage(vk::BufferUsageFlags::STORAGE_TEXEL_BUFFER);
     pub const VERTEX: BufferUsage = BufferUsage(vk::BufferUsageFlags::VERTEX_BUFFER);
     pub const INDEX: BufferUsage = BufferUsage(vk::BufferUsageFlags::INDEX_BUFFER);
     pub const TRANSFER_SRC: BufferUsage = BufferUsage(vk::BufferUsageFlags::TRANSFER_SRC);

@@ -54,7 +54,7 @@ impl AsmMemory {
     /// [`scratch_layers`] layers), stays within `budget`; an error naming the fixed parts when
     /// not even the root tile fits.
     pub fn within(budget: u64, page_bytes: u64, edges: u32) -> Result<(u32, AsmMemory)> {
-        let layers = scratch_layers(budget, page_bytes);
+        let layers = scratch_layers(budget);
         let of = |pages: u32| AsmMemory::of(pages, page_bytes, edges, layers);
         let fixed = of(0).total();
         // A pool of N pages has N / 4 nodes: four pages carry a node's bytes.

@@ -2,8 +2,7 @@
 //! recording of the pool's page operations. Pages are slots of tiles and need not lie side by
 //! side, so every page write goes through a scratch target of tiles side by side: tiles render
 //! into it whole, in one rendering scope, then `asm_pack.comp` packs their stored slots into
-//! 16-bit pages (half of D32's bytes: twice the pages a budget holds) and they are copied out
-//! together. A CPU rasterizer waits at every barrier and pays for every scope and dispatch
+//! 16-bit pages (half of D32's bytes: twice the pages a budget holds), each in place. A CPU rasterizer waits at every barrier and pays for every scope and dispatch
 //! (104 tiles of no triangles storing 16 slots each took 4.1–4.9 ms in batches of 4 tiles,
 //! 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
 //! larger scratch was slower again: 6² tiles rendered a third fewer tiles a frame than 3² (146
@@ -44,26 +43,25 @@ const BATCH_TILES: usize = (SCRATCH_SIDE * SCRATCH_SIDE) as usize;
 const LAYER_SLOTS: u64 = (SCRATCH_SIDE * SCRATCH_SIDE) as u64 * TILE_PAGES;
 /// The most layers of the scratch: past 8 a packing's wait is spread over 72 tiles or more.
 const MAX_SCRATCH_LAYERS: u32 = 8;
-/// The share of the budget the scratch's layers may take (one in 16; one layer whatever the budget).
-const SCRATCH_SHARE: u64 = 16;
+/// Budget bytes per layer of the scratch: 4 MiB, whose pages are short (a second layer, 145 KiB
+/// of pages, left more pixels misclassified at rest), keeps one.
+const BUDGET_PER_LAYER: u64 = 4 << 20;
 /// Bytes of a slot of the D32 depth scratch (and of the ID scratch).
 const SLOT_TEXEL_BYTES: u64 = 4 * ASM_PAGE_TEXELS as u64 * ASM_PAGE_TEXELS as u64;
-/// Bytes of a slot's entry in the packing's list.
-const SLOT_ENTRY_BYTES: u64 = 4;
+/// Bytes of a slot's entry in the packing's list: the slot and its page.
+const SLOT_ENTRY_BYTES: u64 = 8;
 
 /// Bytes of a scratch of `layers` layers for pages of `page_bytes`: per slot its D32 depth (and
-/// with the ID test, whose pages are larger, its IDs), its packed page and its entry in the
-/// packing's list.
+/// with the ID test, whose pages are larger, its IDs) and its entry in the packing's list.
 pub fn scratch_bytes(page_bytes: u64, layers: u32) -> u64 {
     let ids = u64::from(page_bytes > DEPTH_PAGE_BYTES);
-    u64::from(layers) * LAYER_SLOTS * (SLOT_TEXEL_BYTES * (1 + ids) + DEPTH_PAGE_BYTES + SLOT_ENTRY_BYTES)
+    u64::from(layers) * LAYER_SLOTS * (SLOT_TEXEL_BYTES * (1 + ids) + SLOT_ENTRY_BYTES)
 }
 
-/// The scratch's layers under a budget of `budget` bytes: as many as a sixteenth of it holds,
-/// at least one and at most `MAX_SCRATCH_LAYERS` (16 MiB: 4 layers, 0.86 MiB; 4 MiB: 1).
-pub fn scratch_layers(budget: u64, page_bytes: u64) -> u32 {
-    let layers = budget / SCRATCH_SHARE / scratch_bytes(page_bytes, 1);
-    layers.clamp(1, u64::from(MAX_SCRATCH_LAYERS)) as u32
+/// The scratch's layers under a budget of `budget` bytes: one per `BUDGET_PER_LAYER`, at least
+/// one and at most `MAX_SCRATCH_LAYERS` (16 MiB: 4 layers, 0.57 MiB, 1.16 with the ID test).
+pub fn scratch_layers(budget: u64) -> u32 {
+    (budget / BUDGET_PER_LAYER).clamp(1, u64::from(MAX_SCRATCH_LAYERS)) as u32
 }
 
 /// A tile render of this frame (`super::pool::PageOp`): the square of `key`, its slots
@@ -98,8 +96,6 @@ pub struct PageStore {
     scratch: ShadowMaps,
     /// The slots of the scratch a packing packs (`asm_pack.comp`).
     slots: Buffer,
-    /// A batch's packed pages, before they are copied to theirs.
-    packed: Buffer,
     pack: ComputePipeline,
     ids: Option<IdPages>,
     /// Reads the scratch in the packing.
@@ -137,7 +133,7 @@ impl PageStore {
             ctx,
             "asm.pack",
             spirv::ASM_PACK_COMP,
-            &[BindingKind::SampledImage, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            &[BindingKind::SampledImage, BindingKind::StorageBuffer, BindingKind::StorageTexelBuffer],
             size_of::<AsmPackPush>() as u32,
         )?;
         let slots = u64::from(layers) * LAYER_SLOTS;
@@ -150,11 +146,6 @@ impl PageStore {
                 "asm.pack_slots",
                 slots * SLOT_ENTRY_BYTES,
                 BufferUsage::STORAGE | BufferUsage::TRANSFER_DST,
-            )?,
-            packed: storage(
-                "asm.packed",
-                slots * DEPTH_PAGE_BYTES,
-                BufferUsage::STORAGE | BufferUsage::TRANSFER_SRC,
             )?,
             pack,
             ids,
@@ -241,9 +232,9 @@ impl PageStore {
         }
     }
 
-    /// Packs slots of the scratch (each with the page it goes to) and copies them into the
-    /// pages. A page written twice keeps the later slot: a slot given back by a tile and taken
-    /// by another rendered after it in the same packing.
+    /// Packs slots of the scratch into their pages (and copies their IDs). A page written twice
+    /// keeps the later slot: a slot given back by a tile and taken by another rendered after it
+    /// in the same packing.
     fn store(&self, ctx: &Context, cmd: Cmd, pending: &[(u32, u32)]) {
         let mut seen = rustc_hash::FxHashSet::default();
         let squares: Vec<(u32, u32)> =
@@ -251,7 +242,8 @@ impl PageStore {
         if squares.is_empty() {
             return;
         }
-        let slots: Vec<u8> = squares.iter().flat_map(|(slot, _)| slot.to_ne_bytes()).collect();
+        let slots: Vec<u8> =
+            squares.iter().flat_map(|&(slot, page)| [slot, page]).flat_map(u32::to_ne_bytes).collect();
         self.slots.record_update(cmd, 0, &slots);
         // The scratch's depths drawn and the list written before the packing reads them.
         ctx.full_barrier(cmd);
@@ -260,30 +252,22 @@ impl PageStore {
         let bindings = [
             Binding::Sampled(self.scratch.image(), &self.nearest),
             Binding::Storage(&self.slots),
-            Binding::Storage(&self.packed),
+            Binding::StorageTexel(&self.depth),
         ];
         self.pack.dispatch(cmd, &bindings, bytes_of(&push), [count.div_ceil(ASM_PACK_GROUP), 1, 1]);
-        // Packed before they are copied.
-        ctx.full_barrier(cmd);
-        let page_at = |page: u32, bytes: u64| u64::from(page) * bytes;
-        let regions: Vec<(u64, u64, u64)> = squares
-            .iter()
-            .enumerate()
-            .map(|(k, &(_, page))| {
-                (page_at(k as u32, DEPTH_PAGE_BYTES), page_at(page, DEPTH_PAGE_BYTES), DEPTH_PAGE_BYTES)
-            })
-            .collect();
-        self.packed.record_copy_regions(cmd, self.depth.buffer(), &regions);
         if let Some(ids) = &self.ids {
+            let page_at = |page: u32| u64::from(page) * PAGE_ID_BYTES;
             let side = SCRATCH_SIDE * SLOT_SIDE;
             let from = |slot: u32| {
                 let (layer, slot) = (slot / LAYER_SLOTS as u32, slot % LAYER_SLOTS as u32);
                 [slot % side * ASM_PAGE_TEXELS, slot / side * ASM_PAGE_TEXELS, layer]
             };
             let squares: Vec<([u32; 3], u64)> =
-                squares.iter().map(|&(slot, page)| (from(slot), page_at(page, PAGE_ID_BYTES))).collect();
+                squares.iter().map(|&(slot, page)| (from(slot), page_at(page))).collect();
             ids.scratch.record_copy_squares_to(cmd, ids.pages.buffer(), &squares, ASM_PAGE_TEXELS);
         }
+        // Read before the next packing's renders and list overwrite the scratch and the list.
+        ctx.full_barrier(cmd);
     }
 }
 
@@ -347,23 +331,20 @@ mod tests {
         assert_eq!(DEPTH_PAGE_BYTES, 2 * slot_texels + 16);
         assert_eq!(u64::from(ASM_PAGE_ID_TEXELS) * 4, slot_texels);
         assert_eq!(PAGE_ID_BYTES, SLOT_TEXEL_BYTES);
-        // The scratch: a D32 depth (and ID) per texel of its slots, a packed page and a list
-        // entry per slot.
-        assert_eq!(scratch_bytes(DEPTH_PAGE_BYTES, 1), LAYER_SLOTS * (1024 + 528 + 4));
-        assert_eq!(scratch_bytes(ID_PAGE_BYTES, 3), 3 * LAYER_SLOTS * (2048 + 528 + 4));
+        // The scratch: a D32 depth (and ID) per texel of its slots and a list entry (slot,
+        // page) per slot.
+        assert_eq!(scratch_bytes(DEPTH_PAGE_BYTES, 1), LAYER_SLOTS * (1024 + 8));
+        assert_eq!(scratch_bytes(ID_PAGE_BYTES, 3), 3 * LAYER_SLOTS * (2048 + 8));
     }
 
-    /// A sixteenth of the budget in layers: none beyond the first at 4 MiB, whose pages are
-    /// short, 4 at 16 MiB, never more than 8.
+    /// A layer per 4 MiB: none beyond the first at 4 MiB, whose pages are short, 4 at 16 MiB
+    /// (3.5 % of it), never more than 8.
     #[test]
-    fn the_scratch_takes_layers_within_a_sixteenth_of_the_budget() {
+    fn the_scratch_takes_a_layer_per_4_mib() {
         let mib = 1u64 << 20;
         for (budget, layers) in [(mib, 1), (4 * mib, 1), (8 * mib, 2), (16 * mib, 4), (256 * mib, 8)] {
-            assert_eq!(scratch_layers(budget, DEPTH_PAGE_BYTES), layers, "{budget} bytes");
-            if layers > 1 {
-                assert!(scratch_bytes(DEPTH_PAGE_BYTES, layers) <= budget / SCRATCH_SHARE);
-            }
+            assert_eq!(scratch_layers(budget), layers, "{budget} bytes");
+            assert!(scratch_bytes(DEPTH_PAGE_BYTES, layers) * 28 <= budget.max(4 * mib));
         }
-        assert_eq!(scratch_layers(16 * mib, ID_PAGE_BYTES), 2);
     }
 }
