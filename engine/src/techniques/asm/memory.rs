@@ -18,7 +18,7 @@ const WORD: u64 = 4;
 pub struct AsmMemory {
     /// The pages (16-bit depths, and polygon IDs with the ID test).
     pub pages: u64,
-    /// The scratch every tile renders into before its pages are copied out.
+    /// The scratch every tile renders into before its slots are packed into pages.
     pub scratch: u64,
     /// The scratch's layers ([`scratch_layers`]), counted in `scratch`.
     pub scratch_layers: u32,

@@ -442,9 +442,9 @@ impl Asm {
     /// along the view's diagonals), each rendered twice and the second timing kept (the first
     /// pays for cold caches), each stored into pages as a frame's tiles are (into the root's,
     /// which the first frame renders again), and each in as many renders of it as a packing
-    /// takes (a batch in each layer of the scratch): a frame's renders share their packings and
-    /// copies, whose cost a tile rendered alone would pay whole. Without timestamps the model stays at 1 ms per
-    /// tile.
+    /// takes (a batch in each layer of the scratch): a frame's renders share their packings,
+    /// whose cost a tile rendered alone would pay whole. Without timestamps the model stays at
+    /// 1 ms per tile.
     fn calibrate(&self, ctx: &Arc<Context>, gpu: &GpuScene) -> Result<CostModel> {
         if ctx.info().timestamp_period_ns.is_none() {
             return Ok(self.cost);
