@@ -52,9 +52,9 @@ vec3 difference(vec3 p, ivec2 q, ivec2 step) {
 // tangent plane at that texel's centre. On a plane 1/w (w the light's view depth) is affine in
 // light uv, so the plane's depth there follows from p and its screen neighbours (their map
 // coordinates mx, my) with no slope bias, only a margin for the receiver's own curvature and
-// creases.
+// creases. `stored` is that texel's depth.
 #define ASM_PLANE_MARGIN_TEXELS 4.0
-bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my, AsmPage page) {
+bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my, AsmPage page, float stored) {
     vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
     float det = ux.x * uy.y - ux.y * uy.x;
     if (det == 0.0) return false;
@@ -66,7 +66,6 @@ bool occluded_at_plane(ShadowLight s, vec4 m, vec3 p, vec3 ng, vec4 mx, vec4 my,
     vec2 centre = asm_texel_centre(page.tile, texel);
     float inv = iw + dot(slope, centre - m.xy);
     if (inv <= 0.0) return false;
-    float stored = asm_depth(page, texel);
     return !shadow_depth_visible(s, stored, 1.0 / inv, p, ng, asm_texel_size(s, page.tile.x), vec4(ASM_PLANE_MARGIN_TEXELS, 0.0, 0.0, 0.0), page.step);
 }
 
@@ -119,12 +118,9 @@ void main() {
     // Lit, but the slope-scaled bias hides an occluder in front of the receiver's plane (a
     // coarse tile under grazing light): a finer tile's bias is narrower and shows the shadow.
     bool lit = shadow_lit_past(s, stored, shadow_receiver_depth(s, m.z, p, ng, texel, push.bias, page.step));
-    bool hidden = lit && occluded_at_plane(s, m, p, ng, mx, my, page);
+    bool hidden = lit && occluded_at_plane(s, m, p, ng, mx, my, page, stored);
     ivec2 at_slot = asm_slot(at_tile, m.xy);
     uint slot_bit = 1u << (at_slot.y * (KAGE_ASM_TILE_TEXELS / KAGE_ASM_PAGE_TEXELS) + at_slot.x);
-    // Texels from two levels up or more: the slot of the tile's parent over the pixel is asked
-    // for (coarse texels can miss a thin occluder altogether, where no test sees it).
-    if (level + 2u <= at.level) atomicOr(requests[1u + 2u * at.node], slot_bit);
     // Read from its tile's own texels: the slot is in use; from an ancestor's: that one's is.
     atomicOr(requests[2u + 2u * at.node], level == at.level ? slot_bit : slot_bit << 16);
     vec2 ux = mx.xy - m.xy, uy = my.xy - m.xy;
@@ -156,10 +152,14 @@ void main() {
     if (!edge && across != ivec2(0)) {
         edge = shadow_lit_past(s, across_border_depth(page, t + across, stored), wide) != centre;
     }
-    if (!(edge || hidden)) return;
-    // On an edge with its tile's own texels: the tile keeps that slot (see pool.rs, trials).
-    if (level == at.level) atomicOr(requests[1u + 2u * at.node], slot_bit << 16);
-    if (missing < 1.0 || level >= uint(KAGE_ASM_MAX_LEVEL)) return;
+    edge = edge || hidden;
+    // Texels from two levels up or more: the slot of the tile's parent over the pixel is asked
+    // for (coarse texels can miss a thin occluder altogether, where no test sees it). On an
+    // edge with its tile's own texels: the tile keeps that slot (see pool.rs, trials). Never
+    // both, so one atomic (llvmpipe runs each as a loop over the lanes).
+    uint asked = (level + 2u <= at.level ? slot_bit : 0u) | (edge && level == at.level ? slot_bit << 16 : 0u);
+    if (asked != 0u) atomicOr(requests[1u + 2u * at.node], asked);
+    if (!edge || missing < 1.0 || level >= uint(KAGE_ASM_MAX_LEVEL)) return;
     uint record = atomicAdd(requests[0], 1u);
     if (record >= push.size.w) return;
     uint word = 1u + 2u * push.size.z + KAGE_ASM_EDGE_WORDS * record;
