@@ -4,7 +4,8 @@
 // as 16-bit steps over the slot's own span, from the nearest depth drawn to the farthest;
 // texels nothing covers keep the clear depth as 0xffff. A page so takes half the bytes of D32,
 // and a step is the slot's span over 65534: within a slot on one surface far finer than D32
-// near the far plane, across a silhouette the span's. The lookups allow half a step in their bias (asm_lookup.glsl).
+// near the far plane, across a silhouette the span's. The lookups allow half a step in their
+// bias (asm_lookup.glsl).
 //
 // One invocation packs a whole slot, with no shared memory or barrier (llvmpipe runs a
 // workgroup's barriers as coroutine switches; vendor-notes.md).

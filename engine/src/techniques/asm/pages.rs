@@ -1,17 +1,18 @@
 //! The GPU side of the page pool ([`super::pool`]): the pages in texel buffers, and the
 //! recording of the pool's page operations. Pages are slots of tiles and need not lie side by
 //! side, so every page write goes through a scratch target of tiles side by side: tiles render
-//! into it whole, in one rendering scope, then `asm_pack.comp` packs their stored slots into
-//! 16-bit pages (half of D32's bytes: twice the pages a budget holds), each in place. A CPU rasterizer waits at every barrier and pays for every scope and dispatch
-//! (104 tiles of no triangles storing 16 slots each took 4.1–4.9 ms in batches of 4 tiles,
-//! 1.4–2.1 in batches of 8, where copying D32 slots took 0.9–1.1); yet a
-//! larger scratch was slower again: 6² tiles rendered a third fewer tiles a frame than 3² (146
-//! against 217–226 at the `asm` scene's grating at 16 MiB; llvmpipe, 2 Zen 3 cores). So a
-//! batch is `SCRATCH_SIDE`² tiles in one scope, and the scratch has layers, a batch each
-//! ([`scratch_layers`]): the packing waits for every tile drawn before it, but the batches
-//! between two packings are scopes of their own, and llvmpipe bins one while it rasterizes
-//! the one before (4 layers: 20–29 % more tiles in the same milliseconds; one scope of
-//! as many tiles bins them all before it rasterizes any). The scratch counts in the budget.
+//! into it whole, then `asm_pack.comp` packs their stored slots into 16-bit pages (half of
+//! D32's bytes: twice the pages a budget holds), each in place. A CPU rasterizer waits at every
+//! barrier and pays for every scope and dispatch (104 tiles of no triangles storing 16 slots
+//! each took 4.1–4.9 ms in batches of 4 tiles, 1.4–2.1 in batches of 8, where copying D32
+//! slots took 0.9–1.1); yet a larger scope was slower again: 6² tiles rendered a third fewer
+//! tiles a frame than 3² (146 against 217–226 at the `asm` scene's grating at 16 MiB;
+//! llvmpipe, 2 Zen 3 cores). So a batch is `SCRATCH_SIDE`² tiles in one rendering scope, and
+//! the scratch has layers, a batch each ([`scratch_layers`]): the packing waits for every tile
+//! drawn before it, but the batches between two packings are scopes of their own, and
+//! llvmpipe bins one while it rasterizes the one before (4 layers: 20–29 % more tiles in the
+//! same milliseconds; one scope of as many tiles bins them all before it rasterizes any). The
+//! scratch counts in the budget.
 //!
 //! The polygon-ID test keeps a second buffer of pages, of IDs, in the same page order, filled
 //! from an ID scratch laid out as the depth one.
