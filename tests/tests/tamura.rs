@@ -435,13 +435,12 @@ fn the_floor_gets_no_layer_over_the_teapot_from_above() {
 /// two filter passes step over the same texels, so their times must agree within 10× (lavapipe
 /// writes a timestamp at its next flush, which can move part of one pass's work into its
 /// neighbour: up to ~3× measured; a pass timed at nothing is hundreds of times off); and the
-/// passes' times together must hold most of the frame's span (at least 70 %: gaps between
-/// passes are the device's own work, ~13 % of the frame when a pass's work went untimed). The
-/// device is the CPU: a frame during which the system took lavapipe's threads away has gaps no
-/// pass owns (67 % failed a fresh-clone run; 60–76 % are common on a busy host), and such
-/// interference only ever lowers the share. So the share is judged on the best of 9 frames,
-/// the one nearest the device's own timing (0.84–0.99 measured, under two CPU hogs too), while
-/// work that is never timed lowers every frame.
+/// passes' times together must hold most of the frame's span. Before each pass's start
+/// timestamp was followed by a flush (`pass/mod.rs`), its first scope's binning was counted in
+/// no pass: the passes held 0.72–0.81 of a frame (0.98 in one frame of nine), now 0.98 in
+/// each. The device is the CPU, and a frame during which the system takes lavapipe's threads
+/// away has gaps no pass owns: under two CPU hogs the median frame's share was 0.92–0.99
+/// (three runs). So the median of 9 frames must reach 0.85.
 #[test]
 fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
     let ctx = Validated::new();
@@ -478,7 +477,7 @@ fn every_pass_of_a_tamura_frame_reports_a_plausible_time() {
             );
         }
     }
-    let best = shares.iter().copied().fold(0.0, f64::max);
     println!("passes hold {shares:.2?} of their frames");
-    assert!(best >= 0.7, "the passes hold at best {best:.2} of their frames ({shares:.2?})");
+    let median_share = kage::pass::median(&shares);
+    assert!(median_share >= 0.85, "the passes hold {median_share:.2} of the median frame ({shares:.2?})");
 }

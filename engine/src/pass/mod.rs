@@ -7,8 +7,9 @@
 //! - Every image lives in `GENERAL` layout from creation on (see `backend::Image`), so no pass
 //!   tracks or changes layouts.
 //! - Between two consecutive passes the executor records one full memory barrier
-//!   (all commands → all commands, memory writes → memory reads and writes). Within a pass,
-//!   the pass itself is responsible for any hazard between its own commands.
+//!   (all commands → all commands, memory writes → memory reads and writes), and one more
+//!   after each pass's start timestamp, so that lavapipe writes it before the pass's work.
+//!   Within a pass, the pass itself is responsible for any hazard between its own commands.
 //! - A frame is one command buffer, ending with a barrier that makes every write visible to host
 //!   reads, submitted and waited for on its fence before `run` returns, so the host may read or
 //!   rewrite any resource afterwards (readbacks, the ASM analysis' counts).
@@ -128,6 +129,11 @@ impl FrameExecutor {
             self.ctx.begin_label(cmd, pass.name);
             if let Some(t) = timestamps {
                 t.write(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, 2 * i as u32);
+                // lavapipe writes a timestamp when it next rasterizes its binned work: without a
+                // flush here the start waits until the pass's first scope is binned, a time no
+                // pass counted (vendor-notes.md). Nothing is in flight after the barrier above,
+                // so on a GPU this one waits for nothing.
+                self.ctx.full_barrier(cmd);
             }
             let log = AccessLog::default();
             (pass.record)(recorder.cmd(&log));
