@@ -326,7 +326,7 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
             next = left_first ? bvh_pair_left(pair) : bvh_pair_right(pair);
         }
         // A leaf: its triangles, all lanes that hold one together (none where the walk above
-        // ended on a pair with no child entered).
+        // ended on a pair with no child entered); an any-hit walk stops at its first hit.
         uint count = bvh_leaf_count(next);
         uint first = bvh_leaf_first(next);
         for (uint tri = first; tri < first + count; ++tri) {
@@ -335,6 +335,7 @@ bool bvh_traverse_blas(uint instance, vec3 origin, vec3 dir, bool any_hit, inout
             if (bvh_intersect_triangle(wray, tri, hit.t, t, bary)) {
                 hit = RayHit(t, instance, tri, bary);
                 found = true;
+                if (any_hit) break;
             }
         }
         if (found && any_hit) return true;
