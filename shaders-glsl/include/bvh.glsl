@@ -432,7 +432,7 @@ void bvh_closest_hits_packet(uint instance, vec3 origin, vec3 dirs[KAGE_BVH_PACK
 // instance's tree, whose code a CPU driver runs masked off on every pass that no lane needs
 // it, runs once per instance entered and not also on the passes through inner nodes. The stack
 // keeps entry distances as the bottom level's does: a pop tests the distance instead of
-// fetching the node and its box again (closest hits 1.15-1.2x the rays per second on the
+// fetching the node and its box again (closest hits 1.13-1.15x the rays per second on the
 // Stanford bunny on a Zen 4 CPU, BENCHMARKS.md "Ray casting").
 bool bvh_traverse(vec3 origin, vec3 dir, bool any_hit, inout RayHit hit) {
     vec3 inv_dir = 1.0 / dir;
